@@ -1,0 +1,71 @@
+//! Subcommand definitions and dispatch. Each subcommand lives in its own file with its
+//! argument struct; the library does the work, these files only translate arguments,
+//! print results and map errors to exit codes.
+
+use clap::{Parser, Subcommand};
+
+pub mod bench;
+pub mod clone;
+pub mod mesh;
+pub mod render;
+pub mod repl;
+
+/// An argument combination clap cannot reject by itself; exits with code 2.
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct UsageError(pub String);
+
+#[derive(Parser, Debug)]
+#[command(name = "lapclone", version, about = "Seamless image cloning and deformation with the combinatorial Laplacian")]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Mesh a mask into an adaptive, boundary-conforming triangle mesh.
+    Mesh(mesh::MeshArgs),
+    /// Clone a source patch seamlessly into a target image (optionally deformed).
+    Clone(clone::CloneArgs),
+    /// Render a Rhai scene into frames (PNG sequence, GIF or APNG).
+    Render(render::RenderArgs),
+    /// Render one frame of a scene.
+    Preview(render::PreviewArgs),
+    /// Parse, evaluate and validate a scene without rendering it.
+    Check(render::CheckArgs),
+    /// Edit a scene interactively.
+    Repl(repl::ReplArgs),
+    /// Benchmarks (release builds only give meaningful figures).
+    Bench(bench::BenchArgs),
+}
+
+pub fn run(cli: Cli) -> anyhow::Result<()> {
+    match cli.command {
+        Command::Mesh(args) => mesh::run(args),
+        Command::Clone(args) => clone::run(args),
+        Command::Render(args) => render::run_render(args),
+        Command::Preview(args) => render::run_preview(args),
+        Command::Check(args) => render::run_check(args),
+        Command::Repl(args) => repl::run(args),
+        Command::Bench(args) => bench::run(args),
+    }
+}
+
+/// Rejects NaN and infinities in numeric arguments (clap's f64 parser accepts them).
+pub fn finite_f64(text: &str) -> Result<f64, String> {
+    let value: f64 = text.trim().parse().map_err(|_| format!("`{text}` is not a number"))?;
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(format!("`{text}` is not a finite number"))
+    }
+}
+
+/// Parses `X,Y` into two finite numbers.
+pub fn point(text: &str) -> Result<[f64; 2], String> {
+    let (x, y) = text
+        .split_once(',')
+        .ok_or_else(|| format!("`{text}` is not a point X,Y"))?;
+    Ok([finite_f64(x)?, finite_f64(y)?])
+}

@@ -1,0 +1,1 @@
+//! clone stage (not yet implemented).

@@ -1,0 +1,1 @@
+//! deform stage (not yet implemented).

@@ -1,0 +1,20 @@
+//! lapclone: seamless image cloning and deformation with the combinatorial Laplacian
+//! (Cuadros-Vargas, Nonato, Pascucci). The library takes masks, images and scene files in
+//! and gives meshes, factored Laplacians, membranes, deformed meshes and rendered frames
+//! out; the `lapclone` binary is a thin CLI over it.
+//!
+//! The modules follow the pipeline: [`mesh`] → [`solve`] → [`clone`] / [`deform`] →
+//! [`raster`], driven per frame by [`scene`]. [`pixels`] holds the float image type shared by
+//! all stages; [`reference`] holds the pixel-grid and MVC baselines used by tests and benches.
+
+pub mod clone;
+pub mod deform;
+pub mod mesh;
+pub mod output;
+pub mod pixels;
+pub mod raster;
+pub mod reference;
+pub mod scene;
+pub mod script;
+pub mod solve;
+pub mod util;

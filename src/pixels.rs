@@ -1,0 +1,1 @@
+//! Float images shared by all stages (not yet implemented).

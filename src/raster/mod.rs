@@ -1,0 +1,1 @@
+//! raster stage (not yet implemented).

@@ -1,0 +1,1 @@
+//! reference stage (not yet implemented).
