@@ -1,0 +1,340 @@
+//! [`PenaltyFactor`]: takes a Laplacian (lower-triangle [`SymmetricCsc`], symmetric positive
+//! semi-definite) and keeps the LDLᵀ factor of `L + P + εI`, `P = α · diag(constrained)`,
+//! switching constraints by rank-1 updates/downdates and solving multi-RHS systems in place.
+//!
+//! Guard rule (correct always, fast normally). A batch of switches applies all updates
+//! (+α) before all downdates (−α), so every intermediate matrix is at least as positive
+//! definite as the final one. The factor is rebuilt from the stored matrix and the current
+//! constrained set when
+//! 1. a downdate would leave a pivot `≤ ε/2` (positive definiteness lost numerically — e.g.
+//!    the last constraint of a piece released), or
+//! 2. the drift estimate `Σ u · max_j d_j / d̄_j` (u = 2⁻⁵³, summed over downdates since the
+//!    last factorisation; `d_j / d̄_j` is how much cancellation magnified rounding in the
+//!    pivot) exceeds `drift_budget`, or
+//! 3. the batch is so large that refactoring is cheaper (more switches than
+//!    `n / 64 + 16`).
+//!
+//! Updates alone never trigger a refactor: they add positive terms and are stable.
+
+use super::numeric::{factor_numeric, NumericWorkspace};
+use super::solve::ldlt_solve_interleaved;
+use super::symbolic::SymbolicFactor;
+use super::update::{rank1_diagonal, Rank1Outcome};
+use super::{SolveError, SymmetricCsc};
+
+/// Penalty and guard settings. `None` picks the scale-relative default documented in
+/// [`solve`](super) (α = 1e8·s, ε = 1e-12·s, s = max |l_ii|).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PenaltyOptions {
+    pub alpha: Option<f64>,
+    pub epsilon: Option<f64>,
+    /// Refactor when the accumulated downdate drift estimate exceeds this (default 1e-7).
+    pub drift_budget: f64,
+}
+
+impl Default for PenaltyOptions {
+    fn default() -> Self {
+        Self {
+            alpha: None,
+            epsilon: None,
+            drift_budget: DEFAULT_DRIFT_BUDGET,
+        }
+    }
+}
+
+/// Default α relative to the diagonal scale.
+pub const DEFAULT_ALPHA_RELATIVE: f64 = 1e7;
+/// Default ε relative to the diagonal scale.
+pub const DEFAULT_EPSILON_RELATIVE: f64 = 1e-12;
+/// Default drift budget (see the module doc).
+pub const DEFAULT_DRIFT_BUDGET: f64 = 1e-7;
+const UNIT_ROUNDOFF: f64 = f64::EPSILON / 2.0;
+
+/// What one batch of switches did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SwitchStats {
+    pub updates: usize,
+    pub downdates: usize,
+    pub refactored: bool,
+}
+
+/// Factor of `L + P + εI` with switchable penalty constraints. See the module doc.
+pub struct PenaltyFactor {
+    symbolic: SymbolicFactor,
+    alpha: f64,
+    epsilon: f64,
+    drift_budget: f64,
+    /// Values of `L + εI` in the input (lower CSC) layout.
+    base_values: Vec<f64>,
+    /// Scratch for `L + εI + P` at refactorisation.
+    work_values: Vec<f64>,
+    factor_values: Vec<f64>,
+    workspace: NumericWorkspace,
+    constrained: Vec<bool>,
+    constrained_count: usize,
+    drift: f64,
+    refactor_count: usize,
+    /// Rank-1 kernel scratch, all zero between calls.
+    update_scratch: Vec<f64>,
+    /// Interleaved permuted right-hand sides.
+    solve_scratch: Vec<f64>,
+    /// Per-vertex pending state of the current batch: 0 none, 1 on, 2 off.
+    pending: Vec<u8>,
+    touched: Vec<usize>,
+}
+
+impl PenaltyFactor {
+    /// Analyses and factors `l + εI` with no constraint on.
+    pub fn new(l: &SymmetricCsc, opts: &PenaltyOptions) -> Result<Self, SolveError> {
+        let symbolic = SymbolicFactor::analyse(l)?;
+        let scale = l.diagonal_scale();
+        let alpha = opts.alpha.unwrap_or(DEFAULT_ALPHA_RELATIVE * scale);
+        if !(alpha.is_finite() && alpha > 0.0) {
+            return Err(SolveError::BadAlpha(alpha));
+        }
+        let epsilon = opts.epsilon.unwrap_or(DEFAULT_EPSILON_RELATIVE * scale);
+        if !(epsilon.is_finite() && epsilon > 0.0) {
+            return Err(SolveError::InvalidMatrix(format!("regularisation ε = {epsilon} must be positive")));
+        }
+        let mut base_values = l.values.clone();
+        for j in 0..l.n {
+            base_values[l.diagonal_index(j)] += epsilon;
+        }
+        let n = l.n;
+        let workspace = NumericWorkspace::new(&symbolic);
+        let mut this = Self {
+            factor_values: vec![0.0; symbolic.nnz_factor()],
+            work_values: base_values.clone(),
+            base_values,
+            symbolic,
+            alpha,
+            epsilon,
+            drift_budget: opts.drift_budget,
+            workspace,
+            constrained: vec![false; n],
+            constrained_count: 0,
+            drift: 0.0,
+            refactor_count: 0,
+            update_scratch: vec![0.0; n],
+            solve_scratch: Vec::new(),
+            pending: vec![0; n],
+            touched: Vec::new(),
+        };
+        this.factor_current()?;
+        Ok(this)
+    }
+
+    pub fn n(&self) -> usize {
+        self.symbolic.n()
+    }
+
+    pub fn alpha(&self) -> f64 {
+        self.alpha
+    }
+
+    pub fn epsilon(&self) -> f64 {
+        self.epsilon
+    }
+
+    pub fn is_constrained(&self, v: usize) -> bool {
+        self.constrained[v]
+    }
+
+    pub fn constrained_count(&self) -> usize {
+        self.constrained_count
+    }
+
+    pub fn constrained(&self) -> &[bool] {
+        &self.constrained
+    }
+
+    /// How often a guard rebuilt the factor (the initial factorisation does not count).
+    pub fn refactor_count(&self) -> usize {
+        self.refactor_count
+    }
+
+    /// Current drift estimate since the last factorisation.
+    pub fn drift_estimate(&self) -> f64 {
+        self.drift
+    }
+
+    /// Stored entries of the factor.
+    pub fn nnz_factor(&self) -> usize {
+        self.symbolic.nnz_factor()
+    }
+
+    /// The symbolic part (ordering and pattern).
+    pub fn symbolic(&self) -> &SymbolicFactor {
+        &self.symbolic
+    }
+
+    /// Factor values in the layout documented in [`symbolic`](super::symbolic).
+    pub fn factor_values(&self) -> &[f64] {
+        &self.factor_values
+    }
+
+    /// Batch switch: each `(vertex, on)`; a vertex named twice takes its last state.
+    /// Applies updates before downdates; guarded (automatic refactorisation, see module doc).
+    pub fn switch(&mut self, changes: &[(usize, bool)]) -> Result<SwitchStats, SolveError> {
+        let n = self.n();
+        if let Some(&(vertex, _)) = changes.iter().find(|c| c.0 >= n) {
+            return Err(SolveError::VertexOutOfRange { vertex, n });
+        }
+        for &(v, on) in changes {
+            if self.pending[v] == 0 {
+                self.touched.push(v);
+            }
+            self.pending[v] = if on { 1 } else { 2 };
+        }
+        self.apply_pending()
+    }
+
+    /// Makes the constrained set equal to `wanted` (length n), switching only the differences.
+    pub fn set_constrained(&mut self, wanted: &[bool]) -> Result<SwitchStats, SolveError> {
+        if wanted.len() != self.n() {
+            return Err(SolveError::WrongLength {
+                got: wanted.len(),
+                expected: self.n(),
+            });
+        }
+        for (v, &on) in wanted.iter().enumerate() {
+            if on != self.constrained[v] {
+                self.touched.push(v);
+                self.pending[v] = if on { 1 } else { 2 };
+            }
+        }
+        self.apply_pending()
+    }
+
+    /// Forces a refactorisation from the stored matrix and the current constrained set.
+    pub fn refactor(&mut self) -> Result<(), SolveError> {
+        self.refactor_count += 1;
+        self.factor_current()
+    }
+
+    /// Solves `(L + P + εI) X = B` in place; `rhs` is column-major n×k. Allocates only the
+    /// first time a given `k` exceeds every earlier one (scratch is kept).
+    ///
+    /// # Panics
+    /// If `rhs.len() != n * k` (a programming error, not an input error).
+    pub fn solve_in_place(&mut self, rhs: &mut [f64], k: usize) {
+        let n = self.n();
+        assert_eq!(rhs.len(), n * k, "solve_in_place: rhs must be n×k column-major");
+        if self.solve_scratch.len() < n * k {
+            self.solve_scratch.resize(n * k, 0.0);
+        }
+        let x = &mut self.solve_scratch[..n * k];
+        let fwd = &self.symbolic.perm_fwd;
+        for (pos, &v) in fwd.iter().enumerate() {
+            for c in 0..k {
+                x[pos * k + c] = rhs[c * n + v as usize];
+            }
+        }
+        ldlt_solve_interleaved(self.symbolic.col_ptr(), self.symbolic.row_idx(), &self.factor_values, x, k);
+        for (pos, &v) in fwd.iter().enumerate() {
+            for c in 0..k {
+                rhs[c * n + v as usize] = x[pos * k + c];
+            }
+        }
+    }
+
+    /// Dirichlet convenience: on entry `values` (column-major n×k) holds the wanted value at
+    /// constrained rows (other rows ignored); on exit the membrane, ≈ those values there.
+    pub fn solve_dirichlet(&mut self, values: &mut [f64], k: usize) {
+        let n = self.n();
+        assert_eq!(values.len(), n * k, "solve_dirichlet: values must be n×k column-major");
+        for column in values.chunks_exact_mut(n.max(1)) {
+            for (value, &on) in column.iter_mut().zip(&self.constrained) {
+                *value = if on { self.alpha * *value } else { 0.0 };
+            }
+        }
+        self.solve_in_place(values, k);
+    }
+
+    fn factor_current(&mut self) -> Result<(), SolveError> {
+        self.work_values.copy_from_slice(&self.base_values);
+        for (v, &on) in self.constrained.iter().enumerate() {
+            if on {
+                self.work_values[self.symbolic.a_col_ptr[v] as usize] += self.alpha;
+            }
+        }
+        self.drift = 0.0;
+        factor_numeric(
+            &self.symbolic,
+            &self.work_values,
+            &mut self.factor_values,
+            self.epsilon,
+            &mut self.workspace,
+        )
+    }
+
+    /// Applies the batch recorded in `pending`/`touched`, then clears them.
+    fn apply_pending(&mut self) -> Result<SwitchStats, SolveError> {
+        let mut stats = SwitchStats::default();
+        let mut touched = std::mem::take(&mut self.touched);
+        touched.sort_unstable();
+        for &v in &touched {
+            let on = self.pending[v] == 1;
+            if on != self.constrained[v] {
+                if on {
+                    stats.updates += 1;
+                } else {
+                    stats.downdates += 1;
+                }
+            }
+        }
+        let too_many = stats.updates + stats.downdates > self.n() / 64 + 16;
+        let mut needs_refactor = too_many;
+        for pass_on in [true, false] {
+            for &v in &touched {
+                let on = self.pending[v] == 1;
+                if on != pass_on || on == self.constrained[v] {
+                    continue;
+                }
+                self.constrained[v] = on;
+                if on {
+                    self.constrained_count += 1;
+                } else {
+                    self.constrained_count -= 1;
+                }
+                if !needs_refactor {
+                    needs_refactor = !self.modify(v, on);
+                }
+            }
+        }
+        for &v in &touched {
+            self.pending[v] = 0;
+        }
+        touched.clear();
+        self.touched = touched;
+        if needs_refactor || self.drift > self.drift_budget {
+            stats.refactored = true;
+            self.refactor()?;
+        }
+        Ok(stats)
+    }
+
+    /// One rank-1 modification; false when the factor was lost and must be rebuilt.
+    fn modify(&mut self, v: usize, on: bool) -> bool {
+        let p = self.symbolic.position_of(v);
+        let sigma = if on { self.alpha } else { -self.alpha };
+        let (col_ptr, row_idx) = (self.symbolic.col_ptr(), self.symbolic.row_idx());
+        match rank1_diagonal(
+            col_ptr,
+            row_idx,
+            &mut self.factor_values,
+            &mut self.update_scratch,
+            p,
+            sigma,
+            0.5 * self.epsilon,
+        ) {
+            Rank1Outcome::Done { amplification } => {
+                if !on {
+                    self.drift += UNIT_ROUNDOFF * amplification;
+                }
+                true
+            }
+            Rank1Outcome::PivotLost => false,
+        }
+    }
+}

@@ -1,0 +1,170 @@
+//! Rank-1 constraint switching: updated factors against fresh factorisations, and the guards.
+
+use lapclone::solve::{fixtures, laplacian, LaplacianKind, PenaltyFactor, PenaltyOptions, SolveError, SymmetricCsc};
+use proptest::prelude::*;
+use proptest::test_runner::{Config, RngSeed};
+
+/// Deterministic pseudo-random numbers in [0, 1) (SplitMix64).
+struct Rng(u64);
+impl Rng {
+    fn next(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    }
+    fn below(&mut self, n: usize) -> usize {
+        (self.next() * n as f64) as usize
+    }
+}
+
+fn rel_diff(a: &[f64], b: &[f64]) -> f64 {
+    let num: f64 = a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum::<f64>().sqrt();
+    let den: f64 = b.iter().map(|y| y * y).sum::<f64>().sqrt().max(f64::MIN_POSITIVE);
+    num / den
+}
+
+/// Relative difference between the updated factor's solutions and a fresh factorisation's.
+fn compare_with_fresh(l: &SymmetricCsc, f: &mut PenaltyFactor, opts: &PenaltyOptions, seed: u64) -> f64 {
+    let n = l.n;
+    let mut fresh = PenaltyFactor::new(l, opts).unwrap();
+    fresh.set_constrained(f.constrained()).unwrap();
+    // set_constrained may update rather than refactor; force a real fresh factorisation.
+    fresh.refactor().unwrap();
+    let mut rng = Rng(seed);
+    let k = 3;
+    let b: Vec<f64> = (0..n * k).map(|_| rng.next() * 2.0 - 1.0).collect();
+    let (mut x_updated, mut x_fresh) = (b.clone(), b.clone());
+    f.solve_in_place(&mut x_updated, k);
+    fresh.solve_in_place(&mut x_fresh, k);
+    let mut dirichlet_updated: Vec<f64> = b.iter().map(|v| v * 100.0).collect();
+    let mut dirichlet_fresh = dirichlet_updated.clone();
+    f.solve_dirichlet(&mut dirichlet_updated, k);
+    fresh.solve_dirichlet(&mut dirichlet_fresh, k);
+    rel_diff(&x_updated, &x_fresh).max(rel_diff(&dirichlet_updated, &dirichlet_fresh))
+}
+
+#[test]
+fn ten_thousand_random_switches_match_a_fresh_factorisation() {
+    let mesh = fixtures::disc(10);
+    let l = laplacian(&mesh, LaplacianKind::Combinatorial);
+    let n = l.n;
+    let opts = PenaltyOptions::default();
+    let mut f = PenaltyFactor::new(&l, &opts).unwrap();
+    // Start from the boundary constrained, as the cloning stage does.
+    f.set_constrained(&mesh.is_boundary).unwrap();
+    let mut rng = Rng(2024);
+    let (mut updates, mut downdates) = (0, 0);
+    for step in 0..10_000 {
+        let v = rng.below(n);
+        let stats = f.switch(&[(v, !f.is_constrained(v))]).unwrap();
+        updates += stats.updates;
+        downdates += stats.downdates;
+        if step % 2500 == 2499 {
+            let diff = compare_with_fresh(&l, &mut f, &opts, step as u64);
+            assert!(diff <= 1e-9, "after {step} switches: {diff}");
+        }
+    }
+    assert_eq!(updates + downdates, 10_000);
+    let diff = compare_with_fresh(&l, &mut f, &opts, 7);
+    assert!(diff <= 1e-9, "final: {diff}");
+    // Refactorisations must stay the exception, not the rule.
+    assert!(f.refactor_count() < 1000, "guard refactored {} times", f.refactor_count());
+    eprintln!("refactors after 10k switches: {}", f.refactor_count());
+}
+
+#[test]
+fn batches_apply_updates_before_downdates_and_match_fresh() {
+    let mesh = fixtures::grid(12, 9);
+    let l = laplacian(&mesh, LaplacianKind::Cotangent);
+    let n = l.n;
+    let opts = PenaltyOptions::default();
+    let mut f = PenaltyFactor::new(&l, &opts).unwrap();
+    f.set_constrained(&mesh.is_boundary).unwrap();
+    let mut rng = Rng(31);
+    for round in 0..200 {
+        let changes: Vec<(usize, bool)> = (0..1 + rng.below(6)).map(|_| (rng.below(n), rng.next() < 0.5)).collect();
+        let before = f.constrained_count();
+        let stats = f.switch(&changes).unwrap();
+        let after = f.constrained_count();
+        assert_eq!(after as isize - before as isize, stats.updates as isize - stats.downdates as isize);
+        // The last mention of a vertex wins.
+        for &(v, _) in &changes {
+            let last = changes.iter().rev().find(|c| c.0 == v).unwrap().1;
+            assert_eq!(f.is_constrained(v), last, "round {round}");
+        }
+    }
+    assert!(compare_with_fresh(&l, &mut f, &opts, 3) <= 1e-9);
+}
+
+#[test]
+fn guard_refactors_when_the_last_constraint_of_a_piece_is_released() {
+    let mesh = fixtures::grid(4, 4);
+    let l = laplacian(&mesh, LaplacianKind::Combinatorial);
+    let opts = PenaltyOptions::default();
+    let mut f = PenaltyFactor::new(&l, &opts).unwrap();
+    let stats = f.switch(&[(7, true)]).unwrap();
+    assert!(!stats.refactored);
+    // Releasing the only constraint sends a pivot from ≈ α down to ≈ ε: cancellation would
+    // leave garbage, so the pivot guard must rebuild the factor.
+    let stats = f.switch(&[(7, false)]).unwrap();
+    assert!(stats.refactored, "pivot guard did not fire");
+    assert_eq!(f.refactor_count(), 1);
+    let mut zero = vec![0.0; l.n];
+    f.solve_in_place(&mut zero, 1);
+    assert!(zero.iter().all(|&x| x == 0.0));
+    assert!(compare_with_fresh(&l, &mut f, &opts, 1) <= 1e-9);
+}
+
+#[test]
+fn drift_guard_fires_once_the_budget_is_spent() {
+    let mesh = fixtures::disc(6);
+    let l = laplacian(&mesh, LaplacianKind::Combinatorial);
+    let opts = PenaltyOptions {
+        drift_budget: 1e-12,
+        ..Default::default()
+    };
+    let mut f = PenaltyFactor::new(&l, &opts).unwrap();
+    f.set_constrained(&mesh.is_boundary).unwrap();
+    let interior = (0..l.n).find(|&v| !mesh.is_boundary[v]).unwrap();
+    f.switch(&[(interior, true)]).unwrap();
+    // One downdate of a penalty pivot loses ≈ log10(α / d) digits: far above 1e-12.
+    let stats = f.switch(&[(interior, false)]).unwrap();
+    assert!(stats.refactored, "drift guard did not fire (estimate {})", f.drift_estimate());
+    assert_eq!(f.drift_estimate(), 0.0);
+}
+
+#[test]
+fn bad_switch_input_is_an_error_and_changes_nothing() {
+    let l = laplacian(&fixtures::grid(2, 2), LaplacianKind::Combinatorial);
+    let mut f = PenaltyFactor::new(&l, &PenaltyOptions::default()).unwrap();
+    assert!(matches!(f.switch(&[(0, true), (99, true)]), Err(SolveError::VertexOutOfRange { vertex: 99, .. })));
+    assert_eq!(f.constrained_count(), 0);
+    assert!(matches!(f.set_constrained(&[true]), Err(SolveError::WrongLength { .. })));
+    let bad = PenaltyOptions {
+        alpha: Some(-1.0),
+        ..Default::default()
+    };
+    assert!(matches!(PenaltyFactor::new(&l, &bad), Err(SolveError::BadAlpha(_))));
+}
+
+proptest! {
+    #![proptest_config(Config { rng_seed: RngSeed::Fixed(0x5017E), cases: 24, ..Config::default() })]
+    #[test]
+    fn random_switch_sequences_match_fresh(
+        cols in 1usize..9, rows in 1usize..9, cotangent in any::<bool>(),
+        switches in prop::collection::vec((0usize..100, any::<bool>()), 1..120),
+    ) {
+        let mesh = fixtures::grid(cols, rows);
+        let kind = if cotangent { LaplacianKind::Cotangent } else { LaplacianKind::Combinatorial };
+        let l = laplacian(&mesh, kind);
+        let opts = PenaltyOptions::default();
+        let mut f = PenaltyFactor::new(&l, &opts).unwrap();
+        for chunk in switches.chunks(3) {
+            let changes: Vec<(usize, bool)> = chunk.iter().map(|&(v, on)| (v % l.n, on)).collect();
+            f.switch(&changes).unwrap();
+        }
+        prop_assert!(compare_with_fresh(&l, &mut f, &opts, 11) <= 1e-9);
+    }
+}
