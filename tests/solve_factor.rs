@@ -1,7 +1,9 @@
 //! Factorisation, solve and Laplacian tests for the solve stage, against dense references.
 
 use lapclone::mesh::Mesh;
-use lapclone::solve::{fixtures, laplacian, LaplacianKind, PenaltyFactor, PenaltyOptions, SymmetricCsc};
+use lapclone::solve::{
+    fixtures, laplacian, LaplacianKind, PenaltyFactor, PenaltyOptions, SymmetricCsc,
+};
 
 /// Dense Cholesky solve of a small SPD system (reference).
 fn dense_solve(a: &[Vec<f64>], b: &[f64]) -> Vec<f64> {
@@ -60,8 +62,18 @@ fn penalised_dense(l: &SymmetricCsc, f: &PenaltyFactor) -> Vec<Vec<f64>> {
 }
 
 fn rel_diff(a: &[f64], b: &[f64]) -> f64 {
-    let num: f64 = a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum::<f64>().sqrt();
-    let den: f64 = b.iter().map(|y| y * y).sum::<f64>().sqrt().max(f64::MIN_POSITIVE);
+    let num: f64 = a
+        .iter()
+        .zip(b)
+        .map(|(x, y)| (x - y) * (x - y))
+        .sum::<f64>()
+        .sqrt();
+    let den: f64 = b
+        .iter()
+        .map(|y| y * y)
+        .sum::<f64>()
+        .sqrt()
+        .max(f64::MIN_POSITIVE);
     num / den
 }
 
@@ -81,7 +93,11 @@ fn check_against_dense(mesh: &Mesh, kind: LaplacianKind, seed: u64) {
     for c in 0..k {
         let (xc, bc) = (&x[c * n..(c + 1) * n], &b[c * n..(c + 1) * n]);
         let reference = dense_solve(&a, bc);
-        assert!(rel_diff(xc, &reference) <= 1e-10, "column {c}: {}", rel_diff(xc, &reference));
+        assert!(
+            rel_diff(xc, &reference) <= 1e-10,
+            "column {c}: {}",
+            rel_diff(xc, &reference)
+        );
         // Normwise relative residual ‖Ax − b‖ / (‖A‖‖x‖ + ‖b‖) (∞-norms): the scale-free
         // measure for a matrix whose penalty rows are 1e8 times larger than the others.
         let mut ax = vec![0.0; n];
@@ -90,7 +106,10 @@ fn check_against_dense(mesh: &Mesh, kind: LaplacianKind, seed: u64) {
         let residual = (0..n)
             .map(|v| (ax[v] + (a[v][v] - dense_l[v][v]) * xc[v] - bc[v]).abs())
             .fold(0.0, f64::max);
-        let norm_a = a.iter().map(|row| row.iter().map(|x| x.abs()).sum::<f64>()).fold(0.0, f64::max);
+        let norm_a = a
+            .iter()
+            .map(|row| row.iter().map(|x| x.abs()).sum::<f64>())
+            .fold(0.0, f64::max);
         let norm = |x: &[f64]| x.iter().map(|v| v.abs()).fold(0.0, f64::max);
         let rel = residual / (norm_a * norm(xc) + norm(bc));
         assert!(rel <= 1e-10, "residual {rel}");
@@ -99,7 +118,14 @@ fn check_against_dense(mesh: &Mesh, kind: LaplacianKind, seed: u64) {
 
 #[test]
 fn factor_matches_dense_solve_on_small_meshes() {
-    for (i, mesh) in [fixtures::grid(6, 5), fixtures::disc(4), fixtures::grid(1, 1)].iter().enumerate() {
+    for (i, mesh) in [
+        fixtures::grid(6, 5),
+        fixtures::disc(4),
+        fixtures::grid(1, 1),
+    ]
+    .iter()
+    .enumerate()
+    {
         for kind in [LaplacianKind::Combinatorial, LaplacianKind::Cotangent] {
             check_against_dense(mesh, kind, 17 + i as u64);
         }
@@ -157,7 +183,10 @@ fn faer_factor_layout_is_as_assumed() {
             worst = worst.max((ldlt - reference).abs() / f.alpha());
         }
     }
-    assert!(worst <= 1e-13, "LDLᵀ does not reproduce the matrix: {worst}");
+    assert!(
+        worst <= 1e-13,
+        "LDLᵀ does not reproduce the matrix: {worst}"
+    );
 }
 
 #[test]
@@ -169,7 +198,10 @@ fn combinatorial_laplacian_is_degree_minus_adjacency() {
     for (v, row) in dense.iter().enumerate() {
         let sum: f64 = row.iter().sum();
         assert_eq!(sum, 0.0, "row {v} sums to {sum}");
-        let degree = edges.iter().filter(|e| e.0 as usize == v || e.1 as usize == v).count();
+        let degree = edges
+            .iter()
+            .filter(|e| e.0 as usize == v || e.1 as usize == v)
+            .count();
         assert_eq!(row[v], degree as f64);
     }
     for &(i, j) in &edges {
@@ -182,7 +214,11 @@ fn cotangent_laplacian_matches_hand_computation() {
     // Right isosceles triangle: 90° at vertex 0, 45° at 1 and 2. cot 90° = 0, cot 45° = 1.
     let mut mesh = fixtures::grid(1, 1);
     mesh.positions.truncate(3);
-    mesh.positions = vec![glam::DVec2::new(0.0, 0.0), glam::DVec2::new(1.0, 0.0), glam::DVec2::new(0.0, 1.0)];
+    mesh.positions = vec![
+        glam::DVec2::new(0.0, 0.0),
+        glam::DVec2::new(1.0, 0.0),
+        glam::DVec2::new(0.0, 1.0),
+    ];
     mesh.triangles = vec![[0, 1, 2]];
     mesh.is_boundary = vec![true; 3];
     mesh.piece = vec![0; 3];
@@ -191,11 +227,19 @@ fn cotangent_laplacian_matches_hand_computation() {
     let expected = [[1.0, -0.5, -0.5], [-0.5, 0.5, 0.0], [-0.5, 0.0, 0.5]];
     for i in 0..3 {
         for j in 0..3 {
-            assert!((l[i][j] - expected[i][j]).abs() <= 1e-15, "({i},{j}) = {}", l[i][j]);
+            assert!(
+                (l[i][j] - expected[i][j]).abs() <= 1e-15,
+                "({i},{j}) = {}",
+                l[i][j]
+            );
         }
     }
     // Obtuse apex: the edge opposite it gets a negative cotangent, clamped to 0.
-    mesh.positions = vec![glam::DVec2::new(0.0, 0.0), glam::DVec2::new(4.0, 0.0), glam::DVec2::new(2.0, 0.5)];
+    mesh.positions = vec![
+        glam::DVec2::new(0.0, 0.0),
+        glam::DVec2::new(4.0, 0.0),
+        glam::DVec2::new(2.0, 0.5),
+    ];
     let l = laplacian(&mesh, LaplacianKind::Cotangent).to_dense();
     assert_eq!(l[0][1], 0.0);
     let cot_base = 2.0 / 0.5; // cot of the base angles = adjacent / opposite
@@ -244,13 +288,21 @@ fn unconstrained_piece_gives_zero_membrane() {
     f.solve_in_place(&mut zero, 2);
     assert!(zero.iter().all(|&x| x == 0.0));
     // Only the disc's boundary constrained: the grid piece stays zero, the disc takes values.
-    let wanted: Vec<bool> = (0..n).map(|v| v < a.vertex_count() && mesh.is_boundary[v]).collect();
+    let wanted: Vec<bool> = (0..n)
+        .map(|v| v < a.vertex_count() && mesh.is_boundary[v])
+        .collect();
     f.set_constrained(&wanted).unwrap();
-    let mut values: Vec<f64> = (0..n).map(|v| if wanted[v] { 7.0 } else { 123.0 }).collect();
+    let mut values: Vec<f64> = (0..n)
+        .map(|v| if wanted[v] { 7.0 } else { 123.0 })
+        .collect();
     f.solve_dirichlet(&mut values, 1);
     for v in 0..n {
         let expected = if v < a.vertex_count() { 7.0 } else { 0.0 };
-        assert!((values[v] - expected).abs() <= 1e-6 * 7.0, "vertex {v}: {}", values[v]);
+        assert!(
+            (values[v] - expected).abs() <= 1e-6 * 7.0,
+            "vertex {v}: {}",
+            values[v]
+        );
     }
 }
 

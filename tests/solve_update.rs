@@ -1,6 +1,8 @@
 //! Rank-1 constraint switching: updated factors against fresh factorisations, and the guards.
 
-use lapclone::solve::{fixtures, laplacian, LaplacianKind, PenaltyFactor, PenaltyOptions, SolveError, SymmetricCsc};
+use lapclone::solve::{
+    fixtures, laplacian, LaplacianKind, PenaltyFactor, PenaltyOptions, SolveError, SymmetricCsc,
+};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed};
 
@@ -20,13 +22,28 @@ impl Rng {
 }
 
 fn rel_diff(a: &[f64], b: &[f64]) -> f64 {
-    let num: f64 = a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum::<f64>().sqrt();
-    let den: f64 = b.iter().map(|y| y * y).sum::<f64>().sqrt().max(f64::MIN_POSITIVE);
+    let num: f64 = a
+        .iter()
+        .zip(b)
+        .map(|(x, y)| (x - y) * (x - y))
+        .sum::<f64>()
+        .sqrt();
+    let den: f64 = b
+        .iter()
+        .map(|y| y * y)
+        .sum::<f64>()
+        .sqrt()
+        .max(f64::MIN_POSITIVE);
     num / den
 }
 
 /// Relative difference between the updated factor's solutions and a fresh factorisation's.
-fn compare_with_fresh(l: &SymmetricCsc, f: &mut PenaltyFactor, opts: &PenaltyOptions, seed: u64) -> f64 {
+fn compare_with_fresh(
+    l: &SymmetricCsc,
+    f: &mut PenaltyFactor,
+    opts: &PenaltyOptions,
+    seed: u64,
+) -> f64 {
     let n = l.n;
     let mut fresh = PenaltyFactor::new(l, opts).unwrap();
     fresh.set_constrained(f.constrained()).unwrap();
@@ -68,9 +85,14 @@ fn ten_thousand_random_switches_match_a_fresh_factorisation() {
     }
     assert_eq!(updates + downdates, 10_000);
     let diff = compare_with_fresh(&l, &mut f, &opts, 7);
+    eprintln!("relative difference to a fresh factorisation after 10k switches: {diff:e}");
     assert!(diff <= 1e-9, "final: {diff}");
     // Refactorisations must stay the exception, not the rule.
-    assert!(f.refactor_count() < 1000, "guard refactored {} times", f.refactor_count());
+    assert!(
+        f.refactor_count() < 1000,
+        "guard refactored {} times",
+        f.refactor_count()
+    );
     eprintln!("refactors after 10k switches: {}", f.refactor_count());
 }
 
@@ -84,11 +106,16 @@ fn batches_apply_updates_before_downdates_and_match_fresh() {
     f.set_constrained(&mesh.is_boundary).unwrap();
     let mut rng = Rng(31);
     for round in 0..200 {
-        let changes: Vec<(usize, bool)> = (0..1 + rng.below(6)).map(|_| (rng.below(n), rng.next() < 0.5)).collect();
+        let changes: Vec<(usize, bool)> = (0..1 + rng.below(6))
+            .map(|_| (rng.below(n), rng.next() < 0.5))
+            .collect();
         let before = f.constrained_count();
         let stats = f.switch(&changes).unwrap();
         let after = f.constrained_count();
-        assert_eq!(after as isize - before as isize, stats.updates as isize - stats.downdates as isize);
+        assert_eq!(
+            after as isize - before as isize,
+            stats.updates as isize - stats.downdates as isize
+        );
         // The last mention of a vertex wins.
         for &(v, _) in &changes {
             let last = changes.iter().rev().find(|c| c.0 == v).unwrap().1;
@@ -121,36 +148,59 @@ fn guard_refactors_when_the_last_constraint_of_a_piece_is_released() {
 fn drift_guard_fires_once_the_budget_is_spent() {
     let mesh = fixtures::disc(6);
     let l = laplacian(&mesh, LaplacianKind::Combinatorial);
+    // Every downdate adds at least one unit roundoff (≈ 1.1e-16) to the estimate.
     let opts = PenaltyOptions {
-        drift_budget: 1e-12,
+        drift_budget: 1e-15,
         ..Default::default()
     };
     let mut f = PenaltyFactor::new(&l, &opts).unwrap();
     f.set_constrained(&mesh.is_boundary).unwrap();
     let interior = (0..l.n).find(|&v| !mesh.is_boundary[v]).unwrap();
-    f.switch(&[(interior, true)]).unwrap();
-    // One downdate of a penalty pivot loses ≈ log10(α / d) digits: far above 1e-12.
-    let stats = f.switch(&[(interior, false)]).unwrap();
-    assert!(stats.refactored, "drift guard did not fire (estimate {})", f.drift_estimate());
+    let refactors_before = f.refactor_count();
+    let mut fired_after = None;
+    for round in 1..=20 {
+        f.switch(&[(interior, true)]).unwrap();
+        let stats = f.switch(&[(interior, false)]).unwrap();
+        if stats.refactored {
+            fired_after = Some(round);
+            break;
+        }
+        assert!(f.drift_estimate() > 0.0);
+    }
+    let fired_after = fired_after.expect("drift guard never fired");
+    assert!(
+        fired_after > 1,
+        "fired on the first downdate: budget not accumulated"
+    );
     assert_eq!(f.drift_estimate(), 0.0);
+    assert_eq!(f.refactor_count(), refactors_before + 1);
 }
 
 #[test]
 fn bad_switch_input_is_an_error_and_changes_nothing() {
     let l = laplacian(&fixtures::grid(2, 2), LaplacianKind::Combinatorial);
     let mut f = PenaltyFactor::new(&l, &PenaltyOptions::default()).unwrap();
-    assert!(matches!(f.switch(&[(0, true), (99, true)]), Err(SolveError::VertexOutOfRange { vertex: 99, .. })));
+    assert!(matches!(
+        f.switch(&[(0, true), (99, true)]),
+        Err(SolveError::VertexOutOfRange { vertex: 99, .. })
+    ));
     assert_eq!(f.constrained_count(), 0);
-    assert!(matches!(f.set_constrained(&[true]), Err(SolveError::WrongLength { .. })));
+    assert!(matches!(
+        f.set_constrained(&[true]),
+        Err(SolveError::WrongLength { .. })
+    ));
     let bad = PenaltyOptions {
         alpha: Some(-1.0),
         ..Default::default()
     };
-    assert!(matches!(PenaltyFactor::new(&l, &bad), Err(SolveError::BadAlpha(_))));
+    assert!(matches!(
+        PenaltyFactor::new(&l, &bad),
+        Err(SolveError::BadAlpha(_))
+    ));
 }
 
 proptest! {
-    #![proptest_config(Config { rng_seed: RngSeed::Fixed(0x5017E), cases: 24, ..Config::default() })]
+    #![proptest_config(Config { rng_seed: RngSeed::Fixed(0x5017E), cases: 24, failure_persistence: None, ..Config::default() })]
     #[test]
     fn random_switch_sequences_match_fresh(
         cols in 1usize..9, rows in 1usize..9, cotangent in any::<bool>(),

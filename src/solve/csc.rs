@@ -26,7 +26,9 @@ impl SymmetricCsc {
                 )));
             }
             if !v.is_finite() {
-                return Err(SolveError::InvalidMatrix(format!("entry ({i}, {j}) is not finite")));
+                return Err(SolveError::InvalidMatrix(format!(
+                    "entry ({i}, {j}) is not finite"
+                )));
             }
             let (row, col) = if i >= j { (i, j) } else { (j, i) };
             entries.push((col, row, v));
@@ -130,7 +132,9 @@ impl SymmetricCsc {
             }
             let rows = &self.row_idx[start..end];
             if rows.windows(2).any(|w| w[0] >= w[1]) || rows[rows.len() - 1] >= self.n {
-                return bad(format!("column {j} rows not strictly increasing within range"));
+                return bad(format!(
+                    "column {j} rows not strictly increasing within range"
+                ));
             }
             if self.values[start..end].iter().any(|v| !v.is_finite()) {
                 return bad(format!("column {j} holds a non-finite value"));

@@ -20,7 +20,12 @@ pub fn grid(cols: usize, rows: usize) -> Mesh {
     let mut triangles = Vec::with_capacity(2 * cols * rows);
     for j in 0..rows {
         for i in 0..cols {
-            let (a, b, c, d) = (index(i, j), index(i + 1, j), index(i + 1, j + 1), index(i, j + 1));
+            let (a, b, c, d) = (
+                index(i, j),
+                index(i + 1, j),
+                index(i + 1, j + 1),
+                index(i, j + 1),
+            );
             triangles.push([a, b, c]);
             triangles.push([a, c, d]);
         }
@@ -50,17 +55,27 @@ pub fn disc(rings: usize) -> Mesh {
         let inner: Vec<u32> = if r == 1 {
             vec![0]
         } else {
-            (ring_start[r - 1]..ring_start[r - 1] + 6 * (r - 1)).map(|v| v as u32).collect()
+            (ring_start[r - 1]..ring_start[r - 1] + 6 * (r - 1))
+                .map(|v| v as u32)
+                .collect()
         };
-        let outer: Vec<u32> = (ring_start[r]..ring_start[r] + 6 * r).map(|v| v as u32).collect();
+        let outer: Vec<u32> = (ring_start[r]..ring_start[r] + 6 * r)
+            .map(|v| v as u32)
+            .collect();
         stitch_rings(&inner, &outer, &mut triangles);
     }
     let outer = if rings == 0 {
         Vec::new()
     } else {
-        (ring_start[rings]..ring_start[rings] + 6 * rings).map(|v| v as u32).collect()
+        (ring_start[rings]..ring_start[rings] + 6 * rings)
+            .map(|v| v as u32)
+            .collect()
     };
-    let loops = if outer.is_empty() { Vec::new() } else { vec![outer] };
+    let loops = if outer.is_empty() {
+        Vec::new()
+    } else {
+        vec![outer]
+    };
     let mut mesh = finish(positions, triangles, loops);
     orient(&mut mesh);
     mesh
@@ -82,8 +97,10 @@ pub fn disjoint_union(a: &Mesh, b: &Mesh) -> Mesh {
         - b.positions.iter().map(|p| p.x).fold(0.0, f64::min)
         + 2.0;
     let mut mesh = a.clone();
-    mesh.positions.extend(b.positions.iter().map(|p| *p + DVec2::new(shift_x, 0.0)));
-    mesh.triangles.extend(b.triangles.iter().map(|t| t.map(|v| v + offset)));
+    mesh.positions
+        .extend(b.positions.iter().map(|p| *p + DVec2::new(shift_x, 0.0)));
+    mesh.triangles
+        .extend(b.triangles.iter().map(|t| t.map(|v| v + offset)));
     mesh.is_boundary.extend_from_slice(&b.is_boundary);
     mesh.piece.extend(b.piece.iter().map(|p| p + a.piece_count));
     mesh.loops.extend(b.loops.iter().map(|l| BoundaryLoop {

@@ -24,7 +24,9 @@ pub enum LaplacianKind {
 pub fn laplacian(mesh: &Mesh, kind: LaplacianKind) -> SymmetricCsc {
     let n = mesh.vertex_count();
     let weighted_edges = match kind {
-        LaplacianKind::Combinatorial => mesh.edges().into_iter().map(|(i, j)| (i, j, 1.0)).collect(),
+        LaplacianKind::Combinatorial => {
+            mesh.edges().into_iter().map(|(i, j)| (i, j, 1.0)).collect()
+        }
         LaplacianKind::Cotangent => cotangent_edges(mesh),
     };
     let mut triplets = Vec::with_capacity(weighted_edges.len() + n);
@@ -37,7 +39,8 @@ pub fn laplacian(mesh: &Mesh, kind: LaplacianKind) -> SymmetricCsc {
     }
     triplets.extend(diagonal.iter().enumerate().map(|(v, &d)| (v, v, d)));
     // invariant: mesh indices are < n and weights finite (cotangents of non-degenerate triangles).
-    SymmetricCsc::from_triplets(n, &triplets).expect("invariant: mesh indices in range, finite weights")
+    SymmetricCsc::from_triplets(n, &triplets)
+        .expect("invariant: mesh indices in range, finite weights")
 }
 
 /// Edges (i < j, sorted) with their clamped cotangent weight.
@@ -46,12 +49,21 @@ fn cotangent_edges(mesh: &Mesh) -> Vec<(u32, u32, f64)> {
     for t in &mesh.triangles {
         let p = t.map(|v| mesh.positions[v as usize]);
         let twice_area = (p[1] - p[0]).perp_dot(p[2] - p[0]).abs();
-        let scale = (p[1] - p[0]).length_squared().max((p[2] - p[0]).length_squared());
+        let scale = (p[1] - p[0])
+            .length_squared()
+            .max((p[2] - p[0]).length_squared());
         let degenerate = !(twice_area > 1e-12 * scale);
         for corner in 0..3 {
             let (a, b) = (t[(corner + 1) % 3], t[(corner + 2) % 3]);
-            let (u, v) = (p[(corner + 1) % 3] - p[corner], p[(corner + 2) % 3] - p[corner]);
-            let cot = if degenerate { 0.0 } else { u.dot(v) / twice_area };
+            let (u, v) = (
+                p[(corner + 1) % 3] - p[corner],
+                p[(corner + 2) % 3] - p[corner],
+            );
+            let cot = if degenerate {
+                0.0
+            } else {
+                u.dot(v) / twice_area
+            };
             half.push((a.min(b), a.max(b), 0.5 * cot));
         }
     }

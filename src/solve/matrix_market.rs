@@ -8,12 +8,12 @@ use std::path::Path;
 /// Writes `real symmetric` coordinate format, lower triangle, 1-based, with 17 significant
 /// digits so a round trip is exact. Atomic: a failed write leaves no partial file.
 pub fn write_matrix_market(path: &Path, matrix: &SymmetricCsc) -> Result<(), SolveError> {
-    crate::util::write_atomic_with(path, |out| write_matrix_market_to(out, matrix)).map_err(|source| {
-        SolveError::Io {
+    crate::util::write_atomic_with(path, |out| write_matrix_market_to(out, matrix)).map_err(
+        |source| SolveError::Io {
             path: path.to_path_buf(),
             source,
-        }
-    })
+        },
+    )
 }
 
 fn write_matrix_market_to(out: &mut dyn Write, m: &SymmetricCsc) -> std::io::Result<()> {
@@ -22,7 +22,12 @@ fn write_matrix_market_to(out: &mut dyn Write, m: &SymmetricCsc) -> std::io::Res
     text.push_str(&format!("{} {} {}\n", m.n, m.n, m.nnz()));
     for j in 0..m.n {
         for p in m.col_ptr[j]..m.col_ptr[j + 1] {
-            text.push_str(&format!("{} {} {:e}\n", m.row_idx[p] + 1, j + 1, m.values[p]));
+            text.push_str(&format!(
+                "{} {} {:e}\n",
+                m.row_idx[p] + 1,
+                j + 1,
+                m.values[p]
+            ));
         }
     }
     out.write_all(text.as_bytes())
@@ -69,11 +74,15 @@ fn parse_matrix_market(path: &Path, text: &str) -> Result<SymmetricCsc, SolveErr
             upper.push((j, i, v));
         }
     }
-    let (n, nnz) = size.ok_or_else(|| err(text.lines().count().max(1), "missing size line".into()))?;
+    let (n, nnz) =
+        size.ok_or_else(|| err(text.lines().count().max(1), "missing size line".into()))?;
     if lower.len() + upper.len() != nnz {
         return Err(err(
             text.lines().count().max(1),
-            format!("header announces {nnz} entries, file holds {}", lower.len() + upper.len()),
+            format!(
+                "header announces {nnz} entries, file holds {}",
+                lower.len() + upper.len()
+            ),
         ));
     }
     if !symmetric && !upper.is_empty() {
@@ -84,27 +93,41 @@ fn parse_matrix_market(path: &Path, text: &str) -> Result<SymmetricCsc, SolveErr
 
 /// Returns whether the file declares itself symmetric.
 fn parse_header(header: &str) -> Result<bool, String> {
-    let words: Vec<String> = header.split_whitespace().map(str::to_ascii_lowercase).collect();
+    let words: Vec<String> = header
+        .split_whitespace()
+        .map(str::to_ascii_lowercase)
+        .collect();
     if words.len() != 5 || words[0] != "%%matrixmarket" || words[1] != "matrix" {
         return Err(format!("not a Matrix Market header: `{header}`"));
     }
     if words[2] != "coordinate" {
-        return Err(format!("only coordinate format is supported, not `{}`", words[2]));
+        return Err(format!(
+            "only coordinate format is supported, not `{}`",
+            words[2]
+        ));
     }
     if words[3] != "real" && words[3] != "integer" {
-        return Err(format!("only real or integer fields are supported, not `{}`", words[3]));
+        return Err(format!(
+            "only real or integer fields are supported, not `{}`",
+            words[3]
+        ));
     }
     match words[4].as_str() {
         "symmetric" => Ok(true),
         "general" => Ok(false),
-        other => Err(format!("only symmetric or general matrices are supported, not `{other}`")),
+        other => Err(format!(
+            "only symmetric or general matrices are supported, not `{other}`"
+        )),
     }
 }
 
 fn parse_size_line(fields: &[&str]) -> Result<(usize, usize), String> {
     let numbers: Vec<usize> = fields
         .iter()
-        .map(|f| f.parse::<usize>().map_err(|_| format!("`{f}` is not a non-negative integer")))
+        .map(|f| {
+            f.parse::<usize>()
+                .map_err(|_| format!("`{f}` is not a non-negative integer"))
+        })
         .collect::<Result<_, _>>()?;
     match numbers[..] {
         [rows, cols, nnz] if rows == cols => Ok((rows, nnz)),
@@ -135,7 +158,8 @@ fn check_mirrored(
     lower: &mut [(usize, usize, f64)],
     upper: &mut [(usize, usize, f64)],
 ) -> Result<(), String> {
-    let strictly_lower: Vec<(usize, usize, f64)> = lower.iter().copied().filter(|e| e.0 != e.1).collect();
+    let strictly_lower: Vec<(usize, usize, f64)> =
+        lower.iter().copied().filter(|e| e.0 != e.1).collect();
     let mut a = strictly_lower;
     a.sort_by(|x, y| (x.0, x.1).cmp(&(y.0, y.1)));
     upper.sort_by(|x, y| (x.0, x.1).cmp(&(y.0, y.1)));
@@ -144,7 +168,11 @@ fn check_mirrored(
     }
     for (x, y) in a.iter().zip(upper.iter()) {
         if (x.0, x.1) != (y.0, y.1) || (x.2 - y.2).abs() > 1e-12 * x.2.abs().max(y.2.abs()) {
-            return Err(format!("general matrix is not symmetric at ({}, {})", x.0 + 1, x.1 + 1));
+            return Err(format!(
+                "general matrix is not symmetric at ({}, {})",
+                x.0 + 1,
+                x.1 + 1
+            ));
         }
     }
     Ok(())

@@ -38,7 +38,8 @@ pub fn factor_numeric(
     workspace: &mut NumericWorkspace,
 ) -> Result<(), SolveError> {
     let n = symbolic.n;
-    let pattern = SymbolicSparseColMatRef::new_checked(n, n, &symbolic.a_col_ptr, None, &symbolic.a_row_idx);
+    let pattern =
+        SymbolicSparseColMatRef::new_checked(n, n, &symbolic.a_col_ptr, None, &symbolic.a_row_idx);
     let a = SparseColMatRef::new(pattern, a_values);
     let regularization = LdltRegularization {
         dynamic_regularization_signs: Some(&workspace.signs),

@@ -9,8 +9,9 @@
 //! 1. a downdate would leave a pivot `≤ ε/2` (positive definiteness lost numerically — e.g.
 //!    the last constraint of a piece released), or
 //! 2. the drift estimate `Σ u · max_j d_j / d̄_j` (u = 2⁻⁵³, summed over downdates since the
-//!    last factorisation; `d_j / d̄_j` is how much cancellation magnified rounding in the
-//!    pivot) exceeds `drift_budget`, or
+//!    last factorisation; `d_j / d̄_j` over the path below the start pivot — whose pivot is
+//!    recomputed exactly — is how much cancellation magnified rounding) exceeds
+//!    `drift_budget`, or
 //! 3. the batch is so large that refactoring is cheaper (more switches than
 //!    `n / 64 + 16`).
 //!
@@ -19,7 +20,7 @@
 use super::numeric::{factor_numeric, NumericWorkspace};
 use super::solve::ldlt_solve_interleaved;
 use super::symbolic::SymbolicFactor;
-use super::update::{rank1_diagonal, Rank1Outcome};
+use super::update::{pivot_from_row, rank1_diagonal, Rank1Outcome, RowScratch};
 use super::{SolveError, SymmetricCsc};
 
 /// Penalty and guard settings. `None` picks the scale-relative default documented in
@@ -28,7 +29,7 @@ use super::{SolveError, SymmetricCsc};
 pub struct PenaltyOptions {
     pub alpha: Option<f64>,
     pub epsilon: Option<f64>,
-    /// Refactor when the accumulated downdate drift estimate exceeds this (default 1e-7).
+    /// Refactor when the accumulated downdate drift estimate exceeds this (default 1e-11).
     pub drift_budget: f64,
 }
 
@@ -43,11 +44,11 @@ impl Default for PenaltyOptions {
 }
 
 /// Default α relative to the diagonal scale.
-pub const DEFAULT_ALPHA_RELATIVE: f64 = 1e7;
+pub const DEFAULT_ALPHA_RELATIVE: f64 = 1e8;
 /// Default ε relative to the diagonal scale.
 pub const DEFAULT_EPSILON_RELATIVE: f64 = 1e-12;
 /// Default drift budget (see the module doc).
-pub const DEFAULT_DRIFT_BUDGET: f64 = 1e-7;
+pub const DEFAULT_DRIFT_BUDGET: f64 = 1e-11;
 const UNIT_ROUNDOFF: f64 = f64::EPSILON / 2.0;
 
 /// What one batch of switches did.
@@ -81,6 +82,7 @@ pub struct PenaltyFactor {
     /// Per-vertex pending state of the current batch: 0 none, 1 on, 2 off.
     pending: Vec<u8>,
     touched: Vec<usize>,
+    row_scratch: RowScratch,
 }
 
 impl PenaltyFactor {
@@ -94,7 +96,9 @@ impl PenaltyFactor {
         }
         let epsilon = opts.epsilon.unwrap_or(DEFAULT_EPSILON_RELATIVE * scale);
         if !(epsilon.is_finite() && epsilon > 0.0) {
-            return Err(SolveError::InvalidMatrix(format!("regularisation ε = {epsilon} must be positive")));
+            return Err(SolveError::InvalidMatrix(format!(
+                "regularisation ε = {epsilon} must be positive"
+            )));
         }
         let mut base_values = l.values.clone();
         for j in 0..l.n {
@@ -119,6 +123,7 @@ impl PenaltyFactor {
             solve_scratch: Vec::new(),
             pending: vec![0; n],
             touched: Vec::new(),
+            row_scratch: RowScratch::new(n),
         };
         this.factor_current()?;
         Ok(this)
@@ -219,7 +224,11 @@ impl PenaltyFactor {
     /// If `rhs.len() != n * k` (a programming error, not an input error).
     pub fn solve_in_place(&mut self, rhs: &mut [f64], k: usize) {
         let n = self.n();
-        assert_eq!(rhs.len(), n * k, "solve_in_place: rhs must be n×k column-major");
+        assert_eq!(
+            rhs.len(),
+            n * k,
+            "solve_in_place: rhs must be n×k column-major"
+        );
         if self.solve_scratch.len() < n * k {
             self.solve_scratch.resize(n * k, 0.0);
         }
@@ -230,7 +239,13 @@ impl PenaltyFactor {
                 x[pos * k + c] = rhs[c * n + v as usize];
             }
         }
-        ldlt_solve_interleaved(self.symbolic.col_ptr(), self.symbolic.row_idx(), &self.factor_values, x, k);
+        ldlt_solve_interleaved(
+            self.symbolic.col_ptr(),
+            self.symbolic.row_idx(),
+            &self.factor_values,
+            x,
+            k,
+        );
         for (pos, &v) in fwd.iter().enumerate() {
             for c in 0..k {
                 rhs[c * n + v as usize] = x[pos * k + c];
@@ -242,7 +257,11 @@ impl PenaltyFactor {
     /// constrained rows (other rows ignored); on exit the membrane, ≈ those values there.
     pub fn solve_dirichlet(&mut self, values: &mut [f64], k: usize) {
         let n = self.n();
-        assert_eq!(values.len(), n * k, "solve_dirichlet: values must be n×k column-major");
+        assert_eq!(
+            values.len(),
+            n * k,
+            "solve_dirichlet: values must be n×k column-major"
+        );
         for column in values.chunks_exact_mut(n.max(1)) {
             for (value, &on) in column.iter_mut().zip(&self.constrained) {
                 *value = if on { self.alpha * *value } else { 0.0 };
@@ -319,6 +338,19 @@ impl PenaltyFactor {
         let p = self.symbolic.position_of(v);
         let sigma = if on { self.alpha } else { -self.alpha };
         let (col_ptr, row_idx) = (self.symbolic.col_ptr(), self.symbolic.row_idx());
+        let exact_pivot = (!on).then(|| {
+            let a_pp = self.base_values[self.symbolic.a_col_ptr[v] as usize];
+            let neighbours = self.symbolic.neighbours(p);
+            pivot_from_row(
+                col_ptr,
+                row_idx,
+                &self.factor_values,
+                p,
+                a_pp,
+                neighbours,
+                &mut self.row_scratch,
+            )
+        });
         match rank1_diagonal(
             col_ptr,
             row_idx,
@@ -327,6 +359,7 @@ impl PenaltyFactor {
             p,
             sigma,
             0.5 * self.epsilon,
+            exact_pivot,
         ) {
             Rank1Outcome::Done { amplification } => {
                 if !on {

@@ -6,7 +6,13 @@
 
 /// Solves in place. The pattern must satisfy the layout contract checked by
 /// [`SymbolicFactor::check_layout`](super::symbolic::SymbolicFactor::check_layout).
-pub fn ldlt_solve_interleaved(col_ptr: &[u32], row_idx: &[u32], values: &[f64], x: &mut [f64], k: usize) {
+pub fn ldlt_solve_interleaved(
+    col_ptr: &[u32],
+    row_idx: &[u32],
+    values: &[f64],
+    x: &mut [f64],
+    k: usize,
+) {
     let n = col_ptr.len() - 1;
     assert!(x.len() == n * k && values.len() == row_idx.len());
     match k {

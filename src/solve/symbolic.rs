@@ -29,6 +29,10 @@ pub struct SymbolicFactor {
     pub(crate) perm_inv: Vec<u32>,
     pub(crate) a_col_ptr: Vec<u32>,
     pub(crate) a_row_idx: Vec<u32>,
+    /// Full adjacency (both triangles, diagonal excluded) in factor positions:
+    /// neighbours of position p are `adj_idx[adj_ptr[p]..adj_ptr[p + 1]]`.
+    pub(crate) adj_ptr: Vec<u32>,
+    pub(crate) adj_idx: Vec<u32>,
 }
 
 impl SymbolicFactor {
@@ -36,16 +40,25 @@ impl SymbolicFactor {
     pub fn analyse(a: &SymmetricCsc) -> Result<Self, SolveError> {
         a.sanity_check()?;
         let to_u32 = |v: usize| u32::try_from(v).map_err(|_| SolveError::TooLarge(a.n));
-        let a_col_ptr: Vec<u32> = a.col_ptr.iter().map(|&v| to_u32(v)).collect::<Result<_, _>>()?;
-        let a_row_idx: Vec<u32> = a.row_idx.iter().map(|&v| to_u32(v)).collect::<Result<_, _>>()?;
+        let a_col_ptr: Vec<u32> = a
+            .col_ptr
+            .iter()
+            .map(|&v| to_u32(v))
+            .collect::<Result<_, _>>()?;
+        let a_row_idx: Vec<u32> = a
+            .row_idx
+            .iter()
+            .map(|&v| to_u32(v))
+            .collect::<Result<_, _>>()?;
         // SAFETY-free: the pattern was validated by `sanity_check` (sorted, in range).
         let pattern = SymbolicSparseColMatRef::new_checked(a.n, a.n, &a_col_ptr, None, &a_row_idx);
         let params = CholeskySymbolicParams {
             supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SIMPLICIAL,
             ..Default::default()
         };
-        let faer = factorize_symbolic_cholesky(pattern, Side::Lower, SymmetricOrdering::Amd, params)
-            .map_err(|e| SolveError::Symbolic(format!("{e:?}")))?;
+        let faer =
+            factorize_symbolic_cholesky(pattern, Side::Lower, SymmetricOrdering::Amd, params)
+                .map_err(|e| SolveError::Symbolic(format!("{e:?}")))?;
         let (perm_fwd, perm_inv) = match faer.perm() {
             Some(perm) => {
                 let (fwd, inv) = perm.arrays();
@@ -53,7 +66,10 @@ impl SymbolicFactor {
             }
             None => ((0..a.n as u32).collect(), (0..a.n as u32).collect()),
         };
+        let (adj_ptr, adj_idx) = permuted_adjacency(a, &perm_inv);
         let this = Self {
+            adj_ptr,
+            adj_idx,
             n: a.n,
             faer,
             perm_fwd,
@@ -63,6 +79,13 @@ impl SymbolicFactor {
         };
         this.check_layout()?;
         Ok(this)
+    }
+
+    /// Positions adjacent to position `p` in the permuted matrix (diagonal excluded).
+    pub fn neighbours(&self, p: usize) -> impl Iterator<Item = usize> + '_ {
+        self.adj_idx[self.adj_ptr[p] as usize..self.adj_ptr[p + 1] as usize]
+            .iter()
+            .map(|&q| q as usize)
     }
 
     /// Dimension.
@@ -107,7 +130,11 @@ impl SymbolicFactor {
     /// version changed its representation.
     pub fn check_layout(&self) -> Result<(), SolveError> {
         let (col_ptr, row_idx) = (self.col_ptr(), self.row_idx());
-        let broken = |m: String| Err(SolveError::Symbolic(format!("unexpected faer factor layout: {m}")));
+        let broken = |m: String| {
+            Err(SolveError::Symbolic(format!(
+                "unexpected faer factor layout: {m}"
+            )))
+        };
         if col_ptr.len() != self.n + 1 || col_ptr[self.n] as usize != row_idx.len() {
             return broken("column pointers".into());
         }
@@ -130,4 +157,30 @@ impl SymbolicFactor {
         }
         Ok(())
     }
+}
+
+/// Both-triangle adjacency of `a` re-indexed by factor position.
+fn permuted_adjacency(a: &SymmetricCsc, perm_inv: &[u32]) -> (Vec<u32>, Vec<u32>) {
+    let mut count = vec![0u32; a.n + 1];
+    for j in 0..a.n {
+        for &i in &a.row_idx[a.col_ptr[j] + 1..a.col_ptr[j + 1]] {
+            count[perm_inv[i] as usize + 1] += 1;
+            count[perm_inv[j] as usize + 1] += 1;
+        }
+    }
+    for p in 0..a.n {
+        count[p + 1] += count[p];
+    }
+    let mut next = count.clone();
+    let mut idx = vec![0u32; count[a.n] as usize];
+    for j in 0..a.n {
+        for &i in &a.row_idx[a.col_ptr[j] + 1..a.col_ptr[j + 1]] {
+            let (pi, pj) = (perm_inv[i] as usize, perm_inv[j] as usize);
+            idx[next[pi] as usize] = pj as u32;
+            next[pi] += 1;
+            idx[next[pj] as usize] = pi as u32;
+            next[pj] += 1;
+        }
+    }
+    (count, idx)
 }
