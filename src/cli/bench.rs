@@ -1,6 +1,6 @@
 //! `lapclone bench …`: benchmarks of each stage (use a release build).
 
-use std::path::PathBuf;
+use super::bench_solver::{FactorBenchArgs, SolverBenchArgs};
 
 #[derive(clap::Args, Debug)]
 pub struct BenchArgs {
@@ -12,25 +12,13 @@ pub struct BenchArgs {
 pub enum BenchCommand {
     /// Factor, solve and rank-1 switch timings on a Matrix Market Laplacian.
     Solver(SolverBenchArgs),
-}
-
-#[derive(clap::Args, Debug)]
-pub struct SolverBenchArgs {
-    /// Laplacian in Matrix Market coordinate format (as written by `lapclone mesh --laplacian-out`).
-    pub matrix: PathBuf,
-    /// File with one constrained (0-based) vertex index per line.
-    #[arg(long)]
-    pub constrained: PathBuf,
-    /// Penalty weight (default: relative to the matrix scale).
-    #[arg(long, value_parser = super::finite_f64)]
-    pub alpha: Option<f64>,
-    /// Print JSON instead of a table.
-    #[arg(long)]
-    pub json: bool,
+    /// Analyse, factor, 3-RHS solve and switch timings on built-in disc meshes.
+    Factor(FactorBenchArgs),
 }
 
 pub fn run(args: BenchArgs) -> anyhow::Result<()> {
     match args.which {
-        BenchCommand::Solver(_) => anyhow::bail!("`lapclone bench solver` is not implemented yet"),
+        BenchCommand::Solver(args) => super::bench_solver::run_solver(args),
+        BenchCommand::Factor(args) => super::bench_solver::run_factor(args),
     }
 }

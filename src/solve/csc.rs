@@ -34,7 +34,7 @@ impl SymmetricCsc {
             entries.push((col, row, v));
         }
         entries.extend((0..n).map(|d| (d, d, 0.0)));
-        entries.sort_by(|a, b| (a.0, a.1).cmp(&(b.0, b.1)));
+        entries.sort_by_key(|e| (e.0, e.1));
         let mut col_ptr = vec![0usize; n + 1];
         let mut row_idx = Vec::with_capacity(entries.len());
         let mut values: Vec<f64> = Vec::with_capacity(entries.len());
@@ -106,6 +106,7 @@ impl SymmetricCsc {
     /// Dense copy (both triangles), for tests on small matrices.
     pub fn to_dense(&self) -> Vec<Vec<f64>> {
         let mut dense = vec![vec![0.0; self.n]; self.n];
+        #[allow(clippy::needless_range_loop)] // j indexes both the pattern and the output
         for j in 0..self.n {
             for p in self.col_ptr[j]..self.col_ptr[j + 1] {
                 let i = self.row_idx[p];

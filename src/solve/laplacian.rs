@@ -52,6 +52,8 @@ fn cotangent_edges(mesh: &Mesh) -> Vec<(u32, u32, f64)> {
         let scale = (p[1] - p[0])
             .length_squared()
             .max((p[2] - p[0]).length_squared());
+        // NaN-safe: a NaN area counts as degenerate.
+        #[allow(clippy::neg_cmp_op_on_partial_ord)]
         let degenerate = !(twice_area > 1e-12 * scale);
         for corner in 0..3 {
             let (a, b) = (t[(corner + 1) % 3], t[(corner + 2) % 3]);
@@ -67,7 +69,7 @@ fn cotangent_edges(mesh: &Mesh) -> Vec<(u32, u32, f64)> {
             half.push((a.min(b), a.max(b), 0.5 * cot));
         }
     }
-    half.sort_by(|x, y| (x.0, x.1).cmp(&(y.0, y.1)));
+    half.sort_by_key(|e| (e.0, e.1));
     let mut edges: Vec<(u32, u32, f64)> = Vec::with_capacity(half.len());
     for (i, j, w) in half {
         match edges.last_mut() {

@@ -161,8 +161,8 @@ fn check_mirrored(
     let strictly_lower: Vec<(usize, usize, f64)> =
         lower.iter().copied().filter(|e| e.0 != e.1).collect();
     let mut a = strictly_lower;
-    a.sort_by(|x, y| (x.0, x.1).cmp(&(y.0, y.1)));
-    upper.sort_by(|x, y| (x.0, x.1).cmp(&(y.0, y.1)));
+    a.sort_by_key(|e| (e.0, e.1));
+    upper.sort_by_key(|e| (e.0, e.1));
     if a.len() != upper.len() {
         return Err("general matrix is not symmetric (pattern differs)".into());
     }

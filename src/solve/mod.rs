@@ -34,6 +34,7 @@ pub mod laplacian;
 pub mod matrix_market;
 pub mod numeric;
 pub mod penalty;
+#[allow(clippy::module_inception)]
 pub mod solve;
 pub mod symbolic;
 pub mod update;

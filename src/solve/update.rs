@@ -32,6 +32,7 @@ pub enum Rank1Outcome {
 ///
 /// The pattern must satisfy the layout contract checked by
 /// [`SymbolicFactor::check_layout`](super::symbolic::SymbolicFactor::check_layout).
+#[allow(clippy::too_many_arguments)]
 pub fn rank1_diagonal(
     col_ptr: &[u32],
     row_idx: &[u32],
@@ -64,6 +65,8 @@ pub fn rank1_diagonal(
             }
             None => d + sigma * wj * wj,
         };
+        // NaN-safe: a NaN pivot is lost too.
+        #[allow(clippy::neg_cmp_op_on_partial_ord)]
         if !(d_bar > floor) {
             clear_path(col_ptr, row_idx, w, j);
             return Rank1Outcome::PivotLost;

@@ -1,0 +1,179 @@
+//! `lapclone bench solver` and `lapclone bench factor`: timings of the solve stage —
+//! analyse, factor, 3-RHS solve and rank-1 switches — on a Matrix Market Laplacian or on the
+//! built-in disc meshes. Release builds only give meaningful figures.
+
+use anyhow::Context;
+use lapclone::solve::{
+    fixtures, laplacian, read_constrained_list, read_matrix_market, LaplacianKind, PenaltyFactor,
+    PenaltyOptions, SymmetricCsc,
+};
+use std::path::PathBuf;
+use std::time::Instant;
+
+#[derive(clap::Args, Debug)]
+pub struct SolverBenchArgs {
+    /// Laplacian in Matrix Market coordinate format (as written by `lapclone mesh --laplacian-out`).
+    pub matrix: PathBuf,
+    /// File with one constrained (0-based) vertex index per line.
+    #[arg(long)]
+    pub constrained: PathBuf,
+    /// Penalty weight (default: relative to the matrix scale).
+    #[arg(long, value_parser = super::finite_f64)]
+    pub alpha: Option<f64>,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(clap::Args, Debug)]
+pub struct FactorBenchArgs {
+    /// Approximate vertex counts of the disc meshes.
+    #[arg(long, value_delimiter = ',', default_values_t = vec![2_034usize, 52_054, 495_037])]
+    pub sizes: Vec<usize>,
+    /// Use cotangent instead of combinatorial weights.
+    #[arg(long)]
+    pub cotangent: bool,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Timings of one matrix, milliseconds (best of several runs).
+#[derive(serde::Serialize, Debug)]
+struct Timings {
+    n: usize,
+    nnz_factor: usize,
+    analyze_ms: f64,
+    factor_ms: f64,
+    solve3_ms: f64,
+    update_ms: f64,
+    switch100_ms: f64,
+    refactor_ms: f64,
+}
+
+const RUNS: usize = 5;
+
+fn best_ms(runs: usize, mut work: impl FnMut()) -> f64 {
+    (0..runs)
+        .map(|_| {
+            let start = Instant::now();
+            work();
+            start.elapsed().as_secs_f64() * 1e3
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+fn measure(l: &SymmetricCsc, constrained: &[usize], alpha: Option<f64>) -> anyhow::Result<Timings> {
+    let opts = PenaltyOptions {
+        alpha,
+        ..Default::default()
+    };
+    let runs = if l.n > 200_000 { 2 } else { RUNS };
+    let analyze_ms = best_ms(runs, || {
+        let _ = lapclone::solve::symbolic::SymbolicFactor::analyse(l);
+    });
+    let mut factor = PenaltyFactor::new(l, &opts)?;
+    let mut wanted = vec![false; l.n];
+    constrained.iter().for_each(|&v| wanted[v] = true);
+    factor.set_constrained(&wanted)?;
+    let mut failure = None;
+    let factor_ms = best_ms(runs, || {
+        if let Err(e) = factor.refactor() {
+            failure = Some(e);
+        }
+    });
+    if let Some(e) = failure {
+        return Err(e.into());
+    }
+    let rhs: Vec<f64> = (0..3 * l.n)
+        .map(|i| ((i * 7919) % 1000) as f64 / 1000.0)
+        .collect();
+    let mut work = rhs.clone();
+    let solve3_ms = best_ms(RUNS * 4, || {
+        work.copy_from_slice(&rhs);
+        factor.solve_dirichlet(&mut work, 3);
+    });
+    // One switch = a downdate plus the update restoring it, halved.
+    let probe = constrained.get(constrained.len() / 2).copied().unwrap_or(0);
+    let update_ms = best_ms(RUNS * 4, || {
+        let _ = factor.switch(&[(probe, !factor.is_constrained(probe))]);
+        let _ = factor.switch(&[(probe, !factor.is_constrained(probe))]);
+    }) / 2.0;
+    let hundred: Vec<usize> = constrained
+        .iter()
+        .step_by((constrained.len() / 100).max(1))
+        .take(100)
+        .copied()
+        .collect();
+    let switch100_ms = best_ms(runs, || {
+        for &v in &hundred {
+            let _ = factor.switch(&[(v, false)]);
+        }
+        for &v in &hundred {
+            let _ = factor.switch(&[(v, true)]);
+        }
+    }) / 2.0;
+    Ok(Timings {
+        n: l.n,
+        nnz_factor: factor.nnz_factor(),
+        analyze_ms,
+        factor_ms,
+        solve3_ms,
+        update_ms,
+        switch100_ms,
+        refactor_ms: factor_ms,
+    })
+}
+
+fn print(rows: &[Timings], json: bool) -> anyhow::Result<()> {
+    if json {
+        let text = if rows.len() == 1 {
+            serde_json::to_string(&rows[0])?
+        } else {
+            serde_json::to_string(rows)?
+        };
+        println!("{text}");
+        return Ok(());
+    }
+    println!(
+        "{:>9} {:>11} {:>11} {:>11} {:>11} {:>11} {:>13}",
+        "n", "nnz(L)", "analyse ms", "factor ms", "solve3 ms", "switch ms", "100 switch ms"
+    );
+    for t in rows {
+        println!(
+            "{:>9} {:>11} {:>11.3} {:>11.3} {:>11.4} {:>11.4} {:>13.3}",
+            t.n, t.nnz_factor, t.analyze_ms, t.factor_ms, t.solve3_ms, t.update_ms, t.switch100_ms
+        );
+    }
+    Ok(())
+}
+
+pub fn run_solver(args: SolverBenchArgs) -> anyhow::Result<()> {
+    let l = read_matrix_market(&args.matrix)?;
+    let constrained = read_constrained_list(&args.constrained, l.n)?;
+    if constrained.is_empty() {
+        return Err(super::UsageError(format!(
+            "{}: no constrained vertex listed",
+            args.constrained.display()
+        ))
+        .into());
+    }
+    let timings = measure(&l, &constrained, args.alpha).context("benchmark failed")?;
+    print(&[timings], args.json)
+}
+
+pub fn run_factor(args: FactorBenchArgs) -> anyhow::Result<()> {
+    let kind = if args.cotangent {
+        LaplacianKind::Cotangent
+    } else {
+        LaplacianKind::Combinatorial
+    };
+    let mut rows = Vec::new();
+    for &size in &args.sizes {
+        let mesh = fixtures::disc_with_vertices(size);
+        let l = laplacian(&mesh, kind);
+        let boundary: Vec<usize> = (0..l.n).filter(|&v| mesh.is_boundary[v]).collect();
+        rows.push(measure(&l, &boundary, None)?);
+    }
+    print(&rows, args.json)
+}
