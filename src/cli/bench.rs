@@ -12,6 +12,8 @@ pub struct BenchArgs {
 pub enum BenchCommand {
     /// Factor, solve and rank-1 switch timings on a Matrix Market Laplacian.
     Solver(SolverBenchArgs),
+    /// Meshing timings over synthetic masks from 128² to 2000² (spiral family and others).
+    Mesh(super::bench_mesh::MeshBenchArgs),
 }
 
 #[derive(clap::Args, Debug)]
@@ -32,5 +34,6 @@ pub struct SolverBenchArgs {
 pub fn run(args: BenchArgs) -> anyhow::Result<()> {
     match args.which {
         BenchCommand::Solver(_) => anyhow::bail!("`lapclone bench solver` is not implemented yet"),
+        BenchCommand::Mesh(args) => super::bench_mesh::run(args),
     }
 }

@@ -5,6 +5,7 @@
 use clap::{Parser, Subcommand};
 
 pub mod bench;
+pub mod bench_mesh;
 pub mod clone;
 pub mod mesh;
 pub mod render;

@@ -38,7 +38,11 @@ pub fn mesh_mask(mask: &BitMask, options: &MeshOptions) -> Result<MeshResult, Me
     let attempt = |tolerance: f64| -> Result<(Mesh, bool, f64), MeshError> {
         let (loops, deviation) = sample_crack_loops(&crack, tolerance, options.density);
         let t = triangulate_loops(&loops, options.min_angle_deg, options.max_vertices)?;
-        t.mesh.sanity_check()?;
+        // The full check costs about as much as the refinement; the tests run it on every
+        // shape family, so release builds rely on the topology counts below.
+        if cfg!(debug_assertions) {
+            t.mesh.sanity_check()?;
+        }
         if t.mesh.hole_count() != expected_holes || t.mesh.piece_count as usize != pieces {
             return Err(MeshError::IntersectingBoundary { conflicts: 0 });
         }
