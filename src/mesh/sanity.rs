@@ -137,8 +137,7 @@ impl Mesh {
         // piece must be a relabelling of the connectivity labels: a bijection between ids.
         let mut map = vec![u32::MAX; count as usize];
         let mut back = vec![u32::MAX; count as usize];
-        for v in 0..self.positions.len() {
-            let (mine, truth) = (self.piece[v], labels[v]);
+        for (v, (&mine, &truth)) in self.piece.iter().zip(&labels).enumerate() {
             if mine >= count {
                 return Err(SanityError::PieceMismatch { vertex: v as u32 });
             }
