@@ -14,11 +14,14 @@ pub enum BenchCommand {
     Solver(SolverBenchArgs),
     /// Analyse, factor, 3-RHS solve and switch timings on built-in disc meshes.
     Factor(FactorBenchArgs),
+    /// Meshing timings over synthetic masks from 128² to 2000² (spiral family and others).
+    Mesh(super::bench_mesh::MeshBenchArgs),
 }
 
 pub fn run(args: BenchArgs) -> anyhow::Result<()> {
     match args.which {
         BenchCommand::Solver(args) => super::bench_solver::run_solver(args),
         BenchCommand::Factor(args) => super::bench_solver::run_factor(args),
+        BenchCommand::Mesh(args) => super::bench_mesh::run(args),
     }
 }

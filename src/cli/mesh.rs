@@ -1,6 +1,13 @@
 //! `lapclone mesh`: mask → mesh, with an optional picture, JSON stats and Laplacian export.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::Context;
+use lapclone::mesh::{self, BitMask, Mesh, MeshOptions};
+use lapclone::raster::overlay::{draw_mesh_overlay, OverlayStyle};
+
+use super::UsageError;
 
 #[derive(clap::Args, Debug)]
 pub struct MeshArgs {
@@ -29,6 +36,97 @@ pub struct MeshArgs {
     pub laplacian_out: Option<PathBuf>,
 }
 
-pub fn run(_args: MeshArgs) -> anyhow::Result<()> {
-    anyhow::bail!("`lapclone mesh` is not implemented yet")
+pub fn run(args: MeshArgs) -> anyhow::Result<()> {
+    let options = options_from(&args)?;
+    let threshold = args.threshold.unwrap_or(0.5);
+    if !(0.0..=1.0).contains(&threshold) {
+        return Err(UsageError(format!("--threshold must be in [0, 1], got {threshold}")).into());
+    }
+    let mask = BitMask::load(&args.mask, threshold as f32)?;
+    let started = Instant::now();
+    let result = mesh::mesh_mask(&mask, &options)?;
+    let mesh_ms = started.elapsed().as_secs_f64() * 1e3;
+    for warning in &result.warnings {
+        eprintln!("lapclone: warning: {warning}");
+    }
+    if let Some(path) = &args.output {
+        write_picture(&result.mesh, &mask, path)?;
+    }
+    if let Some(path) = &args.laplacian_out {
+        mesh::write_laplacian(&result.mesh, path)?;
+    }
+    let stats = &result.stats;
+    if args.stats {
+        let json = serde_json::json!({
+            "vertices": stats.vertices,
+            "triangles": stats.triangles,
+            "boundary_vertices": stats.boundary_vertices,
+            "pieces": stats.pieces,
+            "holes": stats.holes,
+            "min_angle_deg": stats.min_angle_deg,
+            "uncovered_mask_pixels": mesh::uncovered_mask_pixels(&result.mesh, &mask),
+            "max_boundary_deviation_px": stats.max_boundary_deviation_px,
+            "mesh_ms": mesh_ms,
+        });
+        println!("{json}");
+    } else {
+        println!(
+            "{} vertices, {} triangles, {} boundary vertices, {} piece(s), {} hole(s), min angle {:.1}°, {:.2} ms",
+            stats.vertices, stats.triangles, stats.boundary_vertices, stats.pieces, stats.holes, stats.min_angle_deg, mesh_ms
+        );
+    }
+    Ok(())
+}
+
+fn options_from(args: &MeshArgs) -> anyhow::Result<MeshOptions> {
+    let mut options = MeshOptions::default();
+    if let Some(density) = args.density {
+        options.density = density;
+    }
+    if let Some(angle) = args.min_angle {
+        options.min_angle_deg = angle;
+    }
+    if let Some(max) = args.max_vertices {
+        options.max_vertices = max;
+    }
+    options.validate().map_err(|e| UsageError(e.to_string()))?;
+    Ok(options)
+}
+
+/// The mesh over the mask (light grey inside, dark grey outside), upscaled for viewing.
+fn write_picture(mesh: &Mesh, mask: &BitMask, path: &Path) -> anyhow::Result<()> {
+    let background = image::RgbaImage::from_fn(mask.width as u32, mask.height as u32, |x, y| {
+        let v = if mask.get(x as i64, y as i64) {
+            215
+        } else {
+            60
+        };
+        image::Rgba([v, v, v, 255])
+    });
+    let style = OverlayStyle {
+        scale: OverlayStyle::auto_scale(background.width(), background.height()),
+        ..OverlayStyle::default()
+    };
+    let picture = draw_mesh_overlay(
+        &background,
+        &mesh.positions,
+        &mesh.triangles,
+        &mesh.loops,
+        &[],
+        &style,
+    )?;
+    lapclone::util::write_atomic_with(path, |file| {
+        let mut buffered = std::io::BufWriter::new(file);
+        let encoder = image::codecs::png::PngEncoder::new(&mut buffered);
+        image::ImageEncoder::write_image(
+            encoder,
+            picture.as_raw(),
+            picture.width(),
+            picture.height(),
+            image::ExtendedColorType::Rgba8,
+        )
+        .map_err(std::io::Error::other)?;
+        std::io::Write::flush(&mut buffered)
+    })
+    .with_context(|| format!("cannot write {}", path.display()))
 }

@@ -5,7 +5,34 @@
 //! Coordinates are pixel coordinates of the mask/source image, x to the right, y down; pixel
 //! (i, j) covers the square [i, i+1] × [j, j+1], so its centre is (i + 0.5, j + 0.5) and the
 //! crack boundary runs along integer coordinates.
+//!
+//! Pipeline ([`mesh_mask`]): [`BitMask`] → small pieces dropped → crack loops (`contour`) →
+//! Douglas–Peucker + subdivision to `density` (`simplify`) → spade CDT + refinement
+//! (`triangulate`) → [`Mesh`], verified by [`Mesh::sanity_check`]. Mask-aware checks are in
+//! `coverage`; the Laplacian export in `laplacian_mtx`; test/bench masks in [`synth`].
 
+mod bitmask;
+mod contour;
+mod coverage;
+mod error;
+mod laplacian_mtx;
+mod mesh_mask;
+mod options;
+mod sanity;
+mod simplify;
+pub mod synth;
+mod triangulate;
 mod types;
 
+pub use bitmask::BitMask;
+pub use contour::{label_pieces, trace_crack_loops, CrackLoop};
+pub use coverage::{
+    distance_to_mask, max_outside_distance, uncovered_mask_pixels, COVERAGE_TOLERANCE_PX,
+};
+pub use error::{MeshError, SanityError};
+pub use laplacian_mtx::{boundary_list, boundary_path, laplacian_matrix_market, write_laplacian};
+pub use mesh_mask::{mesh_mask, mesh_polygons, Polygon};
+pub use options::{min_angle_deg, MeshOptions, MeshResult, MeshStats};
+pub use simplify::{doubled_signed_area, simplify_loop, subdivide_loop, Simplified};
+pub use triangulate::{assemble_mesh, triangulate_loops, Triangulated};
 pub use types::{BoundaryLoop, LoopKind, Mesh};

@@ -1,1 +1,3 @@
 //! raster stage (not yet implemented).
+
+pub mod overlay;

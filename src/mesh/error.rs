@@ -1,0 +1,89 @@
+//! Error types of the meshing stage: [`MeshError`] for everything `mesh_mask` /
+//! `mesh_polygons` / the writers can fail on, [`SanityError`] for a mesh that breaks one of
+//! the invariants `Mesh::sanity_check` verifies.
+
+use std::path::PathBuf;
+
+/// Why meshing (or reading a mask, or writing a mesh file) failed.
+#[derive(Debug, thiserror::Error)]
+pub enum MeshError {
+    #[error("cannot read mask {path}")]
+    MaskRead {
+        path: PathBuf,
+        #[source]
+        source: image::ImageError,
+    },
+    #[error("mask has no inside pixels")]
+    EmptyMask,
+    #[error(
+        "every piece of the mask is smaller than the minimum piece area ({min_piece_area} px²); \
+         lower min_piece_area to keep them"
+    )]
+    AllPiecesTooSmall { min_piece_area: f64 },
+    #[error("invalid mesh option: {0}")]
+    InvalidOption(String),
+    #[error("polygon {polygon}: {reason}")]
+    InvalidPolygon { polygon: usize, reason: String },
+    #[error("no polygons to mesh")]
+    NoPolygons,
+    #[error(
+        "boundary loops cross each other ({conflicts} conflicting edges); loops must not intersect"
+    )]
+    IntersectingBoundary { conflicts: usize },
+    #[error(
+        "vertex budget of {max_vertices} is below the {needed} boundary vertices this mask needs; \
+         raise max_vertices or the density (max boundary edge length)"
+    )]
+    VertexBudget { max_vertices: usize, needed: usize },
+    #[error("triangulation failed: {0}")]
+    Triangulation(String),
+    #[error("the mesh failed its sanity check")]
+    Sanity(#[from] SanityError),
+    #[error("cannot write {path}")]
+    Write {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+}
+
+/// The first broken invariant `Mesh::sanity_check` found.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SanityError {
+    #[error("per-vertex arrays have lengths {is_boundary} (is_boundary) and {piece} (piece) for {positions} positions")]
+    LengthMismatch {
+        positions: usize,
+        is_boundary: usize,
+        piece: usize,
+    },
+    #[error("vertex {vertex} has a non-finite position")]
+    NonFinitePosition { vertex: u32 },
+    #[error("triangle {triangle} refers to vertex {vertex}, out of range")]
+    IndexOutOfRange { triangle: usize, vertex: u32 },
+    #[error("triangle {triangle} has signed area {area} (must be > 0, counter-clockwise in raw coordinates)")]
+    NotPositive { triangle: usize, area: f64 },
+    #[error("directed edge {a}→{b} appears in more than one triangle (edge over-shared or orientation flipped)")]
+    EdgeOverShared { a: u32, b: u32 },
+    #[error("vertex {vertex} is used by no triangle")]
+    IsolatedVertex { vertex: u32 },
+    #[error("boundary loop {loop_index} has edge {a}→{b}, which is not a boundary edge of the triangles")]
+    LoopEdgeNotBoundary { loop_index: usize, a: u32, b: u32 },
+    #[error("the loops list {listed} boundary edges but the triangles have {actual}")]
+    BoundaryEdgeCount { listed: usize, actual: usize },
+    #[error("boundary loop {loop_index} has {len} vertices (needs at least 3)")]
+    ShortLoop { loop_index: usize, len: usize },
+    #[error("boundary loop {loop_index} is marked {kind} but its signed area is {area}")]
+    LoopOrientation {
+        loop_index: usize,
+        kind: &'static str,
+        area: f64,
+    },
+    #[error("is_boundary[{vertex}] disagrees with the boundary loops")]
+    BoundaryFlag { vertex: u32 },
+    #[error("piece ids disagree with the triangle connectivity at vertex {vertex}")]
+    PieceMismatch { vertex: u32 },
+    #[error("piece_count is {listed} but the triangles form {actual} connected pieces")]
+    PieceCount { listed: u32, actual: u32 },
+    #[error("Euler characteristic V − E + F = {actual}, expected pieces − holes = {expected}")]
+    Euler { actual: i64, expected: i64 },
+}

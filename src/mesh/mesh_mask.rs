@@ -1,0 +1,217 @@
+//! The meshing pipeline: [`mesh_mask`] takes a [`BitMask`], [`mesh_polygons`] takes
+//! [`Polygon`]s; both give a [`MeshResult`]. Mask path: drop small pieces → crack loops →
+//! Douglas–Peucker (anchored at saddle corners) → subdivide to `density` → CDT + refinement.
+//! If simplification makes two loops touch or cross (a thin gap closed by the tolerance), the
+//! mask is meshed again from the raw crack loops, which never cross.
+
+use glam::DVec2;
+
+use super::contour::{label_pieces, trace_crack_loops, CrackLoop};
+use super::options::min_angle_deg;
+use super::simplify::{doubled_signed_area, simplify_loop, subdivide_loop};
+use super::triangulate::triangulate_loops;
+use super::{BitMask, Mesh, MeshError, MeshOptions, MeshResult, MeshStats};
+
+/// A polygon with holes in pixel coordinates; orientation does not matter (it is fixed up).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Polygon {
+    pub outer: Vec<DVec2>,
+    pub holes: Vec<Vec<DVec2>>,
+}
+
+/// Meshes the inside of a mask.
+pub fn mesh_mask(mask: &BitMask, options: &MeshOptions) -> Result<MeshResult, MeshError> {
+    options.validate()?;
+    if mask.count_inside() == 0 {
+        return Err(MeshError::EmptyMask);
+    }
+    let mut warnings = Vec::new();
+    let (kept, dropped_pieces, dropped_pixels, pieces) =
+        drop_small_pieces(mask, options.min_piece_area, &mut warnings);
+    if pieces == 0 {
+        return Err(MeshError::AllPiecesTooSmall {
+            min_piece_area: options.min_piece_area,
+        });
+    }
+    let crack = trace_crack_loops(kept.as_ref().unwrap_or(mask));
+    let expected_holes = crack.iter().filter(|l| l.is_hole()).count();
+    let attempt = |tolerance: f64| -> Result<(Mesh, bool, f64), MeshError> {
+        let (loops, deviation) = sample_crack_loops(&crack, tolerance, options.density);
+        let t = triangulate_loops(&loops, options.min_angle_deg, options.max_vertices)?;
+        // The full check costs about as much as the refinement; the tests run it on every
+        // shape family, so release builds rely on the topology counts below.
+        if cfg!(debug_assertions) {
+            t.mesh.sanity_check()?;
+        }
+        if t.mesh.hole_count() != expected_holes || t.mesh.piece_count as usize != pieces {
+            return Err(MeshError::IntersectingBoundary { conflicts: 0 });
+        }
+        Ok((t.mesh, t.refinement_complete, deviation))
+    };
+    let mut simplified = options.simplify_tolerance > 0.0;
+    let (mesh, complete, deviation) = match attempt(options.simplify_tolerance) {
+        Ok(done) => done,
+        Err(MeshError::IntersectingBoundary { .. } | MeshError::Sanity(_)) if simplified => {
+            warnings.push(
+                "simplification made boundary loops touch; meshed the unsimplified crack boundary"
+                    .into(),
+            );
+            simplified = false;
+            attempt(0.0)?
+        }
+        Err(e) => return Err(e),
+    };
+    if !complete {
+        warnings.push(format!(
+            "vertex budget of {} reached before refinement finished",
+            options.max_vertices
+        ));
+    }
+    let stats = stats_of(
+        &mesh,
+        deviation,
+        simplified,
+        complete,
+        dropped_pieces,
+        dropped_pixels,
+    );
+    Ok(MeshResult {
+        mesh,
+        warnings,
+        stats,
+    })
+}
+
+/// Meshes polygons with holes (not simplified; edges subdivided to `density`).
+pub fn mesh_polygons(polygons: &[Polygon], options: &MeshOptions) -> Result<MeshResult, MeshError> {
+    options.validate()?;
+    if polygons.is_empty() {
+        return Err(MeshError::NoPolygons);
+    }
+    let mut loops = Vec::new();
+    let mut scratch = Vec::new();
+    for (index, polygon) in polygons.iter().enumerate() {
+        let rings =
+            std::iter::once((&polygon.outer, true)).chain(polygon.holes.iter().map(|h| (h, false)));
+        for (ring, outer) in rings {
+            let mut ring = clean_ring(ring).map_err(|reason| MeshError::InvalidPolygon {
+                polygon: index,
+                reason,
+            })?;
+            if (doubled_signed_area(&ring) > 0.0) != outer {
+                ring.reverse();
+            }
+            subdivide_loop(&ring, options.density, &mut scratch);
+            loops.push(scratch.clone());
+        }
+    }
+    let t = triangulate_loops(&loops, options.min_angle_deg, options.max_vertices)?;
+    t.mesh.sanity_check()?;
+    let mut warnings = Vec::new();
+    if !t.refinement_complete {
+        warnings.push(format!(
+            "vertex budget of {} reached before refinement finished",
+            options.max_vertices
+        ));
+    }
+    let stats = stats_of(&t.mesh, 0.0, false, t.refinement_complete, 0, 0);
+    Ok(MeshResult {
+        mesh: t.mesh,
+        warnings,
+        stats,
+    })
+}
+
+/// Removes repeated points; rejects non-finite, short or zero-area rings.
+fn clean_ring(ring: &[DVec2]) -> Result<Vec<DVec2>, String> {
+    if ring.iter().any(|p| !p.is_finite()) {
+        return Err("has a non-finite point".into());
+    }
+    let mut out: Vec<DVec2> = Vec::with_capacity(ring.len());
+    for &p in ring {
+        if out.last() != Some(&p) {
+            out.push(p);
+        }
+    }
+    while out.len() > 1 && out.first() == out.last() {
+        out.pop();
+    }
+    if out.len() < 3 {
+        return Err(format!(
+            "a ring has {} distinct points (needs 3)",
+            out.len()
+        ));
+    }
+    if doubled_signed_area(&out).abs() < 1e-12 {
+        return Err("a ring has zero area".into());
+    }
+    Ok(out)
+}
+
+/// Returns the mask without pieces below `min_area` (None if nothing was dropped), the number
+/// of dropped pieces and pixels, and the number of kept pieces.
+fn drop_small_pieces(
+    mask: &BitMask,
+    min_area: f64,
+    warnings: &mut Vec<String>,
+) -> (Option<BitMask>, usize, usize, usize) {
+    let (labels, sizes) = label_pieces(mask);
+    let small: Vec<bool> = sizes.iter().map(|&s| (s as f64) < min_area).collect();
+    let dropped_pieces = small.iter().filter(|&&s| s).count();
+    let kept_pieces = sizes.len() - dropped_pieces;
+    if dropped_pieces == 0 {
+        return (None, 0, 0, kept_pieces);
+    }
+    let dropped_pixels: usize = sizes
+        .iter()
+        .zip(&small)
+        .filter(|(_, &s)| s)
+        .map(|(&n, _)| n)
+        .sum();
+    warnings.push(format!(
+        "dropped {dropped_pieces} piece(s) smaller than {min_area} px² ({dropped_pixels} pixels)"
+    ));
+    let kept = BitMask::from_fn(mask.width, mask.height, |x, y| {
+        let label = labels[y * mask.width + x];
+        label != u32::MAX && !small[label as usize]
+    });
+    (Some(kept), dropped_pieces, dropped_pixels, kept_pieces)
+}
+
+fn sample_crack_loops(crack: &[CrackLoop], tolerance: f64, density: f64) -> (Vec<Vec<DVec2>>, f64) {
+    let mut deviation = 0.0f64;
+    let loops = crack
+        .iter()
+        .map(|c| {
+            let s = simplify_loop(&c.points, &c.anchor, tolerance);
+            deviation = deviation.max(s.max_deviation);
+            let mut out = Vec::new();
+            subdivide_loop(&s.points, density, &mut out);
+            out
+        })
+        .collect();
+    (loops, deviation)
+}
+
+fn stats_of(
+    mesh: &Mesh,
+    deviation: f64,
+    simplified: bool,
+    complete: bool,
+    dropped_pieces: usize,
+    dropped_pixels: usize,
+) -> MeshStats {
+    MeshStats {
+        vertices: mesh.vertex_count(),
+        triangles: mesh.triangles.len(),
+        boundary_vertices: mesh.is_boundary.iter().filter(|&&b| b).count(),
+        pieces: mesh.piece_count as usize,
+        holes: mesh.hole_count(),
+        min_angle_deg: min_angle_deg(mesh),
+        max_boundary_deviation_px: deviation,
+        simplified,
+        refinement_complete: complete,
+        dropped_pieces,
+        dropped_pixels,
+    }
+}

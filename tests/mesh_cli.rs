@@ -1,0 +1,190 @@
+//! `lapclone mesh` end to end: --stats JSON keys, -o picture, --laplacian-out files, and bad
+//! inputs with their exit codes.
+
+use std::path::Path;
+use std::process::Command;
+
+use lapclone::mesh::synth;
+
+fn lapclone(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_lapclone"))
+        .args(args)
+        .output()
+        .expect("runs")
+}
+
+fn save_mask(dir: &Path, name: &str, mask: &lapclone::mesh::BitMask) -> String {
+    let path = dir.join(name);
+    mask.to_image().save(&path).unwrap();
+    path.to_string_lossy().into_owned()
+}
+
+#[test]
+fn stats_json_has_exactly_the_contract_keys() {
+    let dir = tempfile::tempdir().unwrap();
+    let mask = save_mask(dir.path(), "ring.png", &synth::annulus(80, 80, 12.0, 35.0));
+    let out = lapclone(&["mesh", &mask, "--stats"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let mut keys: Vec<&str> = json
+        .as_object()
+        .unwrap()
+        .keys()
+        .map(|k| k.as_str())
+        .collect();
+    keys.sort_unstable();
+    let mut expected = vec![
+        "vertices",
+        "triangles",
+        "boundary_vertices",
+        "pieces",
+        "holes",
+        "min_angle_deg",
+        "uncovered_mask_pixels",
+        "max_boundary_deviation_px",
+        "mesh_ms",
+    ];
+    expected.sort_unstable();
+    assert_eq!(keys, expected);
+    assert_eq!(json["pieces"], 1);
+    assert_eq!(json["holes"], 1);
+    assert_eq!(json["uncovered_mask_pixels"], 0);
+}
+
+#[test]
+fn picture_and_laplacian_are_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let mask = save_mask(dir.path(), "disc.png", &synth::disc(40, 30, 12.0));
+    let png = dir.path().join("mesh.png");
+    let mtx = dir.path().join("L.mtx");
+    let out = lapclone(&[
+        "mesh",
+        &mask,
+        "-o",
+        png.to_str().unwrap(),
+        "--laplacian-out",
+        mtx.to_str().unwrap(),
+        "--stats",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let vertices = json["vertices"].as_u64().unwrap() as usize;
+    let picture = image::open(&png).unwrap();
+    assert!(picture.width() >= 40 && picture.height() >= 30);
+
+    // The Laplacian: header, size line, rows that sum to zero.
+    let text = std::fs::read_to_string(&mtx).unwrap();
+    let mut lines = text.lines().filter(|l| !l.starts_with('%'));
+    assert!(text.starts_with("%%MatrixMarket matrix coordinate real symmetric\n"));
+    let size: Vec<usize> = lines
+        .next()
+        .unwrap()
+        .split_whitespace()
+        .map(|t| t.parse().unwrap())
+        .collect();
+    assert_eq!((size[0], size[1]), (vertices, vertices));
+    let mut row_sum = vec![0.0f64; vertices];
+    let mut count = 0;
+    for line in lines {
+        let f: Vec<&str> = line.split_whitespace().collect();
+        let (i, j, v): (usize, usize, f64) = (
+            f[0].parse().unwrap(),
+            f[1].parse().unwrap(),
+            f[2].parse().unwrap(),
+        );
+        assert!(i >= j && j >= 1 && i <= vertices, "lower triangle, 1-based");
+        row_sum[i - 1] += v;
+        if i != j {
+            row_sum[j - 1] += v;
+        }
+        count += 1;
+    }
+    assert_eq!(count, size[2]);
+    assert!(row_sum.iter().all(|&s| s == 0.0));
+
+    let boundary = std::fs::read_to_string(dir.path().join("L.mtx.boundary")).unwrap();
+    let ids: Vec<usize> = boundary.lines().map(|l| l.parse().unwrap()).collect();
+    assert_eq!(
+        ids.len() as u64,
+        json["boundary_vertices"].as_u64().unwrap()
+    );
+    assert!(ids.iter().all(|&v| v < vertices));
+}
+
+#[test]
+fn empty_mask_fails_with_exit_1() {
+    let dir = tempfile::tempdir().unwrap();
+    let mask = save_mask(dir.path(), "empty.png", &lapclone::mesh::BitMask::new(8, 8));
+    let out = lapclone(&["mesh", &mask, "--stats"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("mask has no inside pixels"));
+    assert!(out.stdout.is_empty());
+}
+
+#[test]
+fn missing_file_error_names_the_path() {
+    let out = lapclone(&["mesh", "/no/such/mask.png"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("/no/such/mask.png"));
+}
+
+#[test]
+fn unreadable_file_error_names_the_path() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("garbage.png");
+    std::fs::write(&path, b"not an image").unwrap();
+    let out = lapclone(&["mesh", path.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("garbage.png"));
+}
+
+#[test]
+fn bad_options_are_usage_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let mask = save_mask(dir.path(), "disc.png", &synth::disc(20, 20, 8.0));
+    for args in [
+        vec!["--density", "0"],
+        vec!["--min-angle", "50"],
+        vec!["--threshold", "2"],
+        vec!["--density", "nan"],
+    ] {
+        let mut all = vec!["mesh", mask.as_str()];
+        all.extend(args.iter());
+        let out = lapclone(&all);
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+    }
+}
+
+#[test]
+fn hard_masks_mesh_or_fail_cleanly() {
+    let dir = tempfile::tempdir().unwrap();
+    let masks = [
+        (
+            "full.png",
+            lapclone::mesh::BitMask::from_fn(20, 15, |_, _| true),
+        ),
+        ("line.png", synth::line(40, 9, 40)),
+        ("comb.png", synth::comb(100, 60, 3, 1)),
+        ("nested.png", synth::nested(90, 90)),
+        ("speckle.png", synth::speckle(40, 40, 0.4, 3)),
+    ];
+    for (name, mask) in masks {
+        let path = save_mask(dir.path(), name, &mask);
+        let out = lapclone(&["mesh", &path, "--stats"]);
+        assert!(
+            out.status.success(),
+            "{name}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert!(json["triangles"].as_u64().unwrap() > 0, "{name}");
+    }
+}

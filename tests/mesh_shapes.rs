@@ -1,0 +1,189 @@
+//! Meshing known shapes and random masks: every mesh passes `sanity_check`, covers every
+//! mask pixel centre within 0.5 px, stays within the simplification tolerance of the mask,
+//! and has the hole and piece counts of the shape.
+
+use lapclone::mesh::{
+    self, max_outside_distance, mesh_mask, mesh_polygons, synth, uncovered_mask_pixels, BitMask,
+    MeshError, MeshOptions, Polygon,
+};
+use proptest::prelude::*;
+use proptest::test_runner::{Config, RngSeed};
+
+fn check(mask: &BitMask, options: &MeshOptions) -> mesh::MeshResult {
+    let result = mesh_mask(mask, options).expect("meshes");
+    result.mesh.sanity_check().expect("sane mesh");
+    assert_eq!(
+        uncovered_mask_pixels(&result.mesh, mask),
+        0,
+        "uncovered pixels"
+    );
+    let outside = max_outside_distance(&result.mesh, mask);
+    assert!(
+        outside <= options.simplify_tolerance + 1e-9,
+        "mesh reaches {outside} px outside the mask"
+    );
+    result
+}
+
+fn topology(mask: &BitMask) -> (usize, usize) {
+    let r = check(mask, &MeshOptions::default());
+    (r.stats.pieces, r.stats.holes)
+}
+
+#[test]
+fn known_shapes_have_their_pieces_and_holes() {
+    assert_eq!(topology(&synth::disc(60, 60, 25.0)), (1, 0));
+    assert_eq!(topology(&synth::annulus(60, 60, 10.0, 27.0)), (1, 1));
+    assert_eq!(topology(&synth::two_holes(90, 60)), (1, 2));
+    assert_eq!(topology(&synth::nested(120, 120)), (3, 2));
+    assert_eq!(topology(&synth::comb(120, 60, 4, 1)), (1, 0));
+    assert_eq!(topology(&synth::line(40, 5, 30)), (1, 0));
+    assert_eq!(topology(&synth::diagonal_line(12)), (1, 0));
+    assert_eq!(topology(&BitMask::from_fn(17, 9, |_, _| true)), (1, 0));
+}
+
+#[test]
+fn spiral_meshes_cleanly_at_default_settings() {
+    let mask = synth::spiral(300, 290);
+    let r = check(&mask, &MeshOptions::default());
+    assert_eq!((r.stats.pieces, r.stats.holes), (1, 0));
+    assert!(r.stats.refinement_complete);
+    assert!(r.stats.min_angle_deg > 20.0, "{}", r.stats.min_angle_deg);
+    // Density: no boundary edge longer than the setting.
+    for lp in &r.mesh.loops {
+        let n = lp.vertices.len();
+        for i in 0..n {
+            let a = r.mesh.positions[lp.vertices[i] as usize];
+            let b = r.mesh.positions[lp.vertices[(i + 1) % n] as usize];
+            assert!(a.distance(b) <= MeshOptions::default().density + 1e-9);
+        }
+    }
+}
+
+#[test]
+fn output_is_deterministic() {
+    let mask = synth::blobs(120, 100, 11);
+    let a = mesh_mask(&mask, &MeshOptions::default()).unwrap();
+    let b = mesh_mask(&mask, &MeshOptions::default()).unwrap();
+    assert_eq!(a.mesh, b.mesh);
+}
+
+#[test]
+fn empty_mask_is_an_error() {
+    let err = mesh_mask(&BitMask::new(10, 10), &MeshOptions::default()).unwrap_err();
+    assert!(matches!(err, MeshError::EmptyMask));
+    assert_eq!(err.to_string(), "mask has no inside pixels");
+}
+
+#[test]
+fn speckle_drops_tiny_pieces_with_a_warning() {
+    let mask = synth::speckle(40, 40, 0.3, 9);
+    let r = mesh_mask(&mask, &MeshOptions::default()).unwrap();
+    r.mesh.sanity_check().unwrap();
+    assert!(r.stats.dropped_pieces > 0 && !r.warnings.is_empty());
+    // Keeping every piece covers every pixel.
+    let keep_all = MeshOptions {
+        min_piece_area: 0.0,
+        ..MeshOptions::default()
+    };
+    check(&mask, &keep_all);
+}
+
+#[test]
+fn only_tiny_pieces_is_a_clear_error() {
+    let mask = BitMask::from_fn(10, 10, |x, y| x == 5 && y == 5);
+    let err = mesh_mask(&mask, &MeshOptions::default()).unwrap_err();
+    assert!(matches!(err, MeshError::AllPiecesTooSmall { .. }), "{err}");
+}
+
+#[test]
+fn vertex_budget_is_respected() {
+    let mask = synth::disc(200, 200, 90.0);
+    let options = MeshOptions {
+        max_vertices: 1200,
+        ..MeshOptions::default()
+    };
+    let r = mesh_mask(&mask, &options).unwrap();
+    r.mesh.sanity_check().unwrap();
+    assert!(r.mesh.vertex_count() <= 1200);
+    let tiny = MeshOptions {
+        max_vertices: 10,
+        ..MeshOptions::default()
+    };
+    assert!(matches!(
+        mesh_mask(&mask, &tiny),
+        Err(MeshError::VertexBudget { .. })
+    ));
+}
+
+#[test]
+fn polygons_with_holes_mesh() {
+    let square = |x: f64, y: f64, s: f64| {
+        vec![
+            glam::DVec2::new(x, y),
+            glam::DVec2::new(x + s, y),
+            glam::DVec2::new(x + s, y + s),
+            glam::DVec2::new(x, y + s),
+        ]
+    };
+    let polygons = [
+        Polygon {
+            outer: square(0.0, 0.0, 20.0),
+            holes: vec![square(5.0, 5.0, 4.0), square(11.0, 11.0, 4.0)],
+        },
+        Polygon {
+            outer: square(30.0, 0.0, 10.0),
+            holes: vec![],
+        },
+    ];
+    let r = mesh_polygons(&polygons, &MeshOptions::default()).unwrap();
+    r.mesh.sanity_check().unwrap();
+    assert_eq!((r.stats.pieces, r.stats.holes), (2, 2));
+    let bad = [Polygon {
+        outer: square(0.0, 0.0, 0.0),
+        holes: vec![],
+    }];
+    assert!(matches!(
+        mesh_polygons(&bad, &MeshOptions::default()),
+        Err(MeshError::InvalidPolygon { .. })
+    ));
+}
+
+/// Random masks: blobs with holes and border contact, plus thin strokes and specks.
+fn random_mask() -> impl Strategy<Value = BitMask> {
+    (any::<u64>(), 16usize..72, 16usize..72, 0usize..4).prop_map(|(seed, w, h, strokes)| {
+        let mut mask = synth::blobs(w, h, seed);
+        let mut rng = synth::SplitMix64::new(seed ^ 0xABCD);
+        for _ in 0..strokes {
+            // 1-px lines (horizontal, vertical or diagonal) for thin parts and saddles.
+            let (x0, y0) = (
+                (rng.next_u64() % w as u64) as i64,
+                (rng.next_u64() % h as u64) as i64,
+            );
+            let (dx, dy) = [(1, 0), (0, 1), (1, 1), (1, -1)][(rng.next_u64() % 4) as usize];
+            let len = 3 + (rng.next_u64() % 30) as i64;
+            for k in 0..len {
+                mask.set(x0 + k * dx, y0 + k * dy, true);
+            }
+        }
+        mask
+    })
+}
+
+proptest! {
+    #![proptest_config(Config { cases: 48, rng_seed: RngSeed::Fixed(0x5EED_0002), ..Config::default() })]
+
+    #[test]
+    fn random_masks_mesh_soundly(mask in random_mask()) {
+        let options = MeshOptions { min_piece_area: 0.0, ..MeshOptions::default() };
+        if mask.count_inside() == 0 {
+            prop_assert!(matches!(mesh_mask(&mask, &options), Err(MeshError::EmptyMask)));
+        } else {
+            let r = check(&mask, &options);
+            let (_, sizes) = mesh::label_pieces(&mask);
+            prop_assert_eq!(r.stats.pieces, sizes.len());
+            let holes = mesh::trace_crack_loops(&mask).iter().filter(|l| l.is_hole()).count();
+            prop_assert_eq!(r.stats.holes, holes);
+        }
+    }
+}
