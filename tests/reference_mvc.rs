@@ -171,6 +171,7 @@ fn star_positions() -> (Vec<DVec2>, Vec<u32>) {
 fn apply_reproduces_affine_boundary_data_per_channel() {
     let (positions, boundary) = star_positions();
     let weights = MvcWeights::new(&positions, &boundary).unwrap();
+    weights.sanity_check().unwrap();
     assert_eq!(weights.weight_count(), 30 * 40);
     let affine = |p: DVec2, c: usize| [0.2 * p.x - 0.1 * p.y + 1.0, -0.03 * p.x + 0.5][c];
     let mut values = vec![f32::NAN; positions.len() * 2]; // interior inputs must not be read
@@ -233,6 +234,7 @@ fn holes_are_refused_and_pieces_use_their_own_loop() {
         .map(|v| u32::from(v >= base))
         .collect();
     let weights = MvcWeights::from_mesh(&mesh).unwrap();
+    weights.sanity_check().unwrap();
     assert_eq!(weights.blocks().len(), 2);
     assert_eq!(weights.blocks()[1].interior(), &[base + 3]);
     let lambda = weights.blocks()[1].coordinates(0);
@@ -269,7 +271,7 @@ fn malformed_input_is_a_typed_error() {
     let weights = MvcWeights::new(&positions, &(0..40).collect::<Vec<_>>()).unwrap();
     let mut out = vec![0.0; positions.len()];
     assert!(matches!(
-        weights.apply(&vec![0.0f64; 3], 1, &mut out),
+        weights.apply(&[0.0f64; 3], 1, &mut out),
         Err(MvcError::ValuesLength { what: "values", .. })
     ));
 }

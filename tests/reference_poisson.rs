@@ -142,12 +142,23 @@ fn channels_solve_independently_and_outside_stays_zero() {
         .collect();
     let solver = GridPoisson::new(grid).unwrap();
     let all = solver.solve(&interleaved, 3).unwrap();
+    all.sanity_check().unwrap();
+    let mut broken = all.clone();
+    broken.values[5 * 3 + 2] = f64::INFINITY;
+    assert_eq!(
+        broken.sanity_check().unwrap_err(),
+        PoissonError::NonFiniteValue {
+            x: 5,
+            y: 0,
+            channel: 2
+        }
+    );
     for c in 0..3 {
         let single: Vec<f32> = interleaved.iter().skip(c).step_by(3).copied().collect();
         let one = solver.solve(&single, 1).unwrap();
-        for p in 0..w * h {
+        for (p, &inside) in mask.iter().enumerate() {
             assert!((all.values[p * 3 + c] - one.values[p]).abs() <= 1e-12);
-            if !mask[p] {
+            if !inside {
                 assert_eq!(all.values[p * 3 + c], 0.0);
             }
         }

@@ -44,6 +44,10 @@ pub enum MvcError {
     OuterLoopsPerPiece { piece: u32, count: usize },
     #[error("piece array has {got} entries, expected one per vertex ({expected})")]
     PieceLength { expected: usize, got: usize },
+    #[error("coordinates of vertex {vertex} sum to {sum} (non-finite or not 1)")]
+    BadCoordinates { vertex: u32, sum: f64 },
+    #[error("a weight block's table does not match its interior × boundary size")]
+    BlockShape,
     #[error("channels must be at least 1")]
     NoChannels,
     #[error("{what} has {got} samples, expected vertices × channels = {expected}")]
@@ -151,6 +155,31 @@ impl MvcWeights {
     /// [`from_loops`](Self::from_loops) on a [`Mesh`].
     pub fn from_mesh(mesh: &Mesh) -> Result<Self, MvcError> {
         Self::from_loops(&mesh.positions, &mesh.loops, &mesh.piece)
+    }
+
+    /// Checks shapes, index ranges and that every interior vertex's coordinates are finite
+    /// and sum to 1 (to 1e-9): the partition of unity MVC guarantees inside a simple polygon.
+    pub fn sanity_check(&self) -> Result<(), MvcError> {
+        for block in &self.blocks {
+            if block.weights.len() != block.interior.len() * block.boundary.len() {
+                return Err(MvcError::BlockShape);
+            }
+            for &index in block.boundary.iter().chain(&block.interior) {
+                if index as usize >= self.vertex_count {
+                    return Err(MvcError::VertexOutOfRange {
+                        index,
+                        vertex_count: self.vertex_count,
+                    });
+                }
+            }
+            for (row, &vertex) in block.interior.iter().enumerate() {
+                let sum: f64 = block.coordinates(row).iter().sum();
+                if !sum.is_finite() || (sum - 1.0).abs() > 1e-9 {
+                    return Err(MvcError::BadCoordinates { vertex, sum });
+                }
+            }
+        }
+        Ok(())
     }
 
     pub fn blocks(&self) -> &[MvcBlock] {

@@ -71,6 +71,28 @@ pub struct GridMembrane {
 }
 
 impl GridMembrane {
+    /// Checks the buffer is `width × height × channels` finite samples.
+    pub fn sanity_check(&self) -> Result<(), PoissonError> {
+        let expected = self.width * self.height * self.channels;
+        if self.channels == 0 {
+            return Err(PoissonError::NoChannels);
+        }
+        if self.values.len() != expected {
+            return Err(PoissonError::ValuesLength {
+                expected,
+                got: self.values.len(),
+            });
+        }
+        match self.values.iter().position(|v| !v.is_finite()) {
+            Some(i) => Err(PoissonError::NonFiniteValue {
+                x: (i / self.channels) % self.width,
+                y: (i / self.channels) / self.width,
+                channel: i % self.channels,
+            }),
+            None => Ok(()),
+        }
+    }
+
     pub fn get(&self, x: usize, y: usize, channel: usize) -> f64 {
         self.values[(y * self.width + x) * self.channels + channel]
     }
