@@ -13,7 +13,7 @@ const TOLERANCE: f64 = 1e-9;
 
 fn coordinates(x: DVec2, polygon: &[DVec2]) -> Vec<f64> {
     let mut out = vec![f64::NAN; polygon.len()];
-    mean_value_coordinates(x, polygon, &mut out);
+    mean_value_coordinates(x, polygon, &mut out).unwrap();
     out
 }
 
@@ -257,6 +257,9 @@ fn malformed_input_is_a_typed_error() {
         MvcWeights::new(&positions, &[0, 1, 999]),
         Err(MvcError::VertexOutOfRange { index: 999, .. })
     ));
+    let mut short = [0.0; 2];
+    assert!(mean_value_coordinates(DVec2::ZERO, &positions[..3], &mut short).is_err());
+    assert!(mean_value_coordinates(DVec2::ZERO, &positions[..2], &mut short).is_err());
     let collinear = [DVec2::ZERO, DVec2::X, DVec2::X * 2.0, DVec2::new(0.5, 0.0)];
     assert_eq!(
         MvcWeights::new(&collinear, &[0, 1, 2]).unwrap_err(),

@@ -308,9 +308,22 @@ fn signed_area(polygon: &[DVec2]) -> f64 {
 /// Mean-value coordinates of `x` w.r.t. the closed `polygon` (at least 3 vertices, simple,
 /// either orientation) into `out` (`polygon.len()` entries, summing to 1). Points on a polygon
 /// vertex or edge get the limit values. Allocates nothing.
-pub fn mean_value_coordinates(x: DVec2, polygon: &[DVec2], out: &mut [f64]) {
+pub fn mean_value_coordinates(
+    x: DVec2,
+    polygon: &[DVec2],
+    out: &mut [f64],
+) -> Result<(), MvcError> {
     let n = polygon.len();
-    debug_assert_eq!(out.len(), n);
+    if n < 3 {
+        return Err(MvcError::TooFewBoundaryVertices { count: n });
+    }
+    if out.len() != n {
+        return Err(MvcError::ValuesLength {
+            what: "coordinates",
+            expected: n,
+            got: out.len(),
+        });
+    }
     let scale = polygon
         .iter()
         .map(|p| (*p - x).length())
@@ -319,7 +332,7 @@ pub fn mean_value_coordinates(x: DVec2, polygon: &[DVec2], out: &mut [f64]) {
     if let Some(i) = (0..n).find(|&i| (polygon[i] - x).length() <= tiny) {
         out.fill(0.0);
         out[i] = 1.0;
-        return;
+        return Ok(());
     }
     // First pass: out[i] = tan(α_i / 2) for the edge (i, i+1).
     for i in 0..n {
@@ -331,7 +344,7 @@ pub fn mean_value_coordinates(x: DVec2, polygon: &[DVec2], out: &mut [f64]) {
             out.fill(0.0);
             out[i] = r1 / (r0 + r1);
             out[j] = r0 / (r0 + r1);
-            return;
+            return Ok(());
         }
         out[i] = if dot >= 0.0 {
             area / (r0 * r1 + dot)
@@ -351,4 +364,5 @@ pub fn mean_value_coordinates(x: DVec2, polygon: &[DVec2], out: &mut [f64]) {
     for w in out.iter_mut() {
         *w /= total;
     }
+    Ok(())
 }
