@@ -288,7 +288,7 @@ fn build_block(
             positions[v as usize],
             &polygon,
             &mut weights[row * n..(row + 1) * n],
-        );
+        )?;
     }
     Ok(MvcBlock {
         boundary: boundary.to_vec(),
