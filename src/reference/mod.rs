@@ -8,7 +8,8 @@
 //! - [`mvc`]: Mean-Value-Coordinates cloning (Farbman et al. 2009) on a triangle mesh, the
 //!   speed and quality baseline of the paper's Table I and Fig. 5;
 //! - [`metrics`]: PSNR over a mask, the seam step across the patch boundary, uncovered mask
-//!   pixels, and a one-call comparison of a membrane against the pixel-grid reference.
+//!   pixels, and a one-call comparison of a membrane against the pixel-grid reference;
+//! - [`synthetic`]: masks at the sizes of the paper's Table I models.
 //!
 //! Image buffers throughout are row-major and pixel-interleaved: sample `c` of pixel
 //! `(x, y)` sits at `(y * width + x) * channels + c`.
@@ -17,6 +18,7 @@ pub mod grid_mask;
 pub mod metrics;
 pub mod mvc;
 pub mod poisson_membrane;
+pub mod synthetic;
 
 pub use grid_mask::{GridMask, MaskError};
 pub use metrics::{
