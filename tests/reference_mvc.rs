@@ -155,6 +155,35 @@ proptest! {
     }
 }
 
+proptest! {
+    #![proptest_config(Config {
+        rng_seed: RngSeed::Fixed(0x57a2_0008),
+        cases: 200,
+        ..Config::default()
+    })]
+    #[test]
+    fn star_shaped_polygons_have_linear_precision(
+        radii in proptest::collection::vec(0.7f64..1.3, 5..50),
+        scale in 1.0f64..300.0,
+        direction in 0.0f64..TAU,
+        depth in 0.0f64..0.65,
+    ) {
+        let n = radii.len();
+        let polygon: Vec<DVec2> = radii
+            .iter()
+            .enumerate()
+            .map(|(i, r)| {
+                let t = TAU * i as f64 / n as f64;
+                DVec2::new(t.cos(), t.sin()) * (r * scale)
+            })
+            .collect();
+        // Every ray from the origin leaves the polygon beyond 0.7·cos(π/5)·scale > 0.56·scale.
+        let x = DVec2::new(direction.cos(), direction.sin()) * (depth * 0.85 * scale);
+        let lambda = coordinates(x, &polygon);
+        prop_assert!(linear_precision_error(x, &polygon, &lambda) <= TOLERANCE * scale);
+    }
+}
+
 /// A fan of positions: the star polygon as boundary plus interior points.
 fn star_positions() -> (Vec<DVec2>, Vec<u32>) {
     let mut positions = star_polygon(40, 2.0);
