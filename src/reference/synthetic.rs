@@ -39,7 +39,7 @@ impl SyntheticMask {
 }
 
 /// An Archimedean spiral band (the paper's Fig. 5 spiral, 770×743): three turns, arms about
-/// 60 px wide with 50 px gaps, a round cap at the centre.
+/// 57 px wide with 45 px gaps, a round cap at the centre.
 pub fn spiral(width: usize, height: usize) -> SyntheticMask {
     let (cx, cy) = (width as f64 / 2.0, height as f64 / 2.0);
     let outer = 0.45 * width.min(height) as f64;
