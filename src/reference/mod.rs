@@ -1,1 +1,29 @@
-//! reference stage (not yet implemented).
+//! Baselines the combinatorial-Laplacian clone is measured against; used by tests and
+//! benches, never by the render path. It takes pixel masks, boundary data and meshes in and
+//! gives reference membranes and quality figures out:
+//!
+//! - [`grid_mask`]: the pixel mask shared by the reference solver and the metrics;
+//! - [`poisson_membrane`]: the exact pixel-grid Laplace membrane (Pérez et al. 2003), the
+//!   quality reference;
+//! - [`mvc`]: Mean-Value-Coordinates cloning (Farbman et al. 2009) on a triangle mesh, the
+//!   speed and quality baseline of the paper's Table I and Fig. 5;
+//! - [`metrics`]: PSNR over a mask, the seam step across the patch boundary, uncovered mask
+//!   pixels, and a one-call comparison of a membrane against the pixel-grid reference;
+//! - [`synthetic`]: masks at the sizes of the paper's Table I models.
+//!
+//! Image buffers throughout are row-major and pixel-interleaved: sample `c` of pixel
+//! `(x, y)` sits at `(y * width + x) * channels + c`.
+
+pub mod grid_mask;
+pub mod metrics;
+pub mod mvc;
+pub mod poisson_membrane;
+pub mod synthetic;
+
+pub use grid_mask::{GridMask, MaskError};
+pub use metrics::{
+    composite, psnr, seam_step, uncovered_pixels, ComparisonInput, MembraneComparison, MetricError,
+    SeamStep,
+};
+pub use mvc::{mean_value_coordinates, MvcError, MvcWeights};
+pub use poisson_membrane::{poisson_membrane, GridMembrane, GridPoisson, PoissonError};
