@@ -48,7 +48,10 @@ impl Mesh {
     }
 
     pub fn hole_count(&self) -> usize {
-        self.loops.iter().filter(|l| l.kind == LoopKind::Hole).count()
+        self.loops
+            .iter()
+            .filter(|l| l.kind == LoopKind::Hole)
+            .count()
     }
 
     /// Unique undirected edges (i < j), sorted.
