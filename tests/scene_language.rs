@@ -372,8 +372,8 @@ fn failed_call_leaves_the_patch_unchanged() {
     let options = options();
     let engine = lapclone::script::SceneEngine::new(&options);
     let mut scope = rhai::Scope::new();
-    engine.run(&mut scope, HEAD, &scene_file()).unwrap();
-    engine
+    let _ = engine.run(&mut scope, HEAD, &scene_file()).unwrap();
+    let _ = engine
         .run(
             &mut scope,
             "p.key(1, #{ at: [1, 1], scale: 2 });",
