@@ -8,6 +8,7 @@ mod draft;
 mod engine;
 mod error;
 mod sandbox;
+mod validate;
 mod values;
 
 pub use api::{HandleRef, PatchRef};
@@ -17,3 +18,4 @@ pub use engine::{
 };
 pub use error::{ErrorKind, SceneError};
 pub use sandbox::{Limits, ModuleFiles, SandboxResolver};
+pub use validate::{validate_scene, CheckSummary, MASK_THRESHOLD};
