@@ -18,7 +18,11 @@ pub mod repl;
 pub struct UsageError(pub String);
 
 #[derive(Parser, Debug)]
-#[command(name = "lapclone", version, about = "Seamless image cloning and deformation with the combinatorial Laplacian")]
+#[command(
+    name = "lapclone",
+    version,
+    about = "Seamless image cloning and deformation with the combinatorial Laplacian"
+)]
 pub struct Cli {
     #[command(subcommand)]
     pub command: Command,
@@ -56,7 +60,10 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
 
 /// Rejects NaN and infinities in numeric arguments (clap's f64 parser accepts them).
 pub fn finite_f64(text: &str) -> Result<f64, String> {
-    let value: f64 = text.trim().parse().map_err(|_| format!("`{text}` is not a number"))?;
+    let value: f64 = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{text}` is not a number"))?;
     if value.is_finite() {
         Ok(value)
     } else {

@@ -1,1 +1,57 @@
-//! output stage (not yet implemented).
+//! Frame writers: take rendered frames ([`FrameRef`], RGBA 8 or 16 bits) and give a PNG
+//! sequence (`DIR/frame_0001.png …`, encoded in parallel), an animated GIF or an animated
+//! PNG. Every file appears whole or not at all (temporary file + rename).
+
+mod apng;
+mod atomic;
+mod encode;
+mod frame;
+mod gif;
+mod png_sequence;
+
+pub use apng::{apng_delays, ApngWriter};
+pub use atomic::TempOutput;
+pub use encode::{encode_png, PngCompression};
+pub use frame::{Frame, FrameData, FrameRef, Pixels};
+pub use gif::{gif_delays_cs, GifWriter};
+pub use png_sequence::{frame_digits, frame_file_name, write_png_file, PngSequenceWriter};
+
+use std::path::{Path, PathBuf};
+
+impl OutputError {
+    pub fn io(path: &Path, source: std::io::Error) -> Self {
+        OutputError::Io {
+            path: path.to_path_buf(),
+            source,
+        }
+    }
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum OutputError {
+    #[error("{}: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("PNG encoding failed: {0}")]
+    Png(#[from] png::EncodingError),
+    #[error("GIF encoding failed: {0}")]
+    Gif(#[from] image::ImageError),
+    #[error("bad frame: {0}")]
+    BadFrame(String),
+    #[error("output folder {} does not exist", .0.display())]
+    NotAFolder(PathBuf),
+    #[error("{0}")]
+    Worker(String),
+    #[error("cancelled")]
+    Cancelled,
+}
+
+/// Whole `unit`s per frame (e.g. 100 for centiseconds), rounded from the exact frame times
+/// i·unit/fps so rounding never accumulates over the animation.
+fn rounded_steps(frames: usize, fps: f64, unit: f64) -> Vec<u64> {
+    let at = |i: usize| (i as f64 * unit / fps).round() as u64;
+    (0..frames).map(|i| at(i + 1) - at(i)).collect()
+}

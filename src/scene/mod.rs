@@ -1,1 +1,16 @@
-//! scene stage (not yet implemented).
+//! The scene: a canvas and layered, keyframed patches as plain Rust values ([`Scene`]), their
+//! evaluation at a time ([`Scene::evaluate`] → [`FrameState`]) and their writing back as a
+//! Rhai scene file ([`Scene::to_rhai`]). Parsing scene files lives in [`crate::script`].
+
+mod evaluate;
+mod to_rhai;
+mod track;
+mod types;
+
+pub use evaluate::{frame_time, FrameState, HandleState, PatchState};
+pub use to_rhai::rhai_string_literal;
+pub use track::{Easing, Interpolate, Key, KeyError, Track};
+pub use types::{
+    check_polygons, Background, Canvas, CloneMode, Handle, LaplacianKind, ModelError, Patch, Pin,
+    Placement, Polygon, Scene, Shape, MAX_CANVAS_SIDE,
+};

@@ -1,1 +1,21 @@
-//! script stage (not yet implemented).
+//! The scene language: a sandboxed Rhai engine that runs scene files (or REPL lines) and
+//! builds a [`crate::scene::Scene`]. Takes source text and folders, gives a scene or a
+//! [`SceneError`] with file, line, column and a caret-marked source line. The language is
+//! documented in docs/scene-language.md.
+
+mod api;
+mod draft;
+mod engine;
+mod error;
+mod sandbox;
+mod validate;
+mod values;
+
+pub use api::{HandleRef, PatchRef};
+pub use draft::{Draft, Origin, Origins};
+pub use engine::{
+    find_scripts_dir, load_scene, parse_scene, LoadedScene, SceneEngine, ScriptOptions,
+};
+pub use error::{ErrorKind, SceneError};
+pub use sandbox::{Limits, ModuleFiles, SandboxResolver};
+pub use validate::{validate_scene, CheckSummary, MASK_THRESHOLD};

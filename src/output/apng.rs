@@ -1,0 +1,123 @@
+//! An animated PNG from frames: takes the frame count, fps and frames in order, gives one
+//! file (looping forever), written through a temporary file and renamed on
+//! [`ApngWriter::finish`], so a failed or cancelled write leaves nothing behind.
+
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::{Path, PathBuf};
+
+use super::atomic::TempOutput;
+use super::{FrameRef, OutputError};
+
+pub struct ApngWriter {
+    path: PathBuf,
+    temp: TempOutput,
+    writer: png::Writer<BufWriter<File>>,
+    delays: Vec<(u16, u16)>,
+    written: usize,
+    width: u32,
+    height: u32,
+    sixteen_bit: bool,
+    scratch: Vec<u8>,
+}
+
+impl ApngWriter {
+    /// An animation of `frame_count` frames of `width`×`height` (16-bit if `sixteen_bit`)
+    /// shown at `fps`.
+    pub fn create(
+        path: &Path,
+        width: u32,
+        height: u32,
+        sixteen_bit: bool,
+        frame_count: u32,
+        fps: f64,
+    ) -> Result<Self, OutputError> {
+        if frame_count == 0 || width == 0 || height == 0 {
+            return Err(OutputError::BadFrame(
+                "an animation needs at least one frame of at least 1×1".into(),
+            ));
+        }
+        if !(fps.is_finite() && fps > 0.0) {
+            return Err(OutputError::BadFrame(format!("fps {fps} must be > 0")));
+        }
+        let temp = TempOutput::new(path);
+        let file = File::create(temp.temp_path()).map_err(|e| OutputError::io(path, e))?;
+        let mut encoder = png::Encoder::new(BufWriter::with_capacity(1 << 16, file), width, height);
+        encoder.set_color(png::ColorType::Rgba);
+        encoder.set_depth(if sixteen_bit {
+            png::BitDepth::Sixteen
+        } else {
+            png::BitDepth::Eight
+        });
+        encoder.set_compression(png::Compression::Fast);
+        encoder.set_animated(frame_count, 0)?;
+        let writer = encoder.write_header()?;
+        Ok(ApngWriter {
+            path: path.to_path_buf(),
+            temp,
+            writer,
+            delays: apng_delays(frame_count as usize, fps),
+            written: 0,
+            width,
+            height,
+            sixteen_bit,
+            scratch: Vec::new(),
+        })
+    }
+
+    /// Appends the next frame; it must have the animation's size and bit depth.
+    pub fn add(&mut self, frame: &FrameRef<'_>) -> Result<(), OutputError> {
+        if (frame.width(), frame.height(), frame.is_16_bit())
+            != (self.width, self.height, self.sixteen_bit)
+        {
+            return Err(OutputError::BadFrame(format!(
+                "frame is {}×{} ({}-bit), the animation is {}×{} ({}-bit)",
+                frame.width(),
+                frame.height(),
+                if frame.is_16_bit() { 16 } else { 8 },
+                self.width,
+                self.height,
+                if self.sixteen_bit { 16 } else { 8 }
+            )));
+        }
+        let Some(&(numerator, denominator)) = self.delays.get(self.written) else {
+            return Err(OutputError::BadFrame(format!(
+                "more frames than the {} announced",
+                self.delays.len()
+            )));
+        };
+        self.writer.set_frame_delay(numerator, denominator)?;
+        frame.write_png_bytes(&mut self.scratch);
+        self.writer.write_image_data(&self.scratch)?;
+        self.written += 1;
+        Ok(())
+    }
+
+    /// Completes the file and moves it into place; every announced frame must have been added.
+    pub fn finish(self) -> Result<PathBuf, OutputError> {
+        if self.written != self.delays.len() {
+            return Err(OutputError::BadFrame(format!(
+                "{} of {} frames written",
+                self.written,
+                self.delays.len()
+            )));
+        }
+        self.writer.finish()?;
+        self.temp
+            .commit()
+            .map_err(|e| OutputError::io(&self.path, e))?;
+        Ok(self.path)
+    }
+}
+
+/// Per-frame delays as fractions of a second: `1/fps` exactly for whole fps, otherwise
+/// milliseconds rounded from the exact frame times so the error never accumulates.
+pub fn apng_delays(frames: usize, fps: f64) -> Vec<(u16, u16)> {
+    if fps.fract() == 0.0 && fps <= u16::MAX as f64 {
+        return vec![(1, fps as u16); frames];
+    }
+    super::rounded_steps(frames, fps, 1000.0)
+        .into_iter()
+        .map(|ms| (ms.min(u16::MAX as u64) as u16, 1000))
+        .collect()
+}

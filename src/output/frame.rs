@@ -1,0 +1,113 @@
+//! Frames handed to the writers: RGBA pixels, 8 or 16 bits per channel, row-major, straight
+//! alpha. [`FrameRef`] borrows them (what the renderer hands over), [`Frame`] owns them (what
+//! a parallel writer queues and recycles).
+
+use super::OutputError;
+
+/// Borrowed RGBA samples.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Pixels<'a> {
+    Rgba8(&'a [u8]),
+    Rgba16(&'a [u16]),
+}
+
+/// A borrowed frame whose sample count matches its size (checked by [`FrameRef::new`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameRef<'a> {
+    width: u32,
+    height: u32,
+    pixels: Pixels<'a>,
+}
+
+impl<'a> FrameRef<'a> {
+    pub fn new(width: u32, height: u32, pixels: Pixels<'a>) -> Result<Self, OutputError> {
+        let expected = width as usize * height as usize * 4;
+        let actual = match pixels {
+            Pixels::Rgba8(p) => p.len(),
+            Pixels::Rgba16(p) => p.len(),
+        };
+        if width == 0 || height == 0 || actual != expected {
+            return Err(OutputError::BadFrame(format!(
+                "{width}×{height} RGBA needs {expected} samples, got {actual}"
+            )));
+        }
+        Ok(FrameRef {
+            width,
+            height,
+            pixels,
+        })
+    }
+
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+
+    pub fn pixels(&self) -> Pixels<'a> {
+        self.pixels
+    }
+
+    pub fn is_16_bit(&self) -> bool {
+        matches!(self.pixels, Pixels::Rgba16(_))
+    }
+
+    pub fn to_owned_frame(&self) -> Frame {
+        let data = match self.pixels {
+            Pixels::Rgba8(p) => FrameData::Rgba8(p.to_vec()),
+            Pixels::Rgba16(p) => FrameData::Rgba16(p.to_vec()),
+        };
+        Frame {
+            width: self.width,
+            height: self.height,
+            data,
+        }
+    }
+
+    /// Writes the 8-bit RGBA form into `out` (16-bit samples rounded to the nearest 8-bit).
+    pub fn write_rgba8(&self, out: &mut Vec<u8>) {
+        out.clear();
+        match self.pixels {
+            Pixels::Rgba8(p) => out.extend_from_slice(p),
+            Pixels::Rgba16(p) => {
+                out.extend(p.iter().map(|&v| ((v as u32 * 255 + 32767) / 65535) as u8))
+            }
+        }
+    }
+
+    /// Writes the samples as PNG wants them: bytes, 16-bit ones big-endian.
+    pub fn write_png_bytes(&self, out: &mut Vec<u8>) {
+        out.clear();
+        match self.pixels {
+            Pixels::Rgba8(p) => out.extend_from_slice(p),
+            Pixels::Rgba16(p) => out.extend(p.iter().flat_map(|v| v.to_be_bytes())),
+        }
+    }
+}
+
+/// Owned samples.
+#[derive(Clone, Debug, PartialEq)]
+pub enum FrameData {
+    Rgba8(Vec<u8>),
+    Rgba16(Vec<u16>),
+}
+
+/// An owned frame; its buffer can be reused for the next frame.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Frame {
+    pub width: u32,
+    pub height: u32,
+    pub data: FrameData,
+}
+
+impl Frame {
+    pub fn as_ref(&self) -> Result<FrameRef<'_>, OutputError> {
+        let pixels = match &self.data {
+            FrameData::Rgba8(p) => Pixels::Rgba8(p),
+            FrameData::Rgba16(p) => Pixels::Rgba16(p),
+        };
+        FrameRef::new(self.width, self.height, pixels)
+    }
+}

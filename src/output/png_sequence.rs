@@ -1,0 +1,208 @@
+//! Numbered PNG frames in a folder: takes frames (with their frame numbers) and gives
+//! `DIR/frame_0001.png …`, zero-padded to the width of the last frame number (at least 4
+//! digits). Encoding runs on `jobs` worker threads while the caller renders the next frames;
+//! each file is independent, so the bytes are identical for any number of jobs. Each frame
+//! is written to a temporary file and renamed, so no half-written frame ever exists (files
+//! are not fsynced: the guarantee is against failure and cancellation, not power loss).
+
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::{sync_channel, Receiver, SyncSender};
+use std::sync::{Arc, Mutex};
+use std::thread::JoinHandle;
+
+use super::atomic::TempOutput;
+use super::encode::{encode_png, PngCompression};
+use super::{Frame, OutputError};
+
+/// `frame_` + the number zero-padded to `digits`.
+pub fn frame_file_name(number: u64, digits: usize) -> String {
+    format!("frame_{number:0digits$}.png")
+}
+
+/// Digits for numbers up to `last` (at least 4).
+pub fn frame_digits(last: u64) -> usize {
+    last.to_string().len().max(4)
+}
+
+/// Writes one frame file atomically (also usable without the worker pool).
+pub fn write_png_file(
+    path: &Path,
+    frame: &Frame,
+    compression: PngCompression,
+    scratch: &mut Vec<u8>,
+) -> Result<(), OutputError> {
+    let frame_ref = frame.as_ref()?;
+    let temp = TempOutput::new(path);
+    let io = |e: std::io::Error| OutputError::io(path, e);
+    let file = std::fs::File::create(temp.temp_path()).map_err(io)?;
+    let mut out = BufWriter::with_capacity(1 << 16, file);
+    encode_png(&frame_ref, &mut out, compression, scratch)?;
+    out.flush().map_err(io)?;
+    drop(out);
+    temp.commit().map_err(io)
+}
+
+struct Job {
+    path: PathBuf,
+    frame: Frame,
+}
+
+/// State shared by the workers: the first error, and the cancel flag.
+struct Shared {
+    error: Mutex<Option<OutputError>>,
+    failed: AtomicBool,
+    cancel: Arc<AtomicBool>,
+}
+
+impl Shared {
+    fn stop(&self) -> bool {
+        self.failed.load(Ordering::Relaxed) || self.cancel.load(Ordering::Relaxed)
+    }
+
+    fn record(&self, error: OutputError) {
+        let mut slot = self.error.lock().unwrap_or_else(|p| p.into_inner());
+        slot.get_or_insert(error);
+        self.failed.store(true, Ordering::Relaxed);
+    }
+}
+
+/// A pool of PNG encoders writing numbered frames into a folder.
+pub struct PngSequenceWriter {
+    dir: PathBuf,
+    digits: usize,
+    sender: Option<SyncSender<Job>>,
+    spare: Receiver<Frame>,
+    workers: Vec<JoinHandle<()>>,
+    shared: Arc<Shared>,
+    written: Vec<PathBuf>,
+}
+
+impl PngSequenceWriter {
+    /// Frames numbered up to `last_number` go into `dir` (which must exist), encoded by
+    /// `jobs` threads (at least 1). Raising `cancel` stops after the frames in flight.
+    pub fn new(
+        dir: &Path,
+        last_number: u64,
+        jobs: usize,
+        compression: PngCompression,
+        cancel: Arc<AtomicBool>,
+    ) -> Result<Self, OutputError> {
+        if !dir.is_dir() {
+            return Err(OutputError::NotAFolder(dir.to_path_buf()));
+        }
+        let jobs = jobs.max(1);
+        let (sender, receiver) = sync_channel::<Job>(jobs);
+        let (spare_sender, spare) = sync_channel::<Frame>(2 * jobs + 2);
+        let receiver = Arc::new(Mutex::new(receiver));
+        let shared = Arc::new(Shared {
+            error: Mutex::new(None),
+            failed: AtomicBool::new(false),
+            cancel,
+        });
+        let workers = (0..jobs)
+            .map(|_| {
+                let receiver = receiver.clone();
+                let shared = shared.clone();
+                let spare_sender = spare_sender.clone();
+                std::thread::spawn(move || worker(&receiver, &shared, &spare_sender, compression))
+            })
+            .collect();
+        Ok(PngSequenceWriter {
+            dir: dir.to_path_buf(),
+            digits: frame_digits(last_number),
+            sender: Some(sender),
+            spare,
+            workers,
+            shared,
+            written: Vec::new(),
+        })
+    }
+
+    pub fn path_for(&self, number: u64) -> PathBuf {
+        self.dir.join(frame_file_name(number, self.digits))
+    }
+
+    /// A buffer of an already-written frame, to render the next frame into (no allocation).
+    pub fn spare_frame(&self) -> Option<Frame> {
+        self.spare.try_recv().ok()
+    }
+
+    /// Queues frame `number`; blocks while all workers are busy. Fails once a worker failed
+    /// or the cancel flag is raised.
+    pub fn submit(&mut self, number: u64, frame: Frame) -> Result<(), OutputError> {
+        frame.as_ref()?;
+        if self.shared.cancel.load(Ordering::Relaxed) {
+            return Err(OutputError::Cancelled);
+        }
+        if self.shared.failed.load(Ordering::Relaxed) {
+            return Err(self.take_error());
+        }
+        let path = self.path_for(number);
+        self.written.push(path.clone());
+        let sender = self.sender.as_ref().ok_or(OutputError::Cancelled)?;
+        sender
+            .send(Job { path, frame })
+            .map_err(|_| OutputError::Cancelled)
+    }
+
+    /// Waits for every queued frame; gives the paths written, in submission order.
+    pub fn finish(mut self) -> Result<Vec<PathBuf>, OutputError> {
+        self.join();
+        if self.shared.failed.load(Ordering::Relaxed) {
+            return Err(self.take_error());
+        }
+        if self.shared.cancel.load(Ordering::Relaxed) {
+            return Err(OutputError::Cancelled);
+        }
+        Ok(std::mem::take(&mut self.written))
+    }
+
+    fn join(&mut self) {
+        self.sender = None;
+        for worker in self.workers.drain(..) {
+            if worker.join().is_err() {
+                self.shared
+                    .record(OutputError::Worker("a PNG encoder thread panicked".into()));
+            }
+        }
+    }
+
+    fn take_error(&self) -> OutputError {
+        let mut slot = self.shared.error.lock().unwrap_or_else(|p| p.into_inner());
+        slot.take()
+            .unwrap_or_else(|| OutputError::Worker("an earlier frame failed".into()))
+    }
+}
+
+impl Drop for PngSequenceWriter {
+    fn drop(&mut self) {
+        self.join();
+    }
+}
+
+fn worker(
+    receiver: &Mutex<Receiver<Job>>,
+    shared: &Shared,
+    spare: &SyncSender<Frame>,
+    compression: PngCompression,
+) {
+    let mut scratch = Vec::new();
+    loop {
+        let job = {
+            let receiver = receiver.lock().unwrap_or_else(|p| p.into_inner());
+            receiver.recv()
+        };
+        let Ok(job) = job else { return };
+        if shared.stop() {
+            continue; // drain the queue without writing
+        }
+        match write_png_file(&job.path, &job.frame, compression, &mut scratch) {
+            Ok(()) => {
+                let _ = spare.try_send(job.frame);
+            }
+            Err(e) => shared.record(e),
+        }
+    }
+}

@@ -1,0 +1,324 @@
+//! The scene data model: plain Rust values (no Rhai) describing a canvas and layered,
+//! keyframed patches. Built by `script` from a scene file, consumed by the renderer through
+//! [`Scene::evaluate`](super::Scene::evaluate). Paths are already resolved (relative to the
+//! scene file's folder); coordinates are pixels, x right, y down.
+
+use std::path::PathBuf;
+
+use glam::DVec2;
+
+use super::track::{KeyError, Track};
+
+/// Largest accepted canvas side, in pixels.
+pub const MAX_CANVAS_SIDE: u32 = 16384;
+
+/// A whole scene: one canvas and patches layered in order (each clones onto the composite of
+/// the patches before it; see [`FrameState::draw_order`](super::FrameState::draw_order)).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scene {
+    pub canvas: Canvas,
+    pub patches: Vec<Patch>,
+}
+
+/// Output size, timing and what lies under every patch.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Canvas {
+    pub width: u32,
+    pub height: u32,
+    /// Frames per second; frame i is shown at t = i / fps.
+    pub fps: f64,
+    /// Seconds; the scene has [`Canvas::frame_count`] frames.
+    pub duration: f64,
+    pub background: Background,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum Background {
+    /// An image, drawn at the canvas origin at its own size.
+    Image(PathBuf),
+    /// Straight (not premultiplied) RGBA, each channel in [0, 1].
+    Colour([f32; 4]),
+}
+
+/// A polygon with holes in source-pixel coordinates (same layout as the mesher's polygon).
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct Polygon {
+    pub outer: Vec<DVec2>,
+    pub holes: Vec<Vec<DVec2>>,
+}
+
+/// Which pixels of the source make up the patch.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Shape {
+    /// A mask image of the source's size: non-zero pixels are inside.
+    Mask(PathBuf),
+    Polygons(Vec<Polygon>),
+}
+
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum LaplacianKind {
+    #[default]
+    Combinatorial,
+    Cotangent,
+}
+
+impl LaplacianKind {
+    pub fn name(self) -> &'static str {
+        match self {
+            LaplacianKind::Combinatorial => "combinatorial",
+            LaplacianKind::Cotangent => "cotangent",
+        }
+    }
+    pub fn from_name(name: &str) -> Option<Self> {
+        [LaplacianKind::Combinatorial, LaplacianKind::Cotangent]
+            .into_iter()
+            .find(|k| k.name() == name)
+    }
+}
+
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum CloneMode {
+    #[default]
+    Normal,
+    Monochrome,
+}
+
+impl CloneMode {
+    pub fn name(self) -> &'static str {
+        match self {
+            CloneMode::Normal => "normal",
+            CloneMode::Monochrome => "monochrome",
+        }
+    }
+    pub fn from_name(name: &str) -> Option<Self> {
+        [CloneMode::Normal, CloneMode::Monochrome]
+            .into_iter()
+            .find(|k| k.name() == name)
+    }
+}
+
+/// Where a patch sits in the canvas over time. Empty tracks take their defaults:
+/// `position` = the patch stays where it is in the source (its bounding-box centre keeps its
+/// source coordinates), `scale` 1, `rotation` 0°, `depth` 0.
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct Placement {
+    /// Canvas position of the centre of the patch's bounding box.
+    pub position: Track<DVec2>,
+    /// Uniform scale about the bounding-box centre.
+    pub scale: Track<f64>,
+    /// Degrees, clockwise on screen (y down), about the bounding-box centre.
+    pub rotation: Track<f64>,
+    /// Layering: higher depth is drawn later (in front); ties keep scene order.
+    pub depth: Track<f64>,
+}
+
+/// A drag of the patch's rest point `from` (source coordinates) to `to(t)`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Handle {
+    pub from: DVec2,
+    /// Target over time in source coordinates; an empty track means `to = from`.
+    pub to: Track<DVec2>,
+    /// Radius of influence in source pixels (> 0).
+    pub radius: f64,
+    /// Explicit depth of the dragged region (front/back under self-overlap).
+    pub depth: Option<f64>,
+    /// Centre of the rotation the drag induces; default the patch's rest centroid.
+    pub pivot: Option<DVec2>,
+    /// Rotation override in degrees, replacing the angle derived from the drag; an empty
+    /// track means no override.
+    pub rotation: Track<f64>,
+}
+
+/// Holds a rest point of the patch still while it is active: `start ≤ t < end`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Pin {
+    pub at: DVec2,
+    pub start: f64,
+    pub end: Option<f64>,
+}
+
+impl Pin {
+    pub fn is_active(&self, t: f64) -> bool {
+        t >= self.start && self.end.is_none_or(|end| t < end)
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Patch {
+    pub name: String,
+    pub source: PathBuf,
+    pub shape: Shape,
+    /// Mesh density (mesher's default when `None`).
+    pub density: Option<f64>,
+    pub laplacian: LaplacianKind,
+    pub mode: CloneMode,
+    /// Width in pixels of the softened outer edge (0: hard edge, anti-aliased).
+    pub feather: f64,
+    pub placement: Placement,
+    pub handles: Vec<Handle>,
+    pub pins: Vec<Pin>,
+}
+
+impl Patch {
+    /// A patch with default settings and no keys.
+    pub fn new(name: impl Into<String>, source: PathBuf, shape: Shape) -> Self {
+        Patch {
+            name: name.into(),
+            source,
+            shape,
+            density: None,
+            laplacian: LaplacianKind::default(),
+            mode: CloneMode::default(),
+            feather: 0.0,
+            placement: Placement::default(),
+            handles: Vec::new(),
+            pins: Vec::new(),
+        }
+    }
+}
+
+/// A structural problem found by [`Scene::sanity_check`].
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ModelError {
+    #[error("canvas size {0}×{1} must be between 1 and {MAX_CANVAS_SIDE} on each side")]
+    CanvasSize(u32, u32),
+    #[error("fps {0} must be a finite number > 0")]
+    Fps(f64),
+    #[error("duration {0} must be a finite number > 0")]
+    Duration(f64),
+    #[error("background colour channels must be finite and in [0, 1]")]
+    Colour,
+    #[error("patch `{patch}`: {what}")]
+    Patch { patch: String, what: String },
+    #[error("patch `{patch}`: {track}: {error}")]
+    Key {
+        patch: String,
+        track: String,
+        error: KeyError,
+    },
+}
+
+impl Canvas {
+    /// Number of frames: every i with i / fps < duration.
+    pub fn frame_count(&self) -> u64 {
+        // The small slack keeps e.g. duration 3, fps 24 at exactly 72 frames despite rounding.
+        let frames = (self.duration * self.fps - 1e-9).ceil();
+        (frames.max(1.0)) as u64
+    }
+
+    pub fn sanity_check(&self) -> Result<(), ModelError> {
+        let side_ok = |s: u32| (1..=MAX_CANVAS_SIDE).contains(&s);
+        if !side_ok(self.width) || !side_ok(self.height) {
+            return Err(ModelError::CanvasSize(self.width, self.height));
+        }
+        if !(self.fps.is_finite() && self.fps > 0.0) {
+            return Err(ModelError::Fps(self.fps));
+        }
+        if !(self.duration.is_finite() && self.duration > 0.0) {
+            return Err(ModelError::Duration(self.duration));
+        }
+        if let Background::Colour(c) = &self.background {
+            if !c.iter().all(|v| v.is_finite() && (0.0..=1.0).contains(v)) {
+                return Err(ModelError::Colour);
+            }
+        }
+        Ok(())
+    }
+}
+
+impl Scene {
+    /// Every value finite and in range, every track ordered.
+    pub fn sanity_check(&self) -> Result<(), ModelError> {
+        self.canvas.sanity_check()?;
+        for patch in &self.patches {
+            patch.sanity_check()?;
+        }
+        Ok(())
+    }
+}
+
+impl Patch {
+    pub fn sanity_check(&self) -> Result<(), ModelError> {
+        let fail = |what: String| ModelError::Patch {
+            patch: self.name.clone(),
+            what,
+        };
+        let key = |track: &str, error: KeyError| ModelError::Key {
+            patch: self.name.clone(),
+            track: track.to_string(),
+            error,
+        };
+        if self.name.is_empty() {
+            return Err(fail("empty name".into()));
+        }
+        if let Some(d) = self.density {
+            if !(d.is_finite() && d > 0.0) {
+                return Err(fail(format!("density {d} must be finite and > 0")));
+            }
+        }
+        if !(self.feather.is_finite() && self.feather >= 0.0) {
+            return Err(fail(format!(
+                "feather {} must be finite and ≥ 0",
+                self.feather
+            )));
+        }
+        if let Shape::Polygons(polygons) = &self.shape {
+            check_polygons(polygons).map_err(fail)?;
+        }
+        let p = &self.placement;
+        p.position.sanity_check().map_err(|e| key("position", e))?;
+        p.scale.sanity_check().map_err(|e| key("scale", e))?;
+        p.rotation.sanity_check().map_err(|e| key("rotation", e))?;
+        p.depth.sanity_check().map_err(|e| key("depth", e))?;
+        if p.scale.keys().iter().any(|k| k.value <= 0.0) {
+            return Err(fail("scale must be > 0".into()));
+        }
+        for (i, h) in self.handles.iter().enumerate() {
+            if !(h.from.is_finite() && h.radius.is_finite() && h.radius > 0.0) {
+                return Err(fail(format!(
+                    "handle {i}: rest point and radius must be finite, radius > 0"
+                )));
+            }
+            if h.depth.is_some_and(|d| !d.is_finite()) || h.pivot.is_some_and(|p| !p.is_finite()) {
+                return Err(fail(format!("handle {i}: depth and pivot must be finite")));
+            }
+            h.to.sanity_check()
+                .map_err(|e| key(&format!("handle {i}"), e))?;
+            h.rotation
+                .sanity_check()
+                .map_err(|e| key(&format!("handle {i} rotation"), e))?;
+        }
+        for (i, pin) in self.pins.iter().enumerate() {
+            let window_ok = pin.start.is_finite()
+                && pin.start >= 0.0
+                && pin.end.is_none_or(|e| e.is_finite() && e > pin.start);
+            if !pin.at.is_finite() || !window_ok {
+                return Err(fail(format!(
+                    "pin {i}: point must be finite, 0 ≤ from < until"
+                )));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Polygons need ≥ 3 finite vertices per ring.
+pub fn check_polygons(polygons: &[Polygon]) -> Result<(), String> {
+    if polygons.is_empty() {
+        return Err("no polygons".into());
+    }
+    for (i, polygon) in polygons.iter().enumerate() {
+        for ring in std::iter::once(&polygon.outer).chain(&polygon.holes) {
+            if ring.len() < 3 {
+                return Err(format!(
+                    "polygon {i}: a ring needs at least 3 points, got {}",
+                    ring.len()
+                ));
+            }
+            if ring.iter().any(|p| !p.is_finite()) {
+                return Err(format!("polygon {i}: non-finite point"));
+            }
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,627 @@
+//! The scene language's functions and types, registered on a Rhai engine: takes a
+//! [`SharedDraft`] and gives `canvas(...)`, `patch(...)`, `get_patch(...)` and the `Patch` and
+//! `Handle` types (with `CustomType`/`TypeBuilder`). Every value is validated when it is set;
+//! a refusal is a runtime error at the position of the offending call. See
+//! docs/scene-language.md for the language itself.
+
+use std::path::{Path, PathBuf};
+
+use glam::DVec2;
+use rhai::{CustomType, Dynamic, Engine, EvalAltResult, Map, NativeCallContext, TypeBuilder};
+
+use super::draft::{Origin, SharedDraft};
+use super::values::{self, number};
+use crate::scene::{
+    Background, Canvas, CloneMode, Easing, Handle, LaplacianKind, Patch, Pin, Polygon, Shape, Track,
+};
+
+type Fallible<T> = Result<T, Box<EvalAltResult>>;
+
+/// A runtime error at the position of the current call.
+fn fail(ctx: &NativeCallContext, message: impl Into<String>) -> Box<EvalAltResult> {
+    EvalAltResult::ErrorRuntime(message.into().into(), ctx.call_position()).into()
+}
+
+fn origin(ctx: &NativeCallContext, base_dir: &Path) -> Origin {
+    Origin {
+        file: ctx
+            .call_source()
+            .map(PathBuf::from)
+            .unwrap_or_else(|| base_dir.to_path_buf()),
+        position: ctx.call_position(),
+    }
+}
+
+/// Resolves `text` against the scene folder and insists the file exists.
+fn existing_file(base_dir: &Path, text: &str, what: &str) -> Result<PathBuf, String> {
+    let path = base_dir.join(text);
+    if path.is_file() {
+        Ok(path)
+    } else {
+        Err(format!(
+            "{what} file `{text}` not found (looked for {})",
+            path.display()
+        ))
+    }
+}
+
+/// A patch of the scene, as seen from a script. Cloning it in Rhai shares the patch.
+#[derive(Clone, Debug)]
+pub struct PatchRef {
+    draft: SharedDraft,
+    index: usize,
+}
+
+/// A handle (drag) of a patch, as seen from a script.
+#[derive(Clone, Debug)]
+pub struct HandleRef {
+    draft: SharedDraft,
+    patch: usize,
+    handle: usize,
+}
+
+pub fn register(engine: &mut Engine, draft: &SharedDraft) {
+    engine.build_type::<PatchRef>().build_type::<HandleRef>();
+    let d = draft.clone();
+    engine.register_fn(
+        "canvas",
+        move |ctx: NativeCallContext, w: Dynamic, h: Dynamic| {
+            set_canvas(&ctx, &d, &w, &h, &Map::new())
+        },
+    );
+    let d = draft.clone();
+    engine.register_fn(
+        "canvas",
+        move |ctx: NativeCallContext, w: Dynamic, h: Dynamic, options: Map| {
+            set_canvas(&ctx, &d, &w, &h, &options)
+        },
+    );
+    let d = draft.clone();
+    engine.register_fn(
+        "patch",
+        move |ctx: NativeCallContext, name: Dynamic, options: Dynamic| {
+            new_patch(&ctx, &d, &name, &options)
+        },
+    );
+    let d = draft.clone();
+    engine.register_fn("get_patch", move |ctx: NativeCallContext, name: &str| {
+        let index = d.lock().patches.iter().position(|p| p.name == name);
+        index
+            .map(|index| PatchRef {
+                draft: d.clone(),
+                index,
+            })
+            .ok_or_else(|| fail(&ctx, format!("no patch named `{name}`")))
+    });
+    engine.register_fn("easings", || -> rhai::Array {
+        Easing::ALL
+            .iter()
+            .map(|e| Dynamic::from(e.name().to_string()))
+            .collect()
+    });
+}
+
+fn set_canvas(
+    ctx: &NativeCallContext,
+    draft: &SharedDraft,
+    w: &Dynamic,
+    h: &Dynamic,
+    options: &Map,
+) -> Fallible<()> {
+    let mut d = draft.lock();
+    let canvas = parse_canvas(&d.base_dir, w, h, options).map_err(|m| fail(ctx, m))?;
+    d.origins.canvas = Some(origin(ctx, &d.base_dir));
+    d.canvas = Some(canvas);
+    Ok(())
+}
+
+fn parse_canvas(
+    base_dir: &Path,
+    w: &Dynamic,
+    h: &Dynamic,
+    options: &Map,
+) -> Result<Canvas, String> {
+    values::check_keys(options, &["fps", "duration", "background"], "canvas")?;
+    let width = values::size(w, "canvas width")?;
+    let height = values::size(h, "canvas height")?;
+    let fps = match options.get("fps") {
+        Some(v) => values::positive(v, "fps")?,
+        None => 24.0,
+    };
+    let duration = match options.get("duration") {
+        Some(v) => values::positive(v, "duration")?,
+        None => 1.0,
+    };
+    let background = match options.get("background") {
+        None => Background::Colour([0.0, 0.0, 0.0, 1.0]),
+        Some(v) => match v.read_lock::<rhai::ImmutableString>() {
+            Some(text) if !text.starts_with('#') => {
+                Background::Image(existing_file(base_dir, &text, "background")?)
+            }
+            _ => Background::Colour(values::colour(v)?),
+        },
+    };
+    Ok(Canvas {
+        width,
+        height,
+        fps,
+        duration,
+        background,
+    })
+}
+
+const PATCH_OPTIONS: [&str; 7] = [
+    "source",
+    "mask",
+    "polygons",
+    "density",
+    "laplacian",
+    "mode",
+    "feather",
+];
+
+fn new_patch(
+    ctx: &NativeCallContext,
+    draft: &SharedDraft,
+    name: &Dynamic,
+    options: &Dynamic,
+) -> Fallible<PatchRef> {
+    let mut d = draft.lock();
+    let patch = parse_patch(&d.base_dir, name, options).map_err(|m| fail(ctx, m))?;
+    if d.patches.iter().any(|p| p.name == patch.name) {
+        return Err(fail(
+            ctx,
+            format!("a patch named `{}` already exists", patch.name),
+        ));
+    }
+    let o = origin(ctx, &d.base_dir);
+    d.patches.push(patch);
+    d.origins.patches.push(o);
+    Ok(PatchRef {
+        draft: draft.clone(),
+        index: d.patches.len() - 1,
+    })
+}
+
+fn parse_patch(base_dir: &Path, name: &Dynamic, options: &Dynamic) -> Result<Patch, String> {
+    let name = values::string(name, "patch name")?;
+    if name.is_empty() {
+        return Err("patch name must not be empty".into());
+    }
+    let options = values::map(options, "patch options")?;
+    values::check_keys(&options, &PATCH_OPTIONS, "patch")?;
+    let source = options
+        .get("source")
+        .ok_or("patch needs a `source` image")
+        .and_then(|v| values::string(v, "source").map_err(|_| "`source` must be a string path"))?;
+    let source = existing_file(base_dir, &source, "source")?;
+    let shape = match (options.get("mask"), options.get("polygons")) {
+        (Some(mask), None) => {
+            let mask = values::string(mask, "mask")?;
+            Shape::Mask(existing_file(base_dir, &mask, "mask")?)
+        }
+        (None, Some(polygons)) => Shape::Polygons(parse_polygons(polygons)?),
+        (Some(_), Some(_)) => return Err("give either `mask` or `polygons`, not both".into()),
+        (None, None) => return Err("patch needs a `mask` image or `polygons`".into()),
+    };
+    let mut patch = Patch::new(name, source, shape);
+    if let Some(v) = options.get("density") {
+        patch.density = Some(values::positive(v, "density")?);
+    }
+    if let Some(v) = options.get("laplacian") {
+        let text = values::string(v, "laplacian")?;
+        patch.laplacian = LaplacianKind::from_name(&text).ok_or_else(|| {
+            format!("unknown laplacian `{text}` (expected combinatorial or cotangent)")
+        })?;
+    }
+    if let Some(v) = options.get("mode") {
+        let text = values::string(v, "mode")?;
+        patch.mode = CloneMode::from_name(&text)
+            .ok_or_else(|| format!("unknown mode `{text}` (expected normal or monochrome)"))?;
+    }
+    if let Some(v) = options.get("feather") {
+        patch.feather = values::non_negative(v, "feather")?;
+    }
+    Ok(patch)
+}
+
+/// `[[x, y], ...]` (outer ring only) or `#{ outer: [...], holes: [[...], ...] }`, in an array.
+fn parse_polygons(value: &Dynamic) -> Result<Vec<Polygon>, String> {
+    let items = values::array(value, "polygons")?;
+    let mut polygons = Vec::with_capacity(items.len());
+    for item in &items {
+        let polygon = if let Some(m) = item.read_lock::<Map>() {
+            values::check_keys(&m, &["outer", "holes"], "polygon")?;
+            let outer = m.get("outer").ok_or("polygon map needs `outer`")?;
+            let holes = match m.get("holes") {
+                Some(h) => values::array(h, "holes")?
+                    .iter()
+                    .map(ring)
+                    .collect::<Result<_, _>>()?,
+                None => Vec::new(),
+            };
+            Polygon {
+                outer: ring(outer)?,
+                holes,
+            }
+        } else {
+            Polygon {
+                outer: ring(item)?,
+                holes: Vec::new(),
+            }
+        };
+        polygons.push(polygon);
+    }
+    crate::scene::check_polygons(&polygons)?;
+    Ok(polygons)
+}
+
+fn ring(value: &Dynamic) -> Result<Vec<DVec2>, String> {
+    values::array(value, "polygon ring")?
+        .iter()
+        .map(|p| values::point(p, "polygon point"))
+        .collect()
+}
+
+impl PatchRef {
+    /// Applies `edit` to a copy of the patch and commits it only if it succeeds, so a failed
+    /// call leaves the scene unchanged.
+    fn edit<R>(
+        &self,
+        ctx: &NativeCallContext,
+        edit: impl FnOnce(&mut Patch) -> Result<R, String>,
+    ) -> Fallible<R> {
+        let mut d = self.draft.lock();
+        let Some(current) = d.patches.get(self.index) else {
+            return Err(fail(ctx, "this patch no longer exists in the scene"));
+        };
+        let mut patch = current.clone();
+        let result = edit(&mut patch).map_err(|m| fail(ctx, m))?;
+        d.patches[self.index] = patch;
+        Ok(result)
+    }
+
+    fn name(&mut self) -> String {
+        let d = self.draft.lock();
+        d.patches
+            .get(self.index)
+            .map(|p| p.name.clone())
+            .unwrap_or_default()
+    }
+
+    fn key_map(
+        &mut self,
+        ctx: NativeCallContext,
+        t: Dynamic,
+        values: Map,
+        easing: &str,
+    ) -> Fallible<Self> {
+        self.edit(&ctx, |p| {
+            let t = values::time(&t)?;
+            let easing = values::easing(easing)?;
+            add_placement_keys(p, t, &values, easing)
+        })?;
+        Ok(self.clone())
+    }
+
+    /// `keys([#{ t, at, scale, rotate, depth, ease }, ...])`.
+    fn keys(&mut self, ctx: NativeCallContext, list: rhai::Array) -> Fallible<Self> {
+        self.edit(&ctx, |p| {
+            for item in &list {
+                let mut m = values::map(item, "key")?;
+                let t = values::time(m.get("t").ok_or("each key needs a time `t`")?)?;
+                let easing = take_easing(&mut m)?;
+                m.remove("t");
+                add_placement_keys(p, t, &m, easing)?;
+            }
+            Ok(())
+        })?;
+        Ok(self.clone())
+    }
+
+    fn track_key(
+        &mut self,
+        ctx: NativeCallContext,
+        which: Placed,
+        t: Dynamic,
+        value: Dynamic,
+        easing: &str,
+    ) -> Fallible<Self> {
+        self.edit(&ctx, |p| {
+            let t = values::time(&t)?;
+            let easing = values::easing(easing)?;
+            which.push(p, t, &value, easing)
+        })?;
+        Ok(self.clone())
+    }
+
+    fn drag(
+        &mut self,
+        ctx: NativeCallContext,
+        from: Dynamic,
+        radius: Dynamic,
+        options: Map,
+    ) -> Fallible<HandleRef> {
+        let handle = self.edit(&ctx, |p| {
+            values::check_keys(&options, &["depth", "pivot"], "drag")?;
+            let handle = Handle {
+                from: values::point(&from, "drag rest point")?,
+                to: Track::new(),
+                radius: values::positive(&radius, "drag radius")?,
+                depth: options
+                    .get("depth")
+                    .map(|v| number(v, "depth"))
+                    .transpose()?,
+                pivot: options
+                    .get("pivot")
+                    .map(|v| values::point(v, "pivot"))
+                    .transpose()?,
+                rotation: Track::new(),
+            };
+            p.handles.push(handle);
+            Ok(p.handles.len() - 1)
+        })?;
+        Ok(HandleRef {
+            draft: self.draft.clone(),
+            patch: self.index,
+            handle,
+        })
+    }
+
+    fn pin(&mut self, ctx: NativeCallContext, at: Dynamic, options: Map) -> Fallible<Self> {
+        self.edit(&ctx, |p| {
+            values::check_keys(&options, &["start", "end"], "pin")?;
+            let start = match options.get("start") {
+                Some(v) => values::time(v)?,
+                None => 0.0,
+            };
+            let end = options.get("end").map(values::time).transpose()?;
+            if end.is_some_and(|e| e <= start) {
+                return Err(format!("pin `end` must be after `start` ({start})"));
+            }
+            p.pins.push(Pin {
+                at: values::point(&at, "pin point")?,
+                start,
+                end,
+            });
+            Ok(())
+        })?;
+        Ok(self.clone())
+    }
+}
+
+/// The keyframable placement properties, by their scene-language names.
+#[derive(Clone, Copy)]
+enum Placed {
+    At,
+    Scale,
+    Rotate,
+    Depth,
+}
+
+const PLACEMENT_KEYS: [&str; 4] = ["at", "scale", "rotate", "depth"];
+
+impl Placed {
+    fn from_name(name: &str) -> Option<Placed> {
+        match name {
+            "at" => Some(Placed::At),
+            "scale" => Some(Placed::Scale),
+            "rotate" => Some(Placed::Rotate),
+            "depth" => Some(Placed::Depth),
+            _ => None,
+        }
+    }
+
+    fn push(
+        self,
+        patch: &mut Patch,
+        t: f64,
+        value: &Dynamic,
+        easing: Easing,
+    ) -> Result<(), String> {
+        let p = &mut patch.placement;
+        let result = match self {
+            Placed::At => p.position.push(t, values::point(value, "`at`")?, easing),
+            Placed::Scale => p.scale.push(t, values::positive(value, "`scale`")?, easing),
+            Placed::Rotate => p.rotation.push(t, number(value, "`rotate`")?, easing),
+            Placed::Depth => p.depth.push(t, number(value, "`depth`")?, easing),
+        };
+        result.map_err(|e| e.to_string())
+    }
+}
+
+fn add_placement_keys(patch: &mut Patch, t: f64, keys: &Map, easing: Easing) -> Result<(), String> {
+    values::check_keys(keys, &PLACEMENT_KEYS, "key")?;
+    if keys.is_empty() {
+        return Err("a key needs at least one of: at, scale, rotate, depth".into());
+    }
+    for (name, value) in keys {
+        // invariant: check_keys admitted only placement names.
+        let which = Placed::from_name(name).expect("checked key name");
+        which.push(patch, t, value, easing)?;
+    }
+    Ok(())
+}
+
+/// Removes and parses an optional `ease` entry of a key map (default linear).
+fn take_easing(m: &mut Map) -> Result<Easing, String> {
+    match m.remove("ease") {
+        Some(v) => values::easing(&values::string(&v, "ease")?),
+        None => Ok(Easing::Linear),
+    }
+}
+
+impl HandleRef {
+    fn edit(
+        &self,
+        ctx: &NativeCallContext,
+        edit: impl FnOnce(&mut Handle) -> Result<(), String>,
+    ) -> Fallible<Self> {
+        let mut d = self.draft.lock();
+        let Some(current) = d
+            .patches
+            .get(self.patch)
+            .and_then(|p| p.handles.get(self.handle))
+        else {
+            return Err(fail(ctx, "this handle no longer exists in the scene"));
+        };
+        let mut handle = current.clone();
+        edit(&mut handle).map_err(|m| fail(ctx, m))?;
+        d.patches[self.patch].handles[self.handle] = handle;
+        Ok(self.clone())
+    }
+
+    fn key(
+        &mut self,
+        ctx: NativeCallContext,
+        t: Dynamic,
+        to: Dynamic,
+        easing: &str,
+    ) -> Fallible<Self> {
+        self.edit(&ctx, |h| {
+            let t = values::time(&t)?;
+            let easing = values::easing(easing)?;
+            h.to.push(t, values::point(&to, "handle target")?, easing)
+                .map_err(|e| e.to_string())
+        })
+    }
+
+    /// `keys([#{ t, at, rotate, ease }, ...])`.
+    fn keys(&mut self, ctx: NativeCallContext, list: rhai::Array) -> Fallible<Self> {
+        self.edit(&ctx, |h| {
+            for item in &list {
+                let mut m = values::map(item, "key")?;
+                let easing = take_easing(&mut m)?;
+                values::check_keys(&m, &["t", "at", "rotate"], "handle key")?;
+                let t = values::time(m.get("t").ok_or("each key needs a time `t`")?)?;
+                if let Some(at) = m.get("at") {
+                    let at = values::point(at, "handle target")?;
+                    h.to.push(t, at, easing).map_err(|e| e.to_string())?;
+                }
+                if let Some(r) = m.get("rotate") {
+                    let r = number(r, "handle rotation")?;
+                    h.rotation.push(t, r, easing).map_err(|e| e.to_string())?;
+                }
+            }
+            Ok(())
+        })
+    }
+
+    fn rotate(
+        &mut self,
+        ctx: NativeCallContext,
+        t: Dynamic,
+        degrees: Dynamic,
+        easing: &str,
+    ) -> Fallible<Self> {
+        self.edit(&ctx, |h| {
+            let t = values::time(&t)?;
+            let easing = values::easing(easing)?;
+            let r = number(&degrees, "handle rotation")?;
+            h.rotation.push(t, r, easing).map_err(|e| e.to_string())
+        })
+    }
+}
+
+impl CustomType for PatchRef {
+    fn build(mut b: TypeBuilder<Self>) {
+        b.with_name("Patch")
+            .with_get("name", PatchRef::name)
+            .with_fn("to_string", |p: &mut PatchRef| {
+                format!("patch(\"{}\")", p.name())
+            })
+            .with_fn("to_debug", |p: &mut PatchRef| {
+                format!("patch(\"{}\")", p.name())
+            })
+            .with_fn(
+                "key",
+                |ctx: NativeCallContext, p: &mut PatchRef, t: Dynamic, m: Map| {
+                    p.key_map(ctx, t, m, "linear")
+                },
+            )
+            .with_fn(
+                "key",
+                |ctx: NativeCallContext, p: &mut PatchRef, t: Dynamic, m: Map, e: &str| {
+                    p.key_map(ctx, t, m, e)
+                },
+            )
+            .with_fn(
+                "keys",
+                |ctx: NativeCallContext, p: &mut PatchRef, l: rhai::Array| p.keys(ctx, l),
+            )
+            .with_fn(
+                "drag",
+                |ctx: NativeCallContext, p: &mut PatchRef, from: Dynamic, r: Dynamic| {
+                    p.drag(ctx, from, r, Map::new())
+                },
+            )
+            .with_fn(
+                "drag",
+                |ctx: NativeCallContext, p: &mut PatchRef, from: Dynamic, r: Dynamic, o: Map| {
+                    p.drag(ctx, from, r, o)
+                },
+            )
+            .with_fn(
+                "pin",
+                |ctx: NativeCallContext, p: &mut PatchRef, at: Dynamic| p.pin(ctx, at, Map::new()),
+            )
+            .with_fn(
+                "pin",
+                |ctx: NativeCallContext, p: &mut PatchRef, at: Dynamic, o: Map| p.pin(ctx, at, o),
+            );
+        for (name, which) in [
+            ("at", Placed::At),
+            ("scale", Placed::Scale),
+            ("rotate", Placed::Rotate),
+            ("depth", Placed::Depth),
+        ] {
+            b.with_fn(
+                name,
+                move |ctx: NativeCallContext, p: &mut PatchRef, t: Dynamic, v: Dynamic| {
+                    p.track_key(ctx, which, t, v, "linear")
+                },
+            )
+            .with_fn(
+                name,
+                move |ctx: NativeCallContext, p: &mut PatchRef, t: Dynamic, v: Dynamic, e: &str| {
+                    p.track_key(ctx, which, t, v, e)
+                },
+            );
+        }
+    }
+}
+
+impl CustomType for HandleRef {
+    fn build(mut b: TypeBuilder<Self>) {
+        b.with_name("Handle")
+            .with_fn("to_string", |_: &mut HandleRef| "handle".to_string())
+            .with_fn(
+                "key",
+                |ctx: NativeCallContext, h: &mut HandleRef, t: Dynamic, to: Dynamic| {
+                    h.key(ctx, t, to, "linear")
+                },
+            )
+            .with_fn(
+                "key",
+                |ctx: NativeCallContext, h: &mut HandleRef, t: Dynamic, to: Dynamic, e: &str| {
+                    h.key(ctx, t, to, e)
+                },
+            )
+            .with_fn(
+                "keys",
+                |ctx: NativeCallContext, h: &mut HandleRef, l: rhai::Array| h.keys(ctx, l),
+            )
+            .with_fn(
+                "rotate",
+                |ctx: NativeCallContext, h: &mut HandleRef, t: Dynamic, r: Dynamic| {
+                    h.rotate(ctx, t, r, "linear")
+                },
+            )
+            .with_fn(
+                "rotate",
+                |ctx: NativeCallContext, h: &mut HandleRef, t: Dynamic, r: Dynamic, e: &str| {
+                    h.rotate(ctx, t, r, e)
+                },
+            );
+    }
+}

@@ -1,0 +1,196 @@
+//! Running scene scripts: takes scene source text (a file, or REPL lines against a persistent
+//! `Scope`) and gives the [`Scene`] it builds, or a positioned [`SceneError`].
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
+
+use rhai::{Dynamic, Engine, Scope, AST};
+
+use super::api;
+use super::draft::{Draft, Origins, SharedDraft};
+use super::error::{ErrorKind, SceneError};
+use super::sandbox::{sandboxed_engine, Limits, ModuleFiles, SandboxResolver};
+use crate::scene::Scene;
+
+/// Where a script may import from, how far it may run, and how to stop it.
+#[derive(Clone, Debug)]
+pub struct ScriptOptions {
+    /// Relative paths (images, imports) resolve against this folder.
+    pub scene_dir: PathBuf,
+    /// The project's `scripts/` folder; see [`find_scripts_dir`].
+    pub scripts_dir: Option<PathBuf>,
+    pub limits: Limits,
+    /// Raise to stop a running evaluation (Ctrl-C); the caller lowers it again.
+    pub cancel: Arc<AtomicBool>,
+}
+
+impl ScriptOptions {
+    /// Options for a scene file: its folder, and the nearest `scripts/` folder above it.
+    pub fn for_scene_file(path: &Path) -> Self {
+        let scene_dir = scene_folder(path);
+        ScriptOptions {
+            scripts_dir: find_scripts_dir(&scene_dir),
+            scene_dir,
+            limits: Limits::default(),
+            cancel: Arc::default(),
+        }
+    }
+}
+
+fn scene_folder(path: &Path) -> PathBuf {
+    match path.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() => dir.to_path_buf(),
+        _ => PathBuf::from("."),
+    }
+}
+
+/// The nearest `scripts/` folder in `start` or one of its ancestors.
+pub fn find_scripts_dir(start: &Path) -> Option<PathBuf> {
+    let start = start.canonicalize().ok()?;
+    start
+        .ancestors()
+        .map(|dir| dir.join("scripts"))
+        .find(|candidate| candidate.is_dir())
+}
+
+/// A sandboxed engine with the scene language registered, and the scene it is building.
+pub struct SceneEngine {
+    engine: Engine,
+    draft: SharedDraft,
+    modules: ModuleFiles,
+    cancel: Arc<AtomicBool>,
+}
+
+/// A parsed scene with the source positions of its objects.
+#[derive(Clone, Debug)]
+pub struct LoadedScene {
+    pub scene: Scene,
+    pub origins: Origins,
+    pub file: PathBuf,
+    pub text: String,
+}
+
+impl SceneEngine {
+    pub fn new(options: &ScriptOptions) -> Self {
+        let resolver = SandboxResolver::new(&options.scene_dir, options.scripts_dir.as_deref());
+        let modules = resolver.module_files();
+        let mut engine = sandboxed_engine(resolver, &options.limits, options.cancel.clone());
+        let draft = SharedDraft::new(Draft::new(&options.scene_dir));
+        api::register(&mut engine, &draft);
+        SceneEngine {
+            engine,
+            draft,
+            modules,
+            cancel: options.cancel.clone(),
+        }
+    }
+
+    pub fn engine(&self) -> &Engine {
+        &self.engine
+    }
+
+    pub fn cancel_flag(&self) -> Arc<AtomicBool> {
+        self.cancel.clone()
+    }
+
+    pub fn module_files(&self) -> &ModuleFiles {
+        &self.modules
+    }
+
+    /// Parses `text` (named `file` in errors).
+    pub fn compile(&self, text: &str, file: &Path) -> Result<AST, SceneError> {
+        let mut ast = self
+            .engine
+            .compile(text)
+            .map_err(|e| SceneError::from_parse(&e, file, text))?;
+        ast.set_source(file.to_string_lossy().as_ref());
+        Ok(ast)
+    }
+
+    /// Runs `text` against `scope`, adding to the scene being built. On error the scene is
+    /// left as the calls before the failing one made it (the REPL snapshots around a line).
+    pub fn run(&self, scope: &mut Scope, text: &str, file: &Path) -> Result<Dynamic, SceneError> {
+        let ast = self.compile(text, file)?;
+        self.run_ast(scope, &ast, text, file)
+    }
+
+    /// Runs a compiled script; `text` and `file` are for error messages.
+    pub fn run_ast(
+        &self,
+        scope: &mut Scope,
+        ast: &AST,
+        text: &str,
+        file: &Path,
+    ) -> Result<Dynamic, SceneError> {
+        self.engine
+            .eval_ast_with_scope::<Dynamic>(scope, ast)
+            .map_err(|e| SceneError::from_eval(e, file, text, &|name| self.modules.file_of(name)))
+    }
+
+    /// A copy of the scene under construction.
+    pub fn draft(&self) -> Draft {
+        self.draft.lock().clone()
+    }
+
+    /// Replaces the scene under construction (undo).
+    pub fn restore(&self, draft: Draft) {
+        *self.draft.lock() = draft;
+    }
+
+    /// The finished scene: it must have a canvas. `file` names the scene in errors.
+    pub fn scene(&self, file: &Path) -> Result<(Scene, Origins), SceneError> {
+        let draft = self.draft();
+        let Some(canvas) = draft.canvas else {
+            return Err(SceneError::new(
+                ErrorKind::Validation,
+                file,
+                rhai::Position::NONE,
+                "the scene has no canvas: add canvas(width, height, #{ fps: 24, duration: 2 })",
+            ));
+        };
+        let scene = Scene {
+            canvas,
+            patches: draft.patches,
+        };
+        scene.sanity_check().map_err(|e| {
+            SceneError::new(
+                ErrorKind::Validation,
+                file,
+                rhai::Position::NONE,
+                e.to_string(),
+            )
+        })?;
+        Ok((scene, draft.origins))
+    }
+}
+
+/// Reads, runs and finishes the scene file at `path`.
+pub fn load_scene(path: &Path) -> Result<LoadedScene, SceneError> {
+    let text = std::fs::read_to_string(path).map_err(|e| {
+        SceneError::new(
+            ErrorKind::Io,
+            path,
+            rhai::Position::NONE,
+            format!("cannot read scene: {e}"),
+        )
+    })?;
+    parse_scene(&text, path, &ScriptOptions::for_scene_file(path))
+}
+
+/// Runs scene source `text` (named `file`) with `options` and finishes the scene.
+pub fn parse_scene(
+    text: &str,
+    file: &Path,
+    options: &ScriptOptions,
+) -> Result<LoadedScene, SceneError> {
+    let engine = SceneEngine::new(options);
+    let _ = engine.run(&mut Scope::new(), text, file)?;
+    let (scene, origins) = engine.scene(file)?;
+    Ok(LoadedScene {
+        scene,
+        origins,
+        file: file.to_path_buf(),
+        text: text.to_string(),
+    })
+}

@@ -1,0 +1,213 @@
+//! Scene errors with positions: takes Rhai parse/eval errors (or our own validation failures)
+//! and gives a [`SceneError`] naming the file, line and column, printed as
+//! `file:line:col: message`, the source line, and a caret under the column.
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+use rhai::{EvalAltResult, ParseError, Position};
+
+/// What kind of failure a [`SceneError`] reports (the REPL treats cancellation differently).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ErrorKind {
+    Syntax,
+    /// A failure while running the script: bad values, unknown functions, missing files.
+    Runtime,
+    /// A sandbox limit (operations, call depth, sizes) was hit.
+    Limit,
+    /// The cancel flag was raised.
+    Cancelled,
+    /// The scene was complete but invalid (e.g. no canvas), or a referenced file is unusable.
+    Validation,
+    Io,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneError {
+    pub kind: ErrorKind,
+    pub file: PathBuf,
+    /// Rhai position (1-based line and column); `Position::NONE` when there is none.
+    pub position: Position,
+    pub message: String,
+    /// The offending source line, when known.
+    pub source_line: Option<String>,
+}
+
+impl std::error::Error for SceneError {}
+
+impl SceneError {
+    pub fn new(
+        kind: ErrorKind,
+        file: &Path,
+        position: Position,
+        message: impl Into<String>,
+    ) -> Self {
+        let mut error = SceneError {
+            kind,
+            file: file.to_path_buf(),
+            position,
+            message: message.into(),
+            source_line: None,
+        };
+        error.load_source_line(None);
+        error
+    }
+
+    pub fn line(&self) -> Option<usize> {
+        self.position.line()
+    }
+
+    pub fn column(&self) -> Option<usize> {
+        self.position.position()
+    }
+
+    /// Fills `source_line` from `text` (the file's contents) or, failing that, from disk.
+    pub fn load_source_line(&mut self, text: Option<&str>) {
+        let Some(line) = self.position.line() else {
+            return;
+        };
+        let from_disk;
+        let text = match text {
+            Some(t) => t,
+            None => {
+                let Ok(t) = std::fs::read_to_string(&self.file) else {
+                    return;
+                };
+                from_disk = t;
+                &from_disk
+            }
+        };
+        self.source_line = text.lines().nth(line.saturating_sub(1)).map(str::to_string);
+    }
+
+    /// A syntax error from Rhai's parser.
+    pub fn from_parse(error: &ParseError, file: &Path, text: &str) -> Self {
+        let mut e = SceneError {
+            kind: ErrorKind::Syntax,
+            file: file.to_path_buf(),
+            position: error.position(),
+            message: format!("syntax error: {}", error.err_type()),
+            source_line: None,
+        };
+        e.load_source_line(Some(text));
+        e
+    }
+
+    /// An evaluation error: unwraps function-call and module wrappers down to the innermost
+    /// error so the position points at the offending call, in the file where it is.
+    /// `module_file` maps an import path to the file it resolved to.
+    pub fn from_eval(
+        error: Box<EvalAltResult>,
+        file: &Path,
+        text: &str,
+        module_file: &dyn Fn(&str) -> Option<PathBuf>,
+    ) -> Self {
+        let mut current_file = file.to_path_buf();
+        let mut error = error;
+        loop {
+            match *error {
+                EvalAltResult::ErrorInFunctionCall(_, source, inner, _) => {
+                    if !source.is_empty() {
+                        current_file = PathBuf::from(source);
+                    }
+                    error = inner;
+                }
+                EvalAltResult::ErrorInModule(name, inner, _) => {
+                    if let Some(path) = module_file(&name) {
+                        current_file = path;
+                    }
+                    error = inner;
+                }
+                _ => break,
+            }
+        }
+        let mut error = error;
+        let position = error.take_position();
+        let (kind, message) = classify(&error);
+        let mut e = SceneError {
+            kind,
+            file: current_file.clone(),
+            position,
+            message,
+            source_line: None,
+        };
+        e.load_source_line((current_file == file).then_some(text));
+        e
+    }
+}
+
+fn classify(error: &EvalAltResult) -> (ErrorKind, String) {
+    use EvalAltResult as E;
+    match error {
+        E::ErrorRuntime(value, _) => (ErrorKind::Runtime, value.to_string()),
+        E::ErrorParsing(p, _) => (ErrorKind::Syntax, format!("syntax error: {p}")),
+        E::ErrorTerminated(..) => (ErrorKind::Cancelled, "evaluation cancelled".into()),
+        E::ErrorTooManyOperations(_) => (
+            ErrorKind::Limit,
+            "too many operations: the script runs too long (a runaway loop?)".into(),
+        ),
+        E::ErrorStackOverflow(_) => (
+            ErrorKind::Limit,
+            "call stack overflow: functions nest too deep (runaway recursion?)".into(),
+        ),
+        E::ErrorDataTooLarge(..) | E::ErrorTooManyModules(_) | E::ErrorTooManyVariables(_) => {
+            (ErrorKind::Limit, error.to_string())
+        }
+        E::ErrorFunctionNotFound(signature, _) => (
+            ErrorKind::Runtime,
+            format!("unknown function or wrong argument types: {signature}"),
+        ),
+        E::ErrorModuleNotFound(name, _) => (
+            ErrorKind::Runtime,
+            format!(
+                "module `{name}` not found in the scene's folder or the project's scripts/ folder"
+            ),
+        ),
+        _ => (ErrorKind::Runtime, error.to_string()),
+    }
+}
+
+impl fmt::Display for SceneError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let file = self.file.display();
+        match (self.position.line(), self.position.position()) {
+            (Some(line), Some(col)) => write!(f, "{file}:{line}:{col}: {}", self.message)?,
+            (Some(line), None) => write!(f, "{file}:{line}: {}", self.message)?,
+            _ => return write!(f, "{file}: {}", self.message),
+        }
+        if let Some(source) = &self.source_line {
+            write!(f, "\n{source}")?;
+            if let Some(col) = self.position.position() {
+                write!(f, "\n{}^", caret_indent(source, col))?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Whitespace that lines a caret up under column `col` (1-based), keeping tabs as tabs.
+fn caret_indent(source: &str, col: usize) -> String {
+    source
+        .chars()
+        .chain(std::iter::repeat(' '))
+        .take(col.saturating_sub(1))
+        .map(|c| if c == '\t' { '\t' } else { ' ' })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn caret_sits_under_the_column() {
+        let mut e = SceneError::new(
+            ErrorKind::Runtime,
+            Path::new("s.rhai"),
+            Position::new(2, 5),
+            "bad",
+        );
+        e.load_source_line(Some("first\n\tab(cd);\n"));
+        assert_eq!(e.to_string(), "s.rhai:2:5: bad\n\tab(cd);\n\t   ^");
+    }
+}

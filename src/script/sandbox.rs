@@ -1,0 +1,194 @@
+//! The locked-down Rhai engine: takes the scene's folder, the project's `scripts/` folder,
+//! limits and a cancel flag, and gives an `Engine` that can only import modules from those
+//! two folders, has no `eval`, stops after a bounded number of operations, call depth and
+//! data sizes, and stops when the cancel flag is raised. Rhai itself has no file or network
+//! access; the only file access is the module resolver below (read-only, `.rhai` files).
+
+use std::collections::HashMap;
+use std::path::{Component, Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
+
+use rhai::module_resolvers::ModuleResolver;
+use rhai::{Dynamic, Engine, EvalAltResult, Module, Position, Scope, Shared};
+
+type SharedModule = Shared<Module>;
+
+/// Bounds on what a script may use.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Limits {
+    pub max_operations: u64,
+    pub max_call_levels: usize,
+    pub max_expr_depth: usize,
+    pub max_function_expr_depth: usize,
+    pub max_string_size: usize,
+    pub max_array_size: usize,
+    pub max_map_size: usize,
+    pub max_modules: usize,
+}
+
+impl Default for Limits {
+    /// Generous for scenes (keyframe lists of thousands of entries), small enough that a
+    /// runaway loop stops within about a second.
+    fn default() -> Self {
+        Limits {
+            max_operations: 5_000_000,
+            max_call_levels: 64,
+            max_expr_depth: 64,
+            max_function_expr_depth: 32,
+            max_string_size: 1 << 20,
+            max_array_size: 100_000,
+            max_map_size: 10_000,
+            max_modules: 64,
+        }
+    }
+}
+
+/// A fresh engine with the sandbox applied (no scene functions yet).
+pub fn sandboxed_engine(
+    resolver: SandboxResolver,
+    limits: &Limits,
+    cancel: Arc<AtomicBool>,
+) -> Engine {
+    let mut engine = Engine::new();
+    engine
+        .set_max_operations(limits.max_operations)
+        .set_max_call_levels(limits.max_call_levels)
+        .set_max_expr_depths(limits.max_expr_depth, limits.max_function_expr_depth)
+        .set_max_string_size(limits.max_string_size)
+        .set_max_array_size(limits.max_array_size)
+        .set_max_map_size(limits.max_map_size)
+        .set_max_modules(limits.max_modules)
+        .set_module_resolver(resolver)
+        .disable_symbol("eval");
+    engine.on_progress(move |_| {
+        if cancel.load(Ordering::Relaxed) {
+            Some(Dynamic::from("cancelled"))
+        } else {
+            None
+        }
+    });
+    // Script output goes to stderr so stdout stays machine-readable.
+    engine.on_print(|text| eprintln!("{text}"));
+    engine.on_debug(|text, _, pos| eprintln!("[{pos}] {text}"));
+    engine
+}
+
+/// Resolves `import "name"` to `name.rhai` in the scene's folder, then in the project's
+/// `scripts/` folder — nowhere else: absolute paths and `..` are refused, and the resolved
+/// file must (after following links) lie inside one of the two folders.
+#[derive(Clone, Debug)]
+pub struct SandboxResolver {
+    roots: Vec<PathBuf>,
+    /// Import name → file it resolved to (for error positions), shared with [`ModuleFiles`].
+    files: Arc<Mutex<HashMap<String, PathBuf>>>,
+    /// Successfully evaluated modules by file.
+    modules: Arc<Mutex<HashMap<PathBuf, SharedModule>>>,
+}
+
+impl SandboxResolver {
+    pub fn new(scene_dir: &Path, scripts_dir: Option<&Path>) -> Self {
+        let roots = std::iter::once(scene_dir)
+            .chain(scripts_dir)
+            .filter_map(|d| d.canonicalize().ok())
+            .collect();
+        SandboxResolver {
+            roots,
+            files: Arc::default(),
+            modules: Arc::default(),
+        }
+    }
+
+    /// A shared view of the resolved modules, for mapping import names to files.
+    pub fn module_files(&self) -> ModuleFiles {
+        ModuleFiles {
+            files: self.files.clone(),
+            modules: self.modules.clone(),
+        }
+    }
+
+    fn find(&self, name: &str) -> Result<PathBuf, String> {
+        let relative = Path::new(name);
+        let plain = relative
+            .components()
+            .all(|c| matches!(c, Component::Normal(_)));
+        if !plain || name.is_empty() {
+            return Err(format!(
+                "import `{name}` must be a plain relative name (no absolute paths, no `..`)"
+            ));
+        }
+        let file_name = if relative.extension().is_some() {
+            relative.to_path_buf()
+        } else {
+            relative.with_extension("rhai")
+        };
+        for root in &self.roots {
+            let Ok(found) = root.join(&file_name).canonicalize() else {
+                continue;
+            };
+            if found.is_file() && found.starts_with(root) {
+                return Ok(found);
+            }
+        }
+        Err(format!(
+            "module `{name}` not found in the scene's folder or the project's scripts/ folder"
+        ))
+    }
+}
+
+/// Import name → resolved file, filled as modules are imported.
+#[derive(Clone, Debug)]
+pub struct ModuleFiles {
+    files: Arc<Mutex<HashMap<String, PathBuf>>>,
+    modules: Arc<Mutex<HashMap<PathBuf, SharedModule>>>,
+}
+
+impl ModuleFiles {
+    pub fn file_of(&self, name: &str) -> Option<PathBuf> {
+        lock(&self.files).get(name).cloned()
+    }
+
+    /// Forgets loaded modules so the next import re-reads them (the REPL's `:reload`).
+    pub fn clear(&self) {
+        lock(&self.files).clear();
+        lock(&self.modules).clear();
+    }
+}
+
+/// Locks a cache; the caches hold only whole entries, so a poisoned lock is still usable.
+fn lock<T>(mutex: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    mutex.lock().unwrap_or_else(|p| p.into_inner())
+}
+
+impl ModuleResolver for SandboxResolver {
+    fn resolve(
+        &self,
+        engine: &Engine,
+        _source: Option<&str>,
+        path: &str,
+        pos: Position,
+    ) -> Result<SharedModule, Box<EvalAltResult>> {
+        let file = self
+            .find(path)
+            .map_err(|message| EvalAltResult::ErrorRuntime(message.into(), pos))?;
+        lock(&self.files).insert(path.to_string(), file.clone());
+        if let Some(module) = lock(&self.modules).get(&file) {
+            return Ok(module.clone());
+        }
+        let text = std::fs::read_to_string(&file).map_err(|e| {
+            EvalAltResult::ErrorRuntime(
+                format!("cannot read module {}: {e}", file.display()).into(),
+                pos,
+            )
+        })?;
+        let mut ast = engine
+            .compile(&text)
+            .map_err(|e| EvalAltResult::ErrorInModule(path.to_string(), e.into(), pos))?;
+        ast.set_source(file.to_string_lossy().as_ref());
+        let module: SharedModule = Module::eval_ast_as_new(Scope::new(), &ast, engine)
+            .map_err(|e| EvalAltResult::ErrorInModule(path.to_string(), e, pos))?
+            .into();
+        lock(&self.modules).insert(file, module.clone());
+        Ok(module)
+    }
+}

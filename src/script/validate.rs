@@ -1,0 +1,125 @@
+//! Whole-scene validation for `lapclone check`: takes a [`LoadedScene`] and checks what the
+//! script could not — images decode, masks match their source's size and are non-empty,
+//! polygons enclose area, and every frame evaluates to finite values — giving a summary or a
+//! [`SceneError`] positioned at the call that named the offending file.
+
+use std::path::Path;
+
+use super::draft::Origin;
+use super::engine::LoadedScene;
+use super::error::{ErrorKind, SceneError};
+use crate::scene::{Background, FrameState, Shape};
+
+/// What a valid scene contains.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CheckSummary {
+    pub frames: u64,
+    pub patches: usize,
+    pub handles: usize,
+    pub pins: usize,
+    /// Inside pixels of each patch's mask (polygon patches: rounded polygon area).
+    pub inside_pixels: Vec<u64>,
+}
+
+/// A mask pixel is inside when its luma is at least half scale.
+pub const MASK_THRESHOLD: u8 = 128;
+
+pub fn validate_scene(loaded: &LoadedScene) -> Result<CheckSummary, SceneError> {
+    let scene = &loaded.scene;
+    let fail = |origin: Option<&Origin>, message: String| {
+        let (file, position) = origin
+            .map(|o| (o.file.clone(), o.position))
+            .unwrap_or((loaded.file.clone(), rhai::Position::NONE));
+        let file = if file.is_dir() {
+            loaded.file.clone()
+        } else {
+            file
+        };
+        let mut e = SceneError::new(ErrorKind::Validation, &file, position, message);
+        if file == loaded.file {
+            e.load_source_line(Some(&loaded.text));
+        }
+        e
+    };
+    if let Background::Image(path) = &scene.canvas.background {
+        decode(path).map_err(|m| fail(loaded.origins.canvas.as_ref(), m))?;
+    }
+    let mut inside_pixels = Vec::with_capacity(scene.patches.len());
+    for (i, patch) in scene.patches.iter().enumerate() {
+        let origin = loaded.origins.patches.get(i);
+        let named = |m: String| fail(origin, format!("patch `{}`: {m}", patch.name));
+        let source = decode(&patch.source).map_err(named)?;
+        let inside = match &patch.shape {
+            Shape::Mask(path) => {
+                let mask = decode(path).map_err(named)?;
+                if (mask.width(), mask.height()) != (source.width(), source.height()) {
+                    return Err(named(format!(
+                        "mask is {}×{} but the source is {}×{}",
+                        mask.width(),
+                        mask.height(),
+                        source.width(),
+                        source.height()
+                    )));
+                }
+                let luma = mask.to_luma8();
+                luma.pixels().filter(|p| p.0[0] >= MASK_THRESHOLD).count() as u64
+            }
+            Shape::Polygons(polygons) => polygons
+                .iter()
+                .map(|p| {
+                    let holes: f64 = p.holes.iter().map(|h| ring_area(h)).sum();
+                    (ring_area(&p.outer) - holes).max(0.0)
+                })
+                .sum::<f64>()
+                .round() as u64,
+        };
+        if inside == 0 {
+            return Err(named("the mask is empty (no inside pixels)".into()));
+        }
+        inside_pixels.push(inside);
+    }
+    let mut state = FrameState::default();
+    for index in 0..scene.canvas.frame_count() {
+        scene.evaluate_into(
+            crate::scene::frame_time(index, scene.canvas.fps),
+            &mut state,
+        );
+        if let Some(i) = state.patches.iter().position(|p| !state_is_finite(p)) {
+            return Err(fail(
+                loaded.origins.patches.get(i),
+                format!(
+                    "patch `{}` has non-finite values at frame {index}",
+                    scene.patches[i].name
+                ),
+            ));
+        }
+    }
+    Ok(CheckSummary {
+        frames: scene.canvas.frame_count(),
+        patches: scene.patches.len(),
+        handles: scene.patches.iter().map(|p| p.handles.len()).sum(),
+        pins: scene.patches.iter().map(|p| p.pins.len()).sum(),
+        inside_pixels,
+    })
+}
+
+fn decode(path: &Path) -> Result<image::DynamicImage, String> {
+    image::open(path).map_err(|e| format!("cannot decode {}: {e}", path.display()))
+}
+
+fn ring_area(ring: &[glam::DVec2]) -> f64 {
+    let twice: f64 = ring
+        .iter()
+        .zip(ring.iter().cycle().skip(1))
+        .map(|(a, b)| a.perp_dot(*b))
+        .sum();
+    (twice / 2.0).abs()
+}
+
+fn state_is_finite(p: &crate::scene::PatchState) -> bool {
+    p.position.is_none_or(|v| v.is_finite())
+        && p.scale.is_finite()
+        && p.rotation.is_finite()
+        && p.depth.is_finite()
+        && p.handles.iter().all(|h| h.to.is_finite())
+}

@@ -1,0 +1,174 @@
+//! Converting Rhai values into scene values: takes `Dynamic`s from scene calls and gives
+//! finite numbers (integers and floats alike), points, easings, colours and option maps,
+//! or a message saying what was wrong.
+
+use rhai::{Array, Dynamic, Map};
+
+use crate::scene::Easing;
+use glam::DVec2;
+
+/// A finite number from an integer or a float.
+pub fn number(value: &Dynamic, what: &str) -> Result<f64, String> {
+    let v = if let Ok(i) = value.as_int() {
+        i as f64
+    } else if let Ok(f) = value.as_float() {
+        f
+    } else {
+        return Err(format!("{what} must be a number, got {}", type_name(value)));
+    };
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(format!("{what} must be a finite number, got {v}"))
+    }
+}
+
+pub fn positive(value: &Dynamic, what: &str) -> Result<f64, String> {
+    let v = number(value, what)?;
+    if v > 0.0 {
+        Ok(v)
+    } else {
+        Err(format!("{what} must be > 0, got {v}"))
+    }
+}
+
+pub fn non_negative(value: &Dynamic, what: &str) -> Result<f64, String> {
+    let v = number(value, what)?;
+    if v >= 0.0 {
+        Ok(v)
+    } else {
+        Err(format!("{what} must be ≥ 0, got {v}"))
+    }
+}
+
+/// A key time: finite and ≥ 0.
+pub fn time(value: &Dynamic) -> Result<f64, String> {
+    let t = number(value, "key time")?;
+    if t < 0.0 {
+        return Err(format!("key time must be ≥ 0, got {t}"));
+    }
+    Ok(t)
+}
+
+/// A canvas side: a whole number of pixels ≥ 1.
+pub fn size(value: &Dynamic, what: &str) -> Result<u32, String> {
+    let v = number(value, what)?;
+    let max = crate::scene::MAX_CANVAS_SIDE;
+    if v.fract() != 0.0 || v < 1.0 || v > max as f64 {
+        return Err(format!(
+            "{what} must be a whole number of pixels in 1..={max}, got {v}"
+        ));
+    }
+    Ok(v as u32)
+}
+
+/// `[x, y]` with finite numbers.
+pub fn point(value: &Dynamic, what: &str) -> Result<DVec2, String> {
+    let array = value
+        .read_lock::<Array>()
+        .ok_or_else(|| format!("{what} must be a point [x, y], got {}", type_name(value)))?;
+    if array.len() != 2 {
+        return Err(format!(
+            "{what} must be a point [x, y], got {} numbers",
+            array.len()
+        ));
+    }
+    Ok(DVec2::new(
+        number(&array[0], what)?,
+        number(&array[1], what)?,
+    ))
+}
+
+pub fn string(value: &Dynamic, what: &str) -> Result<String, String> {
+    value
+        .read_lock::<rhai::ImmutableString>()
+        .map(|s| s.to_string())
+        .ok_or_else(|| format!("{what} must be a string, got {}", type_name(value)))
+}
+
+pub fn array(value: &Dynamic, what: &str) -> Result<Array, String> {
+    value
+        .read_lock::<Array>()
+        .map(|a| a.clone())
+        .ok_or_else(|| format!("{what} must be an array, got {}", type_name(value)))
+}
+
+pub fn map(value: &Dynamic, what: &str) -> Result<Map, String> {
+    value
+        .read_lock::<Map>()
+        .map(|m| m.clone())
+        .ok_or_else(|| format!("{what} must be a map #{{ ... }}, got {}", type_name(value)))
+}
+
+pub fn easing(name: &str) -> Result<Easing, String> {
+    Easing::from_name(name).ok_or_else(|| {
+        let names: Vec<&str> = Easing::ALL.iter().map(|e| e.name()).collect();
+        format!(
+            "unknown easing `{name}` (expected one of: {})",
+            names.join(", ")
+        )
+    })
+}
+
+/// Refuses keys of `options` not in `allowed`, naming the allowed ones.
+pub fn check_keys(options: &Map, allowed: &[&str], what: &str) -> Result<(), String> {
+    for key in options.keys() {
+        if !allowed.contains(&key.as_str()) {
+            return Err(format!(
+                "unknown option `{key}` for {what} (expected: {})",
+                allowed.join(", ")
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// A colour: `"#rrggbb"`, `"#rrggbbaa"`, `[r, g, b]` or `[r, g, b, a]` with channels in [0, 1].
+pub fn colour(value: &Dynamic) -> Result<[f32; 4], String> {
+    if let Some(text) = value.read_lock::<rhai::ImmutableString>() {
+        return hex_colour(&text);
+    }
+    let channels = array(value, "colour")?;
+    if !(3..=4).contains(&channels.len()) {
+        return Err(format!(
+            "colour must have 3 or 4 channels, got {}",
+            channels.len()
+        ));
+    }
+    let mut rgba = [1.0f32; 4];
+    for (slot, c) in rgba.iter_mut().zip(&channels) {
+        let v = number(c, "colour channel")?;
+        if !(0.0..=1.0).contains(&v) {
+            return Err(format!("colour channels must be in [0, 1], got {v}"));
+        }
+        *slot = v as f32;
+    }
+    Ok(rgba)
+}
+
+fn hex_colour(text: &str) -> Result<[f32; 4], String> {
+    let digits = text.strip_prefix('#').unwrap_or(text);
+    let bad = || format!("colour `{text}` must be #rrggbb or #rrggbbaa");
+    if !(digits.len() == 6 || digits.len() == 8) || !digits.is_ascii() {
+        return Err(bad());
+    }
+    let mut rgba = [1.0f32; 4];
+    for (i, slot) in rgba.iter_mut().enumerate().take(digits.len() / 2) {
+        let byte = u8::from_str_radix(&digits[2 * i..2 * i + 2], 16).map_err(|_| bad())?;
+        *slot = byte as f32 / 255.0;
+    }
+    Ok(rgba)
+}
+
+fn type_name(value: &Dynamic) -> &'static str {
+    match value.type_name() {
+        "i64" | "i32" => "an integer",
+        "f64" | "f32" => "a float",
+        "string" | "ImmutableString" => "a string",
+        "array" => "an array",
+        "map" => "a map",
+        "bool" => "a boolean",
+        "()" => "nothing (unit)",
+        _ => "another type",
+    }
+}

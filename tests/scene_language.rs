@@ -1,0 +1,393 @@
+//! Scene language: parsing, evaluation against closed-form easings, number acceptance,
+//! positioned errors, the sandbox and importing scripts/motion.rhai.
+
+use std::path::PathBuf;
+use std::sync::atomic::Ordering;
+
+use glam::DVec2;
+use lapclone::scene::{Background, CloneMode, Easing, LaplacianKind, Scene, Shape};
+use lapclone::script::{parse_scene, ErrorKind, Limits, SceneError, ScriptOptions};
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn options() -> ScriptOptions {
+    ScriptOptions {
+        scene_dir: root(),
+        scripts_dir: Some(root().join("scripts")),
+        limits: Limits::default(),
+        cancel: Default::default(),
+    }
+}
+
+fn scene_file() -> PathBuf {
+    root().join("test_scene.rhai")
+}
+
+fn parse(text: &str) -> Result<Scene, SceneError> {
+    parse_scene(text, &scene_file(), &options()).map(|l| l.scene)
+}
+
+fn parse_err(text: &str) -> SceneError {
+    match parse(text) {
+        Ok(_) => panic!("expected an error for:\n{text}"),
+        Err(e) => e,
+    }
+}
+
+const HEAD: &str = r#"canvas(64, 48, #{ fps: 10, duration: 3, background: "assets/coffee.png" });
+let p = patch("p", #{ source: "assets/astronaut.png", mask: "assets/horse_mask.png" });
+"#;
+
+/// The easing formulas, written out independently of the library.
+fn closed_form(easing: Easing, s: f64) -> f64 {
+    match easing {
+        Easing::Linear => s,
+        Easing::Hold => 0.0,
+        Easing::EaseIn => s.powi(3),
+        Easing::EaseOut => 1.0 - (1.0 - s).powi(3),
+        Easing::EaseInOut if s < 0.5 => 4.0 * s.powi(3),
+        Easing::EaseInOut => 1.0 - (2.0 - 2.0 * s).powi(3) / 2.0,
+        Easing::Smooth => 3.0 * s * s - 2.0 * s.powi(3),
+    }
+}
+
+#[test]
+fn full_scene_parses_with_defaults() {
+    let scene = parse(HEAD).unwrap();
+    assert_eq!((scene.canvas.width, scene.canvas.height), (64, 48));
+    assert_eq!(scene.canvas.fps, 10.0);
+    assert_eq!(scene.canvas.frame_count(), 30);
+    assert_eq!(
+        scene.canvas.background,
+        Background::Image(root().join("assets/coffee.png"))
+    );
+    let p = &scene.patches[0];
+    assert_eq!(p.source, root().join("assets/astronaut.png"));
+    assert_eq!(p.shape, Shape::Mask(root().join("assets/horse_mask.png")));
+    assert_eq!(
+        (p.laplacian, p.mode, p.density),
+        (LaplacianKind::Combinatorial, CloneMode::Normal, None)
+    );
+    let state = scene.evaluate(1.0);
+    assert_eq!(state.patches[0].position, None);
+    assert_eq!(state.patches[0].scale, 1.0);
+}
+
+#[test]
+fn every_easing_matches_its_formula_between_keys() {
+    for easing in Easing::ALL {
+        let text = format!(
+            "{HEAD}p.key(0.5, #{{ at: [10, 20], rotate: 0, scale: 1 }});\n\
+             p.key(2.5, #{{ at: [110, -30], rotate: 90, scale: 3 }}, \"{}\");\n",
+            easing.name()
+        );
+        let scene = parse(&text).unwrap();
+        for t in [0.0, 0.5, 0.9, 1.5, 1.73, 2.2, 2.5, 3.0] {
+            let s: f64 = ((t - 0.5) / 2.0_f64).clamp(0.0, 1.0);
+            let w = if s >= 1.0 {
+                1.0
+            } else {
+                closed_form(easing, s)
+            };
+            let state = scene.evaluate(t);
+            let p = &state.patches[0];
+            let expected = DVec2::new(10.0 + 100.0 * w, 20.0 - 50.0 * w);
+            assert!(
+                (p.position.unwrap() - expected).length() < 1e-12,
+                "{easing:?} t={t}"
+            );
+            assert!((p.rotation - 90.0 * w).abs() < 1e-12, "{easing:?} t={t}");
+            assert!(
+                (p.scale - (1.0 + 2.0 * w)).abs() < 1e-12,
+                "{easing:?} t={t}"
+            );
+        }
+    }
+}
+
+#[test]
+fn easing_governs_the_segment_ending_at_its_key() {
+    let text = format!(
+        "{HEAD}p.at(0, [0, 0]);\np.at(1, [10, 0], \"hold\");\np.at(2, [20, 0], \"linear\");\n"
+    );
+    let scene = parse(&text).unwrap();
+    let x = |t: f64| scene.evaluate(t).patches[0].position.unwrap().x;
+    assert_eq!(x(0.99), 0.0, "hold keeps the previous value until its key");
+    assert_eq!(x(1.0), 10.0);
+    assert!((x(1.5) - 15.0).abs() < 1e-12, "the next segment is linear");
+}
+
+#[test]
+fn integers_and_floats_are_accepted_alike() {
+    let ints = parse(&format!("{HEAD}p.key(1, #{{ at: [3, 4], scale: 2, rotate: 45, depth: 1 }});\np.drag([5, 6], 7).key(1, [8, 9]);\np.pin([1, 2], #{{ start: 0, end: 2 }});")).unwrap();
+    let floats = parse(&format!("{HEAD}p.key(1.0, #{{ at: [3.0, 4.0], scale: 2.0, rotate: 45.0, depth: 1.0 }});\np.drag([5.0, 6.0], 7.0).key(1.0, [8.0, 9.0]);\np.pin([1.0, 2.0], #{{ start: 0.0, end: 2.0 }});")).unwrap();
+    assert_eq!(ints, floats);
+    let canvas = parse("canvas(64.0, 48, #{ fps: 12.5, duration: 2 });")
+        .unwrap()
+        .canvas;
+    assert_eq!(
+        (canvas.width, canvas.height, canvas.fps, canvas.duration),
+        (64, 48, 12.5, 2.0)
+    );
+}
+
+#[test]
+fn handles_pins_and_layers_evaluate() {
+    let text = format!(
+        "{HEAD}let h = p.drag([10, 10], 20, #{{ depth: 2, pivot: [5, 5] }});\n\
+         h.key(0, [10, 10]).key(2, [30, 10], \"linear\");\nh.rotate(1, 30);\n\
+         p.pin([1, 1], #{{ start: 1, end: 2 }});\n\
+         let q = patch(\"q\", #{{ source: \"assets/astronaut.png\", polygons: [[[0, 0], [10, 0], [0, 10]]] }});\n\
+         p.depth(0, 1);\n"
+    );
+    let scene = parse(&text).unwrap();
+    let s = scene.evaluate(1.0);
+    let h = s.patches[0].handles[0];
+    assert_eq!(h.to, DVec2::new(20.0, 10.0));
+    assert_eq!(
+        (h.radius, h.depth, h.pivot, h.rotation),
+        (20.0, Some(2.0), Some(DVec2::new(5.0, 5.0)), Some(30.0))
+    );
+    assert_eq!(s.patches[0].pins, vec![DVec2::new(1.0, 1.0)]);
+    assert!(scene.evaluate(0.5).patches[0].pins.is_empty());
+    assert!(
+        scene.evaluate(2.0).patches[0].pins.is_empty(),
+        "`until` is exclusive"
+    );
+    assert_eq!(s.draw_order, vec![1, 0], "higher depth is drawn later");
+}
+
+#[test]
+fn frames_are_evaluated_at_index_over_fps() {
+    let scene = parse(&format!("{HEAD}p.at(0, [0, 0]);\np.at(3, [300, 0]);")).unwrap();
+    for i in [0u64, 1, 7, 29] {
+        let x = scene.evaluate_frame(i).patches[0].position.unwrap().x;
+        assert!((x - 100.0 * (i as f64 / 10.0)).abs() < 1e-9);
+    }
+    let mut reused = lapclone::scene::FrameState::default();
+    scene.evaluate_into(1.25, &mut reused);
+    assert_eq!(reused, scene.evaluate(1.25));
+}
+
+/// (script, line, column, message fragment)
+fn assert_error_at(text: &str, line: usize, column: usize, fragment: &str) {
+    let e = parse_err(text);
+    assert_eq!(
+        (e.line(), e.column()),
+        (Some(line), Some(column)),
+        "{e}\nfor:\n{text}"
+    );
+    assert!(
+        e.message.contains(fragment),
+        "message `{}` lacks `{fragment}`",
+        e.message
+    );
+    let shown = e.to_string();
+    assert!(
+        shown.starts_with(&format!("{}:{line}:{column}: ", scene_file().display())),
+        "{shown}"
+    );
+    assert!(
+        shown
+            .lines()
+            .nth(2)
+            .is_some_and(|caret| caret.ends_with('^')),
+        "{shown}"
+    );
+}
+
+#[test]
+fn bad_inputs_are_positioned() {
+    assert_error_at("canvas(64, 48);\nlet x = (1 + ;\n", 2, 14, "syntax error");
+    assert_error_at("canvas(64, 48);\n  nosuch(1);\n", 2, 3, "nosuch");
+    assert_error_at(
+        "canvas(\"wide\", 48);",
+        1,
+        1,
+        "canvas width must be a number",
+    );
+    assert_error_at("canvas(64, 48, #{ fps: 0 });", 1, 1, "fps must be > 0");
+    assert_error_at("canvas(64, 48, #{ fps: -24 });", 1, 1, "fps must be > 0");
+    assert_error_at("canvas(0, 48);", 1, 1, "canvas width");
+    assert_error_at("canvas(64, -1);", 1, 1, "canvas height");
+    assert_error_at("canvas(64, 48, #{ duration: 1.0 / 0.0 });", 1, 1, "finite");
+    assert_error_at("canvas(64, 48, #{ fsp: 3 });", 1, 1, "unknown option `fsp`");
+    assert_error_at(
+        "canvas(64, 48);\nlet p = patch(\"p\", #{ source: \"assets/nope.png\", mask: \"assets/horse_mask.png\" });",
+        2, 9, "nope.png",
+    );
+    assert_error_at(
+        &format!("{HEAD}p.key(1, #{{ at: [1, 2] }});\np.key(0.5, #{{ at: [1, 2] }});"),
+        4,
+        3,
+        "out of order",
+    );
+    assert_error_at(
+        &format!("{HEAD}p.at(-1, [0, 0]);"),
+        3,
+        3,
+        "key time must be ≥ 0",
+    );
+    assert_error_at(
+        &format!("{HEAD}p.at(1, [0, 0], \"bouncy\");"),
+        3,
+        3,
+        "unknown easing `bouncy`",
+    );
+    assert_error_at(&format!("{HEAD}p.at(1, [0, 0.0 / 0.0]);"), 3, 3, "finite");
+    assert_error_at(
+        &format!("{HEAD}p.at(1, \"here\");"),
+        3,
+        3,
+        "must be a point",
+    );
+    assert_error_at(&format!("{HEAD}p.scale(1, 0);"), 3, 3, "must be > 0");
+    assert_error_at(
+        &format!("{HEAD}p.drag([1, 1], -2);"),
+        3,
+        3,
+        "radius must be > 0",
+    );
+    assert_error_at(
+        &format!("{HEAD}\np.drag([1, 1], 2).key(1, [2, 2]).key(0, [3, 3]);"),
+        4,
+        34,
+        "out of order",
+    );
+}
+
+#[test]
+fn errors_inside_functions_point_inside_them() {
+    let text = format!("{HEAD}fn shift(q) {{\n    q.at(-2, [0, 0]);\n}}\nshift(p);\n");
+    let e = parse_err(&text);
+    assert_eq!((e.line(), e.column()), (Some(4), Some(7)), "{e}");
+}
+
+#[test]
+fn a_scene_without_canvas_is_refused() {
+    let e = parse_err("let x = 1;");
+    assert_eq!(e.kind, ErrorKind::Validation);
+    assert!(e.message.contains("no canvas"));
+}
+
+#[test]
+fn runaway_loop_ends_with_an_error() {
+    let e = parse_err("canvas(8, 8);\nloop { }");
+    assert_eq!(e.kind, ErrorKind::Limit, "{e}");
+}
+
+#[test]
+fn deep_recursion_ends_with_an_error() {
+    let e = parse_err("fn down(n) { down(n + 1) }\ndown(0);");
+    assert_eq!(e.kind, ErrorKind::Limit, "{e}");
+}
+
+#[test]
+fn eval_is_disabled() {
+    let e = parse_err("canvas(8, 8);\neval(\"1\");");
+    assert!(
+        matches!(e.kind, ErrorKind::Syntax | ErrorKind::Runtime),
+        "{e}"
+    );
+}
+
+#[test]
+fn cancel_flag_stops_evaluation() {
+    let options = options();
+    options.cancel.store(true, Ordering::Relaxed);
+    let e = parse_scene(
+        "canvas(8, 8);\nlet i = 0;\nwhile i < 1000 { i += 1; }",
+        &scene_file(),
+        &options,
+    )
+    .unwrap_err();
+    assert_eq!(e.kind, ErrorKind::Cancelled, "{e}");
+}
+
+#[test]
+fn imports_outside_the_allowed_folders_are_refused() {
+    for name in ["../etc/passwd", "/etc/passwd", "src/nothing_here", "nope"] {
+        let e = parse_err(&format!("import \"{name}\" as x;\ncanvas(8, 8);"));
+        assert_eq!((e.line(), e.column()), (Some(1), Some(8)), "{name}: {e}");
+    }
+}
+
+#[test]
+fn scripts_resolve_from_the_scene_folder_too() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("local.rhai"), "fn size() { 32 }").unwrap();
+    std::fs::write(dir.path().join("broken.rhai"), "fn size() {\n  1 +\n}").unwrap();
+    let options = ScriptOptions {
+        scene_dir: dir.path().to_path_buf(),
+        ..options()
+    };
+    let file = dir.path().join("s.rhai");
+    let loaded = parse_scene(
+        "import \"local\" as l;\ncanvas(l::size(), 16);",
+        &file,
+        &options,
+    )
+    .unwrap();
+    assert_eq!(loaded.scene.canvas.width, 32);
+    let e = parse_scene("import \"broken\" as b;\ncanvas(8, 8);", &file, &options).unwrap_err();
+    assert_eq!(e.kind, ErrorKind::Syntax);
+    assert!(e.file.ends_with("broken.rhai"), "{e}");
+    assert_eq!(e.line(), Some(3), "{e}");
+}
+
+#[test]
+fn motion_helpers_import_and_produce_keys() {
+    let text = format!(
+        "import \"motion\" as m;\n{HEAD}p.keys(m::wiggle([32, 24], 5, 1, 0, 2, 0.25));\n\
+         let h = p.drag([10, 10], 8);\nh.keys(m::orbit([10, 10], 4, 2, 0, 2, 0.5));\n\
+         let q = patch(\"q\", #{{ source: \"assets/astronaut.png\", mask: \"assets/horse_mask.png\" }});\n\
+         q.keys(m::bounce([0, 40], [60, 40], 10, 3, 0, 3, 0.1));\nq.keys(m::swing([1, 1], [2, 2], 1, 3.5, 2));"
+    );
+    let scene = parse(&text).unwrap();
+    let wiggle = scene.patches[0].placement.position.keys();
+    assert_eq!(wiggle.len(), 9);
+    assert_eq!(wiggle.last().unwrap().time, 2.0);
+    assert!(wiggle
+        .iter()
+        .all(|k| (k.value - DVec2::new(32.0, 24.0)).abs().max_element() <= 5.0 + 1e-9));
+    let orbit = scene.patches[0].handles[0].to.keys();
+    assert!(orbit
+        .iter()
+        .all(|k| ((k.value - DVec2::new(10.0, 10.0)).length() - 4.0).abs() < 1e-9));
+    let keys = scene.patches[1].placement.position.keys();
+    let (bounce, swing) = keys.split_at(31);
+    assert!(bounce
+        .iter()
+        .all(|k| k.value.y <= 40.0 && k.value.y >= 30.0 - 1e-9));
+    assert_eq!(bounce.last().unwrap().value, DVec2::new(60.0, 40.0));
+    let swing_times: Vec<f64> = swing.iter().map(|k| k.time).collect();
+    assert_eq!(swing_times, [3.5, 4.0, 4.5, 5.0, 5.5]);
+    assert!(swing.iter().all(|k| k.easing == Easing::EaseInOut));
+}
+
+#[test]
+fn failed_call_leaves_the_patch_unchanged() {
+    let options = options();
+    let engine = lapclone::script::SceneEngine::new(&options);
+    let mut scope = rhai::Scope::new();
+    let _ = engine.run(&mut scope, HEAD, &scene_file()).unwrap();
+    let _ = engine
+        .run(
+            &mut scope,
+            "p.key(1, #{ at: [1, 1], scale: 2 });",
+            &scene_file(),
+        )
+        .unwrap();
+    let before = engine.draft();
+    // `at` is valid, `scale` is not: neither track may change.
+    engine
+        .run(
+            &mut scope,
+            "p.key(2, #{ at: [2, 2], scale: -1 });",
+            &scene_file(),
+        )
+        .unwrap_err();
+    assert_eq!(engine.draft(), before);
+}
