@@ -22,6 +22,8 @@ fn white_source(width: u32, height: u32) -> FloatImage {
     FloatImage::from_fn(width, height, PixelFormat::RGBA8, |_, _| [1.0; 4]).unwrap()
 }
 
+// A flat helper keeps each test to one line per draw.
+#[allow(clippy::too_many_arguments)]
 fn draw(
     canvas: &mut Canvas,
     rest: &[DVec2],

@@ -43,17 +43,16 @@ fn lerp(a: f32, b: f32, t: f32) -> f32 {
 fn axis_taps(coordinate: f64, size: u32) -> (usize, usize, f32) {
     let last = size.saturating_sub(1) as f64;
     let u = coordinate - 0.5;
-    if !(u > 0.0) {
-        // Also catches NaN: sample the first pixel.
+    if u.is_nan() || u <= 0.0 {
         return (0, 0, 0.0);
     }
     if u >= last {
         let i = last as usize;
         return (i, i, 0.0);
     }
-    let floor = u.floor();
-    let i = floor as usize;
-    (i, i + 1, (u - floor) as f32)
+    // u > 0 here, so truncation is floor (and avoids a libm call without SSE4.1).
+    let i = u as usize;
+    (i, i + 1, (u - i as f64) as f32)
 }
 
 #[cfg(test)]

@@ -254,6 +254,15 @@ pub(crate) fn composite_over_straight(
 ) -> [f32; 4] {
     let keep = 1.0 - source_alpha;
     let dst_alpha = destination[3];
+    if dst_alpha >= 1.0 {
+        // Opaque destination (the common case): no division.
+        return [
+            (source_premultiplied[0] + keep * destination[0]).clamp(0.0, 1.0),
+            (source_premultiplied[1] + keep * destination[1]).clamp(0.0, 1.0),
+            (source_premultiplied[2] + keep * destination[2]).clamp(0.0, 1.0),
+            1.0,
+        ];
+    }
     let out_alpha = source_alpha + keep * dst_alpha;
     if out_alpha <= 0.0 {
         return [0.0; 4];

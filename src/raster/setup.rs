@@ -23,21 +23,15 @@ pub(crate) struct TriangleSetup {
     pub fixed: [[i64; 2]; 3],
     /// Whether the placed triangle is drawable (non-degenerate, in range).
     pub drawable: bool,
-    /// Placed position of vertex 0 (original order).
-    pub origin: DVec2,
-    /// Inverse of the placed edge matrix [b − a, c − a]: position offset → (λ1, λ2).
-    pub to_barycentric: [[f64; 2]; 2],
-    pub rest_origin: DVec2,
-    pub rest_edge1: DVec2,
-    pub rest_edge2: DVec2,
-    pub membrane_origin: [f32; 3],
-    pub membrane_edge1: [f32; 3],
-    pub membrane_edge2: [f32; 3],
-    pub depth_origin: f32,
-    pub depth_edge1: f32,
-    pub depth_edge2: f32,
+    /// Depth as an affine function of the canvas position: `[constant, d/dx, d/dy]`.
+    pub depth_affine: [f64; 3],
     /// Signed placed area ×2 (negative: inverted).
     pub signed_area2: f64,
+    /// Rest x and y as affine functions of the canvas position: `[constant, d/dx, d/dy]`.
+    pub rest_x: [f64; 3],
+    pub rest_y: [f64; 3],
+    /// Membrane channels as affine functions of the canvas position: `[constant, d/dx, d/dy]`.
+    pub membrane_affine: [[f32; 3]; 3],
 }
 
 /// Barycentric-derived values at one canvas position.
@@ -68,47 +62,48 @@ impl TriangleSetup {
             .all(|p| p.abs().max_element() <= MAX_COORDINATE);
         let drawable = in_range && fixed_area != 0 && det != 0.0 && det.is_finite();
         let inv = if drawable { 1.0 / det } else { 0.0 };
-        let sub = |x: [f32; 3], y: [f32; 3]| [x[0] - y[0], x[1] - y[1], x[2] - y[2]];
+        // Barycentric gradients: λ1 = g1·(p − a), λ2 = g2·(p − a).
+        let g1 = DVec2::new(e2.y * inv, -e2.x * inv);
+        let g2 = DVec2::new(-e1.y * inv, e1.x * inv);
+        let affine = |at_a: f64, edge1: f64, edge2: f64| {
+            let gradient = g1 * edge1 + g2 * edge2;
+            [at_a - gradient.dot(a), gradient.x, gradient.y]
+        };
+        let (r1, r2) = (rest[1] - rest[0], rest[2] - rest[0]);
+        let membrane_affine = [0, 1, 2].map(|c| {
+            let m = |k: usize| f64::from(membrane[k][c]);
+            affine(m(0), m(1) - m(0), m(2) - m(0)).map(|v| v as f32)
+        });
         TriangleSetup {
+            rest_x: affine(rest[0].x, r1.x, r2.x),
+            rest_y: affine(rest[0].y, r1.y, r2.y),
+            membrane_affine,
             fixed,
             drawable,
-            origin: a,
-            to_barycentric: [[e2.y * inv, -e2.x * inv], [-e1.y * inv, e1.x * inv]],
-            rest_origin: rest[0],
-            rest_edge1: rest[1] - rest[0],
-            rest_edge2: rest[2] - rest[0],
-            membrane_origin: membrane[0],
-            membrane_edge1: sub(membrane[1], membrane[0]),
-            membrane_edge2: sub(membrane[2], membrane[0]),
-            depth_origin: depth[0],
-            depth_edge1: depth[1] - depth[0],
-            depth_edge2: depth[2] - depth[0],
+            depth_affine: affine(
+                f64::from(depth[0]),
+                f64::from(depth[1]) - f64::from(depth[0]),
+                f64::from(depth[2]) - f64::from(depth[0]),
+            ),
             signed_area2: det,
         }
     }
 
     #[inline]
-    pub fn barycentric(&self, position: DVec2) -> (f64, f64) {
-        let q = position - self.origin;
-        let m = &self.to_barycentric;
-        (m[0][0] * q.x + m[0][1] * q.y, m[1][0] * q.x + m[1][1] * q.y)
+    pub fn depth_at(&self, x: f64, y: f64) -> f32 {
+        let d = &self.depth_affine;
+        (d[0] + d[1] * x + d[2] * y) as f32
     }
 
+    /// Rest position and membrane at a canvas position (extrapolated outside the triangle).
     #[inline]
-    pub fn depth_at(&self, position: DVec2) -> f32 {
-        let (l1, l2) = self.barycentric(position);
-        self.depth_origin + l1 as f32 * self.depth_edge1 + l2 as f32 * self.depth_edge2
-    }
-
-    #[inline]
-    pub fn interpolate(&self, position: DVec2) -> Interpolated {
-        let (l1, l2) = self.barycentric(position);
-        let rest = self.rest_origin + l1 * self.rest_edge1 + l2 * self.rest_edge2;
-        let (f1, f2) = (l1 as f32, l2 as f32);
-        let mut membrane = self.membrane_origin;
-        for (c, m) in membrane.iter_mut().enumerate() {
-            *m += f1 * self.membrane_edge1[c] + f2 * self.membrane_edge2[c];
-        }
+    pub fn interpolate(&self, x: f64, y: f64) -> Interpolated {
+        let rest = DVec2::new(
+            self.rest_x[0] + self.rest_x[1] * x + self.rest_x[2] * y,
+            self.rest_y[0] + self.rest_y[1] * x + self.rest_y[2] * y,
+        );
+        let (xf, yf) = (x as f32, y as f32);
+        let membrane = self.membrane_affine.map(|m| m[0] + m[1] * xf + m[2] * yf);
         Interpolated { rest, membrane }
     }
 }

@@ -7,8 +7,6 @@
 //! the triangle of the nearest hit pixel within two pixels (ties broken by a fixed scan
 //! order), so the anti-aliased fringe continues the patch's colours instead of guessing.
 
-use glam::DVec2;
-
 use super::setup::TriangleSetup;
 use super::triangles::NO_TRIANGLE;
 use super::PixelRect;
@@ -74,8 +72,8 @@ pub(crate) fn shade_and_composite<T: Texel>(
             let Some(triangle) = owning_triangle(input, x, y) else {
                 continue;
             };
-            let position = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
-            let colour = patch_colour(&input.setups[triangle as usize], input.source, position);
+            let (cx, cy) = (f64::from(x) + 0.5, f64::from(y) + 0.5);
+            let colour = patch_colour(&input.setups[triangle as usize], input.source, cx, cy);
             let alpha = coverage.min(1.0) * colour[3];
             if alpha <= 0.0 {
                 continue;
@@ -92,8 +90,8 @@ pub(crate) fn shade_and_composite<T: Texel>(
 }
 
 #[inline]
-fn patch_colour(setup: &TriangleSetup, source: &FloatImage, position: DVec2) -> [f32; 4] {
-    let values = setup.interpolate(position);
+fn patch_colour(setup: &TriangleSetup, source: &FloatImage, x: f64, y: f64) -> [f32; 4] {
+    let values = setup.interpolate(x, y);
     let sample = source.sample_bilinear(values.rest.x, values.rest.y);
     [
         (sample[0] + values.membrane[0]).clamp(0.0, 1.0),

@@ -64,8 +64,7 @@ fn rasterise_one(
     scan_fixed(setup.fixed, work, |x, y| {
         let cell = (y - work.y0) as usize * width + (x - work.x0) as usize;
         if use_depth {
-            let position = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
-            let depth = setup.depth_at(position);
+            let depth = setup.depth_at(f64::from(x) + 0.5, f64::from(y) + 0.5);
             if depth >= depths[cell] {
                 depths[cell] = depth;
                 ids[cell] = index;
