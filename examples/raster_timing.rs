@@ -1,0 +1,123 @@
+//! Times the raster alone: a ~2,500-vertex patch covering ~400×400 px drawn into a
+//! 1920×1080 canvas, per frame (reset by `copy_from` + `draw_patch`). Run with
+//! `cargo run --release --example raster_timing`.
+
+use std::time::Instant;
+
+use glam::{DAffine2, DVec2};
+use lapclone::mesh::{BoundaryLoop, LoopKind};
+use lapclone::pixels::{Canvas, FloatImage, PixelFormat};
+use lapclone::raster::{
+    covered_boundary_vertices, draw_patch, CoverageGrid, Patch, RasterOptions, RasterScratch,
+};
+
+fn main() {
+    let side = 50u32; // 51×51 = 2,601 vertices, 5,000 triangles
+    let cell = 8.0;
+    let index = |i: u32, j: u32| j * (side + 1) + i;
+    let mut rest = Vec::new();
+    for j in 0..=side {
+        for i in 0..=side {
+            rest.push(DVec2::new(
+                40.0 + f64::from(i) * cell,
+                40.0 + f64::from(j) * cell,
+            ));
+        }
+    }
+    let mut triangles = Vec::new();
+    for j in 0..side {
+        for i in 0..side {
+            triangles.push([index(i, j), index(i + 1, j), index(i, j + 1)]);
+            triangles.push([index(i + 1, j), index(i + 1, j + 1), index(i, j + 1)]);
+        }
+    }
+    let mut boundary = Vec::new();
+    boundary.extend((0..side).map(|i| index(i, 0)));
+    boundary.extend((0..side).map(|j| index(side, j)));
+    boundary.extend((1..=side).rev().map(|i| index(i, side)));
+    boundary.extend((1..=side).rev().map(|j| index(0, j)));
+    let loops = vec![BoundaryLoop {
+        kind: LoopKind::Outer,
+        piece: 0,
+        vertices: boundary.clone(),
+    }];
+    let source = FloatImage::from_fn(480, 480, PixelFormat::RGBA8, |i, j| {
+        [i as f32 / 480.0, j as f32 / 480.0, 0.5, 1.0]
+    })
+    .expect("non-empty");
+    let background = Canvas::from_image(
+        &FloatImage::from_fn(1920, 1080, PixelFormat::RGBA8, |i, j| {
+            [0.2, (i ^ j) as f32 / 4096.0, 0.4, 1.0]
+        })
+        .expect("non-empty"),
+    );
+    let membrane: Vec<[f32; 3]> = rest
+        .iter()
+        .map(|p| [(p.x * 0.001) as f32, -0.05, (p.y * 0.0005) as f32])
+        .collect();
+    let depth: Vec<f32> = rest.iter().map(|p| (p.x * 0.01) as f32).collect();
+    let mut canvas = background.clone();
+    let mut scratch = RasterScratch::new();
+    let mut grid = CoverageGrid::new();
+    let mut covered = Vec::new();
+    for (label, feather, with_depth) in [
+        ("plain", 0.0f32, false),
+        ("depth", 0.0, true),
+        ("depth+feather 4", 4.0, true),
+    ] {
+        let frames = 300;
+        let mut raster_total = 0.0;
+        let mut reset_total = 0.0;
+        let mut query_total = 0.0;
+        for frame in 0..frames {
+            let angle = 0.1 + 0.002 * f64::from(frame);
+            let place =
+                DAffine2::from_translation(DVec2::new(900.0 + f64::from(frame % 50), 500.0))
+                    * DAffine2::from_angle(angle)
+                    * DAffine2::from_translation(-DVec2::new(240.0, 240.0));
+            let placed: Vec<DVec2> = rest.iter().map(|&p| place.transform_point2(p)).collect();
+            let t0 = Instant::now();
+            canvas.copy_from(&background);
+            let t1 = Instant::now();
+            let patch = Patch {
+                rest: &rest,
+                placed: &placed,
+                triangles: &triangles,
+                membrane: &membrane,
+                depth: with_depth.then_some(&depth[..]),
+                loops: &loops,
+                source: &source,
+            };
+            let options = RasterOptions {
+                feather,
+                anti_alias: true,
+            };
+            draw_patch(&mut canvas, &patch, &options, &mut scratch).expect("valid patch");
+            let t2 = Instant::now();
+            covered_boundary_vertices(
+                &placed,
+                &triangles,
+                &depth,
+                &boundary,
+                &mut grid,
+                &mut covered,
+            )
+            .expect("valid");
+            let t3 = Instant::now();
+            if frame >= 20 {
+                reset_total += (t1 - t0).as_secs_f64();
+                raster_total += (t2 - t1).as_secs_f64();
+                query_total += (t3 - t2).as_secs_f64();
+            }
+        }
+        let n = f64::from(frames - 20);
+        println!(
+            "{label:>16}: draw_patch {:.3} ms/frame, canvas reset {:.3} ms, coverage query {:.3} ms ({} verts, {} tris)",
+            raster_total / n * 1e3,
+            reset_total / n * 1e3,
+            query_total / n * 1e3,
+            rest.len(),
+            triangles.len()
+        );
+    }
+}

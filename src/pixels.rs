@@ -1,1 +1,0 @@
-//! Float images shared by all stages (not yet implemented).

@@ -1,0 +1,96 @@
+//! Bilinear sampling: takes a row-major RGBA buffer (any [`Texel`] type) and a point in pixel
+//! coordinates and gives the interpolated straight RGBA colour in [0, 1].
+//!
+//! Pixel-centre convention: pixel (i, j) is exact at (i + 0.5, j + 0.5); outside the centres'
+//! hull the edge pixels are repeated (clamp to edge).
+
+use super::Texel;
+
+/// Samples `pixels` (`width` × `height`, row-major) at `(x, y)`.
+///
+/// The buffer must hold `width * height` pixels and both sizes must be non-zero (every
+/// image type of this crate guarantees it). Non-finite coordinates sample pixel (0, 0).
+#[inline]
+pub fn sample_bilinear_rgba<T: Texel>(
+    pixels: &[[T; 4]],
+    width: u32,
+    height: u32,
+    x: f64,
+    y: f64,
+) -> [f32; 4] {
+    let (x0, x1, tx) = axis_taps(x, width);
+    let (y0, y1, ty) = axis_taps(y, height);
+    let w = width as usize;
+    let row0 = &pixels[y0 * w..y0 * w + w];
+    let row1 = &pixels[y1 * w..y1 * w + w];
+    let (p00, p10, p01, p11) = (row0[x0], row0[x1], row1[x0], row1[x1]);
+    let mut out = [0.0f32; 4];
+    for c in 0..4 {
+        let top = lerp(p00[c].to_unit(), p10[c].to_unit(), tx);
+        let bottom = lerp(p01[c].to_unit(), p11[c].to_unit(), tx);
+        out[c] = lerp(top, bottom, ty);
+    }
+    out
+}
+
+#[inline]
+fn lerp(a: f32, b: f32, t: f32) -> f32 {
+    a + (b - a) * t
+}
+
+/// The two neighbouring pixel indices along one axis and the weight of the second one.
+#[inline]
+fn axis_taps(coordinate: f64, size: u32) -> (usize, usize, f32) {
+    let last = size.saturating_sub(1) as f64;
+    let u = coordinate - 0.5;
+    if u.is_nan() || u <= 0.0 {
+        return (0, 0, 0.0);
+    }
+    if u >= last {
+        let i = last as usize;
+        return (i, i, 0.0);
+    }
+    // u > 0 here, so truncation is floor (and avoids a libm call without SSE4.1).
+    let i = u as usize;
+    (i, i + 1, (u - i as f64) as f32)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hand_computed_value() {
+        // 2×2 grey ramp; (1.25, 0.75) lies 0.75 of the way from column 0 to 1 and 0.25 of
+        // the way from row 0 to 1: top = 0.1 + 0.75·(0.3 − 0.1) = 0.25,
+        // bottom = 0.5 + 0.75·(0.9 − 0.5) = 0.8, value = 0.25 + 0.25·(0.8 − 0.25) = 0.3875.
+        let px = |v: f32| [v, v, v, 1.0];
+        let pixels = [px(0.1), px(0.3), px(0.5), px(0.9)];
+        let s = sample_bilinear_rgba(&pixels, 2, 2, 1.25, 0.75);
+        assert!((s[0] - 0.3875).abs() < 1e-6, "{s:?}");
+        assert_eq!(s[3], 1.0);
+    }
+
+    #[test]
+    fn exact_at_centres_and_clamped_outside() {
+        let pixels: Vec<[f32; 4]> = (0..6).map(|i| [i as f32 / 8.0, 0.0, 0.0, 1.0]).collect();
+        for j in 0..2 {
+            for i in 0..3 {
+                let s = sample_bilinear_rgba(&pixels, 3, 2, i as f64 + 0.5, j as f64 + 0.5);
+                assert_eq!(s[0], pixels[j * 3 + i][0]);
+            }
+        }
+        assert_eq!(
+            sample_bilinear_rgba(&pixels, 3, 2, -5.0, -5.0)[0],
+            pixels[0][0]
+        );
+        assert_eq!(
+            sample_bilinear_rgba(&pixels, 3, 2, 50.0, 50.0)[0],
+            pixels[5][0]
+        );
+        assert_eq!(
+            sample_bilinear_rgba(&pixels, 3, 2, f64::NAN, 0.5)[0],
+            pixels[0][0]
+        );
+    }
+}

@@ -1,0 +1,322 @@
+//! The compositing canvas: takes a [`FloatImage`] (the target or background) and gives the
+//! frame being drawn on, stored in the output bit depth — RGBA `u8` for 8-bit targets, RGBA
+//! `u16` for 16-bit ones — with float reads, bilinear sampling, an allocation-free reset
+//! ([`Canvas::copy_from`]) and PNG output in any [`PixelFormat`].
+
+use std::path::Path;
+
+use super::png_encode::encode_png_rgba;
+use super::{sample_bilinear_rgba, Depth, FloatImage, PixelError, PixelFormat};
+
+/// A channel type that stores a value in [0, 1].
+pub trait Texel: Copy + Send + Sync + 'static {
+    fn to_unit(self) -> f32;
+    /// Rounds a value in [0, 1] (clamped) to the nearest representable one.
+    fn from_unit(value: f32) -> Self;
+}
+
+impl Texel for f32 {
+    #[inline]
+    fn to_unit(self) -> f32 {
+        self
+    }
+    #[inline]
+    fn from_unit(value: f32) -> Self {
+        value.clamp(0.0, 1.0)
+    }
+}
+
+impl Texel for u8 {
+    #[inline]
+    fn to_unit(self) -> f32 {
+        f32::from(self) * (1.0 / 255.0)
+    }
+    #[inline]
+    fn from_unit(value: f32) -> Self {
+        // `as` saturates and maps NaN to 0.
+        (value * 255.0 + 0.5) as u8
+    }
+}
+
+impl Texel for u16 {
+    #[inline]
+    fn to_unit(self) -> f32 {
+        f32::from(self) * (1.0 / 65535.0)
+    }
+    #[inline]
+    fn from_unit(value: f32) -> Self {
+        (value * 65535.0 + 0.5) as u16
+    }
+}
+
+/// Canvas storage in the output bit depth (straight, non-premultiplied RGBA, row-major).
+#[derive(Clone, Debug, PartialEq)]
+pub enum CanvasPixels {
+    Eight(Vec<[u8; 4]>),
+    Sixteen(Vec<[u16; 4]>),
+}
+
+/// The frame being composited.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Canvas {
+    width: u32,
+    height: u32,
+    pixels: CanvasPixels,
+}
+
+impl Canvas {
+    /// A transparent canvas; both sizes must be non-zero.
+    pub fn new(width: u32, height: u32, depth: Depth) -> Result<Canvas, PixelError> {
+        if width == 0 || height == 0 {
+            return Err(PixelError::EmptyImage { width, height });
+        }
+        let count = width as usize * height as usize;
+        let pixels = match depth {
+            Depth::Eight => CanvasPixels::Eight(vec![[0; 4]; count]),
+            Depth::Sixteen => CanvasPixels::Sixteen(vec![[0; 4]; count]),
+        };
+        Ok(Canvas {
+            width,
+            height,
+            pixels,
+        })
+    }
+
+    /// The image quantised to its own bit depth.
+    pub fn from_image(image: &FloatImage) -> Canvas {
+        let pixels = match image.format().depth {
+            Depth::Eight => CanvasPixels::Eight(quantise(image.pixels())),
+            Depth::Sixteen => CanvasPixels::Sixteen(quantise(image.pixels())),
+        };
+        Canvas {
+            width: image.width(),
+            height: image.height(),
+            pixels,
+        }
+    }
+
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+
+    pub fn depth(&self) -> Depth {
+        match self.pixels {
+            CanvasPixels::Eight(_) => Depth::Eight,
+            CanvasPixels::Sixteen(_) => Depth::Sixteen,
+        }
+    }
+
+    pub fn pixels(&self) -> &CanvasPixels {
+        &self.pixels
+    }
+
+    pub fn pixels_mut(&mut self) -> &mut CanvasPixels {
+        &mut self.pixels
+    }
+
+    /// Makes this canvas equal to `other`: one memcpy when size and depth agree (the
+    /// per-frame "reset to background"), a reallocation otherwise.
+    pub fn copy_from(&mut self, other: &Canvas) {
+        match (&mut self.pixels, &other.pixels) {
+            (CanvasPixels::Eight(dst), CanvasPixels::Eight(src)) if dst.len() == src.len() => {
+                dst.copy_from_slice(src)
+            }
+            (CanvasPixels::Sixteen(dst), CanvasPixels::Sixteen(src)) if dst.len() == src.len() => {
+                dst.copy_from_slice(src)
+            }
+            _ => self.pixels = other.pixels.clone(),
+        }
+        self.width = other.width;
+        self.height = other.height;
+    }
+
+    /// Pixel (i, j) as straight RGBA in [0, 1]; `None` outside the canvas.
+    pub fn pixel_f32(&self, i: u32, j: u32) -> Option<[f32; 4]> {
+        if i >= self.width || j >= self.height {
+            return None;
+        }
+        let index = j as usize * self.width as usize + i as usize;
+        Some(match &self.pixels {
+            CanvasPixels::Eight(p) => p[index].map(Texel::to_unit),
+            CanvasPixels::Sixteen(p) => p[index].map(Texel::to_unit),
+        })
+    }
+
+    /// Bilinear sample at `(x, y)` (pixel centres at i + 0.5, clamped to edge).
+    pub fn sample_bilinear(&self, x: f64, y: f64) -> [f32; 4] {
+        match &self.pixels {
+            CanvasPixels::Eight(p) => sample_bilinear_rgba(p, self.width, self.height, x, y),
+            CanvasPixels::Sixteen(p) => sample_bilinear_rgba(p, self.width, self.height, x, y),
+        }
+    }
+
+    /// The canvas as a float image tagged with `format`.
+    pub fn to_float_image(&self, format: PixelFormat) -> FloatImage {
+        let pixels = match &self.pixels {
+            CanvasPixels::Eight(p) => p.iter().map(|px| px.map(Texel::to_unit)).collect(),
+            CanvasPixels::Sixteen(p) => p.iter().map(|px| px.map(Texel::to_unit)).collect(),
+        };
+        // invariant: the canvas is non-empty and holds width·height pixels.
+        FloatImage::new(self.width, self.height, pixels, format).expect("canvas is well-formed")
+    }
+
+    /// PNG bytes in `format` (grey formats store Rec. 709 luma; without alpha the alpha
+    /// channel is dropped, not composited).
+    pub fn encode_png(&self, format: PixelFormat) -> Result<Vec<u8>, PixelError> {
+        match &self.pixels {
+            CanvasPixels::Eight(p) => encode_png_rgba(p, self.width, self.height, format),
+            CanvasPixels::Sixteen(p) => encode_png_rgba(p, self.width, self.height, format),
+        }
+    }
+
+    /// Writes a PNG in `format` atomically (temporary file, then rename).
+    pub fn save_png(&self, path: &Path, format: PixelFormat) -> Result<(), PixelError> {
+        let bytes = self.encode_png(format)?;
+        crate::util::write_atomic(path, &bytes).map_err(|source| PixelError::Write {
+            path: path.to_path_buf(),
+            source,
+        })
+    }
+
+    /// An 8-bit premultiplied copy for tiny-skia drawing (16-bit values are rounded).
+    pub fn to_tiny_skia_pixmap(&self) -> tiny_skia::Pixmap {
+        // invariant: the canvas size is non-zero (checked at construction).
+        let mut pixmap = tiny_skia::Pixmap::new(self.width, self.height).expect("non-empty");
+        let write = |dst: &mut [tiny_skia::PremultipliedColorU8],
+                     rgba: &mut dyn Iterator<Item = [f32; 4]>| {
+            for (d, [r, g, b, a]) in dst.iter_mut().zip(rgba) {
+                let c = tiny_skia::ColorU8::from_rgba(
+                    u8::from_unit(r),
+                    u8::from_unit(g),
+                    u8::from_unit(b),
+                    u8::from_unit(a),
+                );
+                *d = c.premultiply();
+            }
+        };
+        match &self.pixels {
+            CanvasPixels::Eight(p) => write(
+                pixmap.pixels_mut(),
+                &mut p.iter().map(|px| px.map(Texel::to_unit)),
+            ),
+            CanvasPixels::Sixteen(p) => write(
+                pixmap.pixels_mut(),
+                &mut p.iter().map(|px| px.map(Texel::to_unit)),
+            ),
+        }
+        pixmap
+    }
+
+    /// Composites a premultiplied tiny-skia pixmap of the same size over the canvas
+    /// (source-over; overlays drawn on a transparent pixmap). Other sizes are an error.
+    pub fn draw_pixmap_over(&mut self, pixmap: &tiny_skia::Pixmap) -> Result<(), PixelError> {
+        if pixmap.width() != self.width || pixmap.height() != self.height {
+            return Err(PixelError::BufferSize {
+                width: self.width,
+                height: self.height,
+                actual: pixmap.pixels().len(),
+            });
+        }
+        match &mut self.pixels {
+            CanvasPixels::Eight(p) => blend_premultiplied_over(p, pixmap.pixels()),
+            CanvasPixels::Sixteen(p) => blend_premultiplied_over(p, pixmap.pixels()),
+        }
+        Ok(())
+    }
+}
+
+fn quantise<T: Texel>(pixels: &[[f32; 4]]) -> Vec<[T; 4]> {
+    pixels.iter().map(|px| px.map(T::from_unit)).collect()
+}
+
+fn blend_premultiplied_over<T: Texel>(dst: &mut [[T; 4]], src: &[tiny_skia::PremultipliedColorU8]) {
+    for (d, s) in dst.iter_mut().zip(src) {
+        if s.alpha() == 0 {
+            continue;
+        }
+        let alpha = s.alpha().to_unit();
+        let premultiplied = [s.red().to_unit(), s.green().to_unit(), s.blue().to_unit()];
+        *d = composite_over_straight(premultiplied, alpha, d.map(Texel::to_unit)).map(T::from_unit);
+    }
+}
+
+/// Source-over in straight alpha: `source_premultiplied` is the source colour times
+/// `source_alpha`. When the destination is opaque this is `src·α + (1 − α)·dst`.
+#[inline]
+pub(crate) fn composite_over_straight(
+    source_premultiplied: [f32; 3],
+    source_alpha: f32,
+    destination: [f32; 4],
+) -> [f32; 4] {
+    let keep = 1.0 - source_alpha;
+    let dst_alpha = destination[3];
+    if dst_alpha >= 1.0 {
+        // Opaque destination (the common case): no division.
+        return [
+            (source_premultiplied[0] + keep * destination[0]).clamp(0.0, 1.0),
+            (source_premultiplied[1] + keep * destination[1]).clamp(0.0, 1.0),
+            (source_premultiplied[2] + keep * destination[2]).clamp(0.0, 1.0),
+            1.0,
+        ];
+    }
+    let out_alpha = source_alpha + keep * dst_alpha;
+    if out_alpha <= 0.0 {
+        return [0.0; 4];
+    }
+    let weight = keep * dst_alpha;
+    let mut out = [0.0, 0.0, 0.0, out_alpha];
+    for c in 0..3 {
+        out[c] = ((source_premultiplied[c] + weight * destination[c]) / out_alpha).clamp(0.0, 1.0);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn texel_round_trips_are_exact() {
+        for v in 0..=255u8 {
+            assert_eq!(u8::from_unit(v.to_unit()), v);
+        }
+        for v in (0..=65535u16).step_by(7) {
+            assert_eq!(u16::from_unit(v.to_unit()), v);
+        }
+        assert_eq!(u8::from_unit(f32::NAN), 0);
+        assert_eq!(u8::from_unit(7.0), 255);
+    }
+
+    #[test]
+    fn over_opaque_is_the_linear_mix() {
+        let out = composite_over_straight([0.25, 0.0, 0.5], 0.5, [0.2, 0.4, 0.6, 1.0]);
+        let expected = [0.25 + 0.5 * 0.2, 0.5 * 0.4, 0.5 + 0.5 * 0.6, 1.0];
+        for c in 0..4 {
+            assert!((out[c] - expected[c]).abs() < 1e-6, "{out:?}");
+        }
+    }
+
+    #[test]
+    fn copy_from_resets_without_reallocating() {
+        let image = FloatImage::from_fn(3, 2, PixelFormat::RGBA8, |i, j| {
+            [i as f32 / 3.0, j as f32 / 2.0, 0.5, 1.0]
+        })
+        .unwrap();
+        let background = Canvas::from_image(&image);
+        let mut frame = Canvas::new(3, 2, Depth::Eight).unwrap();
+        let before = match frame.pixels() {
+            CanvasPixels::Eight(p) => p.as_ptr(),
+            CanvasPixels::Sixteen(_) => unreachable!(),
+        };
+        frame.copy_from(&background);
+        assert_eq!(frame, background);
+        match frame.pixels() {
+            CanvasPixels::Eight(p) => assert_eq!(p.as_ptr(), before),
+            CanvasPixels::Sixteen(_) => unreachable!(),
+        }
+    }
+}

@@ -1,0 +1,196 @@
+//! The float source image: takes an image file or `image::DynamicImage` and gives a
+//! [`FloatImage`] — straight (non-premultiplied) RGBA `f32` in [0, 1], row-major, with the
+//! [`PixelFormat`] it was stored in. Grey images are expanded to R = G = B.
+
+use std::path::Path;
+
+use super::{sample_bilinear_rgba, ColorKind, Depth, PixelError, PixelFormat};
+
+/// Rec. 709 luma weights (sum exactly 1 in real numbers).
+pub(crate) const LUMA_709: [f32; 3] = [0.2126, 0.7152, 0.0722];
+
+/// A straight-alpha RGBA float image.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FloatImage {
+    width: u32,
+    height: u32,
+    pixels: Vec<[f32; 4]>,
+    format: PixelFormat,
+}
+
+impl FloatImage {
+    /// Wraps a pixel buffer; `pixels.len()` must be `width * height`, both non-zero.
+    pub fn new(
+        width: u32,
+        height: u32,
+        pixels: Vec<[f32; 4]>,
+        format: PixelFormat,
+    ) -> Result<FloatImage, PixelError> {
+        if width == 0 || height == 0 {
+            return Err(PixelError::EmptyImage { width, height });
+        }
+        if pixels.len() != width as usize * height as usize {
+            return Err(PixelError::BufferSize {
+                width,
+                height,
+                actual: pixels.len(),
+            });
+        }
+        Ok(FloatImage {
+            width,
+            height,
+            pixels,
+            format,
+        })
+    }
+
+    /// An image whose pixel (i, j) is `colour(i, j)`.
+    pub fn from_fn(
+        width: u32,
+        height: u32,
+        format: PixelFormat,
+        mut colour: impl FnMut(u32, u32) -> [f32; 4],
+    ) -> Result<FloatImage, PixelError> {
+        let mut pixels = Vec::with_capacity(width as usize * height as usize);
+        for j in 0..height {
+            for i in 0..width {
+                pixels.push(colour(i, j));
+            }
+        }
+        FloatImage::new(width, height, pixels, format)
+    }
+
+    /// Reads and decodes an image file (format guessed from its content).
+    pub fn load(path: &Path) -> Result<FloatImage, PixelError> {
+        let read_error = |source| PixelError::Read {
+            path: path.to_path_buf(),
+            source,
+        };
+        let decoded = image::ImageReader::open(path)
+            .map_err(read_error)?
+            .with_guessed_format()
+            .map_err(read_error)?
+            .decode()
+            .map_err(|source| PixelError::Decode {
+                path: path.to_path_buf(),
+                source,
+            })?;
+        FloatImage::from_dynamic(&decoded).map_err(|err| match err {
+            PixelError::EmptyImage { width, height } => PixelError::Empty {
+                path: path.to_path_buf(),
+                width,
+                height,
+            },
+            other => other,
+        })
+    }
+
+    /// Converts a decoded image, keeping its format for output.
+    pub fn from_dynamic(image: &image::DynamicImage) -> Result<FloatImage, PixelError> {
+        let format = PixelFormat::of(image);
+        let (width, height) = (image.width(), image.height());
+        let pixels: Vec<[f32; 4]> = match image {
+            image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_) => image
+                .to_rgba32f()
+                .pixels()
+                .map(|p| {
+                    p.0.map(|v| if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) })
+                })
+                .collect(),
+            _ if format.depth == Depth::Eight => image
+                .to_rgba8()
+                .pixels()
+                .map(|p| p.0.map(|v| f32::from(v) / 255.0))
+                .collect(),
+            _ => image
+                .to_rgba16()
+                .pixels()
+                .map(|p| p.0.map(|v| f32::from(v) / 65535.0))
+                .collect(),
+        };
+        FloatImage::new(width, height, pixels, format)
+    }
+
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+
+    pub fn format(&self) -> PixelFormat {
+        self.format
+    }
+
+    /// Row-major straight RGBA pixels.
+    pub fn pixels(&self) -> &[[f32; 4]] {
+        &self.pixels
+    }
+
+    pub fn pixels_mut(&mut self) -> &mut [[f32; 4]] {
+        &mut self.pixels
+    }
+
+    /// Pixel (i, j); `None` outside the image.
+    pub fn pixel(&self, i: u32, j: u32) -> Option<[f32; 4]> {
+        (i < self.width && j < self.height)
+            .then(|| self.pixels[j as usize * self.width as usize + i as usize])
+    }
+
+    /// Bilinear sample at `(x, y)` in pixel coordinates (centres at i + 0.5), clamped to edge.
+    #[inline]
+    pub fn sample_bilinear(&self, x: f64, y: f64) -> [f32; 4] {
+        sample_bilinear_rgba(&self.pixels, self.width, self.height, x, y)
+    }
+
+    /// Rec. 709 luma into R = G = B, alpha kept (the `monochrome` cloning mode). The format
+    /// becomes grey.
+    pub fn to_grey(&self) -> FloatImage {
+        let pixels = self
+            .pixels
+            .iter()
+            .map(|&[r, g, b, a]| {
+                let luma = (LUMA_709[0] * r + LUMA_709[1] * g + LUMA_709[2] * b).clamp(0.0, 1.0);
+                [luma, luma, luma, a]
+            })
+            .collect();
+        FloatImage {
+            width: self.width,
+            height: self.height,
+            pixels,
+            format: PixelFormat {
+                color: ColorKind::Grey,
+                ..self.format
+            },
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn grey_of_grey_is_identity_and_of_colour_is_luma() {
+        let image = FloatImage::from_fn(2, 1, PixelFormat::RGBA8, |i, _| {
+            if i == 0 {
+                [0.4, 0.4, 0.4, 0.5]
+            } else {
+                [1.0, 0.0, 0.0, 1.0]
+            }
+        })
+        .unwrap();
+        let grey = image.to_grey();
+        assert!((grey.pixels()[0][0] - 0.4).abs() < 1e-6);
+        assert_eq!(grey.pixels()[0][3], 0.5);
+        assert!((grey.pixels()[1][1] - 0.2126).abs() < 1e-6);
+        assert_eq!(grey.format().color, ColorKind::Grey);
+    }
+
+    #[test]
+    fn empty_and_mismatched_buffers_are_errors() {
+        assert!(FloatImage::new(0, 3, vec![], PixelFormat::RGBA8).is_err());
+        assert!(FloatImage::new(2, 2, vec![[0.0; 4]; 3], PixelFormat::RGBA8).is_err());
+    }
+}

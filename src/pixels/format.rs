@@ -1,0 +1,66 @@
+//! Pixel formats: takes an `image::DynamicImage` and gives the [`PixelFormat`] (grey or RGB,
+//! alpha or not, 8 or 16 bit) that output PNGs reproduce.
+
+/// Colour model of an image file.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ColorKind {
+    Grey,
+    Rgb,
+}
+
+/// Bits per channel of an image file (32-bit float inputs count as 16-bit for output).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Depth {
+    Eight,
+    Sixteen,
+}
+
+/// The format an image was stored in, kept so the output matches the target's.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct PixelFormat {
+    pub color: ColorKind,
+    pub alpha: bool,
+    pub depth: Depth,
+}
+
+impl PixelFormat {
+    pub const RGBA8: PixelFormat = PixelFormat {
+        color: ColorKind::Rgb,
+        alpha: true,
+        depth: Depth::Eight,
+    };
+    pub const RGBA16: PixelFormat = PixelFormat {
+        color: ColorKind::Rgb,
+        alpha: true,
+        depth: Depth::Sixteen,
+    };
+
+    /// Detects the format of a decoded image.
+    pub fn of(image: &image::DynamicImage) -> PixelFormat {
+        let color_type = image.color();
+        let channels = u16::from(color_type.channel_count()).max(1);
+        let bytes_per_channel = u16::from(color_type.bytes_per_pixel()) / channels;
+        PixelFormat {
+            color: if color_type.has_color() {
+                ColorKind::Rgb
+            } else {
+                ColorKind::Grey
+            },
+            alpha: color_type.has_alpha(),
+            depth: if bytes_per_channel <= 1 {
+                Depth::Eight
+            } else {
+                Depth::Sixteen
+            },
+        }
+    }
+
+    /// Channels per pixel in a file of this format.
+    pub fn channel_count(self) -> usize {
+        let colour = match self.color {
+            ColorKind::Grey => 1,
+            ColorKind::Rgb => 3,
+        };
+        colour + usize::from(self.alpha)
+    }
+}

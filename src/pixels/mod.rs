@@ -1,0 +1,26 @@
+//! Pixels shared by all stages: takes image files or `image::DynamicImage`s in and gives
+//! [`FloatImage`]s (straight RGBA `f32` in [0, 1], for sources and targets as loaded) and
+//! [`Canvas`]es (the frame being composited, in the target's output bit depth), plus PNG
+//! output in the target's original [`PixelFormat`].
+//!
+//! Coordinates follow the mesh convention: x right, y down, pixel (i, j) covers
+//! [i, i+1] × [j, j+1] and its centre is (i + 0.5, j + 0.5); bilinear sampling is exact at
+//! pixel centres and clamps to the edge outside the image.
+//!
+//! 16-bit output: tiny-skia only holds 8-bit premultiplied pixmaps, so 16-bit canvases are
+//! stored as `u16` here and encoded with the `png` crate directly; [`Canvas::to_tiny_skia_pixmap`]
+//! exists for 8-bit overlays (a 16-bit canvas is rounded down to 8 bits for it).
+
+mod bilinear;
+mod canvas;
+mod error;
+mod float_image;
+mod format;
+mod png_encode;
+
+pub use bilinear::sample_bilinear_rgba;
+pub(crate) use canvas::composite_over_straight as canvas_composite_over;
+pub use canvas::{Canvas, CanvasPixels, Texel};
+pub use error::PixelError;
+pub use float_image::FloatImage;
+pub use format::{ColorKind, Depth, PixelFormat};

@@ -1,0 +1,30 @@
+//! Errors of the raster stage: takes malformed patch input and gives a typed error naming the
+//! offending array and index.
+
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum RasterError {
+    #[error("{what} has {actual} entries, expected {expected}")]
+    LengthMismatch {
+        what: &'static str,
+        expected: usize,
+        actual: usize,
+    },
+    #[error("triangle {triangle} refers to vertex {vertex}, but there are only {vertex_count}")]
+    TriangleIndex {
+        triangle: usize,
+        vertex: u32,
+        vertex_count: usize,
+    },
+    #[error("boundary loop {boundary_loop} refers to vertex {vertex}, but there are only {vertex_count}")]
+    LoopIndex {
+        boundary_loop: usize,
+        vertex: u32,
+        vertex_count: usize,
+    },
+    #[error("candidate vertex {vertex} is out of range (there are {vertex_count})")]
+    CandidateIndex { vertex: u32, vertex_count: usize },
+    #[error("{what}[{index}] is not finite")]
+    NonFinite { what: &'static str, index: usize },
+    #[error("feather must be finite and ≥ 0, got {0}")]
+    Feather(f32),
+}

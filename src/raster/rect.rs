@@ -1,0 +1,47 @@
+//! Integer pixel rectangles: takes pixel bounds and gives half-open rectangles
+//! [x0, x1) × [y0, y1) with intersection and size helpers.
+
+/// A half-open rectangle of pixels, [x0, x1) × [y0, y1).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub struct PixelRect {
+    pub x0: i32,
+    pub y0: i32,
+    pub x1: i32,
+    pub y1: i32,
+}
+
+impl PixelRect {
+    pub fn width(&self) -> usize {
+        (self.x1 - self.x0).max(0) as usize
+    }
+
+    pub fn height(&self) -> usize {
+        (self.y1 - self.y0).max(0) as usize
+    }
+
+    pub fn area(&self) -> usize {
+        self.width() * self.height()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.area() == 0
+    }
+
+    pub fn intersect(&self, other: &PixelRect) -> PixelRect {
+        PixelRect {
+            x0: self.x0.max(other.x0),
+            y0: self.y0.max(other.y0),
+            x1: self.x1.min(other.x1),
+            y1: self.y1.min(other.y1),
+        }
+    }
+
+    pub fn grow(&self, margin: i32) -> PixelRect {
+        PixelRect {
+            x0: self.x0.saturating_sub(margin),
+            y0: self.y0.saturating_sub(margin),
+            x1: self.x1.saturating_add(margin),
+            y1: self.y1.saturating_add(margin),
+        }
+    }
+}

@@ -1,0 +1,140 @@
+//! Exact triangle coverage with a depth test: takes the per-triangle setups and the work
+//! rectangle and gives, per work pixel, the index of the triangle drawn there (or
+//! [`NO_TRIANGLE`]).
+//!
+//! A pixel belongs to a triangle when its centre is strictly inside the snapped, positively
+//! oriented triangle, or exactly on a *top-left* edge (inner normal pointing right, or a
+//! horizontal edge with the inside below, y down). A shared edge is traversed in opposite
+//! directions by its two triangles, so exactly one of them owns the centres on it, and the
+//! integer edge functions make that decision exact. Triangles are visited in index order and
+//! win a pixel when their interpolated depth is ≥ the stored one, so on equal depth the later
+//! triangle wins.
+
+use glam::DVec2;
+
+use super::setup::{edge_function, TriangleSetup, SUBPIXEL};
+use super::PixelRect;
+
+pub(crate) const NO_TRIANGLE: u32 = u32::MAX;
+
+/// Fills `ids` (and `depths` when `use_depth`) over `work`, both `work.area()` long.
+pub(crate) fn rasterise_triangles(
+    setups: &[TriangleSetup],
+    work: PixelRect,
+    use_depth: bool,
+    ids: &mut [u32],
+    depths: &mut [f32],
+) {
+    ids.fill(NO_TRIANGLE);
+    if use_depth {
+        depths.fill(f32::NEG_INFINITY);
+    }
+    for (index, setup) in setups.iter().enumerate() {
+        if setup.drawable {
+            rasterise_one(setup, index as u32, work, use_depth, ids, depths);
+        }
+    }
+}
+
+/// Whether the edge a→b of a positively oriented triangle is a top or left edge.
+#[inline]
+fn is_top_left(a: [i64; 2], b: [i64; 2]) -> bool {
+    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+    dy < 0 || (dy == 0 && dx > 0)
+}
+
+/// Pixel range whose centres may lie in [lo, hi] (fixed point): i + ½ ∈ [lo, hi].
+#[inline]
+fn centre_range(lo: i64, hi: i64) -> (i64, i64) {
+    let half = SUBPIXEL / 2;
+    let first = (lo - half).div_euclid(SUBPIXEL) + i64::from((lo - half).rem_euclid(SUBPIXEL) != 0);
+    let last = (hi - half).div_euclid(SUBPIXEL);
+    (first, last + 1)
+}
+
+fn rasterise_one(
+    setup: &TriangleSetup,
+    index: u32,
+    work: PixelRect,
+    use_depth: bool,
+    ids: &mut [u32],
+    depths: &mut [f32],
+) {
+    let width = work.width();
+    scan_fixed(setup.fixed, work, |x, y| {
+        let cell = (y - work.y0) as usize * width + (x - work.x0) as usize;
+        if use_depth {
+            let depth = setup.depth_at(f64::from(x) + 0.5, f64::from(y) + 0.5);
+            if depth >= depths[cell] {
+                depths[cell] = depth;
+                ids[cell] = index;
+            }
+        } else {
+            ids[cell] = index;
+        }
+    });
+}
+
+/// Calls `visit(x, y)` for every pixel of `clip` whose centre the placed triangle owns under
+/// the raster's fill rule (either orientation; nothing for degenerate triangles or vertices
+/// beyond ±2^20 px). This is exactly the coverage [`draw_patch`](super::draw_patch) uses.
+pub fn triangle_pixels(corners: [DVec2; 3], clip: PixelRect, visit: impl FnMut(i32, i32)) {
+    let setup = TriangleSetup::new(corners, corners, [[0.0; 3]; 3], [0.0; 3]);
+    if setup.drawable {
+        scan_fixed(setup.fixed, clip, visit);
+    }
+}
+
+/// Scans a positively oriented fixed-point triangle over `clip`.
+fn scan_fixed(fixed: [[i64; 2]; 3], clip: PixelRect, mut visit: impl FnMut(i32, i32)) {
+    let [a, b, c] = fixed;
+    let (x0, x1) = centre_range(a[0].min(b[0]).min(c[0]), a[0].max(b[0]).max(c[0]));
+    let (y0, y1) = centre_range(a[1].min(b[1]).min(c[1]), a[1].max(b[1]).max(c[1]));
+    let x0 = x0.max(i64::from(clip.x0));
+    let x1 = x1.min(i64::from(clip.x1));
+    let y0 = y0.max(i64::from(clip.y0));
+    let y1 = y1.min(i64::from(clip.y1));
+    if x0 >= x1 || y0 >= y1 {
+        return;
+    }
+    // Edge k is opposite vertex k; a top-left edge also owns the centres exactly on it, which
+    // with integer values is "w + 1 > 0" instead of "w > 0".
+    let edges = [(b, c), (c, a), (a, b)];
+    let bias = edges.map(|(p, q)| i64::from(is_top_left(p, q)));
+    let step_x = edges.map(|(p, q)| -(q[1] - p[1]) * SUBPIXEL);
+    let step_y = edges.map(|(p, q)| (q[0] - p[0]) * SUBPIXEL);
+    let centre = |i: i64| i * SUBPIXEL + SUBPIXEL / 2;
+    let start = [centre(x0), centre(y0)];
+    let mut row_w = [0i64; 3];
+    for k in 0..3 {
+        row_w[k] = edge_function(edges[k].0, edges[k].1, start) + bias[k];
+    }
+    for y in y0..y1 {
+        let mut w = row_w;
+        for x in x0..x1 {
+            if w[0] > 0 && w[1] > 0 && w[2] > 0 {
+                // Both lie inside `clip`, whose bounds are i32.
+                visit(x as i32, y as i32);
+            }
+            for k in 0..3 {
+                w[k] += step_x[k];
+            }
+        }
+        for k in 0..3 {
+            row_w[k] += step_y[k];
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn centre_range_includes_exact_centres() {
+        // Centres at 0.5 (=128) and 1.5 (=384).
+        assert_eq!(centre_range(128, 384), (0, 2));
+        assert_eq!(centre_range(129, 383), (1, 1));
+        assert_eq!(centre_range(-128, 128), (-1, 1));
+    }
+}

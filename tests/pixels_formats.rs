@@ -1,0 +1,145 @@
+//! Pixel formats: 8/16-bit grey, grey+alpha, RGB and RGBA PNGs survive encode → decode
+//! exactly, with their format detected; loading errors name the file.
+
+use lapclone::pixels::{Canvas, ColorKind, Depth, FloatImage, PixelFormat};
+
+fn formats() -> Vec<PixelFormat> {
+    let mut all = Vec::new();
+    for color in [ColorKind::Grey, ColorKind::Rgb] {
+        for alpha in [false, true] {
+            for depth in [Depth::Eight, Depth::Sixteen] {
+                all.push(PixelFormat {
+                    color,
+                    alpha,
+                    depth,
+                });
+            }
+        }
+    }
+    all
+}
+
+/// Distinct, exactly representable values in the given format.
+fn test_image(format: PixelFormat) -> FloatImage {
+    let max = match format.depth {
+        Depth::Eight => 255.0,
+        Depth::Sixteen => 65535.0,
+    };
+    let q = |v: u32| (v % (max as u32 + 1)) as f32 / max;
+    FloatImage::from_fn(7, 5, format, |i, j| {
+        let grey = q(i * 9973 + j * 31 + 5);
+        let (r, g, b) = match format.color {
+            ColorKind::Grey => (grey, grey, grey),
+            ColorKind::Rgb => (grey, q(i * 131 + j * 7919), q(i * j * 17 + 3)),
+        };
+        let a = if format.alpha {
+            q(i * 40503 + j * 977 + 1)
+        } else {
+            1.0
+        };
+        [r, g, b, a]
+    })
+    .unwrap()
+}
+
+#[test]
+fn png_round_trips_every_format() {
+    for format in formats() {
+        let image = test_image(format);
+        let canvas = Canvas::from_image(&image);
+        assert_eq!(canvas.depth(), format.depth);
+        let bytes = canvas.encode_png(format).unwrap();
+        let decoded = image::load_from_memory(&bytes).unwrap();
+        assert_eq!(PixelFormat::of(&decoded), format);
+        let back = FloatImage::from_dynamic(&decoded).unwrap();
+        assert_eq!(back.format(), format);
+        assert_eq!(Canvas::from_image(&back), canvas, "{format:?}");
+    }
+}
+
+#[test]
+fn save_and_load_through_files() {
+    let dir = tempfile::tempdir().unwrap();
+    for format in formats() {
+        let image = test_image(format);
+        let path = dir
+            .path()
+            .join(format!("{format:?}.png").replace([' ', '{', '}', ':', ','], ""));
+        Canvas::from_image(&image).save_png(&path, format).unwrap();
+        let loaded = FloatImage::load(&path).unwrap();
+        assert_eq!(loaded.format(), format);
+        assert_eq!(Canvas::from_image(&loaded), Canvas::from_image(&image));
+    }
+}
+
+#[test]
+fn eight_bit_canvas_written_as_sixteen_bit_scales_exactly() {
+    let format8 = PixelFormat {
+        color: ColorKind::Rgb,
+        alpha: false,
+        depth: Depth::Eight,
+    };
+    let image = test_image(format8);
+    let canvas = Canvas::from_image(&image);
+    let format16 = PixelFormat {
+        depth: Depth::Sixteen,
+        ..format8
+    };
+    let decoded = image::load_from_memory(&canvas.encode_png(format16).unwrap()).unwrap();
+    let wide = decoded.to_rgb16();
+    let narrow = image::load_from_memory(&canvas.encode_png(format8).unwrap())
+        .unwrap()
+        .to_rgb8();
+    for (w, n) in wide.pixels().zip(narrow.pixels()) {
+        for c in 0..3 {
+            assert_eq!(w.0[c], u16::from(n.0[c]) * 257);
+        }
+    }
+}
+
+#[test]
+fn load_errors_name_the_path() {
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("missing.png");
+    let message = FloatImage::load(&missing).unwrap_err().to_string();
+    assert!(message.contains("missing.png"), "{message}");
+    let garbage = dir.path().join("garbage.png");
+    std::fs::write(&garbage, b"not an image").unwrap();
+    let message = FloatImage::load(&garbage).unwrap_err().to_string();
+    assert!(message.contains("garbage.png"), "{message}");
+}
+
+#[test]
+fn saving_into_a_missing_folder_fails_without_a_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("nope").join("out.png");
+    let canvas = Canvas::from_image(&test_image(PixelFormat::RGBA8));
+    assert!(canvas.save_png(&path, PixelFormat::RGBA8).is_err());
+    assert!(!path.exists());
+}
+
+#[test]
+fn tiny_skia_pixmap_round_trip_for_opaque_pixels() {
+    let format = PixelFormat {
+        color: ColorKind::Rgb,
+        alpha: false,
+        depth: Depth::Eight,
+    };
+    let canvas = Canvas::from_image(&test_image(format));
+    let pixmap = canvas.to_tiny_skia_pixmap();
+    for j in 0..canvas.height() {
+        for i in 0..canvas.width() {
+            let p = pixmap.pixel(i, j).unwrap();
+            let expected = canvas
+                .pixel_f32(i, j)
+                .unwrap()
+                .map(|v| (v * 255.0).round() as u8);
+            assert_eq!([p.red(), p.green(), p.blue(), p.alpha()], expected);
+        }
+    }
+    let mut overlaid = canvas.clone();
+    overlaid
+        .draw_pixmap_over(&tiny_skia::Pixmap::new(canvas.width(), canvas.height()).unwrap())
+        .unwrap();
+    assert_eq!(overlaid, canvas, "a transparent overlay changes nothing");
+}
