@@ -1,1 +1,17 @@
-//! clone stage (not yet implemented).
+//! Seamless cloning (paper §II-C): takes a source image, a patch mesh in the source's frame
+//! and where to put it, and gives the patch composited seamlessly onto a canvas.
+//!
+//! [`PatchCloner`] owns everything that is built once per patch — the mesh, the factored
+//! Laplacian, the source samples at the boundary, raster scratch — so re-cloning after a
+//! move or a deformation costs only constraint switches, one multi-RHS back-substitution
+//! and the raster.
+
+mod cloner;
+mod error;
+mod membrane;
+mod placement;
+
+pub use cloner::{CloneMode, CloneOptions, CloneStats, PatchCloner};
+pub use error::CloneError;
+pub use membrane::{MembraneSolver, MembraneStats, MEMBRANE_CHANNELS};
+pub use placement::{Anchor, Placement};

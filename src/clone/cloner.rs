@@ -1,0 +1,214 @@
+//! The per-patch cloning engine: takes a source image and its patch mesh once, then, per
+//! call, a placement (and optionally deformed positions with depth) and a canvas, and
+//! composites the seamless clone onto the canvas.
+//!
+//! Built once: the mesh, the factored Laplacian, the source (grey in monochrome mode), raster
+//! and coverage scratch. Per call: place the vertices, find boundary vertices hidden under
+//! the patch's own front layer, switch constraints, one 3-RHS solve, the raster.
+
+use std::time::Instant;
+
+use glam::DVec2;
+
+use super::membrane::{MembraneSolver, MembraneStats};
+use super::{CloneError, Placement};
+use crate::mesh::Mesh;
+use crate::pixels::{Canvas, FloatImage};
+use crate::raster::{
+    covered_boundary_vertices, draw_patch, CoverageGrid, Patch, RasterOptions, RasterScratch,
+    RasterStats,
+};
+use crate::solve::LaplacianKind;
+
+/// How the source's colours enter the clone.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum CloneMode {
+    /// The paper: the source's colours plus the membrane.
+    #[default]
+    Normal,
+    /// The source turned grey first (like OpenCV's MONOCHROME_TRANSFER): only its texture
+    /// is transferred, the colour comes from the target through the membrane.
+    Monochrome,
+}
+
+/// Settings fixed for the life of a [`PatchCloner`] (changing them means a new cloner).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CloneOptions {
+    pub laplacian: LaplacianKind,
+    pub mode: CloneMode,
+    /// Width in px of the soft outer edge (0: a crisp anti-aliased edge).
+    pub feather: f32,
+}
+
+impl Default for CloneOptions {
+    fn default() -> Self {
+        Self {
+            laplacian: LaplacianKind::Combinatorial,
+            mode: CloneMode::Normal,
+            feather: 0.0,
+        }
+    }
+}
+
+/// What one clone did and how long its parts took.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct CloneStats {
+    pub membrane: MembraneStats,
+    pub raster: RasterStats,
+    /// Constraint switches + back-substitution.
+    pub solve_ms: f64,
+    pub raster_ms: f64,
+}
+
+/// Everything kept between clones of one patch. See the module doc.
+pub struct PatchCloner {
+    source: FloatImage,
+    mesh: Mesh,
+    membrane: MembraneSolver,
+    raster_options: RasterOptions,
+    placed: Vec<DVec2>,
+    hidden: Vec<bool>,
+    covered: Vec<u32>,
+    coverage_grid: CoverageGrid,
+    raster_scratch: RasterScratch,
+}
+
+impl PatchCloner {
+    /// Factors the patch's Laplacian and samples the source along the rest boundary.
+    pub fn new(source: FloatImage, mesh: Mesh, options: &CloneOptions) -> Result<Self, CloneError> {
+        if !(options.feather.is_finite() && options.feather >= 0.0) {
+            return Err(CloneError::BadOption(format!(
+                "feather must be a finite number ≥ 0, not {}",
+                options.feather
+            )));
+        }
+        let source = match options.mode {
+            CloneMode::Normal => source,
+            CloneMode::Monochrome => source.to_grey(),
+        };
+        let membrane = MembraneSolver::new(&mesh, &source, options.laplacian)?;
+        let n = mesh.vertex_count();
+        Ok(Self {
+            source,
+            mesh,
+            membrane,
+            raster_options: RasterOptions {
+                feather: options.feather,
+                anti_alias: true,
+            },
+            placed: Vec::with_capacity(n),
+            hidden: vec![false; n],
+            covered: Vec::new(),
+            coverage_grid: CoverageGrid::new(),
+            raster_scratch: RasterScratch::new(),
+        })
+    }
+
+    pub fn mesh(&self) -> &Mesh {
+        &self.mesh
+    }
+
+    pub fn source(&self) -> &FloatImage {
+        &self.source
+    }
+
+    /// Where the vertices went in the last clone (canvas pixels).
+    pub fn placed(&self) -> &[DVec2] {
+        &self.placed
+    }
+
+    /// The membrane of the last clone.
+    pub fn membrane(&self) -> &MembraneSolver {
+        &self.membrane
+    }
+
+    /// Clones the undeformed patch onto `canvas` at `placement`.
+    pub fn clone_onto(
+        &mut self,
+        canvas: &mut Canvas,
+        placement: &Placement,
+    ) -> Result<CloneStats, CloneError> {
+        check_placement(placement)?;
+        placement.apply(&self.mesh.positions, &mut self.placed);
+        self.hidden.fill(false);
+        self.clone_placed(canvas, None)
+    }
+
+    /// Clones the patch with its vertices moved to `deformed` (rest frame) and then placed.
+    /// With `depth`, overlapping parts are depth-ordered and boundary vertices under the
+    /// patch's own front layer lose their constraint.
+    pub fn clone_deformed(
+        &mut self,
+        canvas: &mut Canvas,
+        placement: &Placement,
+        deformed: &[DVec2],
+        depth: Option<&[f32]>,
+    ) -> Result<CloneStats, CloneError> {
+        check_placement(placement)?;
+        let n = self.mesh.vertex_count();
+        if deformed.len() != n || depth.is_some_and(|d| d.len() != n) {
+            return Err(CloneError::VertexCountMismatch(deformed.len(), n));
+        }
+        placement.apply(deformed, &mut self.placed);
+        self.mark_hidden(depth)?;
+        self.clone_placed(canvas, depth)
+    }
+
+    fn mark_hidden(&mut self, depth: Option<&[f32]>) -> Result<(), CloneError> {
+        self.hidden.fill(false);
+        let Some(depth) = depth else {
+            return Ok(());
+        };
+        covered_boundary_vertices(
+            &self.placed,
+            &self.mesh.triangles,
+            depth,
+            self.membrane.boundary_vertices(),
+            &mut self.coverage_grid,
+            &mut self.covered,
+        )?;
+        for &v in &self.covered {
+            self.hidden[v as usize] = true;
+        }
+        Ok(())
+    }
+
+    fn clone_placed(
+        &mut self,
+        canvas: &mut Canvas,
+        depth: Option<&[f32]>,
+    ) -> Result<CloneStats, CloneError> {
+        let started = Instant::now();
+        let membrane = self.membrane.solve(&self.placed, canvas, Some(&self.hidden))?;
+        let solved = Instant::now();
+        let patch = Patch {
+            rest: &self.mesh.positions,
+            placed: &self.placed,
+            triangles: &self.mesh.triangles,
+            membrane: self.membrane.membrane(),
+            depth,
+            loops: &self.mesh.loops,
+            source: &self.source,
+        };
+        let raster = draw_patch(canvas, &patch, &self.raster_options, &mut self.raster_scratch)?;
+        let drawn = Instant::now();
+        Ok(CloneStats {
+            membrane,
+            raster,
+            solve_ms: millis(solved - started),
+            raster_ms: millis(drawn - solved),
+        })
+    }
+}
+
+fn check_placement(placement: &Placement) -> Result<(), CloneError> {
+    if placement.is_finite() && placement.scale > 0.0 {
+        Ok(())
+    } else {
+        Err(CloneError::BadPlacement(format!("{placement:?}")))
+    }
+}
+
+pub(crate) fn millis(duration: std::time::Duration) -> f64 {
+    duration.as_secs_f64() * 1e3
+}

@@ -1,0 +1,125 @@
+//! The cloning membrane (paper §II-C): takes the placed boundary, the source and the canvas
+//! being cloned onto, and gives the per-vertex membrane f solving L f = 0 with
+//! f = target − source at every visible boundary vertex.
+//!
+//! Boundary vertices outside the canvas, or hidden under the patch's own front layer, are
+//! switched off (rank-1 downdates of the kept factor) rather than clamped, and switched back
+//! on when they return. Source colours at the rest boundary never change, so they are sampled
+//! once per mesh; per frame only the canvas is sampled.
+
+use glam::DVec2;
+
+use super::CloneError;
+use crate::mesh::Mesh;
+use crate::pixels::{Canvas, FloatImage};
+use crate::solve::{laplacian, LaplacianKind, PenaltyFactor, PenaltyOptions, SwitchStats};
+
+/// Number of colour channels the membrane carries (alpha is never cloned).
+pub const MEMBRANE_CHANNELS: usize = 3;
+
+/// The factored Laplacian of one patch mesh and the scratch buffers of its per-frame solve.
+pub struct MembraneSolver {
+    factor: PenaltyFactor,
+    boundary: Vec<u32>,
+    /// f_S at each boundary vertex's rest position, RGB.
+    source_at_boundary: Vec<[f32; 3]>,
+    wanted: Vec<bool>,
+    values: Vec<f64>,
+    membrane: Vec<[f32; 3]>,
+}
+
+/// What one membrane solve did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct MembraneStats {
+    /// Boundary vertices constrained in this solve.
+    pub constrained: usize,
+    /// Boundary vertices switched off because they fall outside the canvas.
+    pub outside: usize,
+    /// Boundary vertices switched off because the patch's own front layer covers them.
+    pub hidden: usize,
+    pub switches: SwitchStats,
+}
+
+impl MembraneSolver {
+    /// Builds and factors the Laplacian of `mesh` (no constraint on yet) and samples the
+    /// source at the rest boundary.
+    pub fn new(mesh: &Mesh, source: &FloatImage, kind: LaplacianKind) -> Result<Self, CloneError> {
+        let l = laplacian(mesh, kind);
+        let factor = PenaltyFactor::new(&l, &PenaltyOptions::default())?;
+        let boundary: Vec<u32> = mesh.boundary_vertices().collect();
+        let source_at_boundary = boundary
+            .iter()
+            .map(|&v| {
+                let p = mesh.positions[v as usize];
+                rgb(source.sample_bilinear(p.x, p.y))
+            })
+            .collect();
+        let n = mesh.vertex_count();
+        Ok(Self {
+            factor,
+            boundary,
+            source_at_boundary,
+            wanted: vec![false; n],
+            values: vec![0.0; n * MEMBRANE_CHANNELS],
+            membrane: vec![[0.0; 3]; n],
+        })
+    }
+
+    /// Solves the membrane for a patch whose vertices sit at `placed` on `canvas`.
+    /// `hidden[v]` (if given) marks boundary vertices covered by the patch itself.
+    pub fn solve(
+        &mut self,
+        placed: &[DVec2],
+        canvas: &Canvas,
+        hidden: Option<&[bool]>,
+    ) -> Result<MembraneStats, CloneError> {
+        let n = self.wanted.len();
+        let mut stats = MembraneStats::default();
+        let (width, height) = (f64::from(canvas.width()), f64::from(canvas.height()));
+        for (slot, &v) in self.boundary.iter().enumerate() {
+            let v = v as usize;
+            let p = placed[v];
+            let inside = p.x >= 0.0 && p.y >= 0.0 && p.x <= width && p.y <= height;
+            let covered = hidden.is_some_and(|h| h[v]);
+            stats.outside += usize::from(!inside);
+            stats.hidden += usize::from(inside && covered);
+            let on = inside && !covered;
+            self.wanted[v] = on;
+            if on {
+                let target = canvas.sample_bilinear(p.x, p.y);
+                let source = self.source_at_boundary[slot];
+                for c in 0..MEMBRANE_CHANNELS {
+                    self.values[c * n + v] = f64::from(target[c] - source[c]);
+                }
+            }
+        }
+        stats.switches = self.factor.set_constrained(&self.wanted)?;
+        stats.constrained = self.factor.constrained_count();
+        if stats.constrained == 0 {
+            self.membrane.fill([0.0; 3]);
+            return Ok(stats);
+        }
+        self.factor.solve_dirichlet(&mut self.values, MEMBRANE_CHANNELS);
+        for (v, m) in self.membrane.iter_mut().enumerate() {
+            *m = [0, 1, 2].map(|c| self.values[c * n + v] as f32);
+        }
+        Ok(stats)
+    }
+
+    /// The membrane of the last solve, one RGB offset per vertex.
+    pub fn membrane(&self) -> &[[f32; 3]] {
+        &self.membrane
+    }
+
+    pub fn factor(&self) -> &PenaltyFactor {
+        &self.factor
+    }
+
+    pub fn boundary_vertices(&self) -> &[u32] {
+        &self.boundary
+    }
+}
+
+fn rgb(c: [f32; 4]) -> [f32; 3] {
+    [c[0], c[1], c[2]]
+}
