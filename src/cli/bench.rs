@@ -12,6 +12,8 @@ pub struct BenchArgs {
 pub enum BenchCommand {
     /// Factor, solve and rank-1 switch timings on a Matrix Market Laplacian.
     Solver(SolverBenchArgs),
+    /// Deformation timings (rig build, drag step, constraint switches) on disc fixtures.
+    Deform(super::bench_deform::DeformBenchArgs),
 }
 
 #[derive(clap::Args, Debug)]
@@ -32,5 +34,6 @@ pub struct SolverBenchArgs {
 pub fn run(args: BenchArgs) -> anyhow::Result<()> {
     match args.which {
         BenchCommand::Solver(_) => anyhow::bail!("`lapclone bench solver` is not implemented yet"),
+        BenchCommand::Deform(args) => super::bench_deform::run(args),
     }
 }

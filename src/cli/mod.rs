@@ -5,6 +5,7 @@
 use clap::{Parser, Subcommand};
 
 pub mod bench;
+pub mod bench_deform;
 pub mod clone;
 pub mod mesh;
 pub mod render;

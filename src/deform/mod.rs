@@ -50,11 +50,13 @@
 //!      target of p1 itself would make a handle with p1 = p0 move its vertex, breaking
 //!      identity, and would make the mesh jump when a drag starts.) Between handles the later
 //!      one in the slice wins.
+//!
 //!   The constrained set is switched with
 //!   [`PenaltyFactor::set_constrained`](crate::solve::PenaltyFactor::set_constrained) (rank-1
-//!   updates/downdates, never a deliberate refactor); targets only enter the right-hand side.
-//!   With no handle, no solve is run at all and the positions are the rest positions (unless
-//!   [`DeformOptions::solve_without_handles`]).
+//!   updates/downdates; the deform stage never asks for a refactor, though the solver's own
+//!   guards may take one — reported in [`DeformStats::refactored`]); targets only enter the
+//!   right-hand side. With no handle, no solve is run at all and the positions are the rest
+//!   positions (unless [`DeformOptions::solve_without_handles`]).
 //! * **Depth.** `depth_v = Σ_h depth_h g_h(|p_v − p0_h|)`, `depth_h` = the handle's `depth`
 //!   or 1 (a dragged region comes in front); vertices held by an explicit pin get 0. Larger
 //!   is nearer the viewer.

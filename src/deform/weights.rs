@@ -51,7 +51,8 @@ fn half_cotangents(mesh: &Mesh, tri: &[u32; 3]) -> [f64; 3] {
     let scale = (p[1] - p[0])
         .length_squared()
         .max((p[2] - p[0]).length_squared());
-    if !(twice_area > 1e-12 * scale) {
+    // Written so that a NaN area also counts as degenerate.
+    if twice_area.partial_cmp(&(1e-12 * scale)) != Some(std::cmp::Ordering::Greater) {
         return [0.0; 3];
     }
     let mut out = [0.0; 3];
