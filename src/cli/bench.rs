@@ -16,6 +16,8 @@ pub enum BenchCommand {
     Factor(FactorBenchArgs),
     /// Meshing timings over synthetic masks from 128² to 2000² (spiral family and others).
     Mesh(super::bench_mesh::MeshBenchArgs),
+    /// Deformation timings (rig build, drag step, constraint switches) on disc fixtures.
+    Deform(super::bench_deform::DeformBenchArgs),
 }
 
 pub fn run(args: BenchArgs) -> anyhow::Result<()> {
@@ -23,5 +25,6 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
         BenchCommand::Solver(args) => super::bench_solver::run_solver(args),
         BenchCommand::Factor(args) => super::bench_solver::run_factor(args),
         BenchCommand::Mesh(args) => super::bench_mesh::run(args),
+        BenchCommand::Deform(args) => super::bench_deform::run(args),
     }
 }

@@ -1,0 +1,199 @@
+//! [`DeformRig`]: the once-per-mesh part of the deformation. Takes a rest mesh, a
+//! [`LaplacianKind`] and [`DeformOptions`]; keeps the rest geometry, per-triangle centroids
+//! and share-weighted edge vectors, the rest centroid (default pivot), the assembled Laplacian
+//! and its own [`PenaltyFactor`], plus the per-frame scratch that [`step`](super::step) reuses.
+
+use super::weights::{assemble_laplacian, edge_shares};
+use super::{DeformError, DeformOptions};
+use crate::mesh::Mesh;
+use crate::solve::{LaplacianKind, PenaltyFactor, SymmetricCsc};
+use glam::DVec2;
+
+/// Per-handle values derived once per frame.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct HandleFrame {
+    pub vertex: usize,
+    pub theta: f64,
+    /// `1 / (2σ²)`.
+    pub rate: f64,
+    /// Squared distance beyond which the falloff is below the far-field cutoff.
+    pub far_d2: f64,
+    pub core_d2: f64,
+    pub depth: f32,
+}
+
+/// Once-per-mesh deformation state plus reusable per-frame scratch. See [`deform`](super).
+pub struct DeformRig {
+    pub(crate) options: DeformOptions,
+    pub(crate) rest: Vec<DVec2>,
+    pub(crate) triangles: Vec<[u32; 3]>,
+    pub(crate) centroids: Vec<DVec2>,
+    /// `edge_terms[t][k] = w^t_k (p_{corner k} − p_{corner k+1})`.
+    pub(crate) edge_terms: Vec<[DVec2; 3]>,
+    pub(crate) rest_centroid: DVec2,
+    pub(crate) laplacian: SymmetricCsc,
+    pub(crate) factor: PenaltyFactor,
+    // Per-frame scratch.
+    pub(crate) frames: Vec<HandleFrame>,
+    pub(crate) theta: Vec<f64>,
+    pub(crate) wanted: Vec<bool>,
+    pub(crate) pinned: Vec<bool>,
+    /// Target displacement `c_v − p_v` of constrained vertices.
+    pub(crate) target: Vec<DVec2>,
+    /// Column-major n×2 right-hand side / solution (x then y).
+    pub(crate) rhs: Vec<f64>,
+}
+
+impl DeformRig {
+    /// Builds the rig with default [`DeformOptions`].
+    pub fn new(mesh: &Mesh, kind: LaplacianKind) -> Result<Self, DeformError> {
+        Self::with_options(mesh, kind, DeformOptions::default())
+    }
+
+    /// Builds the rig: validates the mesh, computes shares, Laplacian and factor.
+    pub fn with_options(
+        mesh: &Mesh,
+        kind: LaplacianKind,
+        options: DeformOptions,
+    ) -> Result<Self, DeformError> {
+        validate_mesh(mesh)?;
+        validate_options(&options)?;
+        let n = mesh.vertex_count();
+        let shares = edge_shares(mesh, kind);
+        let laplacian = assemble_laplacian(n, &mesh.triangles, &shares);
+        let factor = PenaltyFactor::new(&laplacian, &options.penalty)?;
+        let p = &mesh.positions;
+        let corners = |t: &[u32; 3]| t.map(|v| p[v as usize]);
+        let centroids = mesh
+            .triangles
+            .iter()
+            .map(|t| corners(t).iter().sum::<DVec2>() / 3.0)
+            .collect();
+        let edge_terms = mesh
+            .triangles
+            .iter()
+            .zip(&shares)
+            .map(|(t, w)| {
+                let c = corners(t);
+                [0, 1, 2].map(|k| w[k] * (c[k] - c[(k + 1) % 3]))
+            })
+            .collect();
+        Ok(Self {
+            options,
+            rest: mesh.positions.clone(),
+            triangles: mesh.triangles.clone(),
+            centroids,
+            edge_terms,
+            rest_centroid: area_weighted_centroid(mesh),
+            laplacian,
+            factor,
+            frames: Vec::new(),
+            theta: vec![0.0; mesh.triangles.len()],
+            wanted: vec![false; n],
+            pinned: vec![false; n],
+            target: vec![DVec2::ZERO; n],
+            rhs: vec![0.0; 2 * n],
+        })
+    }
+
+    pub fn vertex_count(&self) -> usize {
+        self.rest.len()
+    }
+
+    pub fn rest_positions(&self) -> &[DVec2] {
+        &self.rest
+    }
+
+    /// Area-weighted rest centroid: the default pivot o.
+    pub fn rest_centroid(&self) -> DVec2 {
+        self.rest_centroid
+    }
+
+    pub fn options(&self) -> &DeformOptions {
+        &self.options
+    }
+
+    /// The Laplacian the rig factors (assembled from the per-triangle shares).
+    pub fn laplacian(&self) -> &SymmetricCsc {
+        &self.laplacian
+    }
+
+    /// The rig's own penalty factor (its constrained set is the last frame's).
+    pub fn factor(&self) -> &PenaltyFactor {
+        &self.factor
+    }
+
+    /// Vertices constrained in the last solved frame (far field, pins and handles).
+    pub fn constrained(&self) -> &[bool] {
+        self.factor.constrained()
+    }
+
+    /// Index of the rest vertex nearest `point` (lowest index on ties).
+    pub fn nearest_vertex(&self, point: DVec2) -> usize {
+        let mut best = (f64::INFINITY, 0usize);
+        for (v, p) in self.rest.iter().enumerate() {
+            let d2 = p.distance_squared(point);
+            if d2 < best.0 {
+                best = (d2, v);
+            }
+        }
+        best.1
+    }
+}
+
+fn validate_mesh(mesh: &Mesh) -> Result<(), DeformError> {
+    let n = mesh.vertex_count();
+    if n == 0 || mesh.triangles.is_empty() {
+        return Err(DeformError::EmptyMesh);
+    }
+    if let Some(v) = mesh.positions.iter().position(|p| !p.is_finite()) {
+        return Err(DeformError::InvalidMesh(format!(
+            "vertex {v} has a non-finite position"
+        )));
+    }
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        if tri.iter().any(|&v| v as usize >= n) {
+            return Err(DeformError::InvalidMesh(format!(
+                "triangle {t} names a vertex ≥ {n}"
+            )));
+        }
+        if tri[0] == tri[1] || tri[1] == tri[2] || tri[2] == tri[0] {
+            return Err(DeformError::InvalidMesh(format!(
+                "triangle {t} repeats a vertex"
+            )));
+        }
+    }
+    Ok(())
+}
+
+fn validate_options(options: &DeformOptions) -> Result<(), DeformError> {
+    if !(options.far_cutoff > 0.0 && options.far_cutoff < 1.0) {
+        return Err(DeformError::InvalidOptions(format!(
+            "far_cutoff {} must lie in (0, 1)",
+            options.far_cutoff
+        )));
+    }
+    if !(options.core_fraction >= 0.0 && options.core_fraction.is_finite()) {
+        return Err(DeformError::InvalidOptions(format!(
+            "core_fraction {} must be finite and ≥ 0",
+            options.core_fraction
+        )));
+    }
+    Ok(())
+}
+
+/// Area-weighted centroid of the triangles (vertex mean if the total area is zero).
+fn area_weighted_centroid(mesh: &Mesh) -> DVec2 {
+    let (mut weighted, mut total) = (DVec2::ZERO, 0.0);
+    for t in &mesh.triangles {
+        let [a, b, c] = t.map(|v| mesh.positions[v as usize]);
+        let area = 0.5 * (b - a).perp_dot(c - a).abs();
+        weighted += area * (a + b + c) / 3.0;
+        total += area;
+    }
+    if total > 0.0 {
+        weighted / total
+    } else {
+        mesh.positions.iter().sum::<DVec2>() / mesh.vertex_count() as f64
+    }
+}
