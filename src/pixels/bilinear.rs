@@ -4,13 +4,15 @@
 //! Pixel-centre convention: pixel (i, j) is exact at (i + 0.5, j + 0.5); outside the centres'
 //! hull the edge pixels are repeated (clamp to edge).
 
+use glam::Vec4;
+
 use super::Texel;
 
 /// Samples `pixels` (`width` × `height`, row-major) at `(x, y)`.
 ///
 /// The buffer must hold `width * height` pixels and both sizes must be non-zero (every
 /// image type of this crate guarantees it). Non-finite coordinates sample pixel (0, 0).
-#[inline]
+#[inline(always)]
 pub fn sample_bilinear_rgba<T: Texel>(
     pixels: &[[T; 4]],
     width: u32,
@@ -23,23 +25,15 @@ pub fn sample_bilinear_rgba<T: Texel>(
     let w = width as usize;
     let row0 = &pixels[y0 * w..y0 * w + w];
     let row1 = &pixels[y1 * w..y1 * w + w];
-    let (p00, p10, p01, p11) = (row0[x0], row0[x1], row1[x0], row1[x1]);
-    let mut out = [0.0f32; 4];
-    for c in 0..4 {
-        let top = lerp(p00[c].to_unit(), p10[c].to_unit(), tx);
-        let bottom = lerp(p01[c].to_unit(), p11[c].to_unit(), tx);
-        out[c] = lerp(top, bottom, ty);
-    }
-    out
-}
-
-#[inline]
-fn lerp(a: f32, b: f32, t: f32) -> f32 {
-    a + (b - a) * t
+    // glam's Vec4 is SIMD (SSE2 / NEON): one lerp handles all four channels.
+    let texel = |p: [T; 4]| Vec4::from_array(p.map(Texel::to_unit));
+    let top = texel(row0[x0]).lerp(texel(row0[x1]), tx);
+    let bottom = texel(row1[x0]).lerp(texel(row1[x1]), tx);
+    top.lerp(bottom, ty).to_array()
 }
 
 /// The two neighbouring pixel indices along one axis and the weight of the second one.
-#[inline]
+#[inline(always)]
 fn axis_taps(coordinate: f64, size: u32) -> (usize, usize, f32) {
     let last = size.saturating_sub(1) as f64;
     let u = coordinate - 0.5;

@@ -139,7 +139,7 @@ impl FloatImage {
     }
 
     /// Bilinear sample at `(x, y)` in pixel coordinates (centres at i + 0.5), clamped to edge.
-    #[inline]
+    #[inline(always)]
     pub fn sample_bilinear(&self, x: f64, y: f64) -> [f32; 4] {
         sample_bilinear_rgba(&self.pixels, self.width, self.height, x, y)
     }

@@ -96,7 +96,7 @@ impl TriangleSetup {
     }
 
     /// Rest position and membrane at a canvas position (extrapolated outside the triangle).
-    #[inline]
+    #[inline(always)]
     pub fn interpolate(&self, x: f64, y: f64) -> Interpolated {
         let rest = DVec2::new(
             self.rest_x[0] + self.rest_x[1] * x + self.rest_x[2] * y,

@@ -78,8 +78,13 @@ pub(crate) fn shade_and_composite<T: Texel>(
             if alpha <= 0.0 {
                 continue;
             }
-            let premultiplied = [colour[0] * alpha, colour[1] * alpha, colour[2] * alpha];
             let pixel = &mut canvas[canvas_row + x as usize];
+            if alpha >= 1.0 {
+                *pixel = colour.map(T::from_unit);
+                written += 1;
+                continue;
+            }
+            let premultiplied = [colour[0] * alpha, colour[1] * alpha, colour[2] * alpha];
             let under = pixel.map(Texel::to_unit);
             let out = crate::pixels::canvas_composite_over(premultiplied, alpha, under);
             *pixel = out.map(T::from_unit);
@@ -89,7 +94,7 @@ pub(crate) fn shade_and_composite<T: Texel>(
     written
 }
 
-#[inline]
+#[inline(always)]
 fn patch_colour(setup: &TriangleSetup, source: &FloatImage, x: f64, y: f64) -> [f32; 4] {
     let values = setup.interpolate(x, y);
     let sample = source.sample_bilinear(values.rest.x, values.rest.y);
