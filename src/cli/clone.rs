@@ -1,8 +1,334 @@
-//! `lapclone clone`: one seamless clone of a source patch into a target image.
+//! `lapclone clone`: one seamless clone of a source patch into a target image, optionally
+//! deformed by drags and pins, with JSON timings and a mesh overlay on request.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::Context;
+use glam::DVec2;
+use lapclone::clone::{
+    mesh_from_mask, Anchor, CloneMode, CloneOptions, CloneStats, PatchCloner, Placement,
+};
+use lapclone::deform::{DeformRig, Deformed, Handle, Pin};
+use lapclone::mesh::{BitMask, MeshOptions};
+use lapclone::pixels::{Canvas, FloatImage};
+use lapclone::raster::overlay::{draw_mesh_overlay, HandleMarker, OverlayStyle};
+use lapclone::solve::LaplacianKind;
+
+use super::{finite_f64, point, UsageError};
 
 #[derive(clap::Args, Debug)]
-pub struct CloneArgs {}
+pub struct CloneArgs {
+    /// Source image the patch is taken from.
+    #[arg(long)]
+    pub source: PathBuf,
+    /// Mask selecting the patch (white/opaque = inside), the source's size unless offset.
+    #[arg(long)]
+    pub mask: PathBuf,
+    /// Where the mask's pixel (0,0) lies in the source, when the sizes differ.
+    #[arg(long = "mask-offset", value_parser = point)]
+    pub mask_offset: Option<[f64; 2]>,
+    /// Target image the patch is cloned into.
+    #[arg(long)]
+    pub target: PathBuf,
+    /// Target position of the anchor (by default the centre of the mask's bounding box).
+    #[arg(long, value_parser = point)]
+    pub at: [f64; 2],
+    /// Uniform scale of the patch.
+    #[arg(long, default_value_t = 1.0, value_parser = finite_f64)]
+    pub scale: f64,
+    /// Rotation in degrees (positive turns x towards y: clockwise on screen).
+    #[arg(long, default_value_t = 0.0, value_parser = finite_f64, allow_hyphen_values = true)]
+    pub rotate: f64,
+    /// Which point of the mask's bounding box `--at` refers to.
+    #[arg(long, value_enum, default_value_t = AnchorArg::Centre)]
+    pub anchor: AnchorArg,
+    /// Maximum boundary edge length in pixels.
+    #[arg(long, value_parser = finite_f64)]
+    pub density: Option<f64>,
+    /// Inside threshold of the mask in [0, 1].
+    #[arg(long, default_value_t = 0.5, value_parser = finite_f64)]
+    pub threshold: f64,
+    #[arg(long, value_enum, default_value_t = LaplacianArg::Combinatorial)]
+    pub laplacian: LaplacianArg,
+    #[arg(long, value_enum, default_value_t = ModeArg::Normal)]
+    pub mode: ModeArg,
+    /// Soften the patch's outer edge over this many pixels.
+    #[arg(long, default_value_t = 0.0, value_parser = finite_f64)]
+    pub feather: f64,
+    /// Drag X0,Y0:X1,Y1[:R] in the source's frame (repeatable); R defaults to a quarter of
+    /// the mask's larger bounding-box side.
+    #[arg(long, value_parser = parse_drag, allow_hyphen_values = true)]
+    pub drag: Vec<DragArg>,
+    /// Hold the point X,Y of the source's frame still (repeatable).
+    #[arg(long, value_parser = point)]
+    pub pin: Vec<[f64; 2]>,
+    /// Draw the (deformed) mesh and the handles over the result (8-bit RGBA output).
+    #[arg(long = "show-mesh")]
+    pub show_mesh: bool,
+    /// Print one JSON object with sizes and timings on stdout.
+    #[arg(long)]
+    pub stats: bool,
+    /// Output PNG (written in the target's bit depth and colour type).
+    #[arg(short = 'o', long = "output")]
+    pub output: PathBuf,
+}
 
-pub fn run(_args: CloneArgs) -> anyhow::Result<()> {
-    anyhow::bail!("`lapclone clone` is not implemented yet")
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+pub enum AnchorArg {
+    #[value(alias = "center")]
+    Centre,
+    #[value(alias = "top-left")]
+    Topleft,
+}
+
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+pub enum LaplacianArg {
+    Combinatorial,
+    Cotangent,
+}
+
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+pub enum ModeArg {
+    Normal,
+    Monochrome,
+}
+
+#[derive(Clone, Copy, Debug)]
+pub struct DragArg {
+    pub from: DVec2,
+    pub to: DVec2,
+    pub radius: Option<f64>,
+}
+
+fn parse_drag(text: &str) -> Result<DragArg, String> {
+    let parts: Vec<&str> = text.split(':').collect();
+    if !(2..=3).contains(&parts.len()) {
+        return Err(format!("`{text}` is not a drag X0,Y0:X1,Y1[:R]"));
+    }
+    let radius = match parts.get(2) {
+        Some(r) => {
+            let r = finite_f64(r)?;
+            if r <= 0.0 {
+                return Err(format!("drag radius must be positive, not {r}"));
+            }
+            Some(r)
+        }
+        None => None,
+    };
+    Ok(DragArg {
+        from: DVec2::from(point(parts[0])?),
+        to: DVec2::from(point(parts[1])?),
+        radius,
+    })
+}
+
+pub fn run(args: CloneArgs) -> anyhow::Result<()> {
+    check_arguments(&args)?;
+    let total = Instant::now();
+    let source = FloatImage::load(&args.source)?;
+    let target = FloatImage::load(&args.target)?;
+    let mask = BitMask::load(&args.mask, args.threshold as f32)?;
+
+    let mesh_started = Instant::now();
+    let mut mesh_options = MeshOptions::default();
+    if let Some(density) = args.density {
+        mesh_options.density = density;
+    }
+    let patch = mesh_from_mask(
+        &mask,
+        args.mask_offset.map(DVec2::from),
+        (source.width(), source.height()),
+        &mesh_options,
+    )?;
+    let mesh_ms = millis_since(mesh_started);
+    for warning in &patch.result.warnings {
+        eprintln!("lapclone: warning: {warning}");
+    }
+    let anchor = match args.anchor {
+        AnchorArg::Centre => Anchor::Centre,
+        AnchorArg::Topleft => Anchor::TopLeft,
+    };
+    let placement = Placement {
+        pivot: anchor.point(patch.bbox_min, patch.bbox_max),
+        at: DVec2::from(args.at),
+        scale: args.scale,
+        rotation_deg: args.rotate,
+    };
+    let handles = handles_from(&args.drag, patch.bbox_min, patch.bbox_max);
+    let pins: Vec<Pin> = args.pin.iter().map(|&p| Pin(DVec2::from(p))).collect();
+    let mesh = patch.result.mesh;
+
+    let factor_started = Instant::now();
+    let options = CloneOptions {
+        laplacian: laplacian_kind(args.laplacian),
+        mode: match args.mode {
+            ModeArg::Normal => CloneMode::Normal,
+            ModeArg::Monochrome => CloneMode::Monochrome,
+        },
+        feather: args.feather as f32,
+    };
+    let mut cloner = PatchCloner::new(source, mesh, &options)?;
+    let mut deformation = if handles.is_empty() && pins.is_empty() {
+        None
+    } else {
+        let mut rig = DeformRig::new(cloner.mesh(), options.laplacian)?;
+        let mut deformed = Deformed::default();
+        rig.deform(&handles, &pins, &mut deformed)?;
+        Some(deformed)
+    };
+    let factor_ms = millis_since(factor_started);
+
+    let background = Canvas::from_image(&target);
+    let mut canvas = background.clone();
+    let stats = clone_once(&mut cloner, &mut canvas, &placement, deformation.as_mut())?;
+    let total_ms = millis_since(total);
+    report_clone_warnings(&stats);
+
+    let reclone_ms = time_reclone(&mut cloner, &background, &placement, deformation.as_mut())?;
+    write_output(&args, &canvas, &target, &cloner, &handles, &placement)?;
+    if args.stats {
+        let json = serde_json::json!({
+            "vertices": cloner.mesh().vertex_count(),
+            "boundary_vertices": cloner.membrane().boundary_vertices().len(),
+            "constrained": stats.membrane.constrained,
+            "outside": stats.membrane.outside,
+            "hidden": stats.membrane.hidden,
+            "switched": stats.membrane.switches.updates + stats.membrane.switches.downdates,
+            "mesh_ms": mesh_ms,
+            "factor_ms": factor_ms,
+            "solve_ms": stats.solve_ms,
+            "raster_ms": stats.raster_ms,
+            "total_ms": total_ms,
+            "reclone_ms": reclone_ms,
+        });
+        println!("{json}");
+    }
+    Ok(())
+}
+
+fn check_arguments(args: &CloneArgs) -> anyhow::Result<()> {
+    if args.scale <= 0.0 {
+        return Err(UsageError(format!("--scale must be positive, not {}", args.scale)).into());
+    }
+    if !(0.0..=1.0).contains(&args.threshold) {
+        return Err(UsageError(format!("--threshold must lie in [0, 1], not {}", args.threshold)).into());
+    }
+    if args.feather < 0.0 {
+        return Err(UsageError(format!("--feather must be ≥ 0, not {}", args.feather)).into());
+    }
+    if args.density.is_some_and(|d| d <= 0.0) {
+        return Err(UsageError("--density must be positive".into()).into());
+    }
+    check_output_folder(&args.output)
+}
+
+/// Fails before any work when the output's folder does not exist.
+pub fn check_output_folder(output: &Path) -> anyhow::Result<()> {
+    match output.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() && !dir.is_dir() => {
+            anyhow::bail!("{}: the output folder {} does not exist", output.display(), dir.display())
+        }
+        _ => Ok(()),
+    }
+}
+
+fn laplacian_kind(arg: LaplacianArg) -> LaplacianKind {
+    match arg {
+        LaplacianArg::Combinatorial => LaplacianKind::Combinatorial,
+        LaplacianArg::Cotangent => LaplacianKind::Cotangent,
+    }
+}
+
+fn handles_from(drags: &[DragArg], min: DVec2, max: DVec2) -> Vec<Handle> {
+    let default_radius = 0.25 * (max - min).max_element().max(1.0);
+    drags
+        .iter()
+        .map(|d| Handle::drag(d.from, d.to, d.radius.unwrap_or(default_radius)))
+        .collect()
+}
+
+fn clone_once(
+    cloner: &mut PatchCloner,
+    canvas: &mut Canvas,
+    placement: &Placement,
+    deformed: Option<&mut Deformed>,
+) -> anyhow::Result<CloneStats> {
+    Ok(match deformed {
+        None => cloner.clone_onto(canvas, placement)?,
+        Some(d) => cloner.clone_deformed(canvas, placement, &d.positions, Some(&d.depth))?,
+    })
+}
+
+/// One more clone after moving the patch by a few pixels: mesh and factor reused.
+fn time_reclone(
+    cloner: &mut PatchCloner,
+    background: &Canvas,
+    placement: &Placement,
+    deformed: Option<&mut Deformed>,
+) -> anyhow::Result<f64> {
+    let mut scratch = background.clone();
+    let moved = Placement {
+        at: placement.at + DVec2::new(3.0, 2.0),
+        ..*placement
+    };
+    let started = Instant::now();
+    clone_once(cloner, &mut scratch, &moved, deformed)?;
+    Ok(millis_since(started))
+}
+
+fn report_clone_warnings(stats: &CloneStats) {
+    if stats.membrane.constrained == 0 && stats.raster.written == 0 {
+        eprintln!("lapclone: warning: the patch lies entirely outside the target; the output is the target");
+    } else if stats.membrane.constrained == 0 {
+        eprintln!("lapclone: warning: no boundary vertex lies inside the target; the patch is pasted without blending");
+    }
+}
+
+fn write_output(
+    args: &CloneArgs,
+    canvas: &Canvas,
+    target: &FloatImage,
+    cloner: &PatchCloner,
+    handles: &[Handle],
+    placement: &Placement,
+) -> anyhow::Result<()> {
+    if !args.show_mesh {
+        canvas
+            .save_png(&args.output, target.format())
+            .with_context(|| format!("writing {}", args.output.display()))?;
+        return Ok(());
+    }
+    let map = placement.to_affine();
+    let markers: Vec<HandleMarker> = handles
+        .iter()
+        .map(|h| HandleMarker {
+            at: map.transform_point2(h.from),
+            target: Some(map.transform_point2(h.to)),
+        })
+        .collect();
+    let background = canvas.to_rgba8_image();
+    let style = OverlayStyle {
+        scale: 1.0,
+        ..OverlayStyle::default()
+    };
+    let mesh = cloner.mesh();
+    let picture = draw_mesh_overlay(
+        &background,
+        cloner.placed(),
+        &mesh.triangles,
+        &mesh.loops,
+        &markers,
+        &style,
+    )?;
+    let mut bytes = Vec::new();
+    picture
+        .write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
+        .context("encoding the overlay")?;
+    lapclone::util::write_atomic(&args.output, &bytes)
+        .with_context(|| format!("writing {}", args.output.display()))
+}
+
+fn millis_since(start: Instant) -> f64 {
+    start.elapsed().as_secs_f64() * 1e3
 }

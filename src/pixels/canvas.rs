@@ -182,6 +182,20 @@ impl Canvas {
         })
     }
 
+    /// A straight-alpha 8-bit RGBA copy (16-bit values are rounded), e.g. for overlays.
+    pub fn to_rgba8_image(&self) -> image::RgbaImage {
+        let bytes: Vec<u8> = match &self.pixels {
+            CanvasPixels::Eight(p) => p.iter().flatten().copied().collect(),
+            CanvasPixels::Sixteen(p) => p
+                .iter()
+                .flatten()
+                .map(|&v| u8::from_unit(v.to_unit()))
+                .collect(),
+        };
+        // invariant: the buffer holds exactly width × height RGBA pixels.
+        image::RgbaImage::from_raw(self.width, self.height, bytes).expect("canvas buffer size")
+    }
+
     /// An 8-bit premultiplied copy for tiny-skia drawing (16-bit values are rounded).
     pub fn to_tiny_skia_pixmap(&self) -> tiny_skia::Pixmap {
         // invariant: the canvas size is non-zero (checked at construction).

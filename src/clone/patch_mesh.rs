@@ -1,0 +1,90 @@
+//! From a mask to a patch mesh in the source's frame: takes the source's size, a mask (or
+//! polygons) and the mask's offset in the source, and gives the mesh plus the bounding box
+//! that anchors (`centre`, `topleft`) refer to.
+
+use glam::DVec2;
+
+use super::CloneError;
+use crate::mesh::{mesh_mask, mesh_polygons, BitMask, MeshOptions, MeshResult, Polygon};
+
+/// A patch mesh in source coordinates, with its mask's bounding box.
+#[derive(Clone, Debug)]
+pub struct PatchMesh {
+    pub result: MeshResult,
+    /// Bounding box of the inside pixels (pixel corners), in source coordinates.
+    pub bbox_min: DVec2,
+    pub bbox_max: DVec2,
+}
+
+/// Meshes `mask`, whose pixel (0, 0) sits at `offset` in a source of `source_size`.
+/// Without an offset the mask must have the source's size.
+pub fn mesh_from_mask(
+    mask: &BitMask,
+    offset: Option<DVec2>,
+    source_size: (u32, u32),
+    options: &MeshOptions,
+) -> Result<PatchMesh, CloneError> {
+    let mask_size = (mask.width as u32, mask.height as u32);
+    if offset.is_none() && mask_size != source_size {
+        return Err(CloneError::MaskSize {
+            mask: mask_size,
+            source_size,
+        });
+    }
+    let offset = offset.unwrap_or(DVec2::ZERO);
+    if !offset.is_finite() {
+        return Err(CloneError::BadOption(format!("mask offset {offset} is not finite")));
+    }
+    let mut result = mesh_mask(mask, options)?;
+    for p in &mut result.mesh.positions {
+        *p += offset;
+    }
+    let (min, max) = inside_bbox(mask);
+    Ok(PatchMesh {
+        result,
+        bbox_min: min + offset,
+        bbox_max: max + offset,
+    })
+}
+
+/// Meshes polygons given in source coordinates.
+pub fn mesh_from_polygons(
+    polygons: &[Polygon],
+    options: &MeshOptions,
+) -> Result<PatchMesh, CloneError> {
+    let result = mesh_polygons(polygons, options)?;
+    let mut min = DVec2::splat(f64::INFINITY);
+    let mut max = DVec2::splat(f64::NEG_INFINITY);
+    for p in polygons.iter().flat_map(|p| &p.outer) {
+        min = min.min(*p);
+        max = max.max(*p);
+    }
+    Ok(PatchMesh {
+        result,
+        bbox_min: min,
+        bbox_max: max,
+    })
+}
+
+/// Corners of the bounding box of the inside pixels; a zero box at the origin when empty
+/// (meshing reports the empty mask before this matters).
+fn inside_bbox(mask: &BitMask) -> (DVec2, DVec2) {
+    let mut min = (usize::MAX, usize::MAX);
+    let mut max = (0, 0);
+    let mut any = false;
+    for (index, &inside) in mask.as_slice().iter().enumerate() {
+        if inside {
+            let (x, y) = (index % mask.width, index / mask.width);
+            min = (min.0.min(x), min.1.min(y));
+            max = (max.0.max(x), max.1.max(y));
+            any = true;
+        }
+    }
+    if !any {
+        return (DVec2::ZERO, DVec2::ZERO);
+    }
+    (
+        DVec2::new(min.0 as f64, min.1 as f64),
+        DVec2::new(max.0 as f64 + 1.0, max.1 as f64 + 1.0),
+    )
+}
