@@ -14,6 +14,7 @@ pub mod output;
 pub mod pixels;
 pub mod raster;
 pub mod reference;
+pub mod render;
 pub mod scene;
 pub mod script;
 pub mod solve;

@@ -2,9 +2,21 @@
 //! and validates a scene and prints positioned errors with a caret; `render` and `preview`
 //! take their final flags here and are wired to the renderer by the pipeline integration.
 
-use std::path::PathBuf;
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::Instant;
 
+use anyhow::Context;
 use clap::ValueEnum;
+use indicatif::{ProgressBar, ProgressStyle};
+use lapclone::output::{
+    ApngWriter, Frame, FrameData, FrameRef, GifWriter, Pixels, PngCompression, PngSequenceWriter,
+};
+use lapclone::pixels::{Canvas, CanvasPixels, Depth};
+use lapclone::render::{RenderError, Renderer};
+use lapclone::script::{load_scene, validate_scene, ErrorKind, LoadedScene, SceneError};
 
 use crate::cli::UsageError;
 
@@ -79,31 +91,256 @@ pub fn run_render(args: RenderArgs) -> anyhow::Result<()> {
     if args.jobs == Some(0) {
         return Err(UsageError("--jobs must be at least 1".into()).into());
     }
-    anyhow::bail!("`lapclone render` is not implemented yet")
+    let (loaded, mut renderer) = load_renderer(&args.scene)?;
+    let total = renderer.frame_count();
+    let range = match args.frames {
+        None => FrameRange {
+            first: 1,
+            last: total,
+        },
+        Some(r) if r.last > total => {
+            return Err(UsageError(format!(
+                "--frames {}..{}: the scene has {total} frames",
+                r.first, r.last
+            ))
+            .into())
+        }
+        Some(r) => r,
+    };
+    let cancel = install_cancel_handler();
+    let jobs = args.jobs.unwrap_or_else(default_jobs);
+    let started = Instant::now();
+    let mut sink = FrameSink::open(&args, &renderer, range, jobs, cancel.clone())?;
+    let progress = progress_bar(range.last - range.first + 1);
+    let mut compute_ms = 0.0;
+    for number in range.first..=range.last {
+        if cancel.load(Ordering::Relaxed) {
+            sink.abandon();
+            anyhow::bail!("interrupted: stopped after frame {}", number - 1);
+        }
+        renderer
+            .render_frame(number - 1)
+            .map_err(|e| positioned(&loaded, e))?;
+        compute_ms += renderer.last_stats().total_ms;
+        sink.push(number, renderer.frame())?;
+        progress.inc(1);
+    }
+    progress.finish_and_clear();
+    let written = sink.finish()?;
+    let frames = range.last - range.first + 1;
+    let seconds = started.elapsed().as_secs_f64();
+    println!(
+        "rendered {frames} frames to {} in {seconds:.2} s ({:.1} fps; {:.2} ms/frame compute)",
+        written.display(),
+        frames as f64 / seconds,
+        compute_ms / frames as f64
+    );
+    Ok(())
 }
 
 pub fn run_preview(args: PreviewArgs) -> anyhow::Result<()> {
     if args.t.is_some_and(|t| t < 0.0) || args.frame == Some(0) {
         return Err(UsageError("--t must be ≥ 0 and --frame ≥ 1".into()).into());
     }
-    anyhow::bail!("`lapclone preview` is not implemented yet")
+    super::clone::check_output_folder(&args.output)?;
+    let (loaded, mut renderer) = load_renderer(&args.scene)?;
+    let format = renderer.output_format();
+    let canvas = match (args.t, args.frame) {
+        (Some(t), _) => renderer.render_time(t),
+        (None, Some(frame)) => renderer.render_frame(frame - 1),
+        (None, None) => renderer.render_frame(0),
+    }
+    .map_err(|e| positioned(&loaded, e))?;
+    canvas
+        .save_png(&args.output, format)
+        .with_context(|| format!("writing {}", args.output.display()))?;
+    Ok(())
 }
 
 pub fn run_check(args: CheckArgs) -> anyhow::Result<()> {
-    let loaded = lapclone::script::load_scene(&args.scene).map_err(|e| anyhow::anyhow!("{e}"))?;
-    let summary = lapclone::script::validate_scene(&loaded).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let (loaded, renderer) = load_renderer(&args.scene)?;
     let c = &loaded.scene.canvas;
+    let handles: usize = loaded.scene.patches.iter().map(|p| p.handles.len()).sum();
+    let pins: usize = loaded.scene.patches.iter().map(|p| p.pins.len()).sum();
+    let vertices: usize = renderer.vertex_counts().iter().sum();
     println!(
-        "{}: ok — {}×{}, {} fps, {} s ({} frames), {} patches, {} handles, {} pins",
+        "{}: ok — {}×{}, {} fps, {} s ({} frames), {} patches ({vertices} mesh vertices), {handles} handles, {pins} pins",
         args.scene.display(),
         c.width,
         c.height,
         c.fps,
         c.duration,
-        summary.frames,
-        summary.patches,
-        summary.handles,
-        summary.pins
+        c.frame_count(),
+        loaded.scene.patches.len(),
     );
     Ok(())
+}
+
+/// Parses, validates and builds the renderer (meshes and factors every patch); every error
+/// comes back positioned at the scene call it is about.
+fn load_renderer(scene: &Path) -> anyhow::Result<(LoadedScene, Renderer)> {
+    let loaded = load_scene(scene).map_err(|e| anyhow::anyhow!("{e}"))?;
+    validate_scene(&loaded).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let renderer = Renderer::new(loaded.scene.clone()).map_err(|e| positioned(&loaded, e))?;
+    Ok((loaded, renderer))
+}
+
+fn positioned(loaded: &LoadedScene, error: RenderError) -> anyhow::Error {
+    let index = error
+        .patch_name()
+        .and_then(|name| loaded.scene.patches.iter().position(|p| p.name == name));
+    let origin = index.and_then(|i| loaded.origins.patches.get(i));
+    let (file, position) = origin
+        .map(|o| (o.file.clone(), o.position))
+        .unwrap_or((loaded.file.clone(), rhai::Position::NONE));
+    let mut scene_error = SceneError::new(ErrorKind::Validation, &file, position, error.to_string());
+    if file == loaded.file {
+        scene_error.load_source_line(Some(&loaded.text));
+    }
+    anyhow::anyhow!("{scene_error}")
+}
+
+fn install_cancel_handler() -> Arc<AtomicBool> {
+    let cancel = Arc::new(AtomicBool::new(false));
+    let flag = cancel.clone();
+    // A second handler cannot be installed (e.g. in tests running several renders in one
+    // process); rendering then simply is not interruptible, which is harmless.
+    let _ = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed));
+    cancel
+}
+
+fn default_jobs() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
+}
+
+fn progress_bar(frames: u64) -> ProgressBar {
+    if !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::new(frames);
+    if let Ok(style) =
+        ProgressStyle::with_template("{bar:40} {pos}/{len} frames  {per_sec}  eta {eta}")
+    {
+        bar.set_style(style);
+    }
+    bar
+}
+
+/// Where rendered frames go: a PNG folder (encoded in parallel), a GIF or an APNG.
+enum FrameSink {
+    Png(PngSequenceWriter, PathBuf),
+    Gif(GifWriter),
+    Apng(ApngWriter),
+}
+
+impl FrameSink {
+    fn open(
+        args: &RenderArgs,
+        renderer: &Renderer,
+        range: FrameRange,
+        jobs: usize,
+        cancel: Arc<AtomicBool>,
+    ) -> anyhow::Result<Self> {
+        let canvas = &renderer.scene().canvas;
+        Ok(match args.format {
+            OutputFormat::Png => {
+                if !args.output.is_dir() {
+                    super::clone::check_output_folder(&args.output)?;
+                    std::fs::create_dir(&args.output)
+                        .with_context(|| format!("creating {}", args.output.display()))?;
+                }
+                let writer = PngSequenceWriter::new(
+                    &args.output,
+                    renderer.frame_count(),
+                    jobs,
+                    PngCompression::Fast,
+                    cancel,
+                )?;
+                FrameSink::Png(writer, args.output.clone())
+            }
+            OutputFormat::Gif => {
+                super::clone::check_output_folder(&args.output)?;
+                FrameSink::Gif(GifWriter::create(&args.output, canvas.fps)?)
+            }
+            OutputFormat::Apng => {
+                super::clone::check_output_folder(&args.output)?;
+                let frames = u32::try_from(range.last - range.first + 1)
+                    .context("too many frames for an APNG")?;
+                let sixteen = renderer.output_format().depth == Depth::Sixteen;
+                FrameSink::Apng(ApngWriter::create(
+                    &args.output,
+                    canvas.width,
+                    canvas.height,
+                    sixteen,
+                    frames,
+                    canvas.fps,
+                )?)
+            }
+        })
+    }
+
+    fn push(&mut self, number: u64, canvas: &Canvas) -> anyhow::Result<()> {
+        match self {
+            FrameSink::Png(writer, _) => {
+                let mut frame = writer.spare_frame().unwrap_or_else(|| empty_frame(canvas));
+                fill_frame(&mut frame, canvas);
+                writer.submit(number, frame)?;
+            }
+            FrameSink::Gif(writer) => writer.add(&frame_ref(canvas)?)?,
+            FrameSink::Apng(writer) => writer.add(&frame_ref(canvas)?)?,
+        }
+        Ok(())
+    }
+
+    fn finish(self) -> anyhow::Result<PathBuf> {
+        Ok(match self {
+            FrameSink::Png(writer, dir) => {
+                writer.finish()?;
+                dir
+            }
+            FrameSink::Gif(writer) => writer.finish()?,
+            FrameSink::Apng(writer) => writer.finish()?,
+        })
+    }
+
+    /// Drops the sink after an interruption: writers remove their temporary files.
+    fn abandon(self) {
+        if let FrameSink::Png(writer, _) = self {
+            let _ = writer.finish();
+        }
+    }
+}
+
+fn frame_ref(canvas: &Canvas) -> anyhow::Result<FrameRef<'_>> {
+    let pixels = match canvas.pixels() {
+        CanvasPixels::Eight(p) => Pixels::Rgba8(p.as_flattened()),
+        CanvasPixels::Sixteen(p) => Pixels::Rgba16(p.as_flattened()),
+    };
+    Ok(FrameRef::new(canvas.width(), canvas.height(), pixels)?)
+}
+
+fn empty_frame(canvas: &Canvas) -> Frame {
+    Frame {
+        width: canvas.width(),
+        height: canvas.height(),
+        data: FrameData::Rgba8(Vec::new()),
+    }
+}
+
+/// Copies the canvas into a (recycled) frame buffer without reallocating when sizes match.
+fn fill_frame(frame: &mut Frame, canvas: &Canvas) {
+    frame.width = canvas.width();
+    frame.height = canvas.height();
+    match (canvas.pixels(), &mut frame.data) {
+        (CanvasPixels::Eight(p), FrameData::Rgba8(out)) => {
+            out.clear();
+            out.extend_from_slice(p.as_flattened());
+        }
+        (CanvasPixels::Sixteen(p), FrameData::Rgba16(out)) => {
+            out.clear();
+            out.extend_from_slice(p.as_flattened());
+        }
+        (CanvasPixels::Eight(p), data) => *data = FrameData::Rgba8(p.as_flattened().to_vec()),
+        (CanvasPixels::Sixteen(p), data) => *data = FrameData::Rgba16(p.as_flattened().to_vec()),
+    }
 }

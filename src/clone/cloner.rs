@@ -31,6 +31,22 @@ pub enum CloneMode {
     Monochrome,
 }
 
+impl CloneMode {
+    /// The name used in scene files and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            CloneMode::Normal => "normal",
+            CloneMode::Monochrome => "monochrome",
+        }
+    }
+
+    pub fn from_name(name: &str) -> Option<Self> {
+        [CloneMode::Normal, CloneMode::Monochrome]
+            .into_iter()
+            .find(|k| k.name() == name)
+    }
+}
+
 /// Settings fixed for the life of a [`PatchCloner`] (changing them means a new cloner).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CloneOptions {

@@ -55,47 +55,8 @@ pub enum Shape {
     Polygons(Vec<Polygon>),
 }
 
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub enum LaplacianKind {
-    #[default]
-    Combinatorial,
-    Cotangent,
-}
-
-impl LaplacianKind {
-    pub fn name(self) -> &'static str {
-        match self {
-            LaplacianKind::Combinatorial => "combinatorial",
-            LaplacianKind::Cotangent => "cotangent",
-        }
-    }
-    pub fn from_name(name: &str) -> Option<Self> {
-        [LaplacianKind::Combinatorial, LaplacianKind::Cotangent]
-            .into_iter()
-            .find(|k| k.name() == name)
-    }
-}
-
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub enum CloneMode {
-    #[default]
-    Normal,
-    Monochrome,
-}
-
-impl CloneMode {
-    pub fn name(self) -> &'static str {
-        match self {
-            CloneMode::Normal => "normal",
-            CloneMode::Monochrome => "monochrome",
-        }
-    }
-    pub fn from_name(name: &str) -> Option<Self> {
-        [CloneMode::Normal, CloneMode::Monochrome]
-            .into_iter()
-            .find(|k| k.name() == name)
-    }
-}
+pub use crate::clone::CloneMode;
+pub use crate::solve::LaplacianKind;
 
 /// Where a patch sits in the canvas over time. Empty tracks take their defaults:
 /// `position` = the patch stays where it is in the source (its bounding-box centre keeps its

@@ -20,6 +20,22 @@ pub enum LaplacianKind {
     Cotangent,
 }
 
+impl LaplacianKind {
+    /// The name used in scene files and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            LaplacianKind::Combinatorial => "combinatorial",
+            LaplacianKind::Cotangent => "cotangent",
+        }
+    }
+
+    pub fn from_name(name: &str) -> Option<Self> {
+        [LaplacianKind::Combinatorial, LaplacianKind::Cotangent]
+            .into_iter()
+            .find(|k| k.name() == name)
+    }
+}
+
 /// The Laplacian `L = D − W` of the mesh, lower triangle. Vertices without edges get a zero row.
 pub fn laplacian(mesh: &Mesh, kind: LaplacianKind) -> SymmetricCsc {
     let n = mesh.vertex_count();

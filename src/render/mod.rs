@@ -1,0 +1,15 @@
+//! Rendering scenes: takes a [`Scene`](crate::scene::Scene) and a frame index (or a time) and
+//! gives the composited frame as a [`Canvas`](crate::pixels::Canvas).
+//!
+//! Once per scene ([`Renderer::new`]): load images, mesh every patch, factor its cloning
+//! Laplacian and, for patches with handles or pins, its deformation Laplacian. Per frame:
+//! evaluate the timeline at t = i / fps, reset the canvas to the background, then for each
+//! patch back to front: deformation solve (rank-1 switches only), visibility switches,
+//! membrane solve, raster — each patch clones onto the composite of the layers below it.
+
+mod error;
+mod layer;
+mod renderer;
+
+pub use error::RenderError;
+pub use renderer::{FrameStats, Renderer};
