@@ -18,6 +18,8 @@ pub enum BenchCommand {
     Mesh(super::bench_mesh::MeshBenchArgs),
     /// Deformation timings (rig build, drag step, constraint switches) on disc fixtures.
     Deform(super::bench_deform::DeformBenchArgs),
+    /// A 1920×1080 scene with two deforming patches: per-frame compute and PNG encoding.
+    Render(super::bench_render::RenderBenchArgs),
 }
 
 pub fn run(args: BenchArgs) -> anyhow::Result<()> {
@@ -26,5 +28,6 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
         BenchCommand::Factor(args) => super::bench_solver::run_factor(args),
         BenchCommand::Mesh(args) => super::bench_mesh::run(args),
         BenchCommand::Deform(args) => super::bench_deform::run(args),
+        BenchCommand::Render(args) => super::bench_render::run(args),
     }
 }
