@@ -18,6 +18,8 @@ pub enum BenchCommand {
     Mesh(super::bench_mesh::MeshBenchArgs),
     /// Deformation timings (rig build, drag step, constraint switches) on disc fixtures.
     Deform(super::bench_deform::DeformBenchArgs),
+    /// End-to-end clone timings: the paper's spiral (first clone, reclone) and a deform frame.
+    Clone(super::bench_clone::CloneBenchArgs),
 }
 
 pub fn run(args: BenchArgs) -> anyhow::Result<()> {
@@ -26,5 +28,6 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
         BenchCommand::Factor(args) => super::bench_solver::run_factor(args),
         BenchCommand::Mesh(args) => super::bench_mesh::run(args),
         BenchCommand::Deform(args) => super::bench_deform::run(args),
+        BenchCommand::Clone(args) => super::bench_clone::run(args),
     }
 }
