@@ -20,6 +20,8 @@ pub enum BenchCommand {
     Deform(super::bench_deform::DeformBenchArgs),
     /// A 1920×1080 scene with two deforming patches: per-frame compute and PNG encoding.
     Render(super::bench_render::RenderBenchArgs),
+    /// End-to-end clone timings: the paper's spiral (first clone, reclone) and a deform frame.
+    Clone(super::bench_clone::CloneBenchArgs),
 }
 
 pub fn run(args: BenchArgs) -> anyhow::Result<()> {
@@ -29,5 +31,6 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
         BenchCommand::Mesh(args) => super::bench_mesh::run(args),
         BenchCommand::Deform(args) => super::bench_deform::run(args),
         BenchCommand::Render(args) => super::bench_render::run(args),
+        BenchCommand::Clone(args) => super::bench_clone::run(args),
     }
 }

@@ -26,16 +26,16 @@ pub struct CloneArgs {
     #[arg(long)]
     pub mask: PathBuf,
     /// Where the mask's pixel (0,0) lies in the source, when the sizes differ.
-    #[arg(long = "mask-offset", value_parser = point)]
+    #[arg(long = "mask-offset", value_parser = point, allow_hyphen_values = true)]
     pub mask_offset: Option<[f64; 2]>,
     /// Target image the patch is cloned into.
     #[arg(long)]
     pub target: PathBuf,
     /// Target position of the anchor (by default the centre of the mask's bounding box).
-    #[arg(long, value_parser = point)]
+    #[arg(long, value_parser = point, allow_hyphen_values = true)]
     pub at: [f64; 2],
     /// Uniform scale of the patch.
-    #[arg(long, default_value_t = 1.0, value_parser = finite_f64)]
+    #[arg(long, default_value_t = 1.0, value_parser = finite_f64, allow_hyphen_values = true)]
     pub scale: f64,
     /// Rotation in degrees (positive turns x towards y: clockwise on screen).
     #[arg(long, default_value_t = 0.0, value_parser = finite_f64, allow_hyphen_values = true)]
@@ -61,7 +61,7 @@ pub struct CloneArgs {
     #[arg(long, value_parser = parse_drag, allow_hyphen_values = true)]
     pub drag: Vec<DragArg>,
     /// Hold the point X,Y of the source's frame still (repeatable).
-    #[arg(long, value_parser = point)]
+    #[arg(long, value_parser = point, allow_hyphen_values = true)]
     pub pin: Vec<[f64; 2]>,
     /// Draw the (deformed) mesh and the handles over the result (8-bit RGBA output).
     #[arg(long = "show-mesh")]
@@ -212,7 +212,11 @@ fn check_arguments(args: &CloneArgs) -> anyhow::Result<()> {
         return Err(UsageError(format!("--scale must be positive, not {}", args.scale)).into());
     }
     if !(0.0..=1.0).contains(&args.threshold) {
-        return Err(UsageError(format!("--threshold must lie in [0, 1], not {}", args.threshold)).into());
+        return Err(UsageError(format!(
+            "--threshold must lie in [0, 1], not {}",
+            args.threshold
+        ))
+        .into());
     }
     if args.feather < 0.0 {
         return Err(UsageError(format!("--feather must be ≥ 0, not {}", args.feather)).into());
@@ -227,7 +231,11 @@ fn check_arguments(args: &CloneArgs) -> anyhow::Result<()> {
 pub fn check_output_folder(output: &Path) -> anyhow::Result<()> {
     match output.parent() {
         Some(dir) if !dir.as_os_str().is_empty() && !dir.is_dir() => {
-            anyhow::bail!("{}: the output folder {} does not exist", output.display(), dir.display())
+            anyhow::bail!(
+                "{}: the output folder {} does not exist",
+                output.display(),
+                dir.display()
+            )
         }
         _ => Ok(()),
     }
@@ -323,7 +331,10 @@ fn write_output(
     )?;
     let mut bytes = Vec::new();
     picture
-        .write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
+        .write_to(
+            &mut std::io::Cursor::new(&mut bytes),
+            image::ImageFormat::Png,
+        )
         .context("encoding the overlay")?;
     lapclone::util::write_atomic(&args.output, &bytes)
         .with_context(|| format!("writing {}", args.output.display()))

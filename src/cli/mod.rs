@@ -5,6 +5,7 @@
 use clap::{Parser, Subcommand};
 
 pub mod bench;
+pub mod bench_clone;
 pub mod bench_deform;
 pub mod bench_mesh;
 pub mod bench_render;

@@ -1,0 +1,280 @@
+//! Numerical checks of the clone against exact expectations: the membrane matches
+//! target − source at constrained boundary vertices; a clone onto itself reproduces the
+//! source; re-cloning after a move (rank-1 constraint switches in the kept factor) equals a
+//! fresh cloner at the new placement; boundary vertices outside the target switch off and
+//! come back; monochrome mode; the source's alpha.
+
+#[path = "clone_fixtures.rs"]
+mod fixtures;
+
+use glam::DVec2;
+use lapclone::clone::{CloneMode, CloneOptions, PatchCloner, Placement};
+use lapclone::mesh::synth;
+use lapclone::pixels::{Canvas, ColorKind, Depth, FloatImage, PixelFormat};
+
+use fixtures::*;
+
+fn centred(at: DVec2) -> Placement {
+    Placement {
+        pivot: DVec2::new(32.0, 32.0),
+        at,
+        scale: 1.0,
+        rotation_deg: 0.0,
+    }
+}
+
+fn two_holes_cloner(options: &CloneOptions) -> PatchCloner {
+    cloner_for(&textured_source(64, 64), &synth::two_holes(64, 64), options).0
+}
+
+/// Largest |membrane − (target − source)| over constrained boundary vertices.
+fn boundary_mismatch(cloner: &PatchCloner, target: &Canvas) -> f64 {
+    let factor = cloner.membrane().factor();
+    let mut worst = 0.0f64;
+    for &v in cloner.membrane().boundary_vertices() {
+        let v = v as usize;
+        if !factor.is_constrained(v) {
+            continue;
+        }
+        let p = cloner.placed()[v];
+        let rest = cloner.mesh().positions[v];
+        let t = target.sample_bilinear(p.x, p.y);
+        let s = cloner.source().sample_bilinear(rest.x, rest.y);
+        for c in 0..3 {
+            let want = f64::from(t[c]) - f64::from(s[c]);
+            worst = worst.max((f64::from(cloner.membrane().membrane()[v][c]) - want).abs());
+        }
+    }
+    worst
+}
+
+#[test]
+fn membrane_matches_target_minus_source_on_the_boundary() {
+    let mut cloner = two_holes_cloner(&CloneOptions::default());
+    let target = Canvas::from_image(&smooth_target(96, 80));
+    let mut canvas = target.clone();
+    let placement = Placement {
+        rotation_deg: 17.0,
+        scale: 1.1,
+        ..centred(DVec2::new(47.3, 40.6))
+    };
+    let stats = cloner.clone_onto(&mut canvas, &placement).unwrap();
+    assert_eq!(
+        stats.membrane.constrained,
+        cloner.membrane().boundary_vertices().len()
+    );
+    let worst = boundary_mismatch(&cloner, &target);
+    assert!(worst <= 1e-5, "membrane off target − source by {worst}");
+}
+
+#[test]
+fn clone_onto_itself_reproduces_the_source() {
+    let source = textured_source(64, 64);
+    let (mut cloner, _, _) = cloner_for(
+        &source,
+        &synth::disc(64, 64, 24.0),
+        &CloneOptions::default(),
+    );
+    let mut canvas = Canvas::from_image(&source);
+    let stats = cloner
+        .clone_onto(&mut canvas, &Placement::identity())
+        .unwrap();
+    assert!(stats.raster.written > 1000, "the patch was drawn");
+    let out = canvas.to_float_image(source.format());
+    let worst = out
+        .pixels()
+        .iter()
+        .zip(source.pixels())
+        .flat_map(|(a, b)| (0..4).map(move |c| (a[c] - b[c]).abs()))
+        .fold(0.0f32, f32::max);
+    assert!(
+        worst <= 1.0 / 255.0 + 1e-6,
+        "differs from the source by {worst}"
+    );
+}
+
+/// The membranes of two cloners agree to within `tolerance`.
+fn membrane_difference(a: &PatchCloner, b: &PatchCloner) -> f64 {
+    a.membrane()
+        .membrane()
+        .iter()
+        .zip(b.membrane().membrane())
+        .flat_map(|(x, y)| (0..3).map(move |c| f64::from((x[c] - y[c]).abs())))
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn moving_the_patch_equals_a_fresh_cloner_at_the_new_place() {
+    let target = Canvas::from_image(&smooth_target(96, 80));
+    let mut moved = two_holes_cloner(&CloneOptions::default());
+    // A path that leaves the target on the left and top, then comes back in.
+    let path = [
+        DVec2::new(48.0, 40.0),
+        DVec2::new(51.0, 42.0),
+        DVec2::new(10.0, 40.0),
+        DVec2::new(-5.0, 8.0),
+        DVec2::new(30.5, 33.25),
+        DVec2::new(48.0, 40.0),
+    ];
+    for at in path {
+        let mut canvas = target.clone();
+        let stats = moved.clone_onto(&mut canvas, &centred(at)).unwrap();
+        let mut fresh = two_holes_cloner(&CloneOptions::default());
+        let mut fresh_canvas = target.clone();
+        fresh.clone_onto(&mut fresh_canvas, &centred(at)).unwrap();
+        assert_eq!(
+            fresh.membrane().factor().constrained(),
+            moved.membrane().factor().constrained()
+        );
+        let difference = membrane_difference(&moved, &fresh);
+        assert!(
+            difference <= 1e-6,
+            "at {at}: membranes differ by {difference} ({stats:?})"
+        );
+        assert!(boundary_mismatch(&moved, &target) <= 1e-5);
+    }
+}
+
+#[test]
+fn outside_boundary_vertices_switch_off_and_come_back() {
+    let target = Canvas::from_image(&smooth_target(96, 80));
+    let mut cloner = two_holes_cloner(&CloneOptions::default());
+    let boundary = cloner.membrane().boundary_vertices().to_vec();
+    let inside = centred(DVec2::new(48.0, 40.0));
+    let first = cloner.clone_onto(&mut target.clone(), &inside).unwrap();
+    let membrane_inside = cloner.membrane().membrane().to_vec();
+    assert_eq!(
+        (first.membrane.constrained, first.membrane.outside),
+        (boundary.len(), 0)
+    );
+
+    let out = cloner
+        .clone_onto(&mut target.clone(), &centred(DVec2::new(8.0, 40.0)))
+        .unwrap();
+    let width = f64::from(target.width());
+    for &v in &boundary {
+        let p = cloner.placed()[v as usize];
+        let outside = p.x < 0.0 || p.y < 0.0 || p.x > width || p.y > f64::from(target.height());
+        assert_eq!(
+            cloner.membrane().factor().is_constrained(v as usize),
+            !outside,
+            "vertex {v} at {p}"
+        );
+    }
+    assert!(out.membrane.outside > 0);
+    assert_eq!(
+        out.membrane.constrained + out.membrane.outside,
+        boundary.len()
+    );
+    assert!(out.membrane.switches.downdates >= out.membrane.outside);
+
+    let back = cloner.clone_onto(&mut target.clone(), &inside).unwrap();
+    assert_eq!(
+        (back.membrane.constrained, back.membrane.outside),
+        (boundary.len(), 0)
+    );
+    assert_eq!(back.membrane.switches.updates, out.membrane.outside);
+    let drift = cloner
+        .membrane()
+        .membrane()
+        .iter()
+        .zip(&membrane_inside)
+        .flat_map(|(a, b)| (0..3).map(move |c| (a[c] - b[c]).abs()))
+        .fold(0.0f32, f32::max);
+    assert!(drift <= 1e-6, "membrane after returning differs by {drift}");
+}
+
+fn is_grey_offset_of(pixel: [f32; 4], reference: [f32; 4], tolerance: f32) -> bool {
+    let offset = |p: [f32; 4]| [p[0] - p[1], p[1] - p[2]];
+    let (a, b) = (offset(pixel), offset(reference));
+    (a[0] - b[0]).abs() <= tolerance && (a[1] - b[1]).abs() <= tolerance
+}
+
+/// Over a uniform target, monochrome mode adds the same offset to every channel (grey
+/// texture, the target's colour); normal mode keeps the source's colour texture.
+#[test]
+fn monochrome_transfers_grey_texture_and_target_colour() {
+    let teal = [0.2, 0.55, 0.5, 1.0];
+    let target = FloatImage::from_fn(96, 80, RGB8, |_, _| teal).unwrap();
+    let clone = |mode| {
+        let options = CloneOptions {
+            mode,
+            ..CloneOptions::default()
+        };
+        let mut cloner = two_holes_cloner(&options);
+        let mut canvas = Canvas::from_image(&target);
+        cloner
+            .clone_onto(&mut canvas, &centred(DVec2::new(48.0, 40.0)))
+            .unwrap();
+        canvas.to_float_image(RGB8)
+    };
+    let grey_ok = |image: &FloatImage| {
+        let tolerance = 2.5 / 255.0;
+        image
+            .pixels()
+            .iter()
+            .all(|&p| is_grey_offset_of(p, teal, tolerance))
+    };
+    let mono = clone(CloneMode::Monochrome);
+    assert!(grey_ok(&mono), "monochrome clone changed the target's hue");
+    let textured = mono
+        .pixels()
+        .iter()
+        .filter(|p| (p[1] - teal[1]).abs() > 0.01)
+        .count();
+    assert!(
+        textured > 200,
+        "monochrome clone lost the texture ({textured} pixels differ)"
+    );
+    assert!(
+        !grey_ok(&clone(CloneMode::Normal)),
+        "normal mode should carry colour texture"
+    );
+}
+
+#[test]
+fn alpha_of_an_rgba_source_is_kept() {
+    let rgba8 = PixelFormat {
+        color: ColorKind::Rgb,
+        alpha: true,
+        depth: Depth::Eight,
+    };
+    let opaque = textured_source(64, 64);
+    let source = FloatImage::from_fn(64, 64, rgba8, |i, j| {
+        let [r, g, b, _] = opaque.pixel(i, j).unwrap();
+        [r, g, b, 0.3 + 0.6 * i as f32 / 64.0]
+    })
+    .unwrap();
+    let transparent = FloatImage::from_fn(96, 80, rgba8, |_, _| [0.2, 0.4, 0.6, 0.0]).unwrap();
+    let (mut cloner, _, _) = cloner_for(
+        &source,
+        &synth::disc(64, 64, 24.0),
+        &CloneOptions::default(),
+    );
+    let mut canvas = Canvas::from_image(&transparent);
+    cloner
+        .clone_onto(&mut canvas, &centred(DVec2::new(48.0, 40.0)))
+        .unwrap();
+    let out = canvas.to_float_image(rgba8);
+    assert_eq!(out.format(), rgba8);
+    // Pixels well inside the disc (fully covered): alpha is the source's.
+    let mut checked = 0;
+    for j in 0..64u32 {
+        for i in 0..64u32 {
+            let d = DVec2::new(f64::from(i) + 0.5 - 32.0, f64::from(j) + 0.5 - 32.0).length();
+            if d > 21.0 {
+                continue;
+            }
+            let got = out.pixel(i + 16, j + 8).unwrap()[3];
+            let want = source.pixel(i, j).unwrap()[3];
+            assert!(
+                (got - want).abs() <= 1.0 / 255.0 + 1e-6,
+                "pixel ({i}, {j}): alpha {got}, source {want}"
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked > 1000);
+    // Outside the patch the target stays transparent.
+    assert_eq!(out.pixel(1, 1).unwrap()[3], 0.0);
+}
