@@ -5,7 +5,7 @@
 //! depth order), checked for determinism and for exactly which boundary constraints it
 //! switches off.
 
-#[path = "clone_fixtures.rs"]
+#[path = "common/clone_fixtures.rs"]
 mod fixtures;
 #[path = "common/golden.rs"]
 mod golden;

@@ -1,7 +1,7 @@
 //! Shared fixtures of the clone tests: takes sizes (and a mask or placement) and gives small
 //! synthetic sources and targets with clearly different colours and texture, and one-call
 //! clones through the library. Included by the `clone_*` test files with
-//! `#[path = "clone_fixtures.rs"] mod fixtures;` (as its own test target it holds no tests).
+//! `#[path = "common/clone_fixtures.rs"] mod fixtures;`.
 #![allow(dead_code)]
 
 use glam::DVec2;
