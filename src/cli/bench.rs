@@ -18,6 +18,9 @@ pub enum BenchCommand {
     Mesh(super::bench_mesh::MeshBenchArgs),
     /// Deformation timings (rig build, drag step, constraint switches) on disc fixtures.
     Deform(super::bench_deform::DeformBenchArgs),
+    /// The paper's Table I and Fig. 5: MVC vs combinatorial vs cotangent against the
+    /// pixel-grid reference; `--sweep` writes the density table.
+    Paper(super::bench_paper::PaperBenchArgs),
 }
 
 pub fn run(args: BenchArgs) -> anyhow::Result<()> {
@@ -26,5 +29,6 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
         BenchCommand::Factor(args) => super::bench_solver::run_factor(args),
         BenchCommand::Mesh(args) => super::bench_mesh::run(args),
         BenchCommand::Deform(args) => super::bench_deform::run(args),
+        BenchCommand::Paper(args) => super::bench_paper::run(args),
     }
 }

@@ -7,6 +7,7 @@ use clap::{Parser, Subcommand};
 pub mod bench;
 pub mod bench_deform;
 pub mod bench_mesh;
+pub mod bench_paper;
 pub mod bench_solver;
 pub mod clone;
 pub mod mesh;
