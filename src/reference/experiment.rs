@@ -170,6 +170,9 @@ impl Experiment {
             }
         }
         let source_rgb = rgb_samples(&source);
+        // The solvers read the target through a canvas, quantised to its bit depth: compare
+        // against the same quantised target.
+        let target = Canvas::from_image(&target).to_float_image(target.format());
         let target_rgb = rgb_samples(&target);
         let difference: Vec<f32> = target_rgb
             .iter()

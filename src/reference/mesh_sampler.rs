@@ -154,7 +154,7 @@ fn centres_near(
 /// which every comparison rejects).
 fn barycentric(c: &[DVec2; 3], x: DVec2) -> [f64; 3] {
     let area = (c[1] - c[0]).perp_dot(c[2] - c[0]);
-    let w1 = (x - c[0]).perp_dot(c[2] - c[0]) / -area;
+    let w1 = (x - c[0]).perp_dot(c[2] - c[0]) / area;
     let w2 = (c[1] - c[0]).perp_dot(x - c[0]) / area;
     [1.0 - w1 - w2, w1, w2]
 }
