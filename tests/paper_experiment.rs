@@ -30,7 +30,8 @@ fn image(f: impl Fn(f64, f64, usize) -> f64) -> FloatImage {
 /// Smooth, non-harmonic source and target (periods of 20–40 px).
 fn smooth_pair() -> (FloatImage, FloatImage) {
     let source = image(|x, y, c| 0.5 + 0.3 * ((x + 7.0 * c as f64) / 9.0).sin() * (y / 13.0).cos());
-    let target = image(|x, y, c| 0.5 + 0.3 * ((y - 5.0 * c as f64) / 6.0).sin() + 0.1 * (x / 11.0).cos());
+    let target =
+        image(|x, y, c| 0.5 + 0.3 * ((y - 5.0 * c as f64) / 6.0).sin() + 0.1 * (x / 11.0).cos());
     (source, target)
 }
 
@@ -79,8 +80,12 @@ fn refining_the_mesh_improves_the_combinatorial_membrane() {
     let mask = GridMask::new(SIZE, SIZE, &inside).unwrap();
     let (source, target) = smooth_pair();
     let experiment = Experiment::new(mask, source, target).unwrap();
-    let coarse = experiment.run(&exact_cover_options(6.0), &run_options()).unwrap();
-    let fine = experiment.run(&exact_cover_options(1.0), &run_options()).unwrap();
+    let coarse = experiment
+        .run(&exact_cover_options(6.0), &run_options())
+        .unwrap();
+    let fine = experiment
+        .run(&exact_cover_options(1.0), &run_options())
+        .unwrap();
     assert!(fine.mesh.vertex_count() > coarse.mesh.vertex_count());
     assert!(
         fine.combinatorial.comparison.psnr_db > coarse.combinatorial.comparison.psnr_db + 1.0,
@@ -100,14 +105,19 @@ fn linear_boundary_data_is_reproduced_by_cotangent_and_mvc() {
     let source = image(|_, _, c| 0.2 + 0.1 * c as f64);
     let target = image(|x, y, c| 0.1 + 0.006 * x + 0.004 * y + 0.05 * c as f64);
     let experiment = Experiment::new(mask, source, target).unwrap();
-    let run = experiment.run(&exact_cover_options(2.0), &run_options()).unwrap();
+    let run = experiment
+        .run(&exact_cover_options(2.0), &run_options())
+        .unwrap();
     let cotangent = run.cotangent.comparison.psnr_db;
     let mvc = run.mvc.figures().unwrap().comparison.psnr_db;
     let combinatorial = run.combinatorial.comparison.psnr_db;
     // 16-bit quantisation of the target bounds the agreement at roughly 100 dB.
     assert!(cotangent > 75.0, "cotangent {cotangent} dB");
     assert!(mvc > 75.0, "MVC {mvc} dB");
-    assert!(combinatorial < cotangent, "combinatorial {combinatorial} dB");
+    assert!(
+        combinatorial < cotangent,
+        "combinatorial {combinatorial} dB"
+    );
 }
 
 #[test]
@@ -119,7 +129,9 @@ fn mvc_is_not_run_on_a_patch_with_holes() {
     let mask = GridMask::new(SIZE, SIZE, &inside).unwrap();
     let (source, target) = smooth_pair();
     let experiment = Experiment::new(mask, source, target).unwrap();
-    let run = experiment.run(&exact_cover_options(2.0), &run_options()).unwrap();
+    let run = experiment
+        .run(&exact_cover_options(2.0), &run_options())
+        .unwrap();
     assert!(matches!(run.mvc, MvcOutcome::Holes { holes: 1 }));
     assert_eq!(run.mvc.not_run_reason().as_deref(), Some("n/a (holes)"));
     // Measured 29.8 dB at density 2 px.

@@ -26,11 +26,11 @@ use glam::DVec2;
 use thiserror::Error;
 
 use super::mesh_sampler::MeshSampler;
+use super::metrics::ComparisonInput;
 use super::{
     GridMask, GridPoisson, MaskError, MembraneComparison, MetricError, MvcError, MvcWeights,
     PoissonError,
 };
-use super::metrics::ComparisonInput;
 use crate::clone::{CloneError, CloneOptions, MembraneSolver, PatchCloner, Placement};
 use crate::mesh::{mesh_mask, BitMask, Mesh, MeshError, MeshOptions};
 use crate::pixels::{Canvas, FloatImage};
@@ -100,9 +100,14 @@ pub struct MethodFigures {
 pub enum MvcOutcome {
     Measured(MethodFigures),
     /// MVC is undefined on a patch with holes.
-    Holes { holes: usize },
+    Holes {
+        holes: usize,
+    },
     /// The dense weight table would exceed [`RunOptions::mvc_max_weights`].
-    TooLarge { weights: usize, limit: usize },
+    TooLarge {
+        weights: usize,
+        limit: usize,
+    },
 }
 
 impl MvcOutcome {

@@ -98,7 +98,10 @@ fn mask_crop(experiment: &Experiment) -> (usize, usize, usize, usize) {
     if x0 >= x1 {
         return (0, 0, w, h);
     }
-    let (x0, y0) = (x0.saturating_sub(CROP_MARGIN), y0.saturating_sub(CROP_MARGIN));
+    let (x0, y0) = (
+        x0.saturating_sub(CROP_MARGIN),
+        y0.saturating_sub(CROP_MARGIN),
+    );
     let (x1, y1) = ((x1 + CROP_MARGIN).min(w), (y1 + CROP_MARGIN).min(h));
     (x0, y0, x1 - x0, y1 - y0)
 }
@@ -112,8 +115,8 @@ fn tile_pixmap(
     shrink: usize,
 ) -> Result<Pixmap, FigureError> {
     let (tw, th) = (crop.2 / shrink, crop.3 / shrink);
-    let mut tile = Pixmap::new(tw as u32, th as u32)
-        .ok_or(FigureError::TooLarge(tw as u32, th as u32))?;
+    let mut tile =
+        Pixmap::new(tw as u32, th as u32).ok_or(FigureError::TooLarge(tw as u32, th as u32))?;
     let width = experiment.width();
     let mask = experiment.mask();
     let (source, target) = (experiment.source_rgb(), experiment.target_rgb());

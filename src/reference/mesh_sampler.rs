@@ -110,7 +110,9 @@ impl MeshSampler {
             let o = tap.pixel as usize * channels;
             for c in 0..channels {
                 out[o + c] = (0..3)
-                    .map(|k| tap.weights[k] * values[tap.vertices[k] as usize * channels + c].into())
+                    .map(|k| {
+                        tap.weights[k] * values[tap.vertices[k] as usize * channels + c].into()
+                    })
                     .sum();
             }
         }

@@ -77,9 +77,10 @@ pub fn model_mask(assets: &Path, name: &str) -> Result<Option<SyntheticMask>, Mo
 
 /// A model by name with its photos (`None` for an unknown name).
 pub fn paper_model(assets: &Path, name: &str) -> Result<Option<PaperModel>, ModelError> {
-    let Some(mask) = model_mask(assets, name)? else {
+    let Some(mut mask) = model_mask(assets, name)? else {
         return Ok(None);
     };
+    fill_holes(mask.width, mask.height, &mut mask.inside);
     let (source, target, offset) = photos_of(mask.name);
     let (w, h) = (mask.width as u32, mask.height as u32);
     let source = mirror_tile(&FloatImage::load(&assets.join(source))?, w, h, offset)?;
@@ -162,4 +163,37 @@ pub fn horse(assets: &Path, width: usize, height: usize) -> Result<SyntheticMask
         height,
         inside,
     })
+}
+
+/// Marks inside every outside pixel not 4-connected to the image border: the paper's models
+/// have no holes (the synthetic shapes leave a few enclosed specks, and MVC refuses holes).
+pub fn fill_holes(width: usize, height: usize, inside: &mut [bool]) {
+    let mut reached = vec![false; width * height];
+    let mut stack: Vec<usize> = (0..width * height)
+        .filter(|&p| {
+            let (x, y) = (p % width, p / width);
+            !inside[p] && (x == 0 || y == 0 || x + 1 == width || y + 1 == height)
+        })
+        .collect();
+    for &p in &stack {
+        reached[p] = true;
+    }
+    while let Some(p) = stack.pop() {
+        let (x, y) = (p % width, p / width);
+        let neighbours = [
+            (x > 0).then(|| p - 1),
+            (x + 1 < width).then(|| p + 1),
+            (y > 0).then(|| p - width),
+            (y + 1 < height).then(|| p + width),
+        ];
+        for q in neighbours.into_iter().flatten() {
+            if !inside[q] && !reached[q] {
+                reached[q] = true;
+                stack.push(q);
+            }
+        }
+    }
+    for (cell, &r) in inside.iter_mut().zip(&reached) {
+        *cell |= !r;
+    }
 }
