@@ -22,6 +22,9 @@ pub enum BenchCommand {
     Render(super::bench_render::RenderBenchArgs),
     /// End-to-end clone timings: the paper's spiral (first clone, reclone) and a deform frame.
     Clone(super::bench_clone::CloneBenchArgs),
+    /// The paper's Table I and Fig. 5: MVC vs combinatorial vs cotangent against the
+    /// pixel-grid reference; `--sweep` writes the density table.
+    Paper(super::bench_paper::PaperBenchArgs),
 }
 
 pub fn run(args: BenchArgs) -> anyhow::Result<()> {
@@ -32,5 +35,6 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
         BenchCommand::Deform(args) => super::bench_deform::run(args),
         BenchCommand::Render(args) => super::bench_render::run(args),
         BenchCommand::Clone(args) => super::bench_clone::run(args),
+        BenchCommand::Paper(args) => super::bench_paper::run(args),
     }
 }

@@ -9,6 +9,7 @@ pub mod bench_clone;
 pub mod bench_deform;
 pub mod bench_mesh;
 pub mod bench_render;
+pub mod bench_paper;
 pub mod bench_solver;
 pub mod clone;
 pub mod mesh;

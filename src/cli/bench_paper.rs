@@ -1,0 +1,476 @@
+//! `lapclone bench paper`: the paper's Table I and Fig. 5 measured on lapclone (use a release
+//! build). It takes the assets folder and options and prints a table — per model: pixels,
+//! vertices, pre-processing (MVC weights vs Cholesky factor), membrane time (MVC vs ours),
+//! PSNR of the combinatorial, cotangent and MVC membranes against the pixel-grid reference,
+//! seam steps and uncovered pixels — or JSON with `--json`; writes the Fig.-5-style picture
+//! `fig5_spiral.png` into `--out`; with `--sweep`, sweeps the mesh density on the spiral and
+//! writes the markdown table to `--sweep-out` (docs/quality.md).
+//!
+//! JSON keys (`--json`): `density`, `repeats`, `models[]` with `model`, `width`, `height`,
+//! `inside_pixels`, `vertices`, `triangles`, `boundary_vertices`, `mesh_ms`,
+//! `reference_factor_ms`, `reference_solve_ms`, `uncovered`, and `combinatorial`,
+//! `cotangent`, `mvc` objects with `psnr_db`, `seam_step`, `reference_seam_step`,
+//! `preprocess_ms`, `membrane_ms` (MVC: `null` numbers and `not_run` = reason when it did not
+//! run); `figure` (path or null); `sweep[]` (with `--sweep`) with `density`, `vertices`,
+//! `mesh_ms`, `psnr_combinatorial_db`, `psnr_cotangent_db`, `uncovered`, `reclone_ms`.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+use glam::DVec2;
+use lapclone::mesh::MeshOptions;
+use lapclone::reference::experiment::{
+    reclone_ms, Experiment, MeshRun, MethodFigures, MvcOutcome, RunOptions,
+};
+use lapclone::reference::figure::comparison_figure;
+use lapclone::reference::paper_models::{paper_model, MODEL_NAMES};
+use lapclone::reference::GridMask;
+use lapclone::solve::LaplacianKind;
+use lapclone::util::write_atomic;
+
+/// Densities (max boundary edge, px) of the default sweep.
+const SWEEP_DENSITIES: [f64; 7] = [4.0, 3.0, 2.0, 1.5, 1.0, 0.75, 0.5];
+/// Vertex counts of the Fig.-5 meshes (the paper's .5K, 1K, 3K).
+const FIGURE_VERTICES: [usize; 3] = [500, 1000, 3000];
+
+#[derive(clap::Args, Debug)]
+pub struct PaperBenchArgs {
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
+    /// Folder for the comparison picture.
+    #[arg(long, default_value = "out/paper")]
+    pub out: PathBuf,
+    /// Folder holding the bundled photos and horse_mask.png.
+    #[arg(long, default_value = "assets")]
+    pub assets: PathBuf,
+    /// Maximum boundary edge length in px for the table (default: the library default).
+    #[arg(long, value_parser = super::finite_f64)]
+    pub density: Option<f64>,
+    /// Timed runs per figure (the best is reported).
+    #[arg(long, default_value_t = 3)]
+    pub repeat: usize,
+    /// Only models whose name contains this text.
+    #[arg(long)]
+    pub filter: Option<String>,
+    /// Skip MVC on meshes whose dense weight table would exceed this many entries.
+    #[arg(long, default_value_t = 40_000_000)]
+    pub mvc_max_weights: usize,
+    /// Tiny configuration (mouth only, one run, no picture; a small sweep): a smoke test.
+    #[arg(long)]
+    pub quick: bool,
+    /// Do not write the comparison picture.
+    #[arg(long)]
+    pub no_figure: bool,
+    /// Also sweep the mesh density on the spiral and write the markdown table.
+    #[arg(long)]
+    pub sweep: bool,
+    /// Where `--sweep` writes its markdown.
+    #[arg(long, default_value = "docs/quality.md")]
+    pub sweep_out: PathBuf,
+}
+
+#[derive(serde::Serialize)]
+struct MethodJson {
+    psnr_db: Option<f64>,
+    seam_step: Option<f64>,
+    reference_seam_step: Option<f64>,
+    preprocess_ms: Option<f64>,
+    membrane_ms: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    not_run: Option<String>,
+}
+
+#[derive(serde::Serialize)]
+struct ModelJson {
+    model: String,
+    width: usize,
+    height: usize,
+    inside_pixels: usize,
+    vertices: usize,
+    triangles: usize,
+    boundary_vertices: usize,
+    mesh_ms: f64,
+    reference_factor_ms: f64,
+    reference_solve_ms: f64,
+    uncovered: usize,
+    combinatorial: MethodJson,
+    cotangent: MethodJson,
+    mvc: MethodJson,
+}
+
+#[derive(serde::Serialize, Clone)]
+struct SweepRow {
+    density: f64,
+    vertices: usize,
+    mesh_ms: f64,
+    psnr_combinatorial_db: f64,
+    psnr_cotangent_db: f64,
+    uncovered: usize,
+    reclone_ms: f64,
+}
+
+#[derive(serde::Serialize)]
+struct Report {
+    density: f64,
+    repeats: usize,
+    models: Vec<ModelJson>,
+    figure: Option<String>,
+    sweep: Vec<SweepRow>,
+}
+
+pub fn run(args: PaperBenchArgs) -> anyhow::Result<()> {
+    let mut mesh_options = MeshOptions::default();
+    if let Some(density) = args.density {
+        mesh_options.density = density;
+    }
+    mesh_options
+        .validate()
+        .map_err(|e| super::UsageError(e.to_string()))?;
+    if args.repeat == 0 {
+        return Err(super::UsageError("--repeat must be at least 1".into()).into());
+    }
+    let run_options = RunOptions {
+        repeats: if args.quick { 1 } else { args.repeat },
+        mvc_max_weights: args.mvc_max_weights,
+        keep_membranes: false,
+    };
+    let names: Vec<&str> = MODEL_NAMES
+        .into_iter()
+        .filter(|n| !args.quick || *n == "mouth")
+        .filter(|n| args.filter.as_ref().is_none_or(|f| n.contains(f.as_str())))
+        .collect();
+    let mut models = Vec::new();
+    for name in names {
+        let experiment = load_experiment(&args.assets, name)?;
+        let run = experiment
+            .run(&mesh_options, &run_options)
+            .with_context(|| format!("model {name}"))?;
+        if !args.json {
+            eprintln!("measured {name}");
+        }
+        models.push(model_json(name, &experiment, &run));
+    }
+    let figure = if args.quick || args.no_figure {
+        None
+    } else {
+        Some(write_figure(&args, &run_options)?)
+    };
+    let sweep = if args.sweep {
+        run_sweep(&args, &run_options)?
+    } else {
+        Vec::new()
+    };
+    let report = Report {
+        density: mesh_options.density,
+        repeats: run_options.repeats,
+        models,
+        figure: figure.map(|p| p.display().to_string()),
+        sweep,
+    };
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        print!("{}", table_text(&report));
+    }
+    Ok(())
+}
+
+fn load_experiment(assets: &Path, name: &str) -> anyhow::Result<Experiment> {
+    let model = paper_model(assets, name)
+        .with_context(|| format!("loading model {name} from {}", assets.display()))?
+        .with_context(|| format!("unknown model {name}"))?;
+    let mask = GridMask::new(model.width, model.height, &model.inside)?;
+    Ok(Experiment::new(mask, model.source, model.target)?)
+}
+
+fn method_json(figures: &MethodFigures) -> MethodJson {
+    MethodJson {
+        psnr_db: Some(figures.comparison.psnr_db),
+        seam_step: Some(figures.comparison.seam_step.mean_abs),
+        reference_seam_step: Some(figures.comparison.reference_seam_step.mean_abs),
+        preprocess_ms: Some(figures.preprocess_ms),
+        membrane_ms: Some(figures.membrane_ms),
+        not_run: None,
+    }
+}
+
+fn mvc_json(outcome: &MvcOutcome) -> MethodJson {
+    match outcome.figures() {
+        Some(f) => method_json(f),
+        None => MethodJson {
+            psnr_db: None,
+            seam_step: None,
+            reference_seam_step: None,
+            preprocess_ms: None,
+            membrane_ms: None,
+            not_run: outcome.not_run_reason(),
+        },
+    }
+}
+
+fn model_json(name: &str, experiment: &Experiment, run: &MeshRun) -> ModelJson {
+    let (reference_factor_ms, reference_solve_ms) = experiment.reference_ms();
+    ModelJson {
+        model: name.to_string(),
+        width: experiment.width(),
+        height: experiment.height(),
+        inside_pixels: experiment.mask().inside_count(),
+        vertices: run.mesh.vertex_count(),
+        triangles: run.mesh.triangles.len(),
+        boundary_vertices: run.mesh.boundary_vertices().count(),
+        mesh_ms: run.mesh_ms,
+        reference_factor_ms,
+        reference_solve_ms,
+        uncovered: run.uncovered,
+        combinatorial: method_json(&run.combinatorial),
+        cotangent: method_json(&run.cotangent),
+        mvc: mvc_json(&run.mvc),
+    }
+}
+
+fn number(value: Option<f64>, decimals: usize) -> String {
+    match value {
+        Some(v) => format!("{v:.decimals$}"),
+        None => "n/a".into(),
+    }
+}
+
+fn table_text(report: &Report) -> String {
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "Table I (density {} px, best of {}; times in ms; PSNR in dB against the pixel-grid \
+         reference)",
+        report.density, report.repeats
+    );
+    let _ = writeln!(
+        out,
+        "{:<7} {:>9} {:>8} {:>9} {:>9} {:>9} {:>9} {:>8} {:>8} {:>16} {:>8} {:>8} {:>9}",
+        "model",
+        "pixels",
+        "vertices",
+        "pre MVC",
+        "pre ours",
+        "mem MVC",
+        "mem ours",
+        "PSNR cmb",
+        "PSNR cot",
+        "PSNR MVC",
+        "seam cmb",
+        "seam ref",
+        "uncovered"
+    );
+    for m in &report.models {
+        let mvc = &m.mvc;
+        let mvc_psnr = match &mvc.not_run {
+            Some(reason) => reason.clone(),
+            None => number(mvc.psnr_db, 2),
+        };
+        let _ = writeln!(
+            out,
+            "{:<7} {:>9} {:>8} {:>9} {:>9.2} {:>9} {:>9.3} {:>8.2} {:>8.2} {:>16} {:>8.4} {:>8.4} {:>9}",
+            m.model,
+            format!("{}x{}", m.width, m.height),
+            m.vertices,
+            number(mvc.preprocess_ms, 1),
+            m.combinatorial.preprocess_ms.unwrap_or(f64::NAN),
+            number(mvc.membrane_ms, 3),
+            m.combinatorial.membrane_ms.unwrap_or(f64::NAN),
+            m.combinatorial.psnr_db.unwrap_or(f64::NAN),
+            m.cotangent.psnr_db.unwrap_or(f64::NAN),
+            mvc_psnr,
+            m.combinatorial.seam_step.unwrap_or(f64::NAN),
+            m.combinatorial.reference_seam_step.unwrap_or(f64::NAN),
+            m.uncovered,
+        );
+    }
+    if let Some(path) = &report.figure {
+        let _ = writeln!(out, "comparison picture: {path}");
+    }
+    if !report.sweep.is_empty() {
+        out.push('\n');
+        out.push_str(&sweep_markdown(&report.sweep));
+    }
+    out
+}
+
+/// Meshes the spiral at the Fig.-5 vertex counts and writes the picture.
+fn write_figure(args: &PaperBenchArgs, run_options: &RunOptions) -> anyhow::Result<PathBuf> {
+    let experiment = load_experiment(&args.assets, "spiral")?;
+    let run_options = RunOptions {
+        repeats: 1,
+        keep_membranes: true,
+        ..*run_options
+    };
+    let mut runs = Vec::new();
+    for wanted in FIGURE_VERTICES {
+        let options = density_for_vertices(&experiment, wanted)?;
+        runs.push(experiment.run(&options, &run_options)?);
+    }
+    let picture = comparison_figure(&experiment, &runs, 2)?;
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("creating {}", args.out.display()))?;
+    let path = args.out.join("fig5_spiral.png");
+    let bytes = picture.encode_png().context("encoding the picture")?;
+    write_atomic(&path, &bytes).with_context(|| format!("writing {}", path.display()))?;
+    if !args.json {
+        for (wanted, run) in FIGURE_VERTICES.iter().zip(&runs) {
+            let mvc = run
+                .mvc
+                .figures()
+                .map(|f| format!("{:.2}", f.comparison.psnr_db))
+                .unwrap_or_else(|| run.mvc.not_run_reason().unwrap_or_default());
+            eprintln!(
+                "fig5 ~{wanted} vertices: {} vertices, PSNR combinatorial {:.2} dB, cotangent \
+                 {:.2} dB, MVC {mvc} dB",
+                run.mesh.vertex_count(),
+                run.combinatorial.comparison.psnr_db,
+                run.cotangent.comparison.psnr_db,
+            );
+        }
+    }
+    Ok(path)
+}
+
+/// The mesh options whose vertex count on the experiment's mask comes closest to `wanted`:
+/// a geometric bisection on the density, with the simplification tolerance following it
+/// (coarse meshes need coarse boundaries).
+fn density_for_vertices(experiment: &Experiment, wanted: usize) -> anyhow::Result<MeshOptions> {
+    let options_for = |density: f64| MeshOptions {
+        density,
+        simplify_tolerance: (0.5 * density).clamp(0.9, 3.0),
+        ..MeshOptions::default()
+    };
+    let count = |density: f64| -> anyhow::Result<usize> {
+        let mask = experiment.mask();
+        let bits = lapclone::mesh::BitMask::from_fn(mask.width(), mask.height(), |x, y| {
+            mask.is_inside(y * mask.width() + x)
+        });
+        Ok(lapclone::mesh::mesh_mask(&bits, &options_for(density))?
+            .mesh
+            .vertex_count())
+    };
+    let (mut fine, mut coarse) = (0.5_f64, 200.0_f64);
+    let mut best = (usize::MAX, fine);
+    for _ in 0..14 {
+        let middle = (fine * coarse).sqrt();
+        let n = count(middle)?;
+        if n.abs_diff(wanted) < best.0 {
+            best = (n.abs_diff(wanted), middle);
+        }
+        if n > wanted {
+            fine = middle;
+        } else {
+            coarse = middle;
+        }
+    }
+    Ok(options_for(best.1))
+}
+
+fn run_sweep(args: &PaperBenchArgs, run_options: &RunOptions) -> anyhow::Result<Vec<SweepRow>> {
+    let experiment = load_experiment(&args.assets, if args.quick { "mouth" } else { "spiral" })?;
+    let densities: &[f64] = if args.quick {
+        &SWEEP_DENSITIES[..2]
+    } else {
+        &SWEEP_DENSITIES
+    };
+    let run_options = RunOptions {
+        mvc_max_weights: 0,
+        ..*run_options
+    };
+    let mut rows = Vec::new();
+    for &density in densities {
+        let options = MeshOptions {
+            density,
+            ..MeshOptions::default()
+        };
+        let run = experiment.run(&options, &run_options)?;
+        let reclone = reclone_ms(
+            experiment.source(),
+            experiment.target(),
+            run.mesh.clone(),
+            LaplacianKind::Combinatorial,
+            DVec2::new(0.6, 0.3),
+            run_options.repeats.max(5),
+        )?;
+        if !args.json {
+            eprintln!("swept density {density}");
+        }
+        rows.push(SweepRow {
+            density,
+            vertices: run.mesh.vertex_count(),
+            mesh_ms: run.mesh_ms,
+            psnr_combinatorial_db: run.combinatorial.comparison.psnr_db,
+            psnr_cotangent_db: run.cotangent.comparison.psnr_db,
+            uncovered: run.uncovered,
+            reclone_ms: reclone,
+        });
+    }
+    if !args.quick {
+        let old = std::fs::read_to_string(&args.sweep_out).unwrap_or_default();
+        let text = splice_generated(&old, &sweep_document(&experiment, &rows));
+        if let Some(parent) = args.sweep_out.parent() {
+            std::fs::create_dir_all(parent).ok();
+        }
+        write_atomic(&args.sweep_out, text.as_bytes())
+            .with_context(|| format!("writing {}", args.sweep_out.display()))?;
+    }
+    Ok(rows)
+}
+
+fn sweep_markdown(rows: &[SweepRow]) -> String {
+    let mut out = String::from(
+        "| density (px) | vertices | mesh (ms) | PSNR combinatorial (dB) | PSNR cotangent (dB) \
+         | uncovered px | re-clone (ms) |\n|---:|---:|---:|---:|---:|---:|---:|\n",
+    );
+    for r in rows {
+        let _ = writeln!(
+            out,
+            "| {} | {} | {:.1} | {:.2} | {:.2} | {} | {:.2} |",
+            r.density,
+            r.vertices,
+            r.mesh_ms,
+            r.psnr_combinatorial_db,
+            r.psnr_cotangent_db,
+            r.uncovered,
+            r.reclone_ms
+        );
+    }
+    out
+}
+
+const BEGIN: &str = "<!-- bench paper --sweep: begin -->";
+const END: &str = "<!-- bench paper --sweep: end -->";
+
+/// Replaces the text between the markers in `old` with `generated` (keeping the hand-written
+/// rest of the document); a document without markers becomes just the generated part.
+fn splice_generated(old: &str, generated: &str) -> String {
+    let block = format!("{BEGIN}\n{generated}{END}\n");
+    match (old.find(BEGIN), old.find(END)) {
+        (Some(begin), Some(end)) if begin < end => {
+            format!(
+                "{}{block}{}",
+                &old[..begin],
+                old[end + END.len()..].trim_start_matches('\n')
+            )
+        }
+        _ => format!("# Mesh density vs quality\n\n{block}"),
+    }
+}
+
+fn sweep_document(experiment: &Experiment, rows: &[SweepRow]) -> String {
+    format!(
+        "Generated by `lapclone bench paper --sweep` (release build); do not edit by hand.\n\n\
+         Spiral model, {}×{} px, {} mask pixels, other mesh options at their defaults. \
+         PSNR of source + membrane against source + pixel-grid reference membrane over the \
+         mask pixels (peak 1); uncovered = mask pixels whose centre is in no triangle; \
+         re-clone = constraint switches + solve + raster via `PatchCloner` at a placement \
+         nudged by (0.6, 0.3) px, best of several, combinatorial Laplacian.\n\n{}",
+        experiment.width(),
+        experiment.height(),
+        experiment.mask().inside_count(),
+        sweep_markdown(rows)
+    )
+}
