@@ -73,7 +73,12 @@ fn main() {
         ("depth", 0.0, true),
         ("depth+feather 4", 4.0, true),
     ] {
-        let frames = 300;
+        // LAPCLONE_TIMING_FRAMES shortens the run (e.g. under callgrind).
+        let frames: u32 = std::env::var("LAPCLONE_TIMING_FRAMES")
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(300)
+            .max(21);
         let mut raster_total = 0.0;
         let mut reset_total = 0.0;
         let mut query_total = 0.0;

@@ -24,13 +24,14 @@
 //! allocates nothing once the buffers have grown to the patch's size.
 
 mod coverage;
-pub mod overlay;
 mod covered;
 mod draw;
 mod error;
 mod feather;
+pub mod overlay;
 mod patch;
 mod rect;
+mod sampler;
 mod scratch;
 mod setup;
 mod shade;
