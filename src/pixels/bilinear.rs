@@ -41,7 +41,8 @@ fn axis_taps(coordinate: f64, size: u32) -> (usize, usize, f32) {
     // `f64::max` returns the non-NaN operand, so NaN samples pixel 0 like a far-left point.
     let u = (coordinate - 0.5).max(0.0).min(last as f64);
     // u ≥ 0 here, so truncation is floor (and avoids a libm call without SSE4.1).
-    let i = u as usize;
+    // Through i64: u ∈ [0, last] fits, and the saturating f64 → u64 cast costs far more.
+    let i = u as i64 as usize;
     (i, (i + 1).min(last), (u - i as f64) as f32)
 }
 

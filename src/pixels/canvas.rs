@@ -6,8 +6,8 @@
 use std::path::Path;
 
 use super::png_encode::encode_png_rgba;
-use crate::raster::PixelRect;
 use super::{sample_bilinear_rgba, Depth, FloatImage, PixelError, PixelFormat};
+use crate::raster::PixelRect;
 
 /// A channel type that stores a value in [0, 1].
 pub trait Texel: Copy + Send + Sync + 'static {
@@ -367,7 +367,11 @@ mod tests {
             for i in 0..9 {
                 let inside = (6..9).contains(&i) && (0..3).contains(&j);
                 let expected = if inside { &background } else { &blank };
-                assert_eq!(frame.pixel_f32(i, j), expected.pixel_f32(i, j), "({i}, {j})");
+                assert_eq!(
+                    frame.pixel_f32(i, j),
+                    expected.pixel_f32(i, j),
+                    "({i}, {j})"
+                );
             }
         }
         let everything = PixelRect {

@@ -41,7 +41,8 @@ impl<'a> Sampler<'a> {
 #[inline(always)]
 fn taps(coordinate: f64, last: usize) -> (usize, usize, f32) {
     let u = (coordinate - 0.5).max(0.0).min(last as f64);
-    let i = u as usize;
+    // Through i64: u ∈ [0, last] fits, and the saturating f64 → u64 cast costs far more.
+    let i = u as i64 as usize;
     (i, (i + 1).min(last), (u - i as f64) as f32)
 }
 
