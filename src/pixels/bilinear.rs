@@ -33,20 +33,17 @@ pub fn sample_bilinear_rgba<T: Texel>(
 }
 
 /// The two neighbouring pixel indices along one axis and the weight of the second one.
+/// Branch-free: the position is clamped into the centres' range (NaN goes to 0), and the
+/// second tap is clamped to the last pixel, where its weight is 0 anyway.
 #[inline(always)]
 fn axis_taps(coordinate: f64, size: u32) -> (usize, usize, f32) {
-    let last = size.saturating_sub(1) as f64;
-    let u = coordinate - 0.5;
-    if u.is_nan() || u <= 0.0 {
-        return (0, 0, 0.0);
-    }
-    if u >= last {
-        let i = last as usize;
-        return (i, i, 0.0);
-    }
-    // u > 0 here, so truncation is floor (and avoids a libm call without SSE4.1).
-    let i = u as usize;
-    (i, i + 1, (u - i as f64) as f32)
+    let last = size.saturating_sub(1) as usize;
+    // `f64::max` returns the non-NaN operand, so NaN samples pixel 0 like a far-left point.
+    let u = (coordinate - 0.5).max(0.0).min(last as f64);
+    // u ≥ 0 here, so truncation is floor (and avoids a libm call without SSE4.1).
+    // Through i64: u ∈ [0, last] fits, and the saturating f64 → u64 cast costs far more.
+    let i = u as i64 as usize;
+    (i, (i + 1).min(last), (u - i as f64) as f32)
 }
 
 #[cfg(test)]

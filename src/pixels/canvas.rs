@@ -7,6 +7,7 @@ use std::path::Path;
 
 use super::png_encode::encode_png_rgba;
 use super::{sample_bilinear_rgba, Depth, FloatImage, PixelError, PixelFormat};
+use crate::raster::PixelRect;
 
 /// A channel type that stores a value in [0, 1].
 pub trait Texel: Copy + Send + Sync + 'static {
@@ -134,6 +135,43 @@ impl Canvas {
         self.height = other.height;
     }
 
+    /// Copies the pixels of `rect` (clipped to the canvas) from `other`, which must have the
+    /// same size and depth: the cheap per-frame reset that restores only the rectangles the
+    /// previous frame drew into (e.g. [`RasterStats::work`](crate::raster::RasterStats)).
+    pub fn copy_rect_from(&mut self, other: &Canvas, rect: PixelRect) -> Result<(), PixelError> {
+        if (self.width, self.height, self.depth()) != (other.width, other.height, other.depth()) {
+            return Err(PixelError::CanvasMismatch {
+                width: self.width,
+                height: self.height,
+                depth: self.depth(),
+                other_width: other.width,
+                other_height: other.height,
+                other_depth: other.depth(),
+            });
+        }
+        let whole = PixelRect {
+            x0: 0,
+            y0: 0,
+            x1: self.width.min(i32::MAX as u32) as i32,
+            y1: self.height.min(i32::MAX as u32) as i32,
+        };
+        let clipped = rect.intersect(&whole);
+        if clipped.is_empty() {
+            return Ok(());
+        }
+        match (&mut self.pixels, &other.pixels) {
+            (CanvasPixels::Eight(dst), CanvasPixels::Eight(src)) => {
+                copy_rows(dst, src, self.width as usize, clipped)
+            }
+            (CanvasPixels::Sixteen(dst), CanvasPixels::Sixteen(src)) => {
+                copy_rows(dst, src, self.width as usize, clipped)
+            }
+            // invariant: depths were compared above.
+            _ => unreachable!("depths checked equal"),
+        }
+        Ok(())
+    }
+
     /// Pixel (i, j) as straight RGBA in [0, 1]; `None` outside the canvas.
     pub fn pixel_f32(&self, i: u32, j: u32) -> Option<[f32; 4]> {
         if i >= self.width || j >= self.height {
@@ -243,6 +281,15 @@ impl Canvas {
     }
 }
 
+/// Copies `rect` (non-empty, inside both buffers) row by row.
+fn copy_rows<T: Copy>(dst: &mut [T], src: &[T], width: usize, rect: PixelRect) {
+    let (x0, x1) = (rect.x0 as usize, rect.x1 as usize);
+    for y in rect.y0 as usize..rect.y1 as usize {
+        let row = y * width;
+        dst[row + x0..row + x1].copy_from_slice(&src[row + x0..row + x1]);
+    }
+}
+
 fn quantise<T: Texel>(pixels: &[[f32; 4]]) -> Vec<[T; 4]> {
     pixels.iter().map(|px| px.map(T::from_unit)).collect()
 }
@@ -312,6 +359,47 @@ mod tests {
         for c in 0..4 {
             assert!((out[c] - expected[c]).abs() < 1e-6, "{out:?}");
         }
+    }
+
+    #[test]
+    fn copy_rect_from_restores_only_the_clipped_rectangle() {
+        let image = FloatImage::from_fn(9, 7, PixelFormat::RGBA16, |i, j| {
+            [i as f32 / 9.0, j as f32 / 7.0, 0.25, 1.0]
+        })
+        .unwrap();
+        let background = Canvas::from_image(&image);
+        let blank = Canvas::new(9, 7, Depth::Sixteen).unwrap();
+        let mut frame = blank.clone();
+        let rect = PixelRect {
+            x0: 6,
+            y0: -2,
+            x1: 20,
+            y1: 3,
+        };
+        frame.copy_rect_from(&background, rect).unwrap();
+        for j in 0..7 {
+            for i in 0..9 {
+                let inside = (6..9).contains(&i) && (0..3).contains(&j);
+                let expected = if inside { &background } else { &blank };
+                assert_eq!(
+                    frame.pixel_f32(i, j),
+                    expected.pixel_f32(i, j),
+                    "({i}, {j})"
+                );
+            }
+        }
+        let everything = PixelRect {
+            x0: i32::MIN,
+            y0: i32::MIN,
+            x1: i32::MAX,
+            y1: i32::MAX,
+        };
+        frame.copy_rect_from(&background, everything).unwrap();
+        assert_eq!(frame, background);
+        let eight = Canvas::new(9, 7, Depth::Eight).unwrap();
+        assert!(frame.copy_rect_from(&eight, rect).is_err());
+        let smaller = Canvas::new(9, 6, Depth::Sixteen).unwrap();
+        assert!(frame.copy_rect_from(&smaller, rect).is_err());
     }
 
     #[test]

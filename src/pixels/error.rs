@@ -33,6 +33,15 @@ pub enum PixelError {
         #[source]
         source: std::io::Error,
     },
+    #[error("canvases differ: {width}×{height} {depth:?} vs {other_width}×{other_height} {other_depth:?}")]
+    CanvasMismatch {
+        width: u32,
+        height: u32,
+        depth: super::Depth,
+        other_width: u32,
+        other_height: u32,
+        other_depth: super::Depth,
+    },
     #[error("pixel buffer of {actual} pixels does not match {width}×{height}")]
     BufferSize {
         width: u32,

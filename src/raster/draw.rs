@@ -164,6 +164,7 @@ fn compute_coverage(
         width,
         options.feather,
         &mut s.distance,
+        &mut s.distance_row,
         &mut s.coverage,
     );
 }

@@ -31,6 +31,7 @@ mod feather;
 pub mod overlay;
 mod patch;
 mod rect;
+mod sampler;
 mod scratch;
 mod setup;
 mod shade;

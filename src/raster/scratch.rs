@@ -13,6 +13,7 @@ pub struct RasterScratch {
     pub(crate) depths: Vec<f32>,
     pub(crate) coverage: Vec<f32>,
     pub(crate) distance: Vec<f32>,
+    pub(crate) distance_row: Vec<f32>,
     pub(crate) path_builder: Option<tiny_skia::PathBuilder>,
     pub(crate) mask: Option<tiny_skia::Mask>,
 }

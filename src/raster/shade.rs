@@ -7,6 +7,9 @@
 //! the triangle of the nearest hit pixel within two pixels (ties broken by a fixed scan
 //! order), so the anti-aliased fringe continues the patch's colours instead of guessing.
 
+use glam::Vec4;
+
+use super::sampler::Sampler;
 use super::setup::TriangleSetup;
 use super::triangles::NO_TRIANGLE;
 use super::PixelRect;
@@ -51,6 +54,9 @@ pub(crate) struct ShadeInput<'a> {
 
 /// Composites the patch over `canvas` (row-major, `canvas_width` wide) inside `target`
 /// (the work rectangle clipped to the canvas). Returns the number of pixels written.
+///
+/// Each row is walked in runs of equal triangle id, so a run reads its triangle's setup
+/// once; only the fringe (coverage without a triangle at the centre) looks at neighbours.
 pub(crate) fn shade_and_composite<T: Texel>(
     input: &ShadeInput,
     target: PixelRect,
@@ -59,39 +65,119 @@ pub(crate) fn shade_and_composite<T: Texel>(
 ) -> usize {
     let work = input.work;
     let work_width = work.width();
+    let (first, last) = (
+        (target.x0 - work.x0) as usize,
+        (target.x1 - work.x0) as usize,
+    );
+    let sampler = Sampler::new(input.source);
     let mut written = 0;
     for y in target.y0..target.y1 {
         let work_row = (y - work.y0) as usize * work_width;
+        let ids = &input.ids[work_row + first..work_row + last];
+        let coverage = &input.coverage[work_row + first..work_row + last];
         let canvas_row = y as usize * canvas_width;
-        for x in target.x0..target.x1 {
-            let cell = work_row + (x - work.x0) as usize;
-            let coverage = input.coverage[cell];
-            if coverage <= 0.0 {
-                continue;
-            }
-            let Some(triangle) = owning_triangle(input, x, y) else {
-                continue;
+        let row = &mut canvas[canvas_row + target.x0 as usize..canvas_row + target.x1 as usize];
+        let mut start = 0;
+        while start < ids.len() {
+            let id = ids[start];
+            let end = start
+                + ids[start..]
+                    .iter()
+                    .take_while(|&&other| other == id)
+                    .count();
+            let x0 = target.x0 + start as i32;
+            let span = Span {
+                x0,
+                y,
+                coverage: &coverage[start..end],
             };
-            let (cx, cy) = (f64::from(x) + 0.5, f64::from(y) + 0.5);
-            let colour = patch_colour(&input.setups[triangle as usize], input.source, cx, cy);
-            let alpha = coverage.min(1.0) * colour[3];
-            if alpha <= 0.0 {
-                continue;
-            }
-            let pixel = &mut canvas[canvas_row + x as usize];
-            if alpha >= 1.0 {
-                *pixel = colour.map(T::from_unit);
-                written += 1;
-                continue;
-            }
-            let premultiplied = [colour[0] * alpha, colour[1] * alpha, colour[2] * alpha];
-            let under = pixel.map(Texel::to_unit);
-            let out = crate::pixels::canvas_composite_over(premultiplied, alpha, under);
-            *pixel = out.map(T::from_unit);
-            written += 1;
+            written += if id == NO_TRIANGLE {
+                shade_fringe(input, &span, &mut row[start..end])
+            } else {
+                let setup = &input.setups[id as usize];
+                shade_span(setup, &sampler, &span, &mut row[start..end])
+            };
+            start = end;
         }
     }
     written
+}
+
+/// A run of pixels of one row starting at canvas column `x0`, with their coverage.
+struct Span<'a> {
+    x0: i32,
+    y: i32,
+    coverage: &'a [f32],
+}
+
+/// Shades a run of pixels whose centres all lie in `setup`'s triangle. The arithmetic is
+/// exactly [`TriangleSetup::interpolate`]'s, with the row's terms hoisted.
+#[inline(always)]
+fn shade_span<T: Texel>(
+    setup: &TriangleSetup,
+    sampler: &Sampler,
+    span: &Span,
+    pixels: &mut [[T; 4]],
+) -> usize {
+    let cy = f64::from(span.y) + 0.5;
+    let (rx, ry) = (setup.rest_x, setup.rest_y);
+    let (rx_row, ry_row) = (rx[2] * cy, ry[2] * cy);
+    let channel = |k: usize| {
+        let m = &setup.membrane_affine;
+        Vec4::new(m[0][k], m[1][k], m[2][k], 0.0)
+    };
+    let (m_const, m_dx) = (channel(0), channel(1));
+    let m_row = channel(2) * cy as f32;
+    let mut written = 0;
+    for (k, (&coverage, pixel)) in span.coverage.iter().zip(pixels.iter_mut()).enumerate() {
+        if coverage <= 0.0 {
+            continue;
+        }
+        let cx = f64::from(span.x0 + k as i32) + 0.5;
+        let sample = sampler.sample(rx[0] + rx[1] * cx + rx_row, ry[0] + ry[1] * cx + ry_row);
+        let membrane = m_const + m_dx * cx as f32 + m_row;
+        let mut colour = (sample + membrane).clamp(Vec4::ZERO, Vec4::ONE);
+        colour.w = sample.w;
+        written += usize::from(composite(pixel, colour.to_array(), coverage));
+    }
+    written
+}
+
+/// Shades a run of pixels whose centres miss every triangle (the anti-aliased fringe).
+fn shade_fringe<T: Texel>(input: &ShadeInput, span: &Span, pixels: &mut [[T; 4]]) -> usize {
+    let cy = f64::from(span.y) + 0.5;
+    let mut written = 0;
+    for (k, (&coverage, pixel)) in span.coverage.iter().zip(pixels.iter_mut()).enumerate() {
+        if coverage <= 0.0 {
+            continue;
+        }
+        let x = span.x0 + k as i32;
+        let Some(triangle) = owning_triangle(input, x, span.y) else {
+            continue;
+        };
+        let cx = f64::from(x) + 0.5;
+        let colour = patch_colour(&input.setups[triangle as usize], input.source, cx, cy);
+        written += usize::from(composite(pixel, colour, coverage));
+    }
+    written
+}
+
+/// Source-over of a straight colour with `coverage`; whether the pixel changed.
+#[inline(always)]
+fn composite<T: Texel>(pixel: &mut [T; 4], colour: [f32; 4], coverage: f32) -> bool {
+    let alpha = coverage.min(1.0) * colour[3];
+    if alpha <= 0.0 {
+        return false;
+    }
+    if alpha >= 1.0 {
+        *pixel = colour.map(T::from_unit);
+        return true;
+    }
+    let premultiplied = [colour[0] * alpha, colour[1] * alpha, colour[2] * alpha];
+    let under = pixel.map(Texel::to_unit);
+    let out = crate::pixels::canvas_composite_over(premultiplied, alpha, under);
+    *pixel = out.map(T::from_unit);
+    true
 }
 
 #[inline(always)]
