@@ -1,6 +1,11 @@
 //! An animated PNG from frames: takes the frame count, fps and frames in order, gives one
 //! file (looping forever), written through a temporary file and renamed on
 //! [`ApngWriter::finish`], so a failed or cancelled write leaves nothing behind.
+//!
+//! Lossless frame differencing: each frame after the first stores only the bounding
+//! rectangle of samples that differ from the previous frame (a 1×1 rectangle when nothing
+//! changed), with `BlendOp::Source` and `DisposeOp::None`, so compositing the records gives
+//! back every frame exactly, transparency included.
 
 use std::fs::File;
 use std::io::BufWriter;
@@ -19,6 +24,8 @@ pub struct ApngWriter {
     height: u32,
     sixteen_bit: bool,
     scratch: Vec<u8>,
+    previous: Vec<u8>,
+    rect: Vec<u8>,
 }
 
 impl ApngWriter {
@@ -51,6 +58,8 @@ impl ApngWriter {
         });
         encoder.set_compression(png::Compression::Fast);
         encoder.set_animated(frame_count, 0)?;
+        encoder.set_blend_op(png::BlendOp::Source)?;
+        encoder.set_dispose_op(png::DisposeOp::None)?;
         let writer = encoder.write_header()?;
         Ok(ApngWriter {
             path: path.to_path_buf(),
@@ -62,6 +71,8 @@ impl ApngWriter {
             height,
             sixteen_bit,
             scratch: Vec::new(),
+            previous: Vec::new(),
+            rect: Vec::new(),
         })
     }
 
@@ -88,8 +99,33 @@ impl ApngWriter {
         };
         self.writer.set_frame_delay(numerator, denominator)?;
         frame.write_png_bytes(&mut self.scratch);
-        self.writer.write_image_data(&self.scratch)?;
+        if self.written == 0 {
+            self.writer.write_image_data(&self.scratch)?;
+        } else {
+            self.write_changes()?;
+        }
+        std::mem::swap(&mut self.scratch, &mut self.previous);
         self.written += 1;
+        Ok(())
+    }
+
+    /// Writes the rectangle of `scratch` that differs from `previous`.
+    fn write_changes(&mut self) -> Result<(), OutputError> {
+        let pixel = if self.sixteen_bit { 8 } else { 4 };
+        let row = self.width as usize * pixel;
+        let (x, y, w, h) =
+            changed_rect(&self.scratch, &self.previous, row, pixel).unwrap_or((0, 0, 1, 1));
+        self.rect.clear();
+        for r in y..y + h {
+            let start = r * row + x * pixel;
+            self.rect
+                .extend_from_slice(&self.scratch[start..start + w * pixel]);
+        }
+        // Shrinking first keeps every intermediate position in bounds.
+        self.writer.set_frame_position(0, 0)?;
+        self.writer.set_frame_dimension(w as u32, h as u32)?;
+        self.writer.set_frame_position(x as u32, y as u32)?;
+        self.writer.write_image_data(&self.rect)?;
         Ok(())
     }
 
@@ -108,6 +144,32 @@ impl ApngWriter {
             .map_err(|e| OutputError::io(&self.path, e))?;
         Ok(self.path)
     }
+}
+
+/// (x, y, width, height) in pixels of the samples that differ, `None` if none do.
+fn changed_rect(
+    current: &[u8],
+    previous: &[u8],
+    row: usize,
+    pixel: usize,
+) -> Option<(usize, usize, usize, usize)> {
+    let rows = || current.chunks_exact(row).zip(previous.chunks_exact(row));
+    let top = rows().position(|(c, p)| c != p)?;
+    let bottom = rows().rposition(|(c, p)| c != p)? + 1;
+    let (mut left, mut right) = (usize::MAX, 0);
+    for (c, p) in rows().take(bottom).skip(top) {
+        if let Some(first) = c.iter().zip(p).position(|(a, b)| a != b) {
+            // invariant: the row differs somewhere, so a last difference exists too.
+            let last = c
+                .iter()
+                .zip(p)
+                .rposition(|(a, b)| a != b)
+                .expect("row differs");
+            left = left.min(first / pixel);
+            right = right.max(last / pixel + 1);
+        }
+    }
+    Some((left, top, right - left, bottom - top))
 }
 
 /// Per-frame delays as fractions of a second: `1/fps` exactly for whole fps, otherwise

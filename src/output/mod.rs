@@ -7,13 +7,16 @@ mod atomic;
 mod encode;
 mod frame;
 mod gif;
+mod gif_frame;
+mod gif_palette;
 mod png_sequence;
 
 pub use apng::{apng_delays, ApngWriter};
 pub use atomic::TempOutput;
 pub use encode::{encode_png, PngCompression};
 pub use frame::{Frame, FrameData, FrameRef, Pixels};
-pub use gif::{gif_delays_cs, GifWriter};
+pub use gif::{gif_delays_cs, GifOptions, GifWriter, PALETTE_FRAMES};
+pub use gif_palette::{Palette, PaletteMap};
 pub use png_sequence::{frame_digits, frame_file_name, write_png_file, PngSequenceWriter};
 
 use std::path::{Path, PathBuf};
@@ -38,7 +41,7 @@ pub enum OutputError {
     #[error("PNG encoding failed: {0}")]
     Png(#[from] png::EncodingError),
     #[error("GIF encoding failed: {0}")]
-    Gif(#[from] image::ImageError),
+    Gif(#[from] ::gif::EncodingError),
     #[error("bad frame: {0}")]
     BadFrame(String),
     #[error("output folder {} does not exist", .0.display())]
