@@ -24,8 +24,8 @@
 //! * **Guards** (see [`penalty`]): a pivot that would become ≤ `ε/2` during a downdate, an
 //!   accumulated drift estimate `Σ u · max_j d_j / d̄_j` (u = 2⁻⁵³, over downdates since the
 //!   last factorisation) above `PenaltyOptions::drift_budget` (default 1e-11), or a batch
-//!   larger than `n/64 + 16` switches triggers a refactorisation from the stored matrix and
-//!   the current constrained set.
+//!   whose summed elimination-path cost exceeds the estimated refactorisation cost triggers
+//!   a refactorisation from the stored matrix and the current constrained set.
 
 pub mod csc;
 #[doc(hidden)]

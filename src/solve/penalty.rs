@@ -12,8 +12,11 @@
 //!    last factorisation; `d_j / d̄_j` over the path below the start pivot — whose pivot is
 //!    recomputed exactly — is how much cancellation magnified rounding) exceeds
 //!    `drift_budget`, or
-//! 3. the batch is so large that refactoring is cheaper (more switches than
-//!    `n / 64 + 16`).
+//! 3. the batch is so large that refactoring is cheaper: the summed path costs of its
+//!    switches ([`SymbolicFactor::switch_cost`], factor entries on each elimination-tree
+//!    path) exceed the estimated refactorisation cost ([`SymbolicFactor::refactor_cost`],
+//!    flop count calibrated against the kernel). The estimate walks only the index arrays
+//!    and stops as soon as the budget is exceeded, so it costs a fraction of the updates.
 //!
 //! Updates alone never trigger a refactor: they add positive terms and are stable.
 
@@ -305,8 +308,7 @@ impl PenaltyFactor {
                 }
             }
         }
-        let too_many = stats.updates + stats.downdates > self.n() / 64 + 16;
-        let mut needs_refactor = too_many;
+        let mut needs_refactor = self.batch_costs_more_than_refactor(&touched);
         for pass_on in [true, false] {
             for &v in &touched {
                 let on = self.pending[v] == 1;
@@ -334,6 +336,21 @@ impl PenaltyFactor {
             self.refactor()?;
         }
         Ok(stats)
+    }
+
+    /// Rule 3 of the module doc: Σ path costs of the real switches > refactorisation cost.
+    fn batch_costs_more_than_refactor(&self, touched: &[usize]) -> bool {
+        let budget = self.symbolic.refactor_cost();
+        let mut cost = 0.0;
+        for &v in touched {
+            if (self.pending[v] == 1) != self.constrained[v] {
+                cost += self.symbolic.switch_cost(self.symbolic.position_of(v));
+                if cost > budget {
+                    return true;
+                }
+            }
+        }
+        false
     }
 
     /// One rank-1 modification; false when the factor was lost and must be rebuilt.
