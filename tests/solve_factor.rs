@@ -6,6 +6,7 @@ use lapclone::solve::{
 };
 
 /// Dense Cholesky solve of a small SPD system (reference).
+#[allow(clippy::needless_range_loop)] // index loops mirror the textbook algorithm
 fn dense_solve(a: &[Vec<f64>], b: &[f64]) -> Vec<f64> {
     let n = b.len();
     let mut l = vec![vec![0.0; n]; n];
@@ -296,12 +297,11 @@ fn unconstrained_piece_gives_zero_membrane() {
         .map(|v| if wanted[v] { 7.0 } else { 123.0 })
         .collect();
     f.solve_dirichlet(&mut values, 1);
-    for v in 0..n {
+    for (v, &value) in values.iter().enumerate() {
         let expected = if v < a.vertex_count() { 7.0 } else { 0.0 };
         assert!(
-            (values[v] - expected).abs() <= 1e-6 * 7.0,
-            "vertex {v}: {}",
-            values[v]
+            (value - expected).abs() <= 1e-6 * 7.0,
+            "vertex {v}: {value}"
         );
     }
 }

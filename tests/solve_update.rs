@@ -218,3 +218,44 @@ proptest! {
         prop_assert!(compare_with_fresh(&l, &mut f, &opts, 11) <= 1e-9);
     }
 }
+
+/// The batch guard refactors exactly when the summed path costs of the real switches exceed
+/// the refactorisation estimate — small batches update, a whole-mesh batch refactors — and
+/// either way the result matches a fresh factorisation.
+#[test]
+fn batch_guard_compares_path_costs_with_the_refactor_cost() {
+    let mesh = fixtures::disc(12);
+    let l = laplacian(&mesh, LaplacianKind::Combinatorial);
+    let n = l.n;
+    let opts = PenaltyOptions::default();
+    let mut f = PenaltyFactor::new(&l, &opts).unwrap();
+    f.set_constrained(&mesh.is_boundary).unwrap();
+    let interior: Vec<usize> = (0..n).filter(|&v| !mesh.is_boundary[v]).collect();
+    let (mut updated, mut refactored) = (0, 0);
+    for size in [1, 2, 4, 8, 16, 32, 64, 128, interior.len()] {
+        let batch: Vec<(usize, bool)> = interior.iter().take(size).map(|&v| (v, true)).collect();
+        let sym = f.symbolic();
+        let cost: f64 = batch
+            .iter()
+            .map(|&(v, _)| sym.switch_cost(sym.position_of(v)))
+            .sum();
+        let expect_refactor = cost > sym.refactor_cost();
+        let before = f.refactor_count();
+        let stats = f.switch(&batch).unwrap();
+        assert_eq!(stats.refactored, expect_refactor, "batch of {size}");
+        assert_eq!(f.refactor_count(), before + usize::from(expect_refactor));
+        if expect_refactor {
+            refactored += 1;
+        } else {
+            updated += 1;
+        }
+        assert!(compare_with_fresh(&l, &mut f, &opts, size as u64) <= 1e-9);
+        // Back to the boundary only (downdates; may refactor by the same rule).
+        let release: Vec<(usize, bool)> = batch.iter().map(|&(v, _)| (v, false)).collect();
+        f.switch(&release).unwrap();
+    }
+    assert!(
+        updated >= 3 && refactored >= 1,
+        "{updated} updated, {refactored} refactored"
+    );
+}

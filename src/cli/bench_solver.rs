@@ -4,8 +4,8 @@
 
 use anyhow::Context;
 use lapclone::solve::{
-    fixtures, laplacian, read_constrained_list, read_matrix_market, LaplacianKind, PenaltyFactor,
-    PenaltyOptions, SymmetricCsc,
+    fixtures, laplacian, read_constrained_list, read_matrix_market, FactorMethod, LaplacianKind,
+    PenaltyFactor, PenaltyOptions, SymmetricCsc,
 };
 use std::path::PathBuf;
 use std::time::Instant;
@@ -23,6 +23,29 @@ pub struct SolverBenchArgs {
     /// Print JSON instead of a table.
     #[arg(long)]
     pub json: bool,
+    /// Numeric factorisation.
+    #[arg(long, value_enum, default_value_t = MethodArg::Auto)]
+    pub method: MethodArg,
+}
+
+/// `--method` values.
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+pub enum MethodArg {
+    Auto,
+    Simplicial,
+    Supernodal,
+    Relaxed,
+}
+
+impl From<MethodArg> for FactorMethod {
+    fn from(m: MethodArg) -> Self {
+        match m {
+            MethodArg::Auto => FactorMethod::Auto,
+            MethodArg::Simplicial => FactorMethod::Simplicial,
+            MethodArg::Supernodal => FactorMethod::Supernodal,
+            MethodArg::Relaxed => FactorMethod::SupernodalRelaxed,
+        }
+    }
 }
 
 #[derive(clap::Args, Debug)]
@@ -36,6 +59,9 @@ pub struct FactorBenchArgs {
     /// Print JSON instead of a table.
     #[arg(long)]
     pub json: bool,
+    /// Numeric factorisation.
+    #[arg(long, value_enum, default_value_t = MethodArg::Auto)]
+    pub method: MethodArg,
 }
 
 /// Timings of one matrix, milliseconds (best of several runs).
@@ -63,14 +89,20 @@ fn best_ms(runs: usize, mut work: impl FnMut()) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
-fn measure(l: &SymmetricCsc, constrained: &[usize], alpha: Option<f64>) -> anyhow::Result<Timings> {
+fn measure(
+    l: &SymmetricCsc,
+    constrained: &[usize],
+    alpha: Option<f64>,
+    method: FactorMethod,
+) -> anyhow::Result<Timings> {
     let opts = PenaltyOptions {
         alpha,
+        method,
         ..Default::default()
     };
     let runs = if l.n > 200_000 { 2 } else { RUNS };
     let analyze_ms = best_ms(runs, || {
-        let _ = lapclone::solve::symbolic::SymbolicFactor::analyse(l);
+        let _ = lapclone::solve::symbolic::SymbolicFactor::analyse_with(l, method);
     });
     let mut factor = PenaltyFactor::new(l, &opts)?;
     let mut wanted = vec![false; l.n];
@@ -158,7 +190,8 @@ pub fn run_solver(args: SolverBenchArgs) -> anyhow::Result<()> {
         ))
         .into());
     }
-    let timings = measure(&l, &constrained, args.alpha).context("benchmark failed")?;
+    let timings =
+        measure(&l, &constrained, args.alpha, args.method.into()).context("benchmark failed")?;
     print(&[timings], args.json)
 }
 
@@ -173,7 +206,7 @@ pub fn run_factor(args: FactorBenchArgs) -> anyhow::Result<()> {
         let mesh = fixtures::disc_with_vertices(size);
         let l = laplacian(&mesh, kind);
         let boundary: Vec<usize> = (0..l.n).filter(|&v| mesh.is_boundary[v]).collect();
-        rows.push(measure(&l, &boundary, None)?);
+        rows.push(measure(&l, &boundary, None, args.method.into())?);
     }
     print(&rows, args.json)
 }

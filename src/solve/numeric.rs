@@ -1,11 +1,14 @@
 //! Numeric LDLᵀ factorisation by faer on the pattern analysed in
 //! [`symbolic`](super::symbolic): takes the matrix values (lower triangle, original order)
 //! and fills the factor values in place. Runs once per mesh and whenever a guard fires.
+//! A supernodal factor is compacted in place into the column layout of
+//! [`symbolic`](super::symbolic) afterwards (one pass of `memmove`s, O(nnz)).
 
 use super::symbolic::SymbolicFactor;
 use super::SolveError;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
+use faer::sparse::linalg::cholesky::{supernodal::SymbolicSupernodalCholesky, SymbolicCholeskyRaw};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Par, Side};
 
@@ -28,8 +31,10 @@ impl NumericWorkspace {
     }
 }
 
-/// Factors the matrix with values `a_values` (pattern of `symbolic`) into `l_values`.
-/// Pivots at or below `epsilon / 2` are replaced by `epsilon` (see the stage doc).
+/// Factors the matrix with values `a_values` (pattern of `symbolic`) into `l_values`, whose
+/// length must be at least [`SymbolicFactor::factor_buffer_len`]; the factor ends up in its
+/// first [`SymbolicFactor::nnz_factor`] entries. Pivots at or below `epsilon / 2` are
+/// replaced by `epsilon` (see the stage doc).
 pub fn factor_numeric(
     symbolic: &SymbolicFactor,
     a_values: &[f64],
@@ -38,6 +43,7 @@ pub fn factor_numeric(
     workspace: &mut NumericWorkspace,
 ) -> Result<(), SolveError> {
     let n = symbolic.n;
+    let l_values = &mut l_values[..symbolic.faer.len_val()];
     let pattern =
         SymbolicSparseColMatRef::new_checked(n, n, &symbolic.a_col_ptr, None, &symbolic.a_row_idx);
     let a = SparseColMatRef::new(pattern, a_values);
@@ -57,6 +63,27 @@ pub fn factor_numeric(
             MemStack::new(&mut workspace.stack),
             Default::default(),
         )
-        .map(|_| ())
-        .map_err(|e| SolveError::Numeric(format!("{e:?}")))
+        .map_err(|e| SolveError::Numeric(format!("{e:?}")))?;
+    if let SymbolicCholeskyRaw::Supernodal(s) = symbolic.faer.raw() {
+        compact_supernodes(s, &symbolic.col_ptr, l_values);
+    }
+    Ok(())
+}
+
+/// Moves each supernode's columns, minus the zero upper triangle of its diagonal block, to
+/// the column layout `col_ptr`. Destinations never pass their sources
+/// ([`SymbolicFactor::check_layout`] verifies it), so one forward pass works in place.
+fn compact_supernodes(s: &SymbolicSupernodalCholesky<u32>, col_ptr: &[u32], values: &mut [f64]) {
+    for sn in 0..s.n_supernodes() {
+        let (begin, end) = (
+            s.supernode_begin()[sn] as usize,
+            s.supernode_end()[sn] as usize,
+        );
+        let nrows = end - begin + s.supernode(sn).pattern().len();
+        let block_start = s.col_ptr_for_val()[sn] as usize;
+        for c in 0..end - begin {
+            let source = block_start + c * nrows + c;
+            values.copy_within(source..source + nrows - c, col_ptr[begin + c] as usize);
+        }
+    }
 }

@@ -12,14 +12,17 @@
 //!    last factorisation; `d_j / d̄_j` over the path below the start pivot — whose pivot is
 //!    recomputed exactly — is how much cancellation magnified rounding) exceeds
 //!    `drift_budget`, or
-//! 3. the batch is so large that refactoring is cheaper (more switches than
-//!    `n / 64 + 16`).
+//! 3. the batch is so large that refactoring is cheaper: the summed path costs of its
+//!    switches ([`SymbolicFactor::switch_cost`], factor entries on each elimination-tree
+//!    path) exceed the estimated refactorisation cost ([`SymbolicFactor::refactor_cost`],
+//!    flop count calibrated against the kernel). The estimate walks only the index arrays
+//!    and stops as soon as the budget is exceeded, so it costs a fraction of the updates.
 //!
 //! Updates alone never trigger a refactor: they add positive terms and are stable.
 
 use super::numeric::{factor_numeric, NumericWorkspace};
 use super::solve::ldlt_solve_interleaved;
-use super::symbolic::SymbolicFactor;
+use super::symbolic::{FactorMethod, SymbolicFactor};
 use super::update::{pivot_from_row, rank1_diagonal, Rank1Outcome, RowScratch};
 use super::{SolveError, SymmetricCsc};
 
@@ -31,6 +34,8 @@ pub struct PenaltyOptions {
     pub epsilon: Option<f64>,
     /// Refactor when the accumulated downdate drift estimate exceeds this (default 1e-11).
     pub drift_budget: f64,
+    /// Simplicial or supernodal numeric factorisation (default: by size).
+    pub method: FactorMethod,
 }
 
 impl Default for PenaltyOptions {
@@ -39,6 +44,7 @@ impl Default for PenaltyOptions {
             alpha: None,
             epsilon: None,
             drift_budget: DEFAULT_DRIFT_BUDGET,
+            method: FactorMethod::Auto,
         }
     }
 }
@@ -88,7 +94,7 @@ pub struct PenaltyFactor {
 impl PenaltyFactor {
     /// Analyses and factors `l + εI` with no constraint on.
     pub fn new(l: &SymmetricCsc, opts: &PenaltyOptions) -> Result<Self, SolveError> {
-        let symbolic = SymbolicFactor::analyse(l)?;
+        let symbolic = SymbolicFactor::analyse_with(l, opts.method)?;
         let scale = l.diagonal_scale();
         let alpha = opts.alpha.unwrap_or(DEFAULT_ALPHA_RELATIVE * scale);
         if !(alpha.is_finite() && alpha > 0.0) {
@@ -107,7 +113,7 @@ impl PenaltyFactor {
         let n = l.n;
         let workspace = NumericWorkspace::new(&symbolic);
         let mut this = Self {
-            factor_values: vec![0.0; symbolic.nnz_factor()],
+            factor_values: vec![0.0; symbolic.factor_buffer_len()],
             work_values: base_values.clone(),
             base_values,
             symbolic,
@@ -175,7 +181,7 @@ impl PenaltyFactor {
 
     /// Factor values in the layout documented in [`symbolic`](super::symbolic).
     pub fn factor_values(&self) -> &[f64] {
-        &self.factor_values
+        &self.factor_values[..self.symbolic.nnz_factor()]
     }
 
     /// Batch switch: each `(vertex, on)`; a vertex named twice takes its last state.
@@ -242,7 +248,7 @@ impl PenaltyFactor {
         ldlt_solve_interleaved(
             self.symbolic.col_ptr(),
             self.symbolic.row_idx(),
-            &self.factor_values,
+            &self.factor_values[..self.symbolic.nnz_factor()],
             x,
             k,
         );
@@ -302,8 +308,7 @@ impl PenaltyFactor {
                 }
             }
         }
-        let too_many = stats.updates + stats.downdates > self.n() / 64 + 16;
-        let mut needs_refactor = too_many;
+        let mut needs_refactor = self.batch_costs_more_than_refactor(&touched);
         for pass_on in [true, false] {
             for &v in &touched {
                 let on = self.pending[v] == 1;
@@ -333,18 +338,34 @@ impl PenaltyFactor {
         Ok(stats)
     }
 
+    /// Rule 3 of the module doc: Σ path costs of the real switches > refactorisation cost.
+    fn batch_costs_more_than_refactor(&self, touched: &[usize]) -> bool {
+        let budget = self.symbolic.refactor_cost();
+        let mut cost = 0.0;
+        for &v in touched {
+            if (self.pending[v] == 1) != self.constrained[v] {
+                cost += self.symbolic.switch_cost(self.symbolic.position_of(v));
+                if cost > budget {
+                    return true;
+                }
+            }
+        }
+        false
+    }
+
     /// One rank-1 modification; false when the factor was lost and must be rebuilt.
     fn modify(&mut self, v: usize, on: bool) -> bool {
         let p = self.symbolic.position_of(v);
         let sigma = if on { self.alpha } else { -self.alpha };
         let (col_ptr, row_idx) = (self.symbolic.col_ptr(), self.symbolic.row_idx());
+        let factor_values = &mut self.factor_values[..row_idx.len()];
         let exact_pivot = (!on).then(|| {
             let a_pp = self.base_values[self.symbolic.a_col_ptr[v] as usize];
             let neighbours = self.symbolic.neighbours(p);
             pivot_from_row(
                 col_ptr,
                 row_idx,
-                &self.factor_values,
+                factor_values,
                 p,
                 a_pp,
                 neighbours,
@@ -354,7 +375,7 @@ impl PenaltyFactor {
         match rank1_diagonal(
             col_ptr,
             row_idx,
-            &mut self.factor_values,
+            factor_values,
             &mut self.update_scratch,
             p,
             sigma,
