@@ -212,7 +212,11 @@ fn check_arguments(args: &CloneArgs) -> anyhow::Result<()> {
         return Err(UsageError(format!("--scale must be positive, not {}", args.scale)).into());
     }
     if !(0.0..=1.0).contains(&args.threshold) {
-        return Err(UsageError(format!("--threshold must lie in [0, 1], not {}", args.threshold)).into());
+        return Err(UsageError(format!(
+            "--threshold must lie in [0, 1], not {}",
+            args.threshold
+        ))
+        .into());
     }
     if args.feather < 0.0 {
         return Err(UsageError(format!("--feather must be ≥ 0, not {}", args.feather)).into());
@@ -227,7 +231,11 @@ fn check_arguments(args: &CloneArgs) -> anyhow::Result<()> {
 pub fn check_output_folder(output: &Path) -> anyhow::Result<()> {
     match output.parent() {
         Some(dir) if !dir.as_os_str().is_empty() && !dir.is_dir() => {
-            anyhow::bail!("{}: the output folder {} does not exist", output.display(), dir.display())
+            anyhow::bail!(
+                "{}: the output folder {} does not exist",
+                output.display(),
+                dir.display()
+            )
         }
         _ => Ok(()),
     }
@@ -323,7 +331,10 @@ fn write_output(
     )?;
     let mut bytes = Vec::new();
     picture
-        .write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
+        .write_to(
+            &mut std::io::Cursor::new(&mut bytes),
+            image::ImageFormat::Png,
+        )
         .context("encoding the overlay")?;
     lapclone::util::write_atomic(&args.output, &bytes)
         .with_context(|| format!("writing {}", args.output.display()))

@@ -195,7 +195,9 @@ impl PatchCloner {
         depth: Option<&[f32]>,
     ) -> Result<CloneStats, CloneError> {
         let started = Instant::now();
-        let membrane = self.membrane.solve(&self.placed, canvas, Some(&self.hidden))?;
+        let membrane = self
+            .membrane
+            .solve(&self.placed, canvas, Some(&self.hidden))?;
         let solved = Instant::now();
         let patch = Patch {
             rest: &self.mesh.positions,
@@ -206,7 +208,12 @@ impl PatchCloner {
             loops: &self.mesh.loops,
             source: &self.source,
         };
-        let raster = draw_patch(canvas, &patch, &self.raster_options, &mut self.raster_scratch)?;
+        let raster = draw_patch(
+            canvas,
+            &patch,
+            &self.raster_options,
+            &mut self.raster_scratch,
+        )?;
         let drawn = Instant::now();
         Ok(CloneStats {
             membrane,

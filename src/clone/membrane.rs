@@ -99,7 +99,8 @@ impl MembraneSolver {
             self.membrane.fill([0.0; 3]);
             return Ok(stats);
         }
-        self.factor.solve_dirichlet(&mut self.values, MEMBRANE_CHANNELS);
+        self.factor
+            .solve_dirichlet(&mut self.values, MEMBRANE_CHANNELS);
         for (v, m) in self.membrane.iter_mut().enumerate() {
             *m = [0, 1, 2].map(|c| self.values[c * n + v] as f32);
         }

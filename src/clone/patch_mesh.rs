@@ -33,7 +33,9 @@ pub fn mesh_from_mask(
     }
     let offset = offset.unwrap_or(DVec2::ZERO);
     if !offset.is_finite() {
-        return Err(CloneError::BadOption(format!("mask offset {offset} is not finite")));
+        return Err(CloneError::BadOption(format!(
+            "mask offset {offset} is not finite"
+        )));
     }
     let mut result = mesh_mask(mask, options)?;
     for p in &mut result.mesh.positions {

@@ -86,7 +86,9 @@ mod tests {
             scale: 2.0,
             rotation_deg: 90.0,
         };
-        let moved = placement.to_affine().transform_point2(DVec2::new(11.0, 10.0));
+        let moved = placement
+            .to_affine()
+            .transform_point2(DVec2::new(11.0, 10.0));
         // (1, 0) from the pivot, scaled by 2 and turned by 90° towards +y.
         assert!((moved - DVec2::new(0.0, 2.0)).length() < 1e-12);
     }

@@ -24,11 +24,11 @@
 //! allocates nothing once the buffers have grown to the patch's size.
 
 mod coverage;
-pub mod overlay;
 mod covered;
 mod draw;
 mod error;
 mod feather;
+pub mod overlay;
 mod patch;
 mod rect;
 mod scratch;
