@@ -20,7 +20,7 @@ pub struct SceneUpdate {
     pub reused: usize,
     /// Layers meshed and factored anew (new patches, or changed mesh-defining settings).
     pub rebuilt: usize,
-    /// Old layers no patch of the new scene uses any more.
+    /// Old layers not kept: their patch was removed, renamed or changed its mesh settings.
     pub dropped: usize,
     /// Deformation rigs built for kept layers whose patch gained its first handle or pin.
     pub rigs_built: usize,

@@ -226,13 +226,24 @@ impl Session {
         self.imports.extend(import_statements(text));
         self.refresh_words();
         if !value.is_unit() {
+            let shown = self.display(value);
             if self.interactive {
-                println!("=> {value}");
+                println!("=> {shown}");
             } else {
-                println!("{value}");
+                println!("{shown}");
             }
         }
         Ok(())
+    }
+
+    /// A value as the script's own `to_string` shows it (scene types register theirs).
+    fn display(&self, value: Dynamic) -> String {
+        let mut scope = Scope::new();
+        scope.push("value", value.clone());
+        self.engine
+            .engine()
+            .eval_with_scope::<String>(&mut scope, "to_string(value)")
+            .unwrap_or_else(|_| value.to_string())
     }
 
     fn run(&mut self, text: &str, name: &Path) -> anyhow::Result<(Dynamic, AST)> {
