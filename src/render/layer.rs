@@ -216,7 +216,7 @@ fn mesh_patch(
             let mask = BitMask::load(path, MASK_THRESHOLD).map_err(|source| RenderError::Mask {
                 patch: patch.name.clone(),
                 path: path.clone(),
-                source,
+                source: Box::new(source),
             })?;
             mesh_from_mask(&mask, None, (source.width(), source.height()), options)
                 .map_err(clone_error)

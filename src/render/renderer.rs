@@ -119,7 +119,7 @@ impl Renderer {
                     update.rigs_built += usize::from(rig.is_some());
                     // invariant: plan_layers hands out each old index at most once.
                     let mut layer = old[index].take().expect("layer kept once");
-                    layer.update(patch, rig);
+                    layer.update(patch, rig.map(|rig| *rig));
                     layer
                 }
                 Planned::Build(layer) => {
@@ -158,7 +158,7 @@ impl Renderer {
             plan.push(match kept {
                 Some(index) => {
                     taken[index] = true;
-                    let rig = self.layers[index].missing_rig(patch)?;
+                    let rig = self.layers[index].missing_rig(patch)?.map(Box::new);
                     Planned::Keep { index, rig }
                 }
                 None => {
@@ -250,7 +250,7 @@ impl Renderer {
 enum Planned {
     Keep {
         index: usize,
-        rig: Option<crate::deform::DeformRig>,
+        rig: Option<Box<crate::deform::DeformRig>>,
     },
     Build(Box<Layer>),
 }

@@ -131,9 +131,9 @@ fn print_inline(protocol: Inline, png: &[u8]) {
     let mut out = std::io::stdout().lock();
     let _ = match protocol {
         Inline::Kitty => write_kitty(&mut out, &data),
-        Inline::Iterm => write!(
+        Inline::Iterm => writeln!(
             out,
-            "\x1b]1337;File=inline=1;size={};width=64;preserveAspectRatio=1:{data}\x07\n",
+            "\x1b]1337;File=inline=1;size={};width=64;preserveAspectRatio=1:{data}\x07",
             png.len()
         ),
         Inline::None => Ok(()),
