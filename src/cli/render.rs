@@ -110,7 +110,14 @@ pub fn run_render(args: RenderArgs) -> anyhow::Result<()> {
     let cancel = install_cancel_handler();
     let jobs = args.jobs.unwrap_or_else(default_jobs);
     let started = Instant::now();
-    let mut sink = FrameSink::open(&args, &renderer, range, jobs, cancel.clone())?;
+    let mut sink = FrameSink::open(
+        args.format,
+        &args.output,
+        &renderer,
+        range,
+        jobs,
+        cancel.clone(),
+    )?;
     let progress = progress_bar(range.last - range.first + 1);
     let mut compute_ms = 0.0;
     for number in range.first..=range.last {
@@ -185,7 +192,7 @@ fn load_renderer(scene: &Path) -> anyhow::Result<(LoadedScene, Renderer)> {
     Ok((loaded, renderer))
 }
 
-fn positioned(loaded: &LoadedScene, error: RenderError) -> anyhow::Error {
+pub(crate) fn positioned(loaded: &LoadedScene, error: RenderError) -> anyhow::Error {
     let index = error
         .patch_name()
         .and_then(|name| loaded.scene.patches.iter().position(|p| p.name == name));
@@ -193,7 +200,8 @@ fn positioned(loaded: &LoadedScene, error: RenderError) -> anyhow::Error {
     let (file, position) = origin
         .map(|o| (o.file.clone(), o.position))
         .unwrap_or((loaded.file.clone(), rhai::Position::NONE));
-    let mut scene_error = SceneError::new(ErrorKind::Validation, &file, position, error.to_string());
+    let mut scene_error =
+        SceneError::new(ErrorKind::Validation, &file, position, error.to_string());
     if file == loaded.file {
         scene_error.load_source_line(Some(&loaded.text));
     }
@@ -209,7 +217,7 @@ fn install_cancel_handler() -> Arc<AtomicBool> {
     cancel
 }
 
-fn default_jobs() -> usize {
+pub(crate) fn default_jobs() -> usize {
     std::thread::available_parallelism().map_or(1, |n| n.get())
 }
 
@@ -227,48 +235,49 @@ fn progress_bar(frames: u64) -> ProgressBar {
 }
 
 /// Where rendered frames go: a PNG folder (encoded in parallel), a GIF or an APNG.
-enum FrameSink {
+pub(crate) enum FrameSink {
     Png(PngSequenceWriter, PathBuf),
     Gif(GifWriter),
     Apng(ApngWriter),
 }
 
 impl FrameSink {
-    fn open(
-        args: &RenderArgs,
+    pub(crate) fn open(
+        format: OutputFormat,
+        output: &Path,
         renderer: &Renderer,
         range: FrameRange,
         jobs: usize,
         cancel: Arc<AtomicBool>,
     ) -> anyhow::Result<Self> {
         let canvas = &renderer.scene().canvas;
-        Ok(match args.format {
+        Ok(match format {
             OutputFormat::Png => {
-                if !args.output.is_dir() {
-                    super::clone::check_output_folder(&args.output)?;
-                    std::fs::create_dir(&args.output)
-                        .with_context(|| format!("creating {}", args.output.display()))?;
+                if !output.is_dir() {
+                    super::clone::check_output_folder(output)?;
+                    std::fs::create_dir(output)
+                        .with_context(|| format!("creating {}", output.display()))?;
                 }
                 let writer = PngSequenceWriter::new(
-                    &args.output,
+                    output,
                     renderer.frame_count(),
                     jobs,
                     PngCompression::Fast,
                     cancel,
                 )?;
-                FrameSink::Png(writer, args.output.clone())
+                FrameSink::Png(writer, output.to_path_buf())
             }
             OutputFormat::Gif => {
-                super::clone::check_output_folder(&args.output)?;
-                FrameSink::Gif(GifWriter::create(&args.output, canvas.fps)?)
+                super::clone::check_output_folder(output)?;
+                FrameSink::Gif(GifWriter::create(output, canvas.fps)?)
             }
             OutputFormat::Apng => {
-                super::clone::check_output_folder(&args.output)?;
+                super::clone::check_output_folder(output)?;
                 let frames = u32::try_from(range.last - range.first + 1)
                     .context("too many frames for an APNG")?;
                 let sixteen = renderer.output_format().depth == Depth::Sixteen;
                 FrameSink::Apng(ApngWriter::create(
-                    &args.output,
+                    output,
                     canvas.width,
                     canvas.height,
                     sixteen,
@@ -279,7 +288,7 @@ impl FrameSink {
         })
     }
 
-    fn push(&mut self, number: u64, canvas: &Canvas) -> anyhow::Result<()> {
+    pub(crate) fn push(&mut self, number: u64, canvas: &Canvas) -> anyhow::Result<()> {
         match self {
             FrameSink::Png(writer, _) => {
                 let mut frame = writer.spare_frame().unwrap_or_else(|| empty_frame(canvas));
@@ -292,7 +301,7 @@ impl FrameSink {
         Ok(())
     }
 
-    fn finish(self) -> anyhow::Result<PathBuf> {
+    pub(crate) fn finish(self) -> anyhow::Result<PathBuf> {
         Ok(match self {
             FrameSink::Png(writer, dir) => {
                 writer.finish()?;
@@ -304,7 +313,7 @@ impl FrameSink {
     }
 
     /// Drops the sink after an interruption: writers remove their temporary files.
-    fn abandon(self) {
+    pub(crate) fn abandon(self) {
         if let FrameSink::Png(writer, _) = self {
             let _ = writer.finish();
         }

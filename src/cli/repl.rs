@@ -1,8 +1,176 @@
-//! `lapclone repl`: interactive scene editing.
+//! `lapclone repl [SCENE] [--script FILE]`: interactive scene editing. Takes lines from a
+//! terminal (rustyline: history, completion, hints, multi-line input) or, when stdin is not
+//! a terminal or with `--script`, from a stream; each entry is Rhai run against the live
+//! scene or a `:command` (see docs/repl.md). Non-interactive sessions exit with code 1 when
+//! any entry failed.
+
+mod commands;
+mod completion;
+mod helper;
+mod hints;
+mod preview;
+mod session;
+mod validator;
+
+use std::io::{BufRead, IsTerminal};
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
+
+use anyhow::Context as _;
+use rustyline::error::ReadlineError;
+use rustyline::history::FileHistory;
+use rustyline::{Config, Editor};
+
+use helper::ReplHelper;
+use preview::{default_preview_path, Inline, Preview};
+use session::{Session, Step};
+use validator::InputValidator;
 
 #[derive(clap::Args, Debug)]
-pub struct ReplArgs {}
+pub struct ReplArgs {
+    /// Scene file to start from (.rhai).
+    pub scene: Option<PathBuf>,
+    /// Read entries from this file instead of the terminal (non-interactive).
+    #[arg(long)]
+    pub script: Option<PathBuf>,
+    /// Where the live preview PNG goes (default: the system temp folder).
+    #[arg(long)]
+    pub preview: Option<PathBuf>,
+    /// History file (default: DATA_DIR/lapclone/history.txt).
+    #[arg(long)]
+    pub history: Option<PathBuf>,
+}
 
-pub fn run(_args: ReplArgs) -> anyhow::Result<()> {
-    anyhow::bail!("`lapclone repl` is not implemented yet")
+/// Set when a non-interactive entry fails: the process then exits with code 1.
+#[derive(Debug, thiserror::Error)]
+#[error("{0} failed entr{suffix}", suffix = if *.0 == 1 { "y" } else { "ies" })]
+pub struct EntriesFailed(pub usize);
+
+pub fn run(args: ReplArgs) -> anyhow::Result<()> {
+    let interactive = args.script.is_none() && std::io::stdin().is_terminal();
+    let preview_path = args.preview.clone().unwrap_or_else(default_preview_path);
+    preview::check_preview_path(&preview_path)?;
+    let cancel = Arc::new(AtomicBool::new(false));
+    let words = Arc::new(Mutex::new(completion::Words::default()));
+    let preview = Preview::new(preview_path, interactive, Inline::detect(interactive));
+    let mut session = Session::new(cancel.clone(), preview, words.clone(), interactive);
+    let mut failures = 0;
+    if let Some(scene) = &args.scene {
+        if let Err(error) = session.load(scene) {
+            eprintln!("{error:#}");
+            failures += 1;
+        }
+    }
+    if interactive {
+        interactive_loop(&mut session, &args, cancel, words)
+    } else {
+        let input: Box<dyn BufRead> = match &args.script {
+            Some(path) => Box::new(std::io::BufReader::new(
+                std::fs::File::open(path)
+                    .with_context(|| format!("cannot open script {}", path.display()))?,
+            )),
+            None => Box::new(std::io::stdin().lock()),
+        };
+        failures += script_loop(&mut session, input)?;
+        if failures > 0 {
+            return Err(EntriesFailed(failures).into());
+        }
+        Ok(())
+    }
+}
+
+/// Splits `input` into entries as the interactive validator would (unfinished Rhai goes on
+/// on the next line) and runs them; gives the number of failed entries.
+fn script_loop(session: &mut Session, input: Box<dyn BufRead>) -> anyhow::Result<usize> {
+    let validator = InputValidator::new();
+    let mut failures = 0;
+    let mut buffer = String::new();
+    for line in input.lines() {
+        let line = line.context("reading input")?;
+        if buffer.is_empty() && line.trim().is_empty() {
+            continue;
+        }
+        if !buffer.is_empty() {
+            buffer.push('\n');
+        }
+        buffer.push_str(&line);
+        if validator.is_incomplete(&buffer) {
+            continue;
+        }
+        let entry = std::mem::take(&mut buffer);
+        match session.entry(&entry) {
+            Step::Ok => {}
+            Step::Failed => failures += 1,
+            Step::Quit => return Ok(failures),
+        }
+    }
+    if !buffer.trim().is_empty() && session.entry(&buffer) == Step::Failed {
+        failures += 1;
+    }
+    Ok(failures)
+}
+
+fn interactive_loop(
+    session: &mut Session,
+    args: &ReplArgs,
+    cancel: Arc<AtomicBool>,
+    words: completion::SharedWords,
+) -> anyhow::Result<()> {
+    // Ctrl-C while an entry runs raises the cancel flag (the engine and render loops check
+    // it); at the prompt rustyline reads it as a key and we clear the line.
+    let flag = cancel.clone();
+    if ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed)).is_err() {
+        eprintln!("warning: Ctrl-C cannot cancel evaluations in this session");
+    }
+    let config = Config::builder()
+        .auto_add_history(false)
+        .completion_type(rustyline::CompletionType::List)
+        .build();
+    let mut editor: Editor<ReplHelper, FileHistory> =
+        Editor::with_config(config).context("starting the line editor")?;
+    editor.set_helper(Some(ReplHelper::new(words)));
+    let history = args.history.clone().or_else(default_history_path);
+    if let Some(path) = &history {
+        let _ = editor.load_history(path);
+    }
+    println!("lapclone repl — :help for commands, Ctrl-D to quit");
+    loop {
+        match editor.readline("lapclone> ") {
+            Ok(line) => {
+                if !line.trim().is_empty() {
+                    let _ = editor.add_history_entry(line.as_str());
+                }
+                if session.entry(&line) == Step::Quit {
+                    break;
+                }
+            }
+            Err(ReadlineError::Interrupted) => continue,
+            Err(ReadlineError::Eof) => break,
+            Err(error) => return Err(error).context("reading input"),
+        }
+    }
+    if let Some(path) = &history {
+        save_history(&mut editor, path);
+    }
+    Ok(())
+}
+
+/// DATA_DIR/lapclone/history.txt, creating the folder (none if there is no data folder).
+fn default_history_path() -> Option<PathBuf> {
+    let dir = dirs::data_dir()?.join("lapclone");
+    if let Err(error) = std::fs::create_dir_all(&dir) {
+        eprintln!(
+            "warning: no history: cannot create {}: {error}",
+            dir.display()
+        );
+        return None;
+    }
+    Some(dir.join("history.txt"))
+}
+
+fn save_history(editor: &mut Editor<ReplHelper, FileHistory>, path: &std::path::Path) {
+    if let Err(error) = editor.save_history(path) {
+        eprintln!("warning: cannot write history {}: {error}", path.display());
+    }
 }

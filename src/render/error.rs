@@ -24,8 +24,9 @@ pub enum RenderError {
     Mask {
         patch: String,
         path: PathBuf,
+        /// Boxed: mesh errors are large and every render result carries this type.
         #[source]
-        source: crate::mesh::MeshError,
+        source: Box<crate::mesh::MeshError>,
     },
     #[error(transparent)]
     Pixels(#[from] PixelError),

@@ -6,25 +6,57 @@ use glam::DVec2;
 
 use super::RenderError;
 use crate::clone::{
-    mesh_from_mask, mesh_from_polygons, CloneOptions, CloneStats, PatchCloner, PatchMesh,
-    Placement,
+    mesh_from_mask, mesh_from_polygons, CloneOptions, CloneStats, PatchCloner, PatchMesh, Placement,
 };
 use crate::deform::{DeformRig, DeformStats, Deformed, Handle, Pin};
-use crate::mesh::{BitMask, MeshOptions, Polygon};
+use crate::mesh::{BitMask, Mesh, MeshOptions, Polygon};
 use crate::pixels::{Canvas, FloatImage};
-use crate::scene::{Patch, PatchState, Shape};
+use crate::scene::{CloneMode, LaplacianKind, Patch, PatchState, Shape};
 
 /// Mask pixels at or above this luminance (or alpha) are inside.
 const MASK_THRESHOLD: f32 = 0.5;
 
+/// The patch settings a layer's mesh, cloning factor and rig are built from: a layer can be
+/// kept for a new version of its patch exactly when these are equal.
+#[derive(Clone, Debug, PartialEq)]
+pub(super) struct LayerSettings {
+    source: std::path::PathBuf,
+    shape: Shape,
+    density: Option<f64>,
+    laplacian: LaplacianKind,
+    mode: CloneMode,
+    feather: f64,
+}
+
+impl LayerSettings {
+    pub fn of(patch: &Patch) -> Self {
+        LayerSettings {
+            source: patch.source.clone(),
+            shape: patch.shape.clone(),
+            density: patch.density,
+            laplacian: patch.laplacian,
+            mode: patch.mode,
+            feather: patch.feather,
+        }
+    }
+}
+
+/// Whether a patch deforms at some time (and so needs a rig).
+pub(super) fn deforms(patch: &Patch) -> bool {
+    !patch.handles.is_empty() || !patch.pins.is_empty()
+}
+
 /// Everything kept between frames for one patch.
 pub(super) struct Layer {
     pub name: String,
+    pub settings: LayerSettings,
     cloner: PatchCloner,
     /// The rest point a placement's position refers to (bounding-box centre).
     pivot: DVec2,
-    /// Built only for patches that deform at some time.
+    /// Built only once the patch deforms at some time; kept (unused) if it stops deforming.
     rig: Option<DeformRig>,
+    /// Whether the current version of the patch deforms (uses `rig`).
+    deforms: bool,
     deformed: Deformed,
     handles: Vec<Handle>,
     pins: Vec<Pin>,
@@ -47,24 +79,21 @@ impl Layer {
             mode: patch.mode,
             feather: patch.feather as f32,
         };
-        let cloner = PatchCloner::new(source, patch_mesh.result.mesh, &options).map_err(clone_error)?;
-        let deforms = !patch.handles.is_empty() || !patch.pins.is_empty();
+        let cloner =
+            PatchCloner::new(source, patch_mesh.result.mesh, &options).map_err(clone_error)?;
+        let deforms = deforms(patch);
         let rig = if deforms {
-            let rig = DeformRig::new(cloner.mesh(), patch.laplacian).map_err(|source| {
-                RenderError::Deform {
-                    patch: patch.name.clone(),
-                    source,
-                }
-            })?;
-            Some(rig)
+            Some(build_rig(patch, cloner.mesh())?)
         } else {
             None
         };
         Ok(Self {
             name: patch.name.clone(),
+            settings: LayerSettings::of(patch),
             cloner,
             pivot,
             rig,
+            deforms,
             deformed: Deformed::default(),
             handles: Vec::new(),
             pins: Vec::new(),
@@ -84,14 +113,14 @@ impl Layer {
             rotation_deg: state.rotation,
         };
         let deform_stats = self.deform(state)?;
-        let result = match &self.rig {
-            Some(_) => self.cloner.clone_deformed(
+        let result = match (&self.rig, self.deforms) {
+            (Some(_), true) => self.cloner.clone_deformed(
                 canvas,
                 &placement,
                 &self.deformed.positions,
                 Some(&self.deformed.depth),
             ),
-            None => self.cloner.clone_onto(canvas, &placement),
+            _ => self.cloner.clone_onto(canvas, &placement),
         };
         let clone_stats = result.map_err(|source| RenderError::Clone {
             patch: self.name.clone(),
@@ -101,7 +130,7 @@ impl Layer {
     }
 
     fn deform(&mut self, state: &PatchState) -> Result<DeformStats, RenderError> {
-        let Some(rig) = &mut self.rig else {
+        let Some(rig) = self.rig.as_mut().filter(|_| self.deforms) else {
             return Ok(DeformStats::default());
         };
         self.handles.clear();
@@ -122,9 +151,55 @@ impl Layer {
             })
     }
 
+    /// A rig this layer still needs for `patch` (a patch that gains its first handle or pin),
+    /// built without touching the layer so a failure leaves it as it was.
+    pub fn missing_rig(&self, patch: &Patch) -> Result<Option<DeformRig>, RenderError> {
+        if deforms(patch) && self.rig.is_none() {
+            build_rig(patch, self.cloner.mesh()).map(Some)
+        } else {
+            Ok(None)
+        }
+    }
+
+    /// Takes the new version of its patch (same [`LayerSettings`]) and, if given, its new rig.
+    pub fn update(&mut self, patch: &Patch, rig: Option<DeformRig>) {
+        if rig.is_some() {
+            self.rig = rig;
+        }
+        self.deforms = deforms(patch);
+    }
+
+    pub fn has_rig(&self) -> bool {
+        self.rig.is_some()
+    }
+
+    pub fn settings_source(&self) -> &std::path::Path {
+        &self.settings.source
+    }
+
+    pub fn source(&self) -> &FloatImage {
+        self.cloner.source()
+    }
+
+    pub fn mesh(&self) -> &Mesh {
+        self.cloner.mesh()
+    }
+
+    /// Canvas positions of the vertices in the last drawn frame.
+    pub fn placed(&self) -> &[DVec2] {
+        self.cloner.placed()
+    }
+
     pub fn vertex_count(&self) -> usize {
         self.cloner.mesh().vertex_count()
     }
+}
+
+fn build_rig(patch: &Patch, mesh: &Mesh) -> Result<DeformRig, RenderError> {
+    DeformRig::new(mesh, patch.laplacian).map_err(|source| RenderError::Deform {
+        patch: patch.name.clone(),
+        source,
+    })
 }
 
 fn mesh_patch(
@@ -141,7 +216,7 @@ fn mesh_patch(
             let mask = BitMask::load(path, MASK_THRESHOLD).map_err(|source| RenderError::Mask {
                 patch: patch.name.clone(),
                 path: path.clone(),
-                source,
+                source: Box::new(source),
             })?;
             mesh_from_mask(&mask, None, (source.width(), source.height()), options)
                 .map_err(clone_error)

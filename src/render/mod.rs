@@ -6,10 +6,11 @@
 //! evaluate the timeline at t = i / fps, reset the canvas to the background, then for each
 //! patch back to front: deformation solve (rank-1 switches only), visibility switches,
 //! membrane solve, raster — each patch clones onto the composite of the layers below it.
+//! After an edit ([`Renderer::set_scene`]) only new or changed patches are built again.
 
 mod error;
 mod layer;
 mod renderer;
 
 pub use error::RenderError;
-pub use renderer::{FrameStats, Renderer};
+pub use renderer::{FrameStats, PlacedMesh, Renderer, SceneUpdate};

@@ -5,10 +5,37 @@ use std::collections::HashMap;
 use std::path::PathBuf;
 use std::time::Instant;
 
-use super::layer::Layer;
+use glam::DVec2;
+
+use super::layer::{Layer, LayerSettings};
 use super::RenderError;
+use crate::mesh::Mesh;
 use crate::pixels::{Canvas, Depth, FloatImage, PixelFormat};
-use crate::scene::{frame_time, Background, FrameState, Scene};
+use crate::scene::{frame_time, Background, FrameState, Patch, Scene};
+
+/// What [`Renderer::set_scene`] kept and built.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SceneUpdate {
+    /// Layers kept with their mesh, cloning factor and rig.
+    pub reused: usize,
+    /// Layers meshed and factored anew (new patches, or changed mesh-defining settings).
+    pub rebuilt: usize,
+    /// Old layers not kept: their patch was removed, renamed or changed its mesh settings.
+    pub dropped: usize,
+    /// Deformation rigs built for kept layers whose patch gained its first handle or pin.
+    pub rigs_built: usize,
+    /// Whether the background was reloaded (changed background or canvas size).
+    pub background_changed: bool,
+}
+
+/// One patch's mesh where the last frame put it: for mesh overlays.
+#[derive(Clone, Copy, Debug)]
+pub struct PlacedMesh<'a> {
+    pub name: &'a str,
+    pub mesh: &'a Mesh,
+    /// Canvas positions of `mesh`'s vertices in the last rendered frame (empty before one).
+    pub placed: &'a [DVec2],
+}
 
 /// Timings and counts of the last frame.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -46,15 +73,7 @@ impl Renderer {
         let mut sources: HashMap<PathBuf, FloatImage> = HashMap::new();
         let mut layers = Vec::with_capacity(scene.patches.len());
         for patch in &scene.patches {
-            let source = match sources.get(&patch.source) {
-                Some(image) => image.clone(),
-                None => {
-                    let image = FloatImage::load(&patch.source)?;
-                    sources.insert(patch.source.clone(), image.clone());
-                    image
-                }
-            };
-            layers.push(Layer::new(patch, source)?);
+            layers.push(Layer::new(patch, source_image(&mut sources, patch)?)?);
         }
         let frame = background.clone();
         Ok(Self {
@@ -69,6 +88,103 @@ impl Renderer {
 
     pub fn scene(&self) -> &Scene {
         &self.scene
+    }
+
+    /// Switches to a new version of the scene, keeping every layer (mesh, cloning factor,
+    /// deformation rig) whose patch — matched by name — has the same mesh-defining settings
+    /// (source, shape, density, Laplacian kind, mode, feather). Only new or changed patches
+    /// are meshed and factored; a kept patch that gained its first handle or pin gets a rig.
+    /// On error the renderer is unchanged.
+    pub fn set_scene(&mut self, scene: Scene) -> Result<SceneUpdate, RenderError> {
+        scene.sanity_check()?;
+        let mut update = SceneUpdate::default();
+        let canvas_changed = scene.canvas.background != self.scene.canvas.background
+            || (scene.canvas.width, scene.canvas.height)
+                != (self.scene.canvas.width, self.scene.canvas.height);
+        let background = if canvas_changed {
+            update.background_changed = true;
+            Some(background_canvas(&scene)?)
+        } else {
+            None
+        };
+        let plan = self.plan_layers(&scene.patches)?;
+        let mut old: Vec<Option<Layer>> = std::mem::take(&mut self.layers)
+            .into_iter()
+            .map(Some)
+            .collect();
+        for (patch, planned) in scene.patches.iter().zip(plan) {
+            let layer = match planned {
+                Planned::Keep { index, rig } => {
+                    update.reused += 1;
+                    update.rigs_built += usize::from(rig.is_some());
+                    // invariant: plan_layers hands out each old index at most once.
+                    let mut layer = old[index].take().expect("layer kept once");
+                    layer.update(patch, rig.map(|rig| *rig));
+                    layer
+                }
+                Planned::Build(layer) => {
+                    update.rebuilt += 1;
+                    *layer
+                }
+            };
+            self.layers.push(layer);
+        }
+        update.dropped = old.iter().filter(|l| l.is_some()).count();
+        if let Some(background) = background {
+            self.frame = background.clone();
+            self.background = background;
+        }
+        self.scene = scene;
+        Ok(update)
+    }
+
+    /// For each new patch, the old layer it keeps (and a rig it still needs) or a new layer.
+    /// Does all fallible work without touching `self`.
+    fn plan_layers(&self, patches: &[Patch]) -> Result<Vec<Planned>, RenderError> {
+        let mut taken = vec![false; self.layers.len()];
+        let mut sources: HashMap<PathBuf, FloatImage> = self
+            .layers
+            .iter()
+            .map(|l| (l.settings_source().to_path_buf(), l.source().clone()))
+            .collect();
+        let mut plan = Vec::with_capacity(patches.len());
+        for patch in patches {
+            let settings = LayerSettings::of(patch);
+            let kept = self
+                .layers
+                .iter()
+                .enumerate()
+                .position(|(i, l)| !taken[i] && l.name == patch.name && l.settings == settings);
+            plan.push(match kept {
+                Some(index) => {
+                    taken[index] = true;
+                    let rig = self.layers[index].missing_rig(patch)?.map(Box::new);
+                    Planned::Keep { index, rig }
+                }
+                None => {
+                    let source = source_image(&mut sources, patch)?;
+                    Planned::Build(Box::new(Layer::new(patch, source)?))
+                }
+            });
+        }
+        Ok(plan)
+    }
+
+    /// Each patch's mesh and where the last frame placed it, in scene order.
+    pub fn placed_meshes(&self) -> Vec<PlacedMesh<'_>> {
+        self.layers
+            .iter()
+            .map(|l| PlacedMesh {
+                name: &l.name,
+                mesh: l.mesh(),
+                placed: l.placed(),
+            })
+            .collect()
+    }
+
+    /// Whether each patch (scene order) has a deformation rig built.
+    pub fn rigs_built(&self) -> Vec<bool> {
+        self.layers.iter().map(Layer::has_rig).collect()
     }
 
     /// Number of frames: ⌈duration · fps⌉.
@@ -94,8 +210,7 @@ impl Renderer {
             let deform_started = Instant::now();
             let (clone, deform) =
                 self.layers[index].draw(&self.state.patches[index], &mut self.frame)?;
-            stats.deform_ms +=
-                millis(deform_started.elapsed()) - clone.solve_ms - clone.raster_ms;
+            stats.deform_ms += millis(deform_started.elapsed()) - clone.solve_ms - clone.raster_ms;
             stats.solve_ms += clone.solve_ms;
             stats.raster_ms += clone.raster_ms;
             stats.deform_switches += deform.switches();
@@ -130,6 +245,27 @@ impl Renderer {
             Depth::Sixteen => PixelFormat::RGBA16,
         }
     }
+}
+
+enum Planned {
+    Keep {
+        index: usize,
+        rig: Option<Box<crate::deform::DeformRig>>,
+    },
+    Build(Box<Layer>),
+}
+
+/// The patch's source image, loaded once per path.
+fn source_image(
+    sources: &mut HashMap<PathBuf, FloatImage>,
+    patch: &Patch,
+) -> Result<FloatImage, RenderError> {
+    if let Some(image) = sources.get(&patch.source) {
+        return Ok(image.clone());
+    }
+    let image = FloatImage::load(&patch.source)?;
+    sources.insert(patch.source.clone(), image.clone());
+    Ok(image)
 }
 
 /// The canvas every frame starts from: the background image at the origin over opaque

@@ -1,0 +1,261 @@
+//! The REPL's `:commands`: takes an input line starting with `:` and gives a parsed
+//! [`Command`] (or a usage message); also the command table that `:help`, completion and
+//! hints read.
+
+use std::path::PathBuf;
+
+use crate::cli::render::{frame_range, FrameRange};
+
+/// One REPL command: its name (without the colon), argument usage and what it does.
+pub struct CommandInfo {
+    pub name: &'static str,
+    pub usage: &'static str,
+    pub help: &'static str,
+}
+
+/// Every command, in the order `:help` lists them.
+pub const COMMANDS: &[CommandInfo] = &[
+    CommandInfo {
+        name: "help",
+        usage: "",
+        help: "this list",
+    },
+    CommandInfo {
+        name: "load",
+        usage: "FILE",
+        help: "load a scene file (replaces the live scene)",
+    },
+    CommandInfo {
+        name: "reload",
+        usage: "",
+        help: "load the current scene file again (drops REPL edits)",
+    },
+    CommandInfo {
+        name: "save",
+        usage: "FILE",
+        help: "write the live scene as a Rhai scene file",
+    },
+    CommandInfo {
+        name: "t",
+        usage: "SECONDS",
+        help: "show the scene at a time",
+    },
+    CommandInfo {
+        name: "frame",
+        usage: "N",
+        help: "show frame N (from 1)",
+    },
+    CommandInfo {
+        name: "show",
+        usage: "",
+        help: "render and show the current frame again",
+    },
+    CommandInfo {
+        name: "mesh",
+        usage: "",
+        help: "toggle the deformed-mesh overlay on the preview",
+    },
+    CommandInfo {
+        name: "list",
+        usage: "",
+        help: "canvas, patches, keys, handles, pins and variables",
+    },
+    CommandInfo {
+        name: "undo",
+        usage: "",
+        help: "undo the last change to the scene",
+    },
+    CommandInfo {
+        name: "render",
+        usage: "[A..B] [-o DIR]",
+        help: "render frames A..B (default all) to DIR/frame_NNNN.png (default frames)",
+    },
+    CommandInfo {
+        name: "gif",
+        usage: "FILE",
+        help: "render every frame into an animated GIF",
+    },
+    CommandInfo {
+        name: "stats",
+        usage: "",
+        help: "timings of the last frame and what the last edit rebuilt",
+    },
+    CommandInfo {
+        name: "quit",
+        usage: "",
+        help: "leave (Ctrl-D does too)",
+    },
+];
+
+/// Commands that take a file path argument (completed with file names).
+pub const PATH_COMMANDS: &[&str] = &["load", "save", "gif"];
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum Command {
+    Help,
+    Load(PathBuf),
+    Reload,
+    Save(PathBuf),
+    Time(f64),
+    Frame(u64),
+    Show,
+    Mesh,
+    List,
+    Undo,
+    Render {
+        range: Option<FrameRange>,
+        output: PathBuf,
+    },
+    Gif(PathBuf),
+    Stats,
+    Quit,
+}
+
+/// Parses a `:command` line; the error is a message for the user.
+pub fn parse_command(line: &str) -> Result<Command, String> {
+    let body = line.trim().strip_prefix(':').unwrap_or(line.trim());
+    let (name, rest) = match body.split_once(char::is_whitespace) {
+        Some((name, rest)) => (name, rest.trim()),
+        None => (body, ""),
+    };
+    let info = COMMANDS
+        .iter()
+        .find(|c| c.name == name)
+        .ok_or_else(|| format!("unknown command `:{name}` (try :help)"))?;
+    let usage = || format!("usage: :{} {}", info.name, info.usage);
+    let no_args = |command: Command| {
+        if rest.is_empty() {
+            Ok(command)
+        } else {
+            Err(usage())
+        }
+    };
+    let path = || {
+        if rest.is_empty() {
+            Err(usage())
+        } else {
+            Ok(PathBuf::from(unquote(rest)))
+        }
+    };
+    match name {
+        "help" => no_args(Command::Help),
+        "load" => path().map(Command::Load),
+        "reload" => no_args(Command::Reload),
+        "save" => path().map(Command::Save),
+        "t" => match rest.parse::<f64>() {
+            Ok(t) if t.is_finite() && t >= 0.0 => Ok(Command::Time(t)),
+            _ => Err(format!("{}: SECONDS must be a finite number ≥ 0", usage())),
+        },
+        "frame" => match rest.parse::<u64>() {
+            Ok(n) if n >= 1 => Ok(Command::Frame(n)),
+            _ => Err(format!("{}: N must be a frame number ≥ 1", usage())),
+        },
+        "show" => no_args(Command::Show),
+        "mesh" => no_args(Command::Mesh),
+        "list" => no_args(Command::List),
+        "undo" => no_args(Command::Undo),
+        "render" => parse_render(rest).map_err(|e| format!("{}: {e}", usage())),
+        "gif" => path().map(Command::Gif),
+        "stats" => no_args(Command::Stats),
+        "quit" => no_args(Command::Quit),
+        _ => Err(format!("unknown command `:{name}`")),
+    }
+}
+
+fn parse_render(rest: &str) -> Result<Command, String> {
+    let mut range = None;
+    let mut output = PathBuf::from("frames");
+    let mut words = rest.split_whitespace();
+    while let Some(word) = words.next() {
+        if word == "-o" {
+            let dir = words.next().ok_or("-o needs a folder")?;
+            output = PathBuf::from(unquote(dir));
+        } else if range.is_none() && word.contains("..") {
+            range = Some(frame_range(word)?);
+        } else {
+            return Err(format!("unexpected `{word}`"));
+        }
+    }
+    Ok(Command::Render { range, output })
+}
+
+/// Strips one pair of surrounding quotes, so `:save "my scene.rhai"` works.
+fn unquote(text: &str) -> &str {
+    let text = text.trim();
+    for quote in ['"', '\''] {
+        if let Some(inner) = text.strip_prefix(quote).and_then(|t| t.strip_suffix(quote)) {
+            return inner;
+        }
+    }
+    text
+}
+
+/// The `:help` text.
+pub fn help_text() -> String {
+    let mut out = String::from(
+        "Lines are Rhai run against the live scene (see docs/scene-language.md); unfinished\n\
+         input (open brackets, a trailing operator) continues on the next line.\n\
+         Ctrl-C cancels a running evaluation or render (or clears the line); Ctrl-D quits.\n",
+    );
+    for c in COMMANDS {
+        let head = format!(":{} {}", c.name, c.usage);
+        out.push_str(&format!("  {head:<24} {}\n", c.help));
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parses_every_command_shape() {
+        assert_eq!(parse_command(":t 1.5"), Ok(Command::Time(1.5)));
+        assert_eq!(parse_command(":frame 3"), Ok(Command::Frame(3)));
+        assert_eq!(
+            parse_command(":save \"a b.rhai\""),
+            Ok(Command::Save(PathBuf::from("a b.rhai")))
+        );
+        assert_eq!(
+            parse_command(":render 2..4 -o out"),
+            Ok(Command::Render {
+                range: Some(FrameRange { first: 2, last: 4 }),
+                output: PathBuf::from("out")
+            })
+        );
+        assert_eq!(
+            parse_command(":render"),
+            Ok(Command::Render {
+                range: None,
+                output: PathBuf::from("frames")
+            })
+        );
+        assert_eq!(parse_command("  :quit  "), Ok(Command::Quit));
+    }
+
+    #[test]
+    fn refuses_bad_arguments_with_usage() {
+        assert!(parse_command(":nope")
+            .unwrap_err()
+            .contains("unknown command"));
+        assert!(parse_command(":t -1")
+            .unwrap_err()
+            .contains("usage: :t SECONDS"));
+        assert!(parse_command(":t NaN").is_err());
+        assert!(parse_command(":frame 0").is_err());
+        assert!(parse_command(":save")
+            .unwrap_err()
+            .contains("usage: :save FILE"));
+        assert!(parse_command(":list extra").is_err());
+        assert!(parse_command(":render 3..1").is_err());
+        assert!(parse_command(":render -o").is_err());
+    }
+
+    #[test]
+    fn help_lists_every_command() {
+        let help = help_text();
+        for c in COMMANDS {
+            assert!(help.contains(&format!(":{}", c.name)), "{}", c.name);
+        }
+    }
+}

@@ -1,0 +1,220 @@
+//! The live preview: takes the renderer's current frame (and, with `:mesh`, its placed
+//! meshes), writes it to the preview PNG and shows it — inline in terminals that speak the
+//! kitty or iTerm2 image protocol, else as one line naming the file. Never prints escape
+//! sequences unless interactive.
+
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+
+use anyhow::Context as _;
+use lapclone::raster::overlay::{draw_mesh_overlay, OverlayStyle};
+use lapclone::render::Renderer;
+
+/// How the terminal can show images.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Inline {
+    Kitty,
+    Iterm,
+    /// Text line only (also every non-interactive session).
+    None,
+}
+
+impl Inline {
+    /// Detects the image protocol from the environment (`LAPCLONE_INLINE=off` disables).
+    pub fn detect(interactive: bool) -> Inline {
+        let var = |name: &str| std::env::var(name).unwrap_or_default();
+        if !interactive || var("LAPCLONE_INLINE") == "off" {
+            return Inline::None;
+        }
+        if !var("KITTY_WINDOW_ID").is_empty() || var("TERM").contains("kitty") {
+            return Inline::Kitty;
+        }
+        let program = var("TERM_PROGRAM");
+        if program == "iTerm.app" || program == "WezTerm" || var("LC_TERMINAL") == "iTerm2" {
+            return Inline::Iterm;
+        }
+        Inline::None
+    }
+}
+
+pub struct Preview {
+    pub path: PathBuf,
+    pub inline: Inline,
+    pub overlay: bool,
+    announced: bool,
+    interactive: bool,
+}
+
+impl Preview {
+    pub fn new(path: PathBuf, interactive: bool, inline: Inline) -> Self {
+        Preview {
+            path,
+            inline,
+            overlay: false,
+            announced: false,
+            interactive,
+        }
+    }
+
+    /// Writes the renderer's current frame (with the overlay if on) and shows it.
+    pub fn update(&mut self, renderer: &Renderer) -> anyhow::Result<()> {
+        let png = self.encode(renderer)?;
+        lapclone::util::write_atomic(&self.path, &png)
+            .with_context(|| format!("writing the preview {}", self.path.display()))?;
+        self.show(renderer, &png);
+        Ok(())
+    }
+
+    fn encode(&self, renderer: &Renderer) -> anyhow::Result<Vec<u8>> {
+        let frame = renderer.frame();
+        if !self.overlay {
+            return Ok(frame.encode_png(renderer.output_format())?);
+        }
+        let mut picture = frame.to_rgba8_image();
+        let style = OverlayStyle::default();
+        for placed in renderer.placed_meshes() {
+            if placed.placed.len() != placed.mesh.vertex_count() {
+                continue;
+            }
+            picture = draw_mesh_overlay(
+                &picture,
+                placed.placed,
+                &placed.mesh.triangles,
+                &placed.mesh.loops,
+                &[],
+                &style,
+            )
+            .with_context(|| format!("mesh overlay of `{}`", placed.name))?;
+        }
+        let mut png = Vec::new();
+        picture
+            .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+            .context("encoding the preview")?;
+        Ok(png)
+    }
+
+    fn show(&mut self, renderer: &Renderer, png: &[u8]) {
+        let canvas = &renderer.scene().canvas;
+        let stats = renderer.last_stats();
+        let line = format!(
+            "preview: {} ({}×{}, t = {} s, {:.1} ms{})",
+            self.path.display(),
+            canvas.width,
+            canvas.height,
+            stats.time,
+            stats.total_ms,
+            if self.overlay { ", mesh" } else { "" }
+        );
+        match self.inline {
+            Inline::None if self.interactive => println!("{line}"),
+            Inline::None => {
+                if !self.announced {
+                    println!("preview: {}", self.path.display());
+                }
+            }
+            protocol => {
+                print_inline(protocol, png);
+                println!("{}", line.replacen("preview: ", "", 1));
+            }
+        }
+        self.announced = true;
+    }
+}
+
+/// The default preview file: one per process in the system temp folder.
+pub fn default_preview_path() -> PathBuf {
+    std::env::temp_dir().join(format!("lapclone-preview-{}.png", std::process::id()))
+}
+
+fn print_inline(protocol: Inline, png: &[u8]) {
+    let data = base64(png);
+    let mut out = std::io::stdout().lock();
+    let _ = match protocol {
+        Inline::Kitty => write_kitty(&mut out, &data),
+        Inline::Iterm => writeln!(
+            out,
+            "\x1b]1337;File=inline=1;size={};width=64;preserveAspectRatio=1:{data}\x07",
+            png.len()
+        ),
+        Inline::None => Ok(()),
+    };
+    let _ = out.flush();
+}
+
+/// Kitty's graphics protocol: the PNG in base64 chunks of at most 4096 bytes.
+fn write_kitty(out: &mut impl std::io::Write, data: &str) -> std::io::Result<()> {
+    let chunks: Vec<&[u8]> = data.as_bytes().chunks(4096).collect();
+    for (i, chunk) in chunks.iter().enumerate() {
+        let more = u8::from(i + 1 < chunks.len());
+        let chunk = std::str::from_utf8(chunk).unwrap_or_default();
+        if i == 0 {
+            write!(out, "\x1b_Ga=T,f=100,c=64,m={more};{chunk}\x1b\\")?;
+        } else {
+            write!(out, "\x1b_Gm={more};{chunk}\x1b\\")?;
+        }
+    }
+    writeln!(out)
+}
+
+/// Standard base64 with padding.
+pub fn base64(bytes: &[u8]) -> String {
+    const TABLE: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut out = String::with_capacity(bytes.len().div_ceil(3) * 4);
+    for group in bytes.chunks(3) {
+        let b = [
+            group[0],
+            *group.get(1).unwrap_or(&0),
+            *group.get(2).unwrap_or(&0),
+        ];
+        let n = (u32::from(b[0]) << 16) | (u32::from(b[1]) << 8) | u32::from(b[2]);
+        for k in 0..4 {
+            if k <= group.len() {
+                out.push(TABLE[(n >> (18 - 6 * k)) as usize & 63] as char);
+            } else {
+                out.push('=');
+            }
+        }
+    }
+    out
+}
+
+/// Whether `path` can hold a preview: its folder exists.
+pub fn check_preview_path(path: &Path) -> anyhow::Result<()> {
+    crate::cli::clone::check_output_folder(path)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn base64_matches_rfc_4648_vectors() {
+        for (input, expected) in [
+            ("", ""),
+            ("f", "Zg=="),
+            ("fo", "Zm8="),
+            ("foo", "Zm9v"),
+            ("foob", "Zm9vYg=="),
+            ("fooba", "Zm9vYmE="),
+            ("foobar", "Zm9vYmFy"),
+        ] {
+            assert_eq!(base64(input.as_bytes()), expected);
+        }
+    }
+
+    #[test]
+    fn kitty_chunks_are_at_most_4096_bytes_and_flag_continuation() {
+        let data = "A".repeat(5000);
+        let mut out = Vec::new();
+        write_kitty(&mut out, &data).unwrap();
+        let text = String::from_utf8(out).unwrap();
+        assert!(text.starts_with("\x1b_Ga=T,f=100,c=64,m=1;"));
+        assert!(text.contains("\x1b_Gm=0;"));
+        assert_eq!(text.matches('A').count(), 5000);
+    }
+
+    #[test]
+    fn non_interactive_never_uses_an_image_protocol() {
+        assert_eq!(Inline::detect(false), Inline::None);
+    }
+}
