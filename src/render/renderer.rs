@@ -10,6 +10,7 @@ use glam::DVec2;
 use super::layer::{Layer, LayerSettings};
 use super::RenderError;
 use crate::mesh::Mesh;
+use crate::raster::PixelRect;
 use crate::pixels::{Canvas, Depth, FloatImage, PixelFormat};
 use crate::scene::{frame_time, Background, FrameState, Patch, Scene};
 
@@ -63,6 +64,10 @@ pub struct Renderer {
     layers: Vec<Layer>,
     state: FrameState,
     stats: FrameStats,
+    /// Rectangles the last frame drew into (valid when `dirty_valid`): the frame equals the
+    /// background outside them.
+    dirty: Vec<PixelRect>,
+    dirty_valid: bool,
 }
 
 impl Renderer {
@@ -83,6 +88,8 @@ impl Renderer {
             layers,
             state: FrameState::default(),
             stats: FrameStats::default(),
+            dirty: Vec::new(),
+            dirty_valid: true,
         })
     }
 
@@ -133,6 +140,8 @@ impl Renderer {
         if let Some(background) = background {
             self.frame = background.clone();
             self.background = background;
+            self.dirty.clear();
+            self.dirty_valid = true;
         }
         self.scene = scene;
         Ok(update)
@@ -201,7 +210,7 @@ impl Renderer {
     pub fn render_time(&mut self, t: f64) -> Result<&Canvas, RenderError> {
         let started = Instant::now();
         self.scene.evaluate_into(t, &mut self.state);
-        self.frame.copy_from(&self.background);
+        self.restore_background()?;
         let mut stats = FrameStats {
             time: t,
             ..FrameStats::default()
@@ -218,10 +227,28 @@ impl Renderer {
             stats.clone_switches += switches.updates + switches.downdates;
             stats.hidden += clone.membrane.hidden;
             stats.outside += clone.membrane.outside;
+            self.dirty.push(clone.raster.work);
         }
+        self.dirty_valid = true;
         stats.total_ms = millis(started.elapsed());
         self.stats = stats;
         Ok(&self.frame)
+    }
+
+    /// Resets the frame to the background: only the rectangles the last frame drew into when
+    /// they are known (a frame is mostly background), else the whole canvas.
+    fn restore_background(&mut self) -> Result<(), RenderError> {
+        if self.dirty_valid {
+            for rect in &self.dirty {
+                self.frame.copy_rect_from(&self.background, *rect)?;
+            }
+        } else {
+            self.frame.copy_from(&self.background);
+        }
+        // Until this frame completes, a failure may leave other pixels drawn.
+        self.dirty_valid = false;
+        self.dirty.clear();
+        Ok(())
     }
 
     /// The last rendered frame.
