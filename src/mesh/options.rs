@@ -24,8 +24,9 @@ pub struct MeshOptions {
 
 impl Default for MeshOptions {
     /// - `density` 1.5 px: measured seam PSNR on the spiral is 39 dB at 2 px and 45 dB at
-    ///   1 px (issue #2/#8); 1.5 px keeps the 770×743 spiral well inside its 20 ms budget
-    ///   while sitting between the two (the lead revisits with #8's measurements).
+    ///   1 px (issue #2/#8); 1.5 px sits between the two. It does NOT meet the 20 ms
+    ///   spiral target yet: 16K vertices, ≈254M instructions, 45–60 ms on a loaded
+    ///   2-core machine (2 px: 186M, 3 px: 131M, 4 px: 107M). The lead revisits with #8.
     /// - `simplify_tolerance` 0.9 px: keeps every mask pixel centre within 0.5 px of the
     ///   mesh (a centre is 0.5 px inside the crack boundary) and every mesh point within
     ///   0.9 px of the mask.
