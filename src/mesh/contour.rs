@@ -105,11 +105,27 @@ fn is_saddle(mask: &BitMask, cx: i64, cy: i64) -> bool {
 pub fn trace_crack_loops(mask: &BitMask) -> Vec<CrackLoop> {
     let mut visited = vec![0u8; mask.width * mask.height];
     let mut loops = Vec::new();
-    for y in 0..mask.height as i64 {
-        for x in 0..mask.width as i64 {
-            if !mask.get(x, y) {
+    let (w, h) = (mask.width, mask.height);
+    let inside = mask.as_slice();
+    for y in 0..h {
+        for x in 0..w {
+            let i = y * w + x;
+            if !inside[i] {
                 continue;
             }
+            // Pixels with all four neighbours inside have no crack edge: skip them cheaply.
+            let interior = y > 0
+                && y + 1 < h
+                && x > 0
+                && x + 1 < w
+                && inside[i - w]
+                && inside[i + 1]
+                && inside[i + w]
+                && inside[i - 1];
+            if interior {
+                continue;
+            }
+            let (x, y) = (x as i64, y as i64);
             // The four sides of pixel (x, y) as edges with the pixel on their left.
             let starts = [
                 (x, y, Dir::East),
@@ -185,44 +201,88 @@ fn trace_one(
 
 /// 8-connected pieces of the mask: a label per pixel (`u32::MAX` outside) and each
 /// piece's pixel count, labels in raster order of each piece's first pixel.
+///
+/// Works on runs of inside pixels: a union–find joins each run with the runs of the row
+/// above that touch it (diagonals included); the root of a piece is its first run in
+/// raster order, which gives the label order.
 pub fn label_pieces(mask: &BitMask) -> (Vec<u32>, Vec<usize>) {
-    let (w, h) = (mask.width as i64, mask.height as i64);
-    let mut labels = vec![u32::MAX; mask.width * mask.height];
-    let mut sizes = Vec::new();
-    let mut stack = Vec::new();
-    for y in 0..h {
-        for x in 0..w {
-            let index = (y * w + x) as usize;
-            if !mask.get(x, y) || labels[index] != u32::MAX {
-                continue;
+    let (runs, row_start) = inside_runs(mask);
+    let mut parent: Vec<u32> = (0..runs.len() as u32).collect();
+    for y in 1..mask.height {
+        let above = row_start[y - 1]..row_start[y];
+        let mut first_candidate = above.start;
+        for current in row_start[y]..row_start[y + 1] {
+            let (x0, x1) = (runs[current].x0, runs[current].x1);
+            while first_candidate < above.end && runs[first_candidate].x1 < x0 {
+                first_candidate += 1;
             }
-            let label = sizes.len() as u32;
-            let mut size = 0usize;
-            labels[index] = label;
-            stack.push((x, y));
-            while let Some((px, py)) = stack.pop() {
-                size += 1;
-                for (dx, dy) in [
-                    (-1, -1),
-                    (0, -1),
-                    (1, -1),
-                    (-1, 0),
-                    (1, 0),
-                    (-1, 1),
-                    (0, 1),
-                    (1, 1),
-                ] {
-                    let (qx, qy) = (px + dx, py + dy);
-                    if mask.get(qx, qy) && labels[(qy * w + qx) as usize] == u32::MAX {
-                        labels[(qy * w + qx) as usize] = label;
-                        stack.push((qx, qy));
-                    }
-                }
+            let mut other = first_candidate;
+            while other < above.end && runs[other].x0 <= x1 {
+                union(&mut parent, current as u32, other as u32);
+                other += 1;
             }
-            sizes.push(size);
         }
     }
+    let mut labels = vec![u32::MAX; mask.width * mask.height];
+    let mut label_of_root = vec![u32::MAX; runs.len()];
+    let mut sizes = Vec::new();
+    for (index, run) in runs.iter().enumerate() {
+        let root = find(&mut parent, index as u32) as usize;
+        if label_of_root[root] == u32::MAX {
+            label_of_root[root] = sizes.len() as u32;
+            sizes.push(0);
+        }
+        let label = label_of_root[root];
+        sizes[label as usize] += run.x1 - run.x0;
+        labels[run.y * mask.width + run.x0..run.y * mask.width + run.x1].fill(label);
+    }
     (labels, sizes)
+}
+
+/// A maximal horizontal run of inside pixels: row `y`, columns `x0..x1`.
+struct Run {
+    y: usize,
+    x0: usize,
+    x1: usize,
+}
+
+/// Runs in raster order, and `row_start[y]..row_start[y + 1]`, the runs of row `y`.
+fn inside_runs(mask: &BitMask) -> (Vec<Run>, Vec<usize>) {
+    let mut runs = Vec::new();
+    let mut row_start = Vec::with_capacity(mask.height + 1);
+    for (y, row) in mask.as_slice().chunks_exact(mask.width.max(1)).enumerate() {
+        row_start.push(runs.len());
+        let mut x = 0;
+        while x < row.len() {
+            if row[x] {
+                let x0 = x;
+                while x < row.len() && row[x] {
+                    x += 1;
+                }
+                runs.push(Run { y, x0, x1: x });
+            } else {
+                x += 1;
+            }
+        }
+    }
+    row_start.resize(mask.height + 1, runs.len());
+    (runs, row_start)
+}
+
+fn find(parent: &mut [u32], mut v: u32) -> u32 {
+    while parent[v as usize] != v {
+        parent[v as usize] = parent[parent[v as usize] as usize];
+        v = parent[v as usize];
+    }
+    v
+}
+
+/// Joins two sets, keeping the smaller index as the root.
+fn union(parent: &mut [u32], a: u32, b: u32) {
+    let (ra, rb) = (find(parent, a), find(parent, b));
+    if ra != rb {
+        parent[ra.max(rb) as usize] = ra.min(rb);
+    }
 }
 
 #[cfg(test)]
@@ -275,6 +335,58 @@ mod tests {
         assert_eq!((loops.len(), holes), (2, 1));
         let (_, sizes) = label_pieces(&mask_from(&[".#.", "#.#", ".#."]));
         assert_eq!(sizes, vec![4]);
+    }
+
+    /// The straightforward flood fill the run-based labelling must agree with.
+    fn flood_fill_labels(mask: &BitMask) -> (Vec<u32>, Vec<usize>) {
+        let (w, h) = (mask.width as i64, mask.height as i64);
+        let mut labels = vec![u32::MAX; mask.width * mask.height];
+        let mut sizes = Vec::new();
+        for y in 0..h {
+            for x in 0..w {
+                if !mask.get(x, y) || labels[(y * w + x) as usize] != u32::MAX {
+                    continue;
+                }
+                let label = sizes.len() as u32;
+                let mut stack = vec![(x, y)];
+                labels[(y * w + x) as usize] = label;
+                let mut size = 0;
+                while let Some((px, py)) = stack.pop() {
+                    size += 1;
+                    for dy in -1..=1 {
+                        for dx in -1..=1 {
+                            let (qx, qy) = (px + dx, py + dy);
+                            if mask.get(qx, qy) && labels[(qy * w + qx) as usize] == u32::MAX {
+                                labels[(qy * w + qx) as usize] = label;
+                                stack.push((qx, qy));
+                            }
+                        }
+                    }
+                }
+                sizes.push(size);
+            }
+        }
+        (labels, sizes)
+    }
+
+    use proptest::prelude::*;
+
+    proptest! {
+        #![proptest_config(ProptestConfig {
+            cases: 300,
+            rng_seed: proptest::test_runner::RngSeed::Fixed(0x1abe_1500),
+            ..ProptestConfig::default()
+        })]
+        #[test]
+        fn run_labels_match_flood_fill(
+            (width, height, bits) in (1usize..24, 1usize..24).prop_flat_map(|(w, h)| {
+                (Just(w), Just(h), proptest::collection::vec(any::<u8>(), w * h))
+            }),
+            density in 1u8..255,
+        ) {
+            let mask = BitMask::from_fn(width, height, |x, y| bits[y * width + x] < density);
+            prop_assert_eq!(label_pieces(&mask), flood_fill_labels(&mask));
+        }
     }
 
     #[test]
