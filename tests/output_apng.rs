@@ -5,8 +5,11 @@ use std::path::Path;
 
 use lapclone::output::{ApngWriter, Frame, FrameData};
 
-/// Decodes an APNG and composites its records; also gives each record's (x, y, w, h).
-fn composite(path: &Path) -> (Vec<Vec<u8>>, Vec<(u32, u32, u32, u32)>) {
+/// A record's rectangle: (x, y, width, height).
+type Rect = (u32, u32, u32, u32);
+
+/// Decodes an APNG and composites its records; also gives each record's rectangle.
+fn composite(path: &Path) -> (Vec<Vec<u8>>, Vec<Rect>) {
     let decoder = png::Decoder::new(std::fs::File::open(path).unwrap());
     let mut reader = decoder.read_info().unwrap();
     let (width, bytes_per_pixel) = {

@@ -237,8 +237,8 @@ fn progress_bar(frames: u64) -> ProgressBar {
 /// Where rendered frames go: a PNG folder (encoded in parallel), a GIF or an APNG.
 pub(crate) enum FrameSink {
     Png(PngSequenceWriter, PathBuf),
-    Gif(GifWriter),
-    Apng(ApngWriter),
+    Gif(Box<GifWriter>),
+    Apng(Box<ApngWriter>),
 }
 
 impl FrameSink {
@@ -269,21 +269,21 @@ impl FrameSink {
             }
             OutputFormat::Gif => {
                 super::clone::check_output_folder(output)?;
-                FrameSink::Gif(GifWriter::create(output, canvas.fps)?)
+                FrameSink::Gif(Box::new(GifWriter::create(output, canvas.fps)?))
             }
             OutputFormat::Apng => {
                 super::clone::check_output_folder(output)?;
                 let frames = u32::try_from(range.last - range.first + 1)
                     .context("too many frames for an APNG")?;
                 let sixteen = renderer.output_format().depth == Depth::Sixteen;
-                FrameSink::Apng(ApngWriter::create(
+                FrameSink::Apng(Box::new(ApngWriter::create(
                     output,
                     canvas.width,
                     canvas.height,
                     sixteen,
                     frames,
                     canvas.fps,
-                )?)
+                )?))
             }
         })
     }
