@@ -94,8 +94,7 @@ pub fn run(args: MeshBenchArgs) -> anyhow::Result<()> {
             times.push(started.elapsed().as_secs_f64() * 1e3);
             last = Some(result);
         }
-        // invariant: repeat ≥ 1, so the loop ran and set `last`.
-        let stats = last.expect("at least one run").stats;
+        let stats = last.expect("at least one run").stats; // invariant: repeat ≥ 1, so the loop ran and set `last`.
         times.sort_by(f64::total_cmp);
         rows.push(Row {
             name,

@@ -100,7 +100,7 @@ impl BitMask {
             .collect();
         // invariant: data has exactly width * height bytes.
         image::GrayImage::from_raw(self.width as u32, self.height as u32, data)
-            .expect("size matches")
+            .expect("size matches") // invariant: the buffer has width × height bytes
     }
 }
 

@@ -171,8 +171,7 @@ fn trace_one(
         let next = [dir.right(), dir, dir.left()]
             .into_iter()
             .find(|&d| is_boundary_edge(mask, cx, cy, d));
-        // invariant: every corner on a crack loop has as many outgoing as incoming boundary edges.
-        let next = next.expect("crack loop continues");
+        let next = next.expect("crack loop continues"); // invariant: every corner on a crack loop has as many outgoing as incoming boundary edges.
         let saddle = is_saddle(mask, cx, cy);
         if next != dir || saddle {
             corners.push((cx, cy, saddle));

@@ -24,12 +24,12 @@ pub fn laplacian_matrix_market(mesh: &Mesh) -> String {
     let mut text = String::with_capacity(32 + 24 * (n + edges.len()));
     text.push_str("%%MatrixMarket matrix coordinate real symmetric\n");
     text.push_str("% combinatorial Laplacian of a lapclone mesh\n");
-    // invariant: writing into a String cannot fail.
-    writeln!(text, "{n} {n} {}", n + edges.len()).expect("String write");
+    writeln!(text, "{n} {n} {}", n + edges.len()).expect("String write"); // invariant: writing into a String cannot fail.
     for (column, rows) in below.iter().enumerate() {
-        writeln!(text, "{} {} {}", column + 1, column + 1, degree[column]).expect("String write");
+        writeln!(text, "{} {} {}", column + 1, column + 1, degree[column]).expect("String write"); // invariant: writing to a String cannot fail
         for &row in rows {
-            writeln!(text, "{} {} -1", row + 1, column + 1).expect("String write");
+            let (r, c) = (row + 1, column + 1);
+            writeln!(text, "{r} {c} -1").expect("String write"); // invariant: String writes cannot fail
         }
     }
     text

@@ -164,7 +164,7 @@ fn changed_rect(
                 .iter()
                 .zip(p)
                 .rposition(|(a, b)| a != b)
-                .expect("row differs");
+                .expect("row differs"); // invariant: only rows that differ are searched
             left = left.min(first / pixel);
             right = right.max(last / pixel + 1);
         }

@@ -170,13 +170,11 @@ impl GifWriter {
         }
         let path = self.path.clone();
         let io = |e| OutputError::io(&path, e);
-        // invariant: `start` created the encoder.
-        let encoder = self.encoder.take().expect("encoder started");
+        let encoder = self.encoder.take().expect("encoder started"); // invariant: `start` created the encoder.
         let mut file = encoder.into_inner()?;
         file.flush().map_err(io)?;
         drop(file);
-        // invariant: only `finish` (which consumes self) takes the temporary file.
-        let temp = self.temp.take().expect("temporary file present");
+        let temp = self.temp.take().expect("temporary file present"); // invariant: only `finish` (which consumes self) takes the temporary file.
         temp.commit().map_err(io)?;
         Ok(path)
     }
@@ -185,10 +183,8 @@ impl GifWriter {
     fn start(&mut self) -> Result<(), OutputError> {
         let samples: Vec<&[u8]> = self.warmup.iter().map(|f| f.as_slice()).collect();
         let palette = Palette::from_samples(&samples);
-        // invariant: `add` recorded the size before any frame reached the warm-up list.
-        let (width, height) = self.size.expect("size known");
-        // invariant: `create_with` opened the file and only `start` (run once) takes it.
-        let file = self.file.take().expect("file open");
+        let (width, height) = self.size.expect("size known"); // invariant: `add` recorded the size before any frame reached the warm-up list.
+        let file = self.file.take().expect("file open"); // invariant: `create_with` opened the file and only `start` (run once) takes it.
         let mut encoder =
             gif::Encoder::new(file, width as u16, height as u16, &palette.gif_table())?;
         encoder.set_repeat(gif::Repeat::Infinite)?;
@@ -239,8 +235,8 @@ impl GifWriter {
         };
         self.dispatched += 1;
         let fps = self.fps;
-        // invariant: dispatch is only called after `start` set up the pipeline.
-        match self.pipeline.as_mut().expect("pipeline started") {
+        let pipeline = self.pipeline.as_mut().expect("started"); // invariant: dispatch runs after `start`
+        match pipeline {
             Pipeline::Inline(encoder) => {
                 let done = run(encoder, job, fps);
                 self.accept(done)
@@ -311,8 +307,7 @@ impl GifWriter {
     }
 
     fn write_record(&mut self, frame: &gif::Frame<'_>) -> Result<(), OutputError> {
-        // invariant: records exist only after `start` created the encoder.
-        let encoder = self.encoder.as_mut().expect("encoder started");
+        let encoder = self.encoder.as_mut().expect("encoder started"); // invariant: records exist only after `start` created the encoder.
         Ok(encoder.write_lzw_pre_encoded_frame(frame)?)
     }
 

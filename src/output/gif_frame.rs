@@ -205,8 +205,7 @@ impl FrameEncoder {
         delay_cs: u16,
         dispose: gif::DisposalMethod,
     ) -> gif::Frame<'static> {
-        // invariant: frames are at most u16::MAX wide and high (checked by the writer).
-        let dim = |v: usize| u16::try_from(v).expect("frame size checked");
+        let dim = |v: usize| u16::try_from(v).expect("frame size checked"); // invariant: frames are at most u16::MAX wide and high (checked by the writer).
         let mut frame = gif::Frame {
             delay: delay_cs,
             dispose,

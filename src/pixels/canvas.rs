@@ -198,8 +198,8 @@ impl Canvas {
             CanvasPixels::Eight(p) => p.iter().map(|px| px.map(Texel::to_unit)).collect(),
             CanvasPixels::Sixteen(p) => p.iter().map(|px| px.map(Texel::to_unit)).collect(),
         };
-        // invariant: the canvas is non-empty and holds width·height pixels.
-        FloatImage::new(self.width, self.height, pixels, format).expect("canvas is well-formed")
+        let image = FloatImage::new(self.width, self.height, pixels, format);
+        image.expect("well-formed") // invariant: a canvas is non-empty with width·height pixels
     }
 
     /// PNG bytes in `format` (grey formats store Rec. 709 luma; without alpha the alpha
@@ -230,14 +230,13 @@ impl Canvas {
                 .map(|&v| u8::from_unit(v.to_unit()))
                 .collect(),
         };
-        // invariant: the buffer holds exactly width × height RGBA pixels.
-        image::RgbaImage::from_raw(self.width, self.height, bytes).expect("canvas buffer size")
+        let image = image::RgbaImage::from_raw(self.width, self.height, bytes);
+        image.expect("buffer size") // invariant: the buffer holds width × height RGBA pixels
     }
 
     /// An 8-bit premultiplied copy for tiny-skia drawing (16-bit values are rounded).
     pub fn to_tiny_skia_pixmap(&self) -> tiny_skia::Pixmap {
-        // invariant: the canvas size is non-zero (checked at construction).
-        let mut pixmap = tiny_skia::Pixmap::new(self.width, self.height).expect("non-empty");
+        let mut pixmap = tiny_skia::Pixmap::new(self.width, self.height).expect("non-empty"); // invariant: the canvas size is non-zero (checked at construction).
         let write = |dst: &mut [tiny_skia::PremultipliedColorU8],
                      rgba: &mut dyn Iterator<Item = [f32; 4]>| {
             for (d, [r, g, b, a]) in dst.iter_mut().zip(rgba) {

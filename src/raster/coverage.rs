@@ -125,9 +125,8 @@ fn ensure_mask(slot: &mut Option<Mask>, work: PixelRect) -> &mut Mask {
         .is_some_and(|m| m.width() >= w && m.height() >= h);
     if !fits {
         let (old_w, old_h) = slot.as_ref().map_or((0, 0), |m| (m.width(), m.height()));
-        // invariant: the work rectangle is non-empty, so both sizes are ≥ 1.
-        *slot = Some(Mask::new(w.max(old_w), h.max(old_h)).expect("non-empty mask"));
+        let mask = Mask::new(w.max(old_w), h.max(old_h));
+        *slot = Some(mask.expect("non-empty")); // invariant: the work rectangle is non-empty
     }
-    // invariant: set just above when missing.
-    slot.as_mut().expect("mask present")
+    slot.as_mut().expect("mask present") // invariant: set just above when missing.
 }

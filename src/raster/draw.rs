@@ -146,8 +146,7 @@ fn compute_coverage(
     let width = work.width();
     if options.anti_alias {
         let stride = fill_silhouette(patch, &s.setups, work, &mut s.path_builder, &mut s.mask);
-        // invariant: fill_silhouette always leaves a mask in the slot.
-        let mask = s.mask.as_ref().expect("mask filled").data();
+        let mask = s.mask.as_ref().expect("mask filled").data(); // invariant: fill_silhouette always leaves a mask in the slot.
         for (row, out) in s.coverage.chunks_mut(width).enumerate() {
             let src = &mask[row * stride..row * stride + width];
             for (c, &m) in out.iter_mut().zip(src) {

@@ -204,8 +204,8 @@ impl Experiment {
     }
 
     pub fn mask(&self) -> GridMask<'_> {
-        // invariant: `inside` was copied from a validated GridMask of this width and height.
-        GridMask::new(self.width, self.height, &self.inside).expect("validated in new")
+        let mask = GridMask::new(self.width, self.height, &self.inside);
+        mask.expect("validated in new") // invariant: copied from a validated mask of this size
     }
 
     pub fn width(&self) -> usize {
@@ -310,8 +310,7 @@ impl Experiment {
             preprocess_ms = preprocess_ms.min(millis(started.elapsed()));
             solver = Some(fresh);
         }
-        // invariant: repeats ≥ 1 was checked, so the loop ran at least once.
-        let mut solver = solver.expect("repeats ≥ 1");
+        let mut solver = solver.expect("repeats ≥ 1"); // invariant: repeats ≥ 1 was checked, so the loop ran at least once.
         let mut membrane_ms = f64::INFINITY;
         for _ in 0..run.repeats {
             let started = Instant::now();
@@ -348,8 +347,7 @@ impl Experiment {
             preprocess_ms = preprocess_ms.min(millis(started.elapsed()));
             mvc = Some(fresh);
         }
-        // invariant: repeats ≥ 1 was checked, so the loop ran at least once.
-        let mvc = mvc.expect("repeats ≥ 1");
+        let mvc = mvc.expect("repeats ≥ 1"); // invariant: repeats ≥ 1 was checked, so the loop ran at least once.
         let source_at_boundary = boundary_samples(mesh, |p| self.source.sample_bilinear(p.x, p.y));
         let n = mesh.vertex_count();
         let mut values = vec![0.0f64; n * CHANNELS];

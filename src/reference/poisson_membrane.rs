@@ -147,8 +147,8 @@ impl GridPoisson {
     }
 
     fn mask(&self) -> GridMask<'_> {
-        // invariant: built from a validated GridMask of the same width, height and data.
-        GridMask::new(self.width, self.height, &self.inside).expect("validated in new")
+        let mask = GridMask::new(self.width, self.height, &self.inside);
+        mask.expect("validated in new") // invariant: copied from a validated mask of this size
     }
 
     /// Solves the membrane for boundary values `values` (interleaved, `width × height ×

@@ -124,8 +124,7 @@ impl Renderer {
                 Planned::Keep { index, rig } => {
                     update.reused += 1;
                     update.rigs_built += usize::from(rig.is_some());
-                    // invariant: plan_layers hands out each old index at most once.
-                    let mut layer = old[index].take().expect("layer kept once");
+                    let mut layer = old[index].take().expect("layer kept once"); // invariant: plan_layers hands out each old index at most once.
                     layer.update(patch, rig.map(|rig| *rig));
                     layer
                 }

@@ -44,7 +44,7 @@ fn write_canvas(out: &mut String, canvas: &Canvas) {
         num(canvas.duration),
         background
     )
-    .expect("write to String");
+    .expect("write to String"); // invariant: writing to a String cannot fail
 }
 
 fn write_patch(out: &mut String, patch: &Patch, var: &str) {

@@ -190,8 +190,7 @@ impl<T: Interpolate> Track<T> {
     /// The value at time `t`, or `None` for an empty track.
     pub fn value_at(&self, t: f64) -> Option<T> {
         let first = self.keys.first()?;
-        // invariant: a non-empty track has a last key.
-        let last = self.keys.last().expect("non-empty track");
+        let last = self.keys.last().expect("non-empty track"); // invariant: a non-empty track has a last key.
         if t <= first.time {
             return Some(first.value);
         }

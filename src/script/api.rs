@@ -436,8 +436,7 @@ fn add_placement_keys(patch: &mut Patch, t: f64, keys: &Map, easing: Easing) -> 
         return Err("a key needs at least one of: at, scale, rotate, depth".into());
     }
     for (name, value) in keys {
-        // invariant: check_keys admitted only placement names.
-        let which = Placed::from_name(name).expect("checked key name");
+        let which = Placed::from_name(name).expect("checked key name"); // invariant: check_keys admitted only placement names.
         which.push(patch, t, value, easing)?;
     }
     Ok(())

@@ -41,8 +41,7 @@ impl SymmetricCsc {
         let mut last: Option<(usize, usize)> = None;
         for (col, row, v) in entries {
             if last == Some((col, row)) {
-                // invariant: `last` is Some only after a push.
-                *values.last_mut().expect("invariant: an entry was pushed") += v;
+                *values.last_mut().expect("invariant: an entry was pushed") += v; // invariant: `last` is Some only after a push.
                 continue;
             }
             last = Some((col, row));

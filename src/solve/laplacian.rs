@@ -56,7 +56,7 @@ pub fn laplacian(mesh: &Mesh, kind: LaplacianKind) -> SymmetricCsc {
     triplets.extend(diagonal.iter().enumerate().map(|(v, &d)| (v, v, d)));
     // invariant: mesh indices are < n and weights finite (cotangents of non-degenerate triangles).
     SymmetricCsc::from_triplets(n, &triplets)
-        .expect("invariant: mesh indices in range, finite weights")
+        .expect("invariant: mesh indices in range, finite weights") // invariant: mesh indices in range, finite weights
 }
 
 /// Edges (i < j, sorted) with their clamped cotangent weight.
