@@ -9,7 +9,6 @@
 
 use glam::DVec2;
 
-use super::boundary_probe::{loop_neighbours, outside_probe, Neighbours};
 use super::CloneError;
 use crate::mesh::Mesh;
 use crate::pixels::{Canvas, FloatImage};
@@ -22,10 +21,7 @@ pub const MEMBRANE_CHANNELS: usize = 3;
 pub struct MembraneSolver {
     factor: PenaltyFactor,
     boundary: Vec<u32>,
-    neighbours: Vec<Option<Neighbours>>,
-    /// Rest positions, for the local scale of the placed boundary.
-    rest: Vec<DVec2>,
-    /// f_S half a pixel outside each rest boundary vertex, RGB.
+    /// f_S at each boundary vertex's rest position, RGB.
     source_at_boundary: Vec<[f32; 3]>,
     wanted: Vec<bool>,
     values: Vec<f64>,
@@ -51,12 +47,10 @@ impl MembraneSolver {
         let l = laplacian(mesh, kind);
         let factor = PenaltyFactor::new(&l, &PenaltyOptions::default())?;
         let boundary: Vec<u32> = mesh.boundary_vertices().collect();
-        let neighbours = loop_neighbours(mesh, &boundary);
         let source_at_boundary = boundary
             .iter()
-            .zip(&neighbours)
-            .map(|(&v, &nb)| {
-                let p = outside_probe(v, nb, &mesh.positions, &mesh.positions);
+            .map(|&v| {
+                let p = mesh.positions[v as usize];
                 rgb(source.sample_bilinear(p.x, p.y))
             })
             .collect();
@@ -64,8 +58,6 @@ impl MembraneSolver {
         Ok(Self {
             factor,
             boundary,
-            neighbours,
-            rest: mesh.positions.clone(),
             source_at_boundary,
             wanted: vec![false; n],
             values: vec![0.0; n * MEMBRANE_CHANNELS],
@@ -94,8 +86,7 @@ impl MembraneSolver {
             let on = inside && !covered;
             self.wanted[v] = on;
             if on {
-                let probe = outside_probe(v as u32, self.neighbours[slot], placed, &self.rest);
-                let target = canvas.sample_bilinear(probe.x, probe.y);
+                let target = canvas.sample_bilinear(p.x, p.y);
                 let source = self.source_at_boundary[slot];
                 for c in 0..MEMBRANE_CHANNELS {
                     self.values[c * n + v] = f64::from(target[c] - source[c]);

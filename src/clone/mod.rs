@@ -6,14 +6,12 @@
 //! move or a deformation costs only constraint switches, one multi-RHS back-substitution
 //! and the raster.
 
-mod boundary_probe;
 mod cloner;
 mod error;
 mod membrane;
 mod patch_mesh;
 mod placement;
 
-pub use boundary_probe::PROBE_OFFSET;
 pub use cloner::{CloneMode, CloneOptions, CloneStats, PatchCloner};
 pub use error::CloneError;
 pub use membrane::{MembraneSolver, MembraneStats, MEMBRANE_CHANNELS};
