@@ -4,7 +4,7 @@
 
 use glam::DVec2;
 
-use super::CloneError;
+use super::{expand_boundary, CloneError, HALF_PIXEL};
 use crate::mesh::{mesh_mask, mesh_polygons, BitMask, MeshOptions, MeshResult, Polygon};
 
 /// A patch mesh in source coordinates, with its mask's bounding box.
@@ -17,7 +17,8 @@ pub struct PatchMesh {
 }
 
 /// Meshes `mask`, whose pixel (0, 0) sits at `offset` in a source of `source_size`.
-/// Without an offset the mask must have the source's size.
+/// Without an offset the mask must have the source's size. The boundary is moved half a
+/// pixel out, onto the outside pixel centres ([`expand_boundary`]).
 pub fn mesh_from_mask(
     mask: &BitMask,
     offset: Option<DVec2>,
@@ -41,6 +42,7 @@ pub fn mesh_from_mask(
     for p in &mut result.mesh.positions {
         *p += offset;
     }
+    expand_boundary(&mut result.mesh, HALF_PIXEL);
     let (min, max) = inside_bbox(mask);
     Ok(PatchMesh {
         result,

@@ -262,6 +262,9 @@ impl Experiment {
             mesh = mesh_mask(&bits, mesh_options)?.mesh;
             mesh_ms = mesh_ms.min(millis(started.elapsed()));
         }
+        // The product's clone uses the mask mesh with its boundary on the outside pixel
+        // centres (clone::expand_boundary); measure exactly that.
+        crate::clone::expand_boundary(&mut mesh, crate::clone::HALF_PIXEL);
         self.run_on_mesh(mesh, mesh_ms, run)
     }
 

@@ -1,0 +1,137 @@
+//! Puts a mask mesh's boundary where the exact clone fixes its values: takes a mesh whose
+//! boundary runs along pixel cracks and moves every boundary vertex half a pixel outward,
+//! onto the outside pixel centres.
+//!
+//! Why: the exact pixel-grid Poisson clone (Pérez et al.) leaves every mask pixel free and
+//! fixes the membrane at the outside 4-neighbours' centres, half a pixel beyond the crack.
+//! A mesh whose boundary sits on the crack fixes it half a pixel too far in, where bilinear
+//! sampling averages an inside and an outside pixel. Moving the boundary out makes the two
+//! agree at the seam (docs/quality.md) while keeping the values at the vertices themselves, so
+//! linear data is still reproduced exactly by the cotangent Laplacian.
+//!
+//! A vertex whose move would invert or flatten one of its triangles stays where it is.
+
+use glam::DVec2;
+
+use crate::mesh::Mesh;
+
+/// Distance from a crack to the outside pixel centre, in pixels.
+pub const HALF_PIXEL: f64 = 0.5;
+
+/// Moves boundary vertices `by` pixels outward (see the module doc); gives how many moved.
+pub fn expand_boundary(mesh: &mut Mesh, by: f64) -> usize {
+    let targets = outward_targets(mesh, by);
+    let mut moved: Vec<bool> = targets.iter().map(Option::is_some).collect();
+    let rest = mesh.positions.clone();
+    for (v, target) in targets.iter().enumerate() {
+        if let Some(p) = target {
+            mesh.positions[v] = *p;
+        }
+    }
+    // Undo moves that spoil a triangle; undoing can only help its neighbours, so this ends.
+    loop {
+        let mut undone = false;
+        for t in &mesh.triangles {
+            if is_healthy(
+                t.map(|v| mesh.positions[v as usize]),
+                t.map(|v| rest[v as usize]),
+            ) {
+                continue;
+            }
+            for &v in t {
+                if moved[v as usize] {
+                    moved[v as usize] = false;
+                    mesh.positions[v as usize] = rest[v as usize];
+                    undone = true;
+                }
+            }
+        }
+        if !undone {
+            break;
+        }
+    }
+    moved.iter().filter(|&&m| m).count()
+}
+
+/// Where each boundary vertex on exactly one loop would go.
+fn outward_targets(mesh: &Mesh, by: f64) -> Vec<Option<DVec2>> {
+    let n = mesh.vertex_count();
+    let mut loops_through = vec![0u8; n];
+    let mut target: Vec<Option<DVec2>> = vec![None; n];
+    for lp in &mesh.loops {
+        let k = lp.vertices.len();
+        for (i, &v) in lp.vertices.iter().enumerate() {
+            loops_through[v as usize] = loops_through[v as usize].saturating_add(1);
+            let prev = mesh.positions[lp.vertices[(i + k - 1) % k] as usize];
+            let next = mesh.positions[lp.vertices[(i + 1) % k] as usize];
+            let chord = next - prev;
+            // Inside lies left of the loop direction, so outward is the chord turned right.
+            let outward = DVec2::new(chord.y, -chord.x).normalize_or_zero();
+            target[v as usize] = Some(mesh.positions[v as usize] + outward * by);
+        }
+    }
+    for (v, t) in target.iter_mut().enumerate() {
+        // A vertex shared by two loops (pieces touching at a corner) has no single outside.
+        if loops_through[v] != 1 {
+            *t = None;
+        }
+    }
+    target
+}
+
+/// Positive area, and not squashed below a tenth of its rest area.
+fn is_healthy(moved: [DVec2; 3], rest: [DVec2; 3]) -> bool {
+    let area = |p: [DVec2; 3]| (p[1] - p[0]).perp_dot(p[2] - p[0]);
+    area(moved) > 0.1 * area(rest)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::{mesh_mask, synth, BitMask, MeshOptions};
+
+    fn square_mask() -> BitMask {
+        BitMask::from_fn(12, 12, |x, y| (2..10).contains(&x) && (2..10).contains(&y))
+    }
+
+    #[test]
+    fn boundary_moves_half_a_pixel_out_and_triangles_stay_positive() {
+        let mut mesh = mesh_mask(&square_mask(), &MeshOptions::default())
+            .unwrap()
+            .mesh;
+        let before = mesh.clone();
+        let moved = expand_boundary(&mut mesh, HALF_PIXEL);
+        assert_eq!(moved, mesh.boundary_vertices().count());
+        mesh.sanity_check().unwrap();
+        for v in before.boundary_vertices() {
+            let (a, b) = (before.positions[v as usize], mesh.positions[v as usize]);
+            assert!(((a - b).length() - 0.5).abs() < 1e-12);
+            // Outward: away from the square's centre (6, 6).
+            assert!((b - DVec2::splat(6.0)).length() > (a - DVec2::splat(6.0)).length());
+        }
+        for v in 0..mesh.vertex_count() {
+            if !mesh.is_boundary[v] {
+                assert_eq!(mesh.positions[v], before.positions[v]);
+            }
+        }
+    }
+
+    #[test]
+    fn thin_and_spiky_masks_keep_every_triangle_positive() {
+        for mask in [
+            synth::comb(120, 90, 6, 4),
+            synth::spiral(160, 150),
+            synth::line(64, 40, 30),
+        ] {
+            let Ok(result) = mesh_mask(&mask, &MeshOptions::default()) else {
+                continue;
+            };
+            let mut mesh = result.mesh;
+            expand_boundary(&mut mesh, HALF_PIXEL);
+            for t in &mesh.triangles {
+                let p = t.map(|v| mesh.positions[v as usize]);
+                assert!((p[1] - p[0]).perp_dot(p[2] - p[0]) > 0.0);
+            }
+        }
+    }
+}
