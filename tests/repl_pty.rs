@@ -54,3 +54,54 @@ fn prompt_line_completion_and_ctrl_d() {
     let saved = std::fs::read_to_string(&history).unwrap();
     assert!(saved.contains("40 + 2"), "{saved}");
 }
+
+#[test]
+fn ctrl_c_cancels_a_running_render_and_keeps_the_session() {
+    let dir = tempfile::tempdir().unwrap();
+    // A long scene (2,880 frames): far more than can render before the Ctrl-C arrives.
+    let assets = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets");
+    let scene = dir.path().join("long.rhai");
+    std::fs::write(
+        &scene,
+        format!(
+            "canvas(600, 400, #{{ fps: 24, duration: 120, background: \"{0}/coffee.png\" }});\n\
+             let cat = patch(\"cat\", #{{ source: \"{0}/chelsea.png\", mask: \"{0}/masks/chelsea_face.png\" }});\n\
+             cat.at(0, [100, 100]).at(120, [500, 300]);\n",
+            assets.display()
+        ),
+    )
+    .unwrap();
+    let frames = dir.path().join("frames");
+    let mut command = Command::new(env!("CARGO_BIN_EXE_lapclone"));
+    command
+        .arg("repl")
+        .arg(&scene)
+        .arg("--preview")
+        .arg(dir.path().join("preview.png"))
+        .arg("--history")
+        .arg(dir.path().join("history.txt"))
+        .env("TERM", "xterm")
+        .env("LAPCLONE_INLINE", "off");
+    let mut p = spawn_command(command, Some(60_000)).unwrap();
+    p.exp_string("lapclone> ").unwrap();
+    // Interrupt the render once its first frame file exists.
+    p.send_line(&format!(":render -o {}", frames.display()))
+        .unwrap();
+    let first = frames.join("frame_0001.png");
+    while !first.exists() {
+        std::thread::yield_now();
+    }
+    p.send_control('c').unwrap();
+    p.exp_string("cancelled").unwrap();
+    p.exp_string("lapclone> ").unwrap();
+    let written = std::fs::read_dir(&frames).unwrap().count();
+    assert!(
+        written < 2880,
+        "all {written} frames were written: nothing was cancelled"
+    );
+    // The session goes on.
+    p.send_line("1 + 1").unwrap();
+    p.exp_string("=> 2").unwrap();
+    p.send_control('d').unwrap();
+    p.exp_eof().unwrap();
+}

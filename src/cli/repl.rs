@@ -10,6 +10,7 @@ mod helper;
 mod hints;
 mod preview;
 mod session;
+mod sixel;
 mod validator;
 
 use std::io::{BufRead, IsTerminal};
@@ -117,18 +118,19 @@ fn interactive_loop(
     cancel: Arc<AtomicBool>,
     words: completion::SharedWords,
 ) -> anyhow::Result<()> {
-    // Ctrl-C while an entry runs raises the cancel flag (the engine and render loops check
-    // it); at the prompt rustyline reads it as a key and we clear the line.
-    let flag = cancel.clone();
-    if ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed)).is_err() {
-        eprintln!("warning: Ctrl-C cannot cancel evaluations in this session");
-    }
     let config = Config::builder()
         .auto_add_history(false)
         .completion_type(rustyline::CompletionType::List)
         .build();
     let mut editor: Editor<ReplHelper, FileHistory> =
         Editor::with_config(config).context("starting the line editor")?;
+    // Ctrl-C while an entry runs raises the cancel flag (the engine and render loops check
+    // it); at the prompt rustyline reads it as a key and we clear the line. Installed after
+    // the editor: rustyline takes SIGINT for itself when it is created.
+    let flag = cancel.clone();
+    if ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed)).is_err() {
+        eprintln!("warning: Ctrl-C cannot cancel evaluations in this session");
+    }
     editor.set_helper(Some(ReplHelper::new(words)));
     let history = args.history.clone().or_else(default_history_path);
     if let Some(path) = &history {

@@ -1,6 +1,6 @@
 //! The live preview: takes the renderer's current frame (and, with `:mesh`, its placed
 //! meshes), writes it to the preview PNG and shows it — inline in terminals that speak the
-//! kitty or iTerm2 image protocol, else as one line naming the file. Never prints escape
+//! kitty or iTerm2 image protocol or sixel, else as one line naming the file. Never prints escape
 //! sequences unless interactive.
 
 use std::io::Write as _;
@@ -15,16 +15,25 @@ use lapclone::render::Renderer;
 pub enum Inline {
     Kitty,
     Iterm,
+    Sixel,
     /// Text line only (also every non-interactive session).
     None,
 }
 
 impl Inline {
-    /// Detects the image protocol from the environment (`LAPCLONE_INLINE=off` disables).
+    /// Detects the image protocol from the environment. `LAPCLONE_INLINE` = `off`, `kitty`,
+    /// `iterm` or `sixel` overrides the detection.
     pub fn detect(interactive: bool) -> Inline {
         let var = |name: &str| std::env::var(name).unwrap_or_default();
-        if !interactive || var("LAPCLONE_INLINE") == "off" {
+        if !interactive {
             return Inline::None;
+        }
+        match var("LAPCLONE_INLINE").as_str() {
+            "off" => return Inline::None,
+            "kitty" => return Inline::Kitty,
+            "iterm" => return Inline::Iterm,
+            "sixel" => return Inline::Sixel,
+            _ => {}
         }
         if !var("KITTY_WINDOW_ID").is_empty() || var("TERM").contains("kitty") {
             return Inline::Kitty;
@@ -32,6 +41,10 @@ impl Inline {
         let program = var("TERM_PROGRAM");
         if program == "iTerm.app" || program == "WezTerm" || var("LC_TERMINAL") == "iTerm2" {
             return Inline::Iterm;
+        }
+        let term = var("TERM");
+        if term.contains("sixel") || term.starts_with("foot") || term.starts_with("mlterm") {
+            return Inline::Sixel;
         }
         Inline::None
     }
@@ -113,7 +126,11 @@ impl Preview {
                 }
             }
             protocol => {
-                print_inline(protocol, png);
+                if protocol == Inline::Sixel {
+                    print_sixel(renderer);
+                } else {
+                    print_inline(protocol, png);
+                }
                 println!("{}", line.replacen("preview: ", "", 1));
             }
         }
@@ -136,8 +153,16 @@ fn print_inline(protocol: Inline, png: &[u8]) {
             "\x1b]1337;File=inline=1;size={};width=64;preserveAspectRatio=1:{data}\x07",
             png.len()
         ),
-        Inline::None => Ok(()),
+        Inline::None | Inline::Sixel => Ok(()),
     };
+    let _ = out.flush();
+}
+
+fn print_sixel(renderer: &Renderer) {
+    let picture = renderer.frame().to_rgba8_image();
+    let text = super::sixel::encode_sixel(picture.as_raw(), picture.width(), picture.height());
+    let mut out = std::io::stdout().lock();
+    let _ = writeln!(out, "{text}");
     let _ = out.flush();
 }
 
