@@ -12,6 +12,8 @@ pub(crate) struct Sampler<'a> {
     width: usize,
     last_x: usize,
     last_y: usize,
+    last_x_f32: f32,
+    last_y_f32: f32,
 }
 
 impl<'a> Sampler<'a> {
@@ -21,9 +23,13 @@ impl<'a> Sampler<'a> {
             width: source.width() as usize,
             last_x: source.width().saturating_sub(1) as usize,
             last_y: source.height().saturating_sub(1) as usize,
+            last_x_f32: source.width().saturating_sub(1) as f32,
+            last_y_f32: source.height().saturating_sub(1) as f32,
         }
     }
 
+    /// The f64 reference path (tests: bit-identical to the image sampler).
+    #[cfg(test)]
     /// Bilinear sample at `(x, y)` (centres at i + ½, clamped to edge, NaN → pixel 0).
     #[inline(always)]
     pub fn sample(&self, x: f64, y: f64) -> Vec4 {
@@ -35,8 +41,33 @@ impl<'a> Sampler<'a> {
         let bottom = texel(row1 + x0).lerp(texel(row1 + x1), tx);
         top.lerp(bottom, ty)
     }
+
+    /// [`sample`](Self::sample) with `f32` coordinates and tap arithmetic (the shading hot
+    /// path; differs from the f64 taps only by the f32 rounding of the position).
+    #[inline(always)]
+    pub fn sample_f32(&self, x: f32, y: f32) -> Vec4 {
+        let (x0, x1, tx) = taps_f32(x, self.last_x, self.last_x_f32);
+        let (y0, y1, ty) = taps_f32(y, self.last_y, self.last_y_f32);
+        let (row0, row1) = (y0 * self.width, y1 * self.width);
+        let texel = |i: usize| Vec4::from_array(self.pixels[i]);
+        let top = texel(row0 + x0).lerp(texel(row0 + x1), tx);
+        let bottom = texel(row1 + x0).lerp(texel(row1 + x1), tx);
+        top.lerp(bottom, ty)
+    }
 }
 
+/// f32 taps: clamped into the centres' range (`f32::max` maps NaN to 0), then truncated
+/// without the saturating cast's range checks.
+#[inline(always)]
+fn taps_f32(coordinate: f32, last: usize, last_f32: f32) -> (usize, usize, f32) {
+    let u = (coordinate - 0.5).max(0.0).min(last_f32);
+    // SAFETY: u is finite and in [0, last] ⊂ [0, 2^32) after the clamp (±∞ and NaN included),
+    // so it is representable in i64.
+    let i = unsafe { u.to_int_unchecked::<i64>() } as usize;
+    (i, (i + 1).min(last), u - i as f32)
+}
+
+#[cfg(test)]
 /// Same arithmetic as the pixels module's bilinear taps (so results agree bit for bit).
 #[inline(always)]
 fn taps(coordinate: f64, last: usize) -> (usize, usize, f32) {
@@ -82,6 +113,14 @@ mod tests {
                     reference.map(f32::to_bits),
                     "{x} {y}"
                 );
+                // f32 taps: same up to the f32 rounding of the position (tiny here).
+                let single = sampler.sample_f32(x as f32, y as f32).to_array();
+                for (s, r) in single.iter().zip(reference) {
+                    assert!(
+                        (s - r).abs() <= 1e-5,
+                        "{x} {y}: {single:?} vs {reference:?}"
+                    );
+                }
             }
         }
     }
