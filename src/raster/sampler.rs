@@ -23,8 +23,8 @@ impl<'a> Sampler<'a> {
             width: source.width() as usize,
             last_x: source.width().saturating_sub(1) as usize,
             last_y: source.height().saturating_sub(1) as usize,
-            last_x_f32: source.width().saturating_sub(1) as f32,
-            last_y_f32: source.height().saturating_sub(1) as f32,
+            last_x_f32: last_as_f32(source.width()),
+            last_y_f32: last_as_f32(source.height()),
         }
     }
 
@@ -49,18 +49,35 @@ impl<'a> Sampler<'a> {
         let (x0, x1, tx) = taps_f32(x, self.last_x, self.last_x_f32);
         let (y0, y1, ty) = taps_f32(y, self.last_y, self.last_y_f32);
         let (row0, row1) = (y0 * self.width, y1 * self.width);
-        let texel = |i: usize| Vec4::from_array(self.pixels[i]);
+        // SAFETY: the taps are ≤ last_x < width and ≤ last_y < height (see `taps_f32`), and
+        // `pixels` holds width · height texels.
+        let texel = |i: usize| Vec4::from_array(unsafe { *self.pixels.get_unchecked(i) });
         let top = texel(row0 + x0).lerp(texel(row0 + x1), tx);
         let bottom = texel(row1 + x0).lerp(texel(row1 + x1), tx);
         top.lerp(bottom, ty)
     }
 }
 
-/// f32 taps: clamped into the centres' range (`f32::max` maps NaN to 0), then truncated
-/// without the saturating cast's range checks.
+/// `size − 1` rounded down to an f32, so clamped positions never truncate past the last
+/// pixel (only matters above 2^24 px).
+fn last_as_f32(size: u32) -> f32 {
+    let last = size.saturating_sub(1);
+    let rounded = last as f32;
+    if rounded as u64 > u64::from(last) {
+        rounded.next_down()
+    } else {
+        rounded
+    }
+}
+
+/// f32 taps: clamped into the centres' range (NaN goes to 0), then truncated
+/// without the saturating cast's range checks. Both taps are ≤ `last`: u ≤ `last_f32` ≤ last.
 #[inline(always)]
 fn taps_f32(coordinate: f32, last: usize, last_f32: f32) -> (usize, usize, f32) {
-    let u = (coordinate - 0.5).max(0.0).min(last_f32);
+    // Plain comparisons compile to maxss/minss (NaN → 0 by the first), unlike f32::max/min.
+    let shifted = coordinate - 0.5;
+    let low = if shifted > 0.0 { shifted } else { 0.0 };
+    let u = if low < last_f32 { low } else { last_f32 };
     // SAFETY: u is finite and in [0, last] ⊂ [0, 2^32) after the clamp (±∞ and NaN included),
     // so it is representable in i64.
     let i = unsafe { u.to_int_unchecked::<i64>() } as usize;

@@ -138,13 +138,13 @@ fn shade_span<T: StoreTexel>(
     for (&coverage, pixel) in span.coverage.iter().zip(pixels.iter_mut()) {
         if coverage > 0.0 {
             let sample = sampler.sample_f32(u_first + u_step * t, v_first + v_step * t);
+            // The membrane's alpha lane is 0, so an opaque sample clamps to alpha 1 here.
             let mut colour = (sample + m_first + m_step * t).clamp(Vec4::ZERO, Vec4::ONE);
-            colour.w = sample.w;
             written += if coverage >= 1.0 && sample.w >= 1.0 {
-                colour.w = 1.0;
                 *pixel = T::store_unit(colour);
                 1
             } else {
+                colour.w = sample.w;
                 usize::from(composite(pixel, colour.to_array(), coverage))
             };
         }
@@ -179,6 +179,25 @@ pub(crate) trait StoreTexel: Texel {
 }
 
 impl StoreTexel for u8 {
+    /// SSE2: one truncating conversion and two saturating packs (all in range, so the packs
+    /// saturate nothing) — exactly `from_unit` per channel.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn store_unit(colour: Vec4) -> [u8; 4] {
+        use std::arch::x86_64::{
+            __m128, _mm_cvtsi128_si32, _mm_cvttps_epi32, _mm_packs_epi32, _mm_packus_epi16,
+        };
+        let scaled: __m128 = (colour * 255.0 + 0.5).into();
+        // SAFETY: SSE2 is part of the x86_64 baseline, so these intrinsics are available.
+        let packed = unsafe {
+            let words = _mm_cvttps_epi32(scaled);
+            let halves = _mm_packs_epi32(words, words);
+            _mm_cvtsi128_si32(_mm_packus_epi16(halves, halves))
+        };
+        packed.to_le_bytes()
+    }
+
+    #[cfg(not(target_arch = "x86_64"))]
     #[inline(always)]
     fn store_unit(colour: Vec4) -> [u8; 4] {
         let scaled = (colour * 255.0 + 0.5).to_array();
