@@ -64,7 +64,8 @@ fn last_as_f32(size: u32) -> f32 {
     let last = size.saturating_sub(1);
     let rounded = last as f32;
     if rounded as u64 > u64::from(last) {
-        rounded.next_down()
+        // The next f32 towards zero (positive, normal): one ulp down.
+        f32::from_bits(rounded.to_bits() - 1)
     } else {
         rounded
     }
