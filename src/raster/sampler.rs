@@ -1,6 +1,9 @@
 //! The shading sampler: takes the source [`FloatImage`] and gives bilinear samples as SIMD
 //! [`Vec4`]s for the raster's inner loop — branch-free clamped taps, one slice, no per-call
-//! setup. Values are bit-identical to [`FloatImage::sample_bilinear`].
+//! setup. The hot path ([`Sampler::sample_f32`]) takes f32 positions and unchecked
+//! (proven in-range) taps; it differs from [`FloatImage::sample_bilinear`] only by the f32
+//! rounding of the position (tested to 1e-5 per channel). The f64 path, kept for tests, is
+//! bit-identical to it.
 
 use glam::Vec4;
 
@@ -99,6 +102,27 @@ fn taps(coordinate: f64, last: usize) -> (usize, usize, f32) {
 mod tests {
     use super::*;
     use crate::pixels::PixelFormat;
+
+    #[test]
+    fn f32_last_never_rounds_past_the_last_pixel() {
+        for size in [
+            1u32,
+            2,
+            480,
+            (1 << 24) + 1,
+            (1 << 24) + 3,
+            (1 << 25) + 7,
+            u32::MAX,
+        ] {
+            let last = last_as_f32(size);
+            assert!(last as u64 <= u64::from(size - 1), "{size}: {last}");
+            assert!(
+                last as u64 + 4 >= u64::from(size - 1) || size > 1 << 24,
+                "{size}"
+            );
+        }
+        assert_eq!(last_as_f32(480), 479.0);
+    }
 
     #[test]
     fn agrees_bit_for_bit_with_the_image_sampler() {
