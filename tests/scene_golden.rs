@@ -50,9 +50,7 @@ fn check_scene(name: &str) {
     let mut renderer = renderer(name);
     let middle = renderer.frame_count() / 2;
     for frame in [0, middle] {
-        let canvas = renderer
-            .render_frame(frame)
-            .unwrap_or_else(|e| panic!("{e}"));
+        let canvas = renderer.render_frame(frame).unwrap_or_else(|e| panic!("{e}"));
         golden::assert_golden(
             &format!("scene_{name}_{frame:03}"),
             &downscaled(canvas),

@@ -57,10 +57,7 @@ struct Report {
 
 pub fn run(args: RenderBenchArgs) -> anyhow::Result<()> {
     if args.frames == 0 || args.encode_frames == 0 || args.jobs == 0 {
-        return Err(super::UsageError(
-            "--frames, --encode-frames and --jobs must be positive".into(),
-        )
-        .into());
+        return Err(super::UsageError("--frames, --encode-frames and --jobs must be positive".into()).into());
     }
     let scene = bench_scene(&args.assets, args.frames);
     let started = Instant::now();
@@ -137,18 +134,8 @@ fn bench_scene(assets: &Path, frames: u64) -> Scene {
     let duration = frames as f64 / fps;
     let mut patches = Vec::new();
     for (k, (source, centre, from, to)) in [
-        (
-            "astronaut.png",
-            DVec2::new(256.0, 256.0),
-            DVec2::new(400.0, 900.0),
-            DVec2::new(1500.0, 300.0),
-        ),
-        (
-            "chelsea.png",
-            DVec2::new(225.0, 150.0),
-            DVec2::new(1500.0, 850.0),
-            DVec2::new(400.0, 250.0),
-        ),
+        ("astronaut.png", DVec2::new(256.0, 256.0), DVec2::new(400.0, 900.0), DVec2::new(1500.0, 300.0)),
+        ("chelsea.png", DVec2::new(225.0, 150.0), DVec2::new(1500.0, 850.0), DVec2::new(400.0, 250.0)),
     ]
     .into_iter()
     .enumerate()
@@ -169,14 +156,8 @@ fn bench_scene(assets: &Path, frames: u64) -> Scene {
             }]),
         );
         patch.density = Some(1.0);
-        push_keys(
-            &mut patch.placement.position,
-            &[(0.0, from), (duration, to)],
-        );
-        push_keys(
-            &mut patch.placement.rotation,
-            &[(0.0, -15.0), (duration, 15.0)],
-        );
+        push_keys(&mut patch.placement.position, &[(0.0, from), (duration, to)]);
+        push_keys(&mut patch.placement.rotation, &[(0.0, -15.0), (duration, 15.0)]);
         let grab = centre + DVec2::new(radius * 0.6, 0.0);
         let mut to_track = Track::new();
         let swing = [grab, grab + DVec2::new(-40.0, 60.0)];
@@ -235,13 +216,7 @@ fn encode_ms_per_frame(frames: &[Frame], jobs: usize) -> anyhow::Result<f64> {
     std::fs::create_dir_all(&dir)?;
     let cancel = Arc::new(AtomicBool::new(false));
     let started = Instant::now();
-    let mut writer = PngSequenceWriter::new(
-        &dir,
-        frames.len() as u64,
-        jobs,
-        PngCompression::Fast,
-        cancel,
-    )?;
+    let mut writer = PngSequenceWriter::new(&dir, frames.len() as u64, jobs, PngCompression::Fast, cancel)?;
     for (i, frame) in frames.iter().enumerate() {
         writer.submit(i as u64 + 1, frame.clone())?;
     }

@@ -41,11 +41,7 @@ pub(crate) fn loop_neighbours(mesh: &Mesh, boundary: &[u32]) -> Vec<Option<Neigh
     }
     boundary
         .iter()
-        .map(|&v| {
-            (seen[v as usize] == 1)
-                .then_some(found[v as usize])
-                .flatten()
-        })
+        .map(|&v| (seen[v as usize] == 1).then_some(found[v as usize]).flatten())
         .collect()
 }
 
