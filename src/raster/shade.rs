@@ -172,15 +172,16 @@ fn shade_fringe<T: Texel>(input: &ShadeInput, span: &Span, pixels: &mut [[T; 4]]
     written
 }
 
-/// Canvas texels the interior fast path can store without the saturating casts.
+/// Canvas texels with a fast store for the interior path (8-bit on x86_64: SSE2 packs).
 pub(crate) trait StoreTexel: Texel {
     /// `from_unit` of each channel of a colour already clamped to [0, 1].
     fn store_unit(colour: Vec4) -> [Self; 4];
 }
 
 impl StoreTexel for u8 {
-    /// SSE2: one truncating conversion and two saturating packs (all in range, so the packs
-    /// saturate nothing) — exactly `from_unit` per channel.
+    /// SSE2: one truncating conversion and two saturating packs — exactly `from_unit` per
+    /// channel for values in [0, 1] (the packs saturate nothing; NaN was clamped to 0 by
+    /// SSE max/min, and even a NaN would only give a wrong byte, never UB).
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
     fn store_unit(colour: Vec4) -> [u8; 4] {
@@ -200,19 +201,17 @@ impl StoreTexel for u8 {
     #[cfg(not(target_arch = "x86_64"))]
     #[inline(always)]
     fn store_unit(colour: Vec4) -> [u8; 4] {
-        let scaled = (colour * 255.0 + 0.5).to_array();
-        // SAFETY: channels are in [0, 1] (clamped; NaN clamps to 0), so scaled ∈ [0.5, 255.5]
-        // and its truncation fits u8; this is exactly `Texel::from_unit`.
-        scaled.map(|v| unsafe { v.to_int_unchecked::<u8>() })
+        // Elsewhere a NaN channel may survive the clamp (NEON max/min propagate NaN), so keep
+        // the saturating cast.
+        colour.to_array().map(u8::from_unit)
     }
 }
 
 impl StoreTexel for u16 {
     #[inline(always)]
     fn store_unit(colour: Vec4) -> [u16; 4] {
-        let scaled = (colour * 65535.0 + 0.5).to_array();
-        // SAFETY: as for u8: scaled ∈ [0.5, 65535.5], whose truncation fits u16.
-        scaled.map(|v| unsafe { v.to_int_unchecked::<u16>() })
+        // The saturating cast: a NaN channel may survive the clamp on some SIMD backends.
+        colour.to_array().map(u16::from_unit)
     }
 }
 
