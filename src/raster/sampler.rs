@@ -53,7 +53,7 @@ impl<'a> Sampler<'a> {
         let (y0, y1, ty) = taps_f32(y, self.last_y, self.last_y_f32);
         let (row0, row1) = (y0 * self.width, y1 * self.width);
         // SAFETY: the taps are ≤ last_x < width and ≤ last_y < height (see `taps_f32`), and
-        // `pixels` holds width · height texels.
+        // `pixels` holds width · height ≥ 1 texels (a FloatImage is never empty).
         let texel = |i: usize| Vec4::from_array(unsafe { *self.pixels.get_unchecked(i) });
         let top = texel(row0 + x0).lerp(texel(row0 + x1), tx);
         let bottom = texel(row1 + x0).lerp(texel(row1 + x1), tx);
