@@ -74,19 +74,30 @@ fn chamfer_distance(ids: &[u32], width: usize, cap: f32, distance: &mut [f32], r
     }
 }
 
+/// `a.min(b)` for the (never NaN) distances: a plain comparison vectorises to `minps`
+/// without `f32::min`'s NaN fix-ups.
+#[inline(always)]
+fn smaller(a: f32, b: f32) -> f32 {
+    if b < a {
+        b
+    } else {
+        a
+    }
+}
+
 /// `current[x] = min(current[x], other[x] + 1, other[x ± 1] + √2)`.
 fn from_neighbour_row(other: &[f32], current: &mut [f32]) {
     let width = current.len();
     let other = &other[..width];
     for (d, &o) in current.iter_mut().zip(other) {
-        *d = d.min(o + 1.0);
+        *d = smaller(*d, o + 1.0);
     }
     if width > 1 {
         for (d, &o) in current[1..].iter_mut().zip(&other[..width - 1]) {
-            *d = d.min(o + DIAGONAL);
+            *d = smaller(*d, o + DIAGONAL);
         }
         for (d, &o) in current[..width - 1].iter_mut().zip(&other[1..]) {
-            *d = d.min(o + DIAGONAL);
+            *d = smaller(*d, o + DIAGONAL);
         }
     }
 }
@@ -105,7 +116,7 @@ fn along_row(current: &mut [f32], scratch: &mut [f32], reach: usize, backward: b
             (&mut current[step..], &before[..width - step])
         };
         for (d, &o) in pairs.0.iter_mut().zip(pairs.1) {
-            *d = d.min(o + offset);
+            *d = smaller(*d, o + offset);
         }
     }
 }

@@ -1,6 +1,9 @@
 //! The shading sampler: takes the source [`FloatImage`] and gives bilinear samples as SIMD
 //! [`Vec4`]s for the raster's inner loop — branch-free clamped taps, one slice, no per-call
-//! setup. Values are bit-identical to [`FloatImage::sample_bilinear`].
+//! setup. The hot path ([`Sampler::sample_f32`]) takes f32 positions and unchecked
+//! (proven in-range) taps; it differs from [`FloatImage::sample_bilinear`] only by the f32
+//! rounding of the position (tested to 1e-5 per channel). The f64 path, kept for tests, is
+//! bit-identical to it.
 
 use glam::Vec4;
 
@@ -12,6 +15,8 @@ pub(crate) struct Sampler<'a> {
     width: usize,
     last_x: usize,
     last_y: usize,
+    last_x_f32: f32,
+    last_y_f32: f32,
 }
 
 impl<'a> Sampler<'a> {
@@ -21,9 +26,13 @@ impl<'a> Sampler<'a> {
             width: source.width() as usize,
             last_x: source.width().saturating_sub(1) as usize,
             last_y: source.height().saturating_sub(1) as usize,
+            last_x_f32: last_as_f32(source.width()),
+            last_y_f32: last_as_f32(source.height()),
         }
     }
 
+    /// The f64 reference path (tests: bit-identical to the image sampler).
+    #[cfg(test)]
     /// Bilinear sample at `(x, y)` (centres at i + ½, clamped to edge, NaN → pixel 0).
     #[inline(always)]
     pub fn sample(&self, x: f64, y: f64) -> Vec4 {
@@ -35,8 +44,51 @@ impl<'a> Sampler<'a> {
         let bottom = texel(row1 + x0).lerp(texel(row1 + x1), tx);
         top.lerp(bottom, ty)
     }
+
+    /// [`sample`](Self::sample) with `f32` coordinates and tap arithmetic (the shading hot
+    /// path; differs from the f64 taps only by the f32 rounding of the position).
+    #[inline(always)]
+    pub fn sample_f32(&self, x: f32, y: f32) -> Vec4 {
+        let (x0, x1, tx) = taps_f32(x, self.last_x, self.last_x_f32);
+        let (y0, y1, ty) = taps_f32(y, self.last_y, self.last_y_f32);
+        let (row0, row1) = (y0 * self.width, y1 * self.width);
+        // SAFETY: the taps are ≤ last_x < width and ≤ last_y < height (see `taps_f32`), and
+        // `pixels` holds width · height ≥ 1 texels (a FloatImage is never empty).
+        let texel = |i: usize| Vec4::from_array(unsafe { *self.pixels.get_unchecked(i) });
+        let top = texel(row0 + x0).lerp(texel(row0 + x1), tx);
+        let bottom = texel(row1 + x0).lerp(texel(row1 + x1), tx);
+        top.lerp(bottom, ty)
+    }
 }
 
+/// `size − 1` rounded down to an f32, so clamped positions never truncate past the last
+/// pixel (only matters above 2^24 px).
+fn last_as_f32(size: u32) -> f32 {
+    let last = size.saturating_sub(1);
+    let rounded = last as f32;
+    if rounded as u64 > u64::from(last) {
+        // The next f32 towards zero (positive, normal): one ulp down.
+        f32::from_bits(rounded.to_bits() - 1)
+    } else {
+        rounded
+    }
+}
+
+/// f32 taps: clamped into the centres' range (NaN goes to 0), then truncated
+/// without the saturating cast's range checks. Both taps are ≤ `last`: u ≤ `last_f32` ≤ last.
+#[inline(always)]
+fn taps_f32(coordinate: f32, last: usize, last_f32: f32) -> (usize, usize, f32) {
+    // Plain comparisons compile to maxss/minss (NaN → 0 by the first), unlike f32::max/min.
+    let shifted = coordinate - 0.5;
+    let low = if shifted > 0.0 { shifted } else { 0.0 };
+    let u = if low < last_f32 { low } else { last_f32 };
+    // SAFETY: u is finite and in [0, last] ⊂ [0, 2^32) after the clamp (±∞ and NaN included),
+    // so it is representable in i64.
+    let i = unsafe { u.to_int_unchecked::<i64>() } as usize;
+    (i, (i + 1).min(last), u - i as f32)
+}
+
+#[cfg(test)]
 /// Same arithmetic as the pixels module's bilinear taps (so results agree bit for bit).
 #[inline(always)]
 fn taps(coordinate: f64, last: usize) -> (usize, usize, f32) {
@@ -50,6 +102,27 @@ fn taps(coordinate: f64, last: usize) -> (usize, usize, f32) {
 mod tests {
     use super::*;
     use crate::pixels::PixelFormat;
+
+    #[test]
+    fn f32_last_never_rounds_past_the_last_pixel() {
+        for size in [
+            1u32,
+            2,
+            480,
+            (1 << 24) + 1,
+            (1 << 24) + 3,
+            (1 << 25) + 7,
+            u32::MAX,
+        ] {
+            let last = last_as_f32(size);
+            assert!(last as u64 <= u64::from(size - 1), "{size}: {last}");
+            assert!(
+                last as u64 + 4 >= u64::from(size - 1) || size > 1 << 24,
+                "{size}"
+            );
+        }
+        assert_eq!(last_as_f32(480), 479.0);
+    }
 
     #[test]
     fn agrees_bit_for_bit_with_the_image_sampler() {
@@ -82,6 +155,14 @@ mod tests {
                     reference.map(f32::to_bits),
                     "{x} {y}"
                 );
+                // f32 taps: same up to the f32 rounding of the position (tiny here).
+                let single = sampler.sample_f32(x as f32, y as f32).to_array();
+                for (s, r) in single.iter().zip(reference) {
+                    assert!(
+                        (s - r).abs() <= 1e-5,
+                        "{x} {y}: {single:?} vs {reference:?}"
+                    );
+                }
             }
         }
     }

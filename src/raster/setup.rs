@@ -112,7 +112,23 @@ impl TriangleSetup {
 #[inline]
 pub(crate) fn snap(p: DVec2) -> [i64; 2] {
     let s = SUBPIXEL as f64;
-    [(p.x * s).round() as i64, (p.y * s).round() as i64]
+    [round_to_i64(p.x * s), round_to_i64(p.y * s)]
+}
+
+/// `value.round() as i64` (half away from zero, saturating, NaN → 0) without the libm call
+/// `f64::round` becomes on baseline x86_64: below 2^52 the fraction `value − trunc(value)`
+/// is exact; above, values are integers and the fraction is 0 (or the cast saturated).
+#[inline]
+fn round_to_i64(value: f64) -> i64 {
+    let truncated = value as i64;
+    let fraction = value - truncated as f64;
+    if fraction >= 0.5 {
+        truncated.saturating_add(1)
+    } else if fraction <= -0.5 {
+        truncated.saturating_sub(1)
+    } else {
+        truncated
+    }
 }
 
 /// (b − a) × (p − a) in fixed point; positive when p is left of a→b in raw coordinates
@@ -120,4 +136,53 @@ pub(crate) fn snap(p: DVec2) -> [i64; 2] {
 #[inline]
 pub(crate) fn edge_function(a: [i64; 2], b: [i64; 2], p: [i64; 2]) -> i64 {
     (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rounding_matches_f64_round() {
+        let special = [
+            0.0,
+            -0.0,
+            0.5,
+            -0.5,
+            1.5,
+            -2.5,
+            0.49999999999999994,
+            -0.49999999999999994,
+            4503599627370495.5,
+            -4503599627370495.5,
+            9007199254740993.0,
+            1e300,
+            -1e300,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+            9.223372036854776e18,
+        ];
+        for v in special {
+            assert_eq!(round_to_i64(v), v.round() as i64, "{v}");
+        }
+        use proptest::prelude::*;
+        use proptest::test_runner::{Config, RngSeed, TestRunner};
+        let config = Config {
+            rng_seed: RngSeed::Fixed(0x0d5e),
+            cases: 20_000,
+            ..Config::default()
+        };
+        let strategy = prop_oneof![
+            -1e6f64..1e6,
+            (-4_000_000i64..4_000_000).prop_map(|k| k as f64 * 0.25),
+            any::<f64>(),
+        ];
+        TestRunner::new(config)
+            .run(&strategy, |v| {
+                prop_assert_eq!(round_to_i64(v), v.round() as i64, "{}", v);
+                Ok(())
+            })
+            .unwrap();
+    }
 }

@@ -61,16 +61,21 @@ fn rasterise_one(
     depths: &mut [f32],
 ) {
     let width = work.width();
-    scan_fixed(setup.fixed, work, |x, y| {
-        let cell = (y - work.y0) as usize * width + (x - work.x0) as usize;
-        if use_depth {
-            let depth = setup.depth_at(f64::from(x) + 0.5, f64::from(y) + 0.5);
-            if depth >= depths[cell] {
-                depths[cell] = depth;
-                ids[cell] = index;
+    scan_spans(setup.fixed, work, |y, x0, x1| {
+        let row = (y - work.y0) as usize * width;
+        let cells = row + (x0 - work.x0) as usize..row + (x1 - work.x0) as usize;
+        if !use_depth {
+            ids[cells].fill(index);
+            return;
+        }
+        let cy = f64::from(y) + 0.5;
+        let cell_ids = &mut ids[cells.clone()];
+        for ((x, id), stored) in (x0..x1).zip(cell_ids).zip(&mut depths[cells]) {
+            let depth = setup.depth_at(f64::from(x) + 0.5, cy);
+            if depth >= *stored {
+                *stored = depth;
+                *id = index;
             }
-        } else {
-            ids[cell] = index;
         }
     });
 }
@@ -78,15 +83,18 @@ fn rasterise_one(
 /// Calls `visit(x, y)` for every pixel of `clip` whose centre the placed triangle owns under
 /// the raster's fill rule (either orientation; nothing for degenerate triangles or vertices
 /// beyond ±2^20 px). This is exactly the coverage [`draw_patch`](super::draw_patch) uses.
-pub fn triangle_pixels(corners: [DVec2; 3], clip: PixelRect, visit: impl FnMut(i32, i32)) {
+pub fn triangle_pixels(corners: [DVec2; 3], clip: PixelRect, mut visit: impl FnMut(i32, i32)) {
     let setup = TriangleSetup::new(corners, corners, [[0.0; 3]; 3], [0.0; 3]);
     if setup.drawable {
-        scan_fixed(setup.fixed, clip, visit);
+        scan_spans(setup.fixed, clip, |y, x0, x1| {
+            (x0..x1).for_each(|x| visit(x, y))
+        });
     }
 }
 
-/// Scans a positively oriented fixed-point triangle over `clip`.
-fn scan_fixed(fixed: [[i64; 2]; 3], clip: PixelRect, mut visit: impl FnMut(i32, i32)) {
+/// Scans a positively oriented fixed-point triangle over `clip`, calling `visit(y, x0, x1)`
+/// with each non-empty row span `[x0, x1)` of owned pixel centres.
+fn scan_spans(fixed: [[i64; 2]; 3], clip: PixelRect, mut visit: impl FnMut(i32, i32, i32)) {
     let [a, b, c] = fixed;
     let (x0, x1) = centre_range(a[0].min(b[0]).min(c[0]), a[0].max(b[0]).max(c[0]));
     let (y0, y1) = centre_range(a[1].min(b[1]).min(c[1]), a[1].max(b[1]).max(c[1]));
@@ -110,19 +118,39 @@ fn scan_fixed(fixed: [[i64; 2]; 3], clip: PixelRect, mut visit: impl FnMut(i32, 
         row_w[k] = edge_function(edges[k].0, edges[k].1, start) + bias[k];
     }
     for y in y0..y1 {
-        let mut w = row_w;
-        for x in x0..x1 {
-            if w[0] > 0 && w[1] > 0 && w[2] > 0 {
-                // Both lie inside `clip`, whose bounds are i32.
-                visit(x as i32, y as i32);
-            }
-            for k in 0..3 {
-                w[k] += step_x[k];
-            }
+        let (lo, hi) = row_span(row_w, step_x, x1 - x0);
+        if lo < hi {
+            // All lie inside `clip`, whose bounds are i32.
+            visit(y as i32, (x0 + lo) as i32, (x0 + hi) as i32);
         }
         for k in 0..3 {
             row_w[k] += step_y[k];
         }
+    }
+}
+
+/// The exact range `[lo, hi)` of steps `t ∈ [0, len)` with `w[k] + t·step[k] > 0` for all
+/// three edges: each edge bounds t from one side by an exact integer division, so the span
+/// is precisely the set of pixels the per-pixel test would accept.
+#[inline]
+fn row_span(w: [i64; 3], step: [i64; 3], len: i64) -> (i64, i64) {
+    let (mut lo, mut hi) = (0, len);
+    for k in 0..3 {
+        let (w, s) = (w[k], step[k]);
+        if s > 0 {
+            // t > −w / s  ⇔  t ≥ ⌊−w / s⌋ + 1.
+            lo = lo.max((-w).div_euclid(s) + 1);
+        } else if s < 0 {
+            // t < w / |s|  ⇔  t < ⌈w / |s|⌉ = −⌊−w / |s|⌋.
+            hi = hi.min(-(-w).div_euclid(-s));
+        } else if w <= 0 {
+            return (0, 0);
+        }
+    }
+    if lo < hi {
+        (lo, hi)
+    } else {
+        (0, 0)
     }
 }
 
@@ -136,5 +164,38 @@ mod tests {
         assert_eq!(centre_range(128, 384), (0, 2));
         assert_eq!(centre_range(129, 383), (1, 1));
         assert_eq!(centre_range(-128, 128), (-1, 1));
+    }
+
+    /// The per-pixel edge test the spans replace.
+    fn brute_span(w: [i64; 3], step: [i64; 3], len: i64) -> Vec<i64> {
+        (0..len)
+            .filter(|&t| (0..3).all(|k| w[k] + t * step[k] > 0))
+            .collect()
+    }
+
+    #[test]
+    fn row_spans_match_the_per_pixel_edge_test() {
+        use proptest::prelude::*;
+        use proptest::test_runner::{Config, RngSeed, TestRunner};
+        let config = Config {
+            rng_seed: RngSeed::Fixed(0x5a4e),
+            cases: 4000,
+            ..Config::default()
+        };
+        let value = -3000i64..3000;
+        let step = prop_oneof![Just(0i64), -700i64..700, Just(256), Just(-256)];
+        let strategy = (
+            [value.clone(), value.clone(), value],
+            [step.clone(), step.clone(), step],
+            0i64..40,
+        );
+        TestRunner::new(config)
+            .run(&strategy, |(w, step, len)| {
+                let (lo, hi) = row_span(w, step, len);
+                let span: Vec<i64> = (lo..hi).collect();
+                prop_assert_eq!(span, brute_span(w, step, len));
+                Ok(())
+            })
+            .unwrap();
     }
 }
