@@ -23,11 +23,12 @@ pub struct MeshOptions {
 }
 
 impl Default for MeshOptions {
-    /// - `density` 2 px: on the spiral, PSNR against the pixel-grid clone saturates with
-    ///   boundary density (`lapclone bench paper --sweep`, docs/quality.md: combinatorial
-    ///   36.5 dB at 2 px, 36.9 at 1.5, 37.1 at 1, 37.6 at 0.5), while vertices, meshing
-    ///   and re-clone time grow as 1/density: 2 px meshes the 770×743 spiral in ≈186M
-    ///   instructions (1.5 px: 254M, 1 px: 399M), inside the 20 ms budget.
+    /// - `density` 3 px: on the spiral, PSNR against the pixel-grid clone saturates with
+    ///   boundary density (`lapclone bench paper --sweep`, docs/quality.md: combinatorial /
+    ///   cotangent 36.2 / 39.4 dB at 3 px, 37.4 / 41.6 at 2, 38.6 / 42.8 at 1), while
+    ///   vertices, meshing and re-clone time grow as 1/density. 3 px is the finest setting
+    ///   that meshes the 770×743 spiral inside its 20 ms budget on the 2-core reference
+    ///   machine (16 ms; 2 px: 25 ms). Seam-critical work can ask for `density` 1–2.
     /// - `simplify_tolerance` 0.9 px: keeps every mask pixel centre within 0.5 px of the
     ///   mesh (a centre is 0.5 px inside the crack boundary) and every mesh point within
     ///   0.9 px of the mask.
@@ -36,7 +37,7 @@ impl Default for MeshOptions {
     /// - `min_piece_area` 4 px: drops isolated specks of 1–3 pixels.
     fn default() -> Self {
         Self {
-            density: 2.0,
+            density: 3.0,
             simplify_tolerance: 0.9,
             min_angle_deg: 25.0,
             max_vertices: 2_000_000,
