@@ -49,6 +49,8 @@ pub struct Session {
     undo: Vec<Snapshot>,
     renderer: Option<Renderer>,
     last_update: Option<SceneUpdate>,
+    /// The scene last handed to the renderer, to position render errors at their calls.
+    installed: Option<LoadedScene>,
     time: f64,
     preview: Preview,
     entries: u64,
@@ -83,6 +85,7 @@ impl Session {
             undo: Vec::new(),
             renderer: None,
             last_update: None,
+            installed: None,
             time: 0.0,
             preview,
             entries: 0,
@@ -304,6 +307,7 @@ impl Session {
             );
         }
         self.last_update = Some(update);
+        self.installed = Some(loaded.clone());
         Ok(())
     }
 
@@ -320,7 +324,10 @@ impl Session {
             .as_mut()
             .context("no scene yet: :load FILE, or call canvas(width, height) first")?;
         if let Err(error) = renderer.render_time(self.time) {
-            return Err(render_error(error));
+            return Err(match &self.installed {
+                Some(loaded) => positioned(loaded, error),
+                None => render_error(error),
+            });
         }
         self.preview.update(renderer)
     }
