@@ -9,7 +9,7 @@ use crate::clone::{
     mesh_from_mask, mesh_from_polygons, CloneOptions, CloneStats, PatchCloner, PatchMesh, Placement,
 };
 use crate::deform::{DeformRig, DeformStats, Deformed, Handle, Pin};
-use crate::mesh::{BitMask, Mesh, MeshOptions, Polygon};
+use crate::mesh::{BitMask, Mesh, MeshOptions};
 use crate::pixels::{Canvas, FloatImage};
 use crate::scene::{CloneMode, LaplacianKind, Patch, PatchState, Shape};
 
@@ -221,15 +221,6 @@ fn mesh_patch(
             mesh_from_mask(&mask, None, (source.width(), source.height()), options)
                 .map_err(clone_error)
         }
-        Shape::Polygons(polygons) => {
-            let polygons: Vec<Polygon> = polygons
-                .iter()
-                .map(|p| Polygon {
-                    outer: p.outer.clone(),
-                    holes: p.holes.clone(),
-                })
-                .collect();
-            mesh_from_polygons(&polygons, options).map_err(clone_error)
-        }
+        Shape::Polygons(polygons) => mesh_from_polygons(polygons, options).map_err(clone_error),
     }
 }

@@ -40,12 +40,8 @@ pub enum Background {
     Colour([f32; 4]),
 }
 
-/// A polygon with holes in source-pixel coordinates (same layout as the mesher's polygon).
-#[derive(Clone, Debug, PartialEq, Default)]
-pub struct Polygon {
-    pub outer: Vec<DVec2>,
-    pub holes: Vec<Vec<DVec2>>,
-}
+/// A polygon with holes in source-pixel coordinates: the mesher's own type.
+pub use crate::mesh::Polygon;
 
 /// Which pixels of the source make up the patch.
 #[derive(Clone, Debug, PartialEq)]
