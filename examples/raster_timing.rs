@@ -70,6 +70,11 @@ fn main() {
     let mut grid = CoverageGrid::new();
     let mut covered = Vec::new();
     let mut dirty = PixelRect::default();
+    // LAPCLONE_THREADS: threads per draw (default 1, so CPU time measures the work).
+    let threads: usize = std::env::var("LAPCLONE_THREADS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(1);
     for (label, feather, with_depth) in [
         ("plain", 0.0f32, false),
         ("depth", 0.0, true),
@@ -110,7 +115,8 @@ fn main() {
             };
             let options = RasterOptions {
                 feather,
-                anti_alias: true,
+                threads,
+                ..RasterOptions::default()
             };
             dirty = draw_patch(&mut canvas, &patch, &options, &mut scratch)
                 .expect("valid patch")

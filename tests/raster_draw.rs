@@ -56,6 +56,7 @@ fn identity_reproduces_the_source_inside() {
     let options = RasterOptions {
         anti_alias: false,
         feather: 0.0,
+        ..RasterOptions::default()
     };
     draw(
         &mut canvas,
@@ -99,6 +100,7 @@ fn integer_translation_shifts_the_source_and_membrane_adds_exactly() {
     let options = RasterOptions {
         anti_alias: false,
         feather: 0.0,
+        ..RasterOptions::default()
     };
     draw(
         &mut canvas,
@@ -145,6 +147,7 @@ fn depth_picks_the_front_layer_and_ties_go_to_the_later_triangle() {
     let options = RasterOptions {
         anti_alias: false,
         feather: 0.0,
+        ..RasterOptions::default()
     };
     let red = Some([1.0, 0.0, 0.0, 1.0]);
     let blue = Some([0.0, 0.0, 1.0, 1.0]);
@@ -313,6 +316,7 @@ fn feather_is_monotone_inward_and_softer_than_none() {
         let options = RasterOptions {
             anti_alias: true,
             feather,
+            ..RasterOptions::default()
         };
         draw(
             &mut canvas,
@@ -402,7 +406,60 @@ fn patch_outside_the_canvas_draws_nothing_and_bad_input_is_an_error() {
     let bad_feather = RasterOptions {
         feather: -1.0,
         anti_alias: true,
+        ..RasterOptions::default()
     };
     assert!(draw_patch(&mut canvas, &patch, &bad_feather, &mut RasterScratch::new()).is_err());
     assert_eq!(canvas, before);
+}
+
+#[test]
+fn every_thread_count_draws_the_same_pixels() {
+    // Large enough for the threaded path (≥ 64K px) and for many row bands; a wavy,
+    // rotated placement with a depth ramp so bands cut through folds and spans.
+    let source = raster_meshes::pattern_image(200, 200);
+    let mesh = raster_meshes::grid(DVec2::new(2.0, 3.0), 6.0, 32, 32);
+    let placed: Vec<DVec2> = mesh
+        .positions
+        .iter()
+        .map(|p| {
+            let wave = DVec2::new((p.y * 0.05).sin() * 40.0, (p.x * 0.04).cos() * 25.0);
+            DVec2::new(1.6 * p.x - 0.5 * p.y + 60.0, 0.5 * p.x + 1.6 * p.y + 10.0) + wave
+        })
+        .collect();
+    let membrane: Vec<[f32; 3]> = mesh
+        .positions
+        .iter()
+        .map(|p| [(p.x * 0.002) as f32, -0.1, (p.y * 0.001) as f32])
+        .collect();
+    let depth: Vec<f32> = mesh.positions.iter().map(|p| (p.x * 0.01) as f32).collect();
+    let render = |threads: usize, depth: Option<&[f32]>| {
+        let mut canvas = opaque_canvas(520, 470, 0.3);
+        let options = RasterOptions {
+            threads,
+            ..RasterOptions::default()
+        };
+        let patch = Patch {
+            rest: &mesh.positions,
+            placed: &placed,
+            triangles: &mesh.triangles,
+            membrane: &membrane,
+            depth,
+            loops: &mesh.loops,
+            source: &source,
+        };
+        let stats = draw_patch(&mut canvas, &patch, &options, &mut RasterScratch::new()).unwrap();
+        (canvas.to_float_image(PixelFormat::RGBA8), stats)
+    };
+    for depth in [None, Some(&depth[..])] {
+        let (single, single_stats) = render(1, depth);
+        assert!(single_stats.centre_hits > 64 * 1024, "{single_stats:?}");
+        for threads in [2, 3, 5, 0] {
+            let (image, stats) = render(threads, depth);
+            assert_eq!(stats, single_stats, "{threads} threads");
+            assert!(
+                image.pixels() == single.pixels(),
+                "{threads} threads differ from one"
+            );
+        }
+    }
 }

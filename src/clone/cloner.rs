@@ -110,7 +110,7 @@ impl PatchCloner {
             membrane,
             raster_options: RasterOptions {
                 feather: options.feather,
-                anti_alias: true,
+                ..RasterOptions::default()
             },
             placed: Vec::with_capacity(n),
             hidden: vec![false; n],

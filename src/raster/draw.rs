@@ -1,11 +1,16 @@
 //! Drawing one patch: takes a [`Patch`], options and a [`RasterScratch`] and composites the
-//! patch over a [`Canvas`]. Per frame: per-triangle setup, exact coverage with depth test,
-//! silhouette coverage, feather, shading — all inside the patch's bounding box.
+//! patch over a [`Canvas`]. Per frame: per-triangle setup and silhouette coverage once, then
+//! per row band (threaded for large patches) exact coverage with depth test and shading —
+//! all inside the patch's bounding box. Feathered patches draw in one piece.
 
+use std::sync::{Mutex, OnceLock};
+
+use super::bands::{Bands, APRON};
 use super::coverage::fill_silhouette;
 use super::feather::apply_feather;
+use super::scratch::BandScratch;
 use super::setup::{TriangleSetup, MAX_COORDINATE};
-use super::shade::{shade_and_composite, ShadeInput};
+use super::shade::{shade_and_composite, CoverageTexel, ShadeInput, StoreTexel};
 use super::triangles::{rasterise_triangles, NO_TRIANGLE};
 use super::{Patch, PixelRect, RasterError, RasterScratch};
 use crate::pixels::{Canvas, CanvasPixels};
@@ -17,6 +22,8 @@ pub struct RasterOptions {
     pub feather: f32,
     /// Anti-alias the silhouette (tiny-skia coverage); off: pixel-centre coverage only.
     pub anti_alias: bool,
+    /// Threads drawing one large patch (0: one per core). Any count gives the same pixels.
+    pub threads: usize,
 }
 
 impl Default for RasterOptions {
@@ -24,6 +31,7 @@ impl Default for RasterOptions {
         RasterOptions {
             feather: 0.0,
             anti_alias: true,
+            threads: 0,
         }
     }
 }
@@ -39,7 +47,8 @@ pub struct RasterStats {
     pub written: usize,
 }
 
-/// Composites `patch` over `canvas`. Allocates nothing once `scratch` has grown.
+/// Composites `patch` over `canvas`. Allocates nothing once `scratch` has grown (apart from
+/// the worker threads of a large patch).
 pub fn draw_patch(
     canvas: &mut Canvas,
     patch: &Patch,
@@ -54,36 +63,238 @@ pub fn draw_patch(
         return Ok(RasterStats::default());
     };
     build_setups(patch, &mut scratch.setups);
-    scratch.prepare_pixels(work.area());
-    let use_depth = patch.depth.is_some();
-    rasterise_triangles(
-        &scratch.setups,
+    let mask_stride = options.anti_alias.then(|| {
+        fill_silhouette(
+            patch,
+            &scratch.setups,
+            work,
+            &mut scratch.path_builder,
+            &mut scratch.mask,
+        )
+    });
+    let frame = Frame {
+        patch,
         work,
-        use_depth,
-        &mut scratch.ids,
-        &mut scratch.depths,
-    );
-    let centre_hits = scratch.ids.iter().filter(|&&id| id != NO_TRIANGLE).count();
-    compute_coverage(patch, work, options, scratch);
-    let canvas_rect = canvas_rect(canvas);
-    let target = work.intersect(&canvas_rect);
-    let input = ShadeInput {
-        setups: &scratch.setups,
-        ids: &scratch.ids,
-        coverage: &scratch.coverage,
-        work,
-        source: patch.source,
+        target: work.intersect(&canvas_rect(canvas)),
+        mask_stride,
+        use_depth: patch.depth.is_some(),
     };
     let canvas_width = canvas.width() as usize;
-    let written = match canvas.pixels_mut() {
-        CanvasPixels::Eight(p) => shade_and_composite(&input, target, p, canvas_width),
-        CanvasPixels::Sixteen(p) => shade_and_composite(&input, target, p, canvas_width),
+    let (centre_hits, written) = match canvas.pixels_mut() {
+        CanvasPixels::Eight(p) => draw_frame(&frame, options, scratch, p, canvas_width),
+        CanvasPixels::Sixteen(p) => draw_frame(&frame, options, scratch, p, canvas_width),
     };
     Ok(RasterStats {
         work,
         centre_hits,
         written,
     })
+}
+
+/// What every band of one draw shares.
+struct Frame<'a> {
+    patch: &'a Patch<'a>,
+    work: PixelRect,
+    /// The work rectangle clipped to the canvas: the pixels that can be written.
+    target: PixelRect,
+    /// Row stride of the silhouette mask when anti-aliasing.
+    mask_stride: Option<usize>,
+    use_depth: bool,
+}
+
+/// Draws over the canvas pixels; gives (centre hits, pixels written).
+fn draw_frame<T: StoreTexel + Send>(
+    frame: &Frame,
+    options: &RasterOptions,
+    scratch: &mut RasterScratch,
+    canvas: &mut [[T; 4]],
+    canvas_width: usize,
+) -> (usize, usize) {
+    if options.feather > 0.0 {
+        return draw_feathered(frame, options.feather, scratch, canvas, canvas_width);
+    }
+    let target = frame.target;
+    scratch.bands.build(
+        &scratch.setups,
+        (target.y0, target.y1),
+        target.width(),
+        scratch.band_pixels,
+    );
+    let threads = worker_threads(options.threads, target.area(), scratch.bands.count());
+    if scratch.workers.len() < threads {
+        scratch.workers.resize_with(threads, BandScratch::default);
+    }
+    let shared = BandInput {
+        frame,
+        setups: &scratch.setups,
+        bands: &scratch.bands,
+        mask: scratch.mask.as_ref().map(|m| m.data()),
+    };
+    let band_rows = scratch.bands.height() as usize * canvas_width;
+    let rows = &mut canvas[target.y0 as usize * canvas_width..target.y1 as usize * canvas_width];
+    let mut jobs = rows.chunks_mut(band_rows).enumerate();
+    let workers = &mut scratch.workers[..threads];
+    if threads == 1 {
+        let worker = &mut workers[0];
+        return jobs.fold((0, 0), |(hits, written), (band, rows)| {
+            let (h, w) = draw_band(&shared, band, rows, canvas_width, worker);
+            (hits + h, written + w)
+        });
+    }
+    let queue = Mutex::new(&mut jobs);
+    let mut totals = [(0usize, 0usize); MAX_THREADS];
+    std::thread::scope(|scope| {
+        for (worker, total) in workers.iter_mut().zip(&mut totals) {
+            let (queue, shared) = (&queue, &shared);
+            scope.spawn(move || loop {
+                let job = queue.lock().unwrap_or_else(|e| e.into_inner()).next();
+                let Some((band, rows)) = job else { break };
+                let (h, w) = draw_band(shared, band, rows, canvas_width, worker);
+                *total = (total.0 + h, total.1 + w);
+            });
+        }
+    });
+    totals.iter().fold((0, 0), |(h, w), t| (h + t.0, w + t.1))
+}
+
+/// At most this many threads draw one patch.
+const MAX_THREADS: usize = 8;
+
+/// Below this many target pixels a second thread costs more than it saves.
+const THREADED_AREA: usize = 64 * 1024;
+
+/// Threads for one draw: `requested` (0: one per core), at most one per band.
+fn worker_threads(requested: usize, area: usize, bands: usize) -> usize {
+    static CORES: OnceLock<usize> = OnceLock::new();
+    let cores = *CORES.get_or_init(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+    let wanted = if requested == 0 { cores } else { requested };
+    if area < THREADED_AREA {
+        return 1;
+    }
+    wanted.clamp(1, MAX_THREADS).min(bands.max(1))
+}
+
+/// What a band worker reads.
+struct BandInput<'a> {
+    frame: &'a Frame<'a>,
+    setups: &'a [TriangleSetup],
+    bands: &'a Bands,
+    mask: Option<&'a [u8]>,
+}
+
+/// Rasterises one band's triangles over the band and its apron, then shades the band's
+/// rows (`canvas_rows`: those canvas rows, whole). Gives (centre hits, pixels written).
+fn draw_band<T: StoreTexel>(
+    input: &BandInput,
+    band: usize,
+    canvas_rows: &mut [[T; 4]],
+    canvas_width: usize,
+    scratch: &mut BandScratch,
+) -> (usize, usize) {
+    let frame = input.frame;
+    let (work, target) = (frame.work, frame.target);
+    let (y0, y1) = input.bands.rows(band);
+    let ids_rect = PixelRect {
+        y0: (y0 - APRON).max(work.y0),
+        y1: (y1 + APRON).min(work.y1),
+        ..work
+    };
+    scratch.prepare(ids_rect.area(), frame.use_depth);
+    let triangles = input.bands.triangles(band).iter().copied();
+    rasterise_triangles(
+        input.setups,
+        triangles,
+        ids_rect,
+        frame.use_depth,
+        &mut scratch.ids,
+        &mut scratch.depths,
+    );
+    let rows = PixelRect { y0, y1, ..target };
+    let (coverage, coverage_stride, coverage_origin) = match (input.mask, frame.mask_stride) {
+        (Some(mask), Some(stride)) => (mask, stride, (work.x0, work.y0)),
+        _ => {
+            let hit = |&id: &u32| if id == NO_TRIANGLE { 0 } else { u8::MAX };
+            scratch.coverage.clear();
+            scratch.coverage.extend(scratch.ids.iter().map(hit));
+            (
+                scratch.coverage.as_slice(),
+                ids_rect.width(),
+                (ids_rect.x0, ids_rect.y0),
+            )
+        }
+    };
+    let shade = ShadeInput {
+        setups: input.setups,
+        ids: &scratch.ids,
+        ids_rect,
+        coverage,
+        coverage_stride,
+        coverage_origin,
+        source: frame.patch.source,
+    };
+    shade_and_composite(&shade, rows, canvas_rows, canvas_width)
+}
+
+/// The feathered draw, in one piece: the feather's distance transform needs the ids of the
+/// whole work rectangle at once.
+fn draw_feathered<T: StoreTexel>(
+    frame: &Frame,
+    feather: f32,
+    scratch: &mut RasterScratch,
+    canvas: &mut [[T; 4]],
+    canvas_width: usize,
+) -> (usize, usize) {
+    let (work, target) = (frame.work, frame.target);
+    if scratch.workers.is_empty() {
+        scratch.workers.push(BandScratch::default());
+    }
+    let worker = &mut scratch.workers[0];
+    worker.prepare(work.area(), frame.use_depth);
+    let all = 0..scratch.setups.len() as u32;
+    rasterise_triangles(
+        &scratch.setups,
+        all,
+        work,
+        frame.use_depth,
+        &mut worker.ids,
+        &mut worker.depths,
+    );
+    let width = work.width();
+    let coverage = &mut scratch.coverage;
+    coverage.clear();
+    match (&scratch.mask, frame.mask_stride) {
+        (Some(mask), Some(stride)) => {
+            for row in mask.data().chunks(stride).take(work.height()) {
+                coverage.extend(row[..width].iter().map(|&m| m.unit()));
+            }
+        }
+        _ => coverage.extend(
+            worker
+                .ids
+                .iter()
+                .map(|&id| if id == NO_TRIANGLE { 0.0 } else { 1.0 }),
+        ),
+    }
+    scratch.distance.resize(work.area(), 0.0);
+    apply_feather(
+        &worker.ids,
+        width,
+        feather,
+        &mut scratch.distance,
+        &mut scratch.distance_row,
+        coverage,
+    );
+    let shade = ShadeInput {
+        setups: &scratch.setups,
+        ids: &worker.ids,
+        ids_rect: work,
+        coverage: coverage.as_slice(),
+        coverage_stride: width,
+        coverage_origin: (work.x0, work.y0),
+        source: frame.patch.source,
+    };
+    let rows = &mut canvas[target.y0 as usize * canvas_width..];
+    shade_and_composite(&shade, target, rows, canvas_width)
 }
 
 fn canvas_rect(canvas: &Canvas) -> PixelRect {
@@ -137,33 +348,96 @@ fn build_setups(patch: &Patch, setups: &mut Vec<TriangleSetup>) {
     }));
 }
 
-fn compute_coverage(
-    patch: &Patch,
-    work: PixelRect,
-    options: &RasterOptions,
-    s: &mut RasterScratch,
-) {
-    let width = work.width();
-    if options.anti_alias {
-        let stride = fill_silhouette(patch, &s.setups, work, &mut s.path_builder, &mut s.mask);
-        let mask = s.mask.as_ref().expect("mask filled").data(); // invariant: fill_silhouette always leaves a mask in the slot.
-        for (row, out) in s.coverage.chunks_mut(width).enumerate() {
-            let src = &mask[row * stride..row * stride + width];
-            for (c, &m) in out.iter_mut().zip(src) {
-                *c = f32::from(m) * (1.0 / 255.0);
-            }
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::{BoundaryLoop, LoopKind};
+    use crate::pixels::{FloatImage, PixelFormat};
+    use glam::DVec2;
+
+    /// A wavy ring of thin triangles: long silhouettes cross every band border, so fringe
+    /// pixels there look up neighbours in the apron.
+    fn ring(segments: u32) -> (Vec<DVec2>, Vec<[u32; 3]>, Vec<BoundaryLoop>) {
+        let mut positions = Vec::new();
+        for k in 0..segments {
+            let angle = std::f64::consts::TAU * f64::from(k) / f64::from(segments);
+            let direction = DVec2::new(angle.cos(), angle.sin());
+            let wobble = 6.0 * (angle * 7.0).sin();
+            positions.push(DVec2::new(150.0, 140.0) + direction * (100.0 + wobble));
+            positions.push(DVec2::new(150.0, 140.0) + direction * (123.3 + wobble));
         }
-    } else {
-        for (c, &id) in s.coverage.iter_mut().zip(&s.ids) {
-            *c = if id == NO_TRIANGLE { 0.0 } else { 1.0 };
+        let mut triangles = Vec::new();
+        for k in 0..segments {
+            let (inner, outer) = (2 * k, 2 * k + 1);
+            let (next_inner, next_outer) =
+                ((2 * k + 2) % (2 * segments), (2 * k + 3) % (2 * segments));
+            triangles.push([inner, outer, next_inner]);
+            triangles.push([outer, next_outer, next_inner]);
         }
+        let outer_loop = (0..segments).map(|k| 2 * k + 1).collect();
+        let inner_loop = (0..segments).rev().map(|k| 2 * k).collect();
+        let loops = vec![
+            BoundaryLoop {
+                kind: LoopKind::Outer,
+                piece: 0,
+                vertices: outer_loop,
+            },
+            BoundaryLoop {
+                kind: LoopKind::Hole,
+                piece: 0,
+                vertices: inner_loop,
+            },
+        ];
+        (positions, triangles, loops)
     }
-    apply_feather(
-        &s.ids,
-        width,
-        options.feather,
-        &mut s.distance,
-        &mut s.distance_row,
-        &mut s.coverage,
-    );
+
+    #[test]
+    fn band_height_changes_no_pixel() {
+        let (rest, triangles, loops) = ring(97);
+        let placed: Vec<DVec2> = rest
+            .iter()
+            .map(|p| *p * 1.3 + DVec2::new(7.3, 4.1))
+            .collect();
+        let source = FloatImage::from_fn(300, 300, PixelFormat::RGBA8, |i, j| {
+            [(i % 17) as f32 / 16.0, (j % 13) as f32 / 12.0, 0.5, 1.0]
+        })
+        .unwrap();
+        let membrane: Vec<[f32; 3]> = rest
+            .iter()
+            .map(|p| [(p.x * 1e-3) as f32, 0.0, -0.05])
+            .collect();
+        let patch = Patch {
+            rest: &rest,
+            placed: &placed,
+            triangles: &triangles,
+            membrane: &membrane,
+            depth: None,
+            loops: &loops,
+            source: &source,
+        };
+        let draw = |band_pixels: usize| {
+            let background =
+                FloatImage::from_fn(420, 400, PixelFormat::RGBA8, |_, _| [0.2; 4]).unwrap();
+            let mut canvas = Canvas::from_image(&background);
+            let mut scratch = RasterScratch::new();
+            scratch.band_pixels = band_pixels;
+            let options = RasterOptions {
+                threads: 1,
+                ..RasterOptions::default()
+            };
+            let stats = draw_patch(&mut canvas, &patch, &options, &mut scratch).unwrap();
+            (canvas.to_float_image(PixelFormat::RGBA8), stats)
+        };
+        // One band for the whole patch versus 8-row bands.
+        let (whole, whole_stats) = draw(usize::MAX);
+        let (banded, banded_stats) = draw(1);
+        assert_eq!(whole_stats, banded_stats);
+        let fringe = whole
+            .pixels()
+            .iter()
+            .zip(banded.pixels())
+            .filter(|(a, b)| a != b)
+            .count();
+        assert_eq!(fringe, 0, "pixels differ between band heights");
+    }
 }

@@ -19,10 +19,16 @@
 //! [`covered_boundary_vertices`] answers, independently of pixels, which boundary vertices
 //! lie under the patch's own front layer (issue 5 switches their constraints off).
 //!
+//! Work is split into row bands of a few dozen rows ([`bands`]): a band's ids, depths and
+//! coverage stay in cache, and bands are shaded by up to one thread per core in any order —
+//! every band's pixels depend only on the frame's inputs, so any thread count gives the
+//! same bytes. Feathering draws in one piece (its distance transform spans the patch).
+//!
 //! Once-per-mesh vs per-frame: nothing is cached across frames except the buffers in
 //! [`RasterScratch`] and [`CoverageGrid`]; a frame re-does the per-triangle setup (cheap) and
 //! allocates nothing once the buffers have grown to the patch's size.
 
+mod bands;
 mod coverage;
 mod covered;
 mod draw;

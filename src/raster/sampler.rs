@@ -48,9 +48,17 @@ impl<'a> Sampler<'a> {
     /// [`sample`](Self::sample) with `f32` coordinates and tap arithmetic (the shading hot
     /// path; differs from the f64 taps only by the f32 rounding of the position).
     #[inline(always)]
+    #[cfg(test)]
     pub fn sample_f32(&self, x: f32, y: f32) -> Vec4 {
-        let (x0, x1, tx) = taps_f32(x, self.last_x, self.last_x_f32);
-        let (y0, y1, ty) = taps_f32(y, self.last_y, self.last_y_f32);
+        self.sample_texel_space(x - 0.5, y - 0.5)
+    }
+
+    /// [`sample_f32`](Self::sample_f32) at `(x + ½, y + ½)`: positions in texel space,
+    /// where texel (i, j)'s centre is at (i, j) (the shading loop folds the ½ into its maps).
+    #[inline(always)]
+    pub fn sample_texel_space(&self, x: f32, y: f32) -> Vec4 {
+        let (x0, x1, tx) = taps_shifted(x, self.last_x, self.last_x_f32);
+        let (y0, y1, ty) = taps_shifted(y, self.last_y, self.last_y_f32);
         let (row0, row1) = (y0 * self.width, y1 * self.width);
         // SAFETY: the taps are ≤ last_x < width and ≤ last_y < height (see `taps_f32`), and
         // `pixels` holds width · height ≥ 1 texels (a FloatImage is never empty).
@@ -74,18 +82,22 @@ fn last_as_f32(size: u32) -> f32 {
     }
 }
 
-/// f32 taps: clamped into the centres' range (NaN goes to 0), then truncated
-/// without the saturating cast's range checks. Both taps are ≤ `last`: u ≤ `last_f32` ≤ last.
+/// f32 taps of a texel-space coordinate: clamped into the centres' range (NaN goes to 0),
+/// then truncated without the saturating cast's range checks. Both taps are ≤ `last`:
+/// u ≤ `last_f32` ≤ last.
 #[inline(always)]
-fn taps_f32(coordinate: f32, last: usize, last_f32: f32) -> (usize, usize, f32) {
+fn taps_shifted(shifted: f32, last: usize, last_f32: f32) -> (usize, usize, f32) {
     // Plain comparisons compile to maxss/minss (NaN → 0 by the first), unlike f32::max/min.
-    let shifted = coordinate - 0.5;
     let low = if shifted > 0.0 { shifted } else { 0.0 };
     let u = if low < last_f32 { low } else { last_f32 };
     // SAFETY: u is finite and in [0, last] ⊂ [0, 2^32) after the clamp (±∞ and NaN included),
     // so it is representable in i64.
-    let i = unsafe { u.to_int_unchecked::<i64>() } as usize;
-    (i, (i + 1).min(last), u - i as f32)
+    let whole = unsafe { u.to_int_unchecked::<i64>() };
+    // The signed conversion back is one instruction; an unsigned 64-bit one is a branchy
+    // sequence on x86_64. Same value either way (0 ≤ whole < 2^32).
+    let fraction = u - whole as f32;
+    let i = whole as usize;
+    (i, i + usize::from(i < last), fraction)
 }
 
 #[cfg(test)]

@@ -1,33 +1,64 @@
 //! Reusable per-frame buffers of the raster: takes nothing and gives grow-only storage for
-//! triangle setups, the per-pixel triangle ids and depths, coverage, feather distances, the
-//! silhouette path and mask, so that a warmed-up frame allocates nothing.
+//! triangle setups, the row bands, each worker's per-pixel triangle ids, depths and coverage,
+//! feather distances, the silhouette path and mask, so that a warmed-up frame allocates
+//! nothing.
 
+use super::bands::{Bands, BAND_PIXELS};
 use super::setup::TriangleSetup;
 
 /// Scratch buffers for [`draw_patch`](super::draw_patch); keep one per patch (or per thread)
 /// and pass it every frame.
-#[derive(Default)]
 pub struct RasterScratch {
     pub(crate) setups: Vec<TriangleSetup>,
-    pub(crate) ids: Vec<u32>,
-    pub(crate) depths: Vec<f32>,
+    pub(crate) bands: Bands,
+    pub(crate) workers: Vec<BandScratch>,
+    /// The feathered coverage of the whole work rectangle.
     pub(crate) coverage: Vec<f32>,
     pub(crate) distance: Vec<f32>,
     pub(crate) distance_row: Vec<f32>,
     pub(crate) path_builder: Option<tiny_skia::PathBuilder>,
     pub(crate) mask: Option<tiny_skia::Mask>,
+    /// Pixels per row band (tests vary it to prove it changes nothing).
+    pub(crate) band_pixels: usize,
+}
+
+impl Default for RasterScratch {
+    fn default() -> Self {
+        RasterScratch {
+            setups: Vec::new(),
+            bands: Bands::default(),
+            workers: Vec::new(),
+            coverage: Vec::new(),
+            distance: Vec::new(),
+            distance_row: Vec::new(),
+            path_builder: None,
+            mask: None,
+            band_pixels: BAND_PIXELS,
+        }
+    }
 }
 
 impl RasterScratch {
     pub fn new() -> RasterScratch {
         RasterScratch::default()
     }
+}
 
-    /// Sizes the per-pixel buffers for `area` pixels (grow-only capacity).
-    pub(crate) fn prepare_pixels(&mut self, area: usize) {
-        for buffer in [&mut self.depths, &mut self.coverage, &mut self.distance] {
-            buffer.resize(area, 0.0);
-        }
+/// One worker's per-pixel buffers over a band (or, feathered, the whole work rectangle).
+#[derive(Default)]
+pub(crate) struct BandScratch {
+    pub ids: Vec<u32>,
+    pub depths: Vec<f32>,
+    /// Pixel-centre coverage when not anti-aliasing.
+    pub coverage: Vec<u8>,
+}
+
+impl BandScratch {
+    /// Sizes the buffers for `area` pixels (grow-only capacity).
+    pub fn prepare(&mut self, area: usize, use_depth: bool) {
         self.ids.resize(area, 0);
+        if use_depth {
+            self.depths.resize(area, 0.0);
+        }
     }
 }

@@ -7,7 +7,7 @@
 //! triangles); interpolation uses the unsnapped `f64` positions (so an identity placement
 //! samples the source exactly at pixel centres).
 
-use glam::DVec2;
+use glam::{DVec2, Vec4};
 
 /// Fixed-point subpixel resolution (1/256 px).
 pub(crate) const SUBPIXEL_BITS: u32 = 8;
@@ -32,6 +32,23 @@ pub(crate) struct TriangleSetup {
     pub rest_y: [f64; 3],
     /// Membrane channels as affine functions of the canvas position: `[constant, d/dx, d/dy]`.
     pub membrane_affine: [[f32; 3]; 3],
+    /// The same maps in single precision relative to a pixel centre near the triangle,
+    /// for the shading loop.
+    pub span: SpanSetup,
+}
+
+/// Single-precision affine maps for shading, relative to the pixel centre `origin` + ½ near
+/// the triangle: offsets from it are small exact integers in f32, so evaluating there costs
+/// no precision even far from the canvas origin.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct SpanSetup {
+    pub origin: [i32; 2],
+    /// Rest x − ½ and rest y − ½ (the sampler's texel-centre shift, folded in):
+    /// `[at origin, d/dx, d/dy]`.
+    pub texel_x: [f32; 3],
+    pub texel_y: [f32; 3],
+    /// Membrane (RGB, alpha lane 0) at the origin and its steps along x and y.
+    pub membrane: [Vec4; 3],
 }
 
 /// Barycentric-derived values at one canvas position.
@@ -74,9 +91,16 @@ impl TriangleSetup {
             let m = |k: usize| f64::from(membrane[k][c]);
             affine(m(0), m(1) - m(0), m(2) - m(0)).map(|v| v as f32)
         });
+        let rest_x = affine(rest[0].x, r1.x, r2.x);
+        let rest_y = affine(rest[0].y, r1.y, r2.y);
+        let membrane_f64 = [0, 1, 2].map(|c| {
+            let m = |k: usize| f64::from(membrane[k][c]);
+            affine(m(0), m(1) - m(0), m(2) - m(0))
+        });
         TriangleSetup {
-            rest_x: affine(rest[0].x, r1.x, r2.x),
-            rest_y: affine(rest[0].y, r1.y, r2.y),
+            span: SpanSetup::new(a, rest_x, rest_y, membrane_f64),
+            rest_x,
+            rest_y,
             membrane_affine,
             fixed,
             drawable,
@@ -89,10 +113,15 @@ impl TriangleSetup {
         }
     }
 
+    /// Depth at the centre of pixel (x, y) and its step per pixel along the row: a span
+    /// evaluates `first + step · k` in f32 (exact f64 at the span's start, so no error
+    /// accumulates across the canvas; along a span it is far below any depth gap that
+    /// matters, and the same for every thread count).
     #[inline]
-    pub fn depth_at(&self, x: f64, y: f64) -> f32 {
+    pub fn depth_along_row(&self, x: i32, y: i32) -> (f32, f32) {
         let d = &self.depth_affine;
-        (d[0] + d[1] * x + d[2] * y) as f32
+        let (cx, cy) = (f64::from(x) + 0.5, f64::from(y) + 0.5);
+        ((d[0] + d[1] * cx + d[2] * cy) as f32, d[1] as f32)
     }
 
     /// Rest position and membrane at a canvas position (extrapolated outside the triangle).
@@ -105,6 +134,31 @@ impl TriangleSetup {
         let (xf, yf) = (x as f32, y as f32);
         let membrane = self.membrane_affine.map(|m| m[0] + m[1] * xf + m[2] * yf);
         Interpolated { rest, membrane }
+    }
+}
+
+impl SpanSetup {
+    /// Re-bases the affine maps `[constant, d/dx, d/dy]` at the pixel centre nearest `near`.
+    fn new(near: DVec2, rest_x: [f64; 3], rest_y: [f64; 3], membrane: [[f64; 3]; 3]) -> Self {
+        let clamp = |v: f64| v.floor().clamp(-MAX_COORDINATE, MAX_COORDINATE) as i32;
+        let origin = [clamp(near.x), clamp(near.y)];
+        let (cx, cy) = (f64::from(origin[0]) + 0.5, f64::from(origin[1]) + 0.5);
+        let at = |m: [f64; 3]| m[0] + m[1] * cx + m[2] * cy;
+        let texel = |m: [f64; 3]| [(at(m) - 0.5) as f32, m[1] as f32, m[2] as f32];
+        let lanes = |value: &dyn Fn([f64; 3]) -> f64| {
+            Vec4::new(
+                value(membrane[0]) as f32,
+                value(membrane[1]) as f32,
+                value(membrane[2]) as f32,
+                0.0,
+            )
+        };
+        SpanSetup {
+            origin,
+            texel_x: texel(rest_x),
+            texel_y: texel(rest_y),
+            membrane: [lanes(&at), lanes(&|m| m[1]), lanes(&|m| m[2])],
+        }
     }
 }
 

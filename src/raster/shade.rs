@@ -43,40 +43,90 @@ const NEIGHBOURS: [(i32, i32); 24] = [
     (2, 2),
 ];
 
+/// A coverage texel: 8-bit (the tiny-skia mask) or f32 (after feathering).
+pub(crate) trait CoverageTexel: Copy {
+    fn unit(self) -> f32;
+    /// `unit() > 0`, without the conversion.
+    fn is_covered(self) -> bool;
+    /// `unit() >= 1`, without the conversion.
+    fn is_full(self) -> bool;
+}
+
+impl CoverageTexel for u8 {
+    #[inline(always)]
+    fn unit(self) -> f32 {
+        f32::from(self) * (1.0 / 255.0)
+    }
+    #[inline(always)]
+    fn is_covered(self) -> bool {
+        self > 0
+    }
+    #[inline(always)]
+    fn is_full(self) -> bool {
+        self == u8::MAX
+    }
+}
+
+impl CoverageTexel for f32 {
+    #[inline(always)]
+    fn unit(self) -> f32 {
+        self
+    }
+    #[inline(always)]
+    fn is_covered(self) -> bool {
+        self > 0.0
+    }
+    #[inline(always)]
+    fn is_full(self) -> bool {
+        self >= 1.0
+    }
+}
+
 /// Everything shading reads, bundled to keep signatures short.
-pub(crate) struct ShadeInput<'a> {
+pub(crate) struct ShadeInput<'a, C> {
     pub setups: &'a [TriangleSetup],
+    /// Triangle ids over `ids_rect` (row-major, `ids_rect.width()` wide).
     pub ids: &'a [u32],
-    pub coverage: &'a [f32],
-    pub work: PixelRect,
+    pub ids_rect: PixelRect,
+    /// Coverage, row-major with `coverage_stride`, its element 0 at canvas pixel
+    /// `coverage_origin`; it covers every pixel shaded.
+    pub coverage: &'a [C],
+    pub coverage_stride: usize,
+    pub coverage_origin: (i32, i32),
     pub source: &'a FloatImage,
 }
 
-/// Composites the patch over `canvas` (row-major, `canvas_width` wide) inside `target`
-/// (the work rectangle clipped to the canvas). Returns the number of pixels written.
+/// Composites the patch over `canvas` inside `rows` (a rectangle of the canvas inside
+/// `ids_rect`). `canvas` holds the canvas rows from `rows.y0` on, `canvas_width` wide.
+/// Returns the number of pixels whose centre a triangle owns, and the number written.
 ///
 /// Each row is walked in runs of equal triangle id, so a run reads its triangle's setup
 /// once; only the fringe (coverage without a triangle at the centre) looks at neighbours.
-pub(crate) fn shade_and_composite<T: StoreTexel>(
-    input: &ShadeInput,
-    target: PixelRect,
+pub(crate) fn shade_and_composite<T: StoreTexel, C: CoverageTexel>(
+    input: &ShadeInput<C>,
+    rows: PixelRect,
     canvas: &mut [[T; 4]],
     canvas_width: usize,
-) -> usize {
-    let work = input.work;
-    let work_width = work.width();
+) -> (usize, usize) {
+    let ids_rect = input.ids_rect;
+    let ids_width = ids_rect.width();
     let (first, last) = (
-        (target.x0 - work.x0) as usize,
-        (target.x1 - work.x0) as usize,
+        (rows.x0 - ids_rect.x0) as usize,
+        (rows.x1 - ids_rect.x0) as usize,
+    );
+    let (cover_first, cover_last) = (
+        (rows.x0 - input.coverage_origin.0) as usize,
+        (rows.x1 - input.coverage_origin.0) as usize,
     );
     let sampler = Sampler::new(input.source);
-    let mut written = 0;
-    for y in target.y0..target.y1 {
-        let work_row = (y - work.y0) as usize * work_width;
-        let ids = &input.ids[work_row + first..work_row + last];
-        let coverage = &input.coverage[work_row + first..work_row + last];
-        let canvas_row = y as usize * canvas_width;
-        let row = &mut canvas[canvas_row + target.x0 as usize..canvas_row + target.x1 as usize];
+    let (mut hits, mut written) = (0, 0);
+    for y in rows.y0..rows.y1 {
+        let ids_row = (y - ids_rect.y0) as usize * ids_width;
+        let ids = &input.ids[ids_row + first..ids_row + last];
+        let cover_row = (y - input.coverage_origin.1) as usize * input.coverage_stride;
+        let coverage = &input.coverage[cover_row + cover_first..cover_row + cover_last];
+        let canvas_row = (y - rows.y0) as usize * canvas_width;
+        let row = &mut canvas[canvas_row + rows.x0 as usize..canvas_row + rows.x1 as usize];
         let mut start = 0;
         while start < ids.len() {
             let id = ids[start];
@@ -85,7 +135,7 @@ pub(crate) fn shade_and_composite<T: StoreTexel>(
                     .iter()
                     .take_while(|&&other| other == id)
                     .count();
-            let x0 = target.x0 + start as i32;
+            let x0 = rows.x0 + start as i32;
             let span = Span {
                 x0,
                 y,
@@ -94,70 +144,74 @@ pub(crate) fn shade_and_composite<T: StoreTexel>(
             written += if id == NO_TRIANGLE {
                 shade_fringe(input, &span, &mut row[start..end])
             } else {
+                hits += end - start;
                 let setup = &input.setups[id as usize];
                 shade_span(setup, &sampler, &span, &mut row[start..end])
             };
             start = end;
         }
     }
-    written
+    (hits, written)
 }
 
 /// A run of pixels of one row starting at canvas column `x0`, with their coverage.
-struct Span<'a> {
+struct Span<'a, C> {
     x0: i32,
     y: i32,
-    coverage: &'a [f32],
+    coverage: &'a [C],
 }
 
-/// Shades a run of pixels whose centres all lie in `setup`'s triangle. The affine maps are
-/// evaluated exactly (f64) at the run's first centre, then stepped in f32 along the run
-/// (`value = first + step · t`, no accumulated rounding): over a run of a few dozen pixels
-/// the source position moves by far less than 1/1000 px, invisible after 8- or 16-bit
-/// rounding. Interior pixels (full coverage, opaque source) skip the blend.
+/// Shades a run of pixels whose centres all lie in `setup`'s triangle. The single-precision
+/// maps are evaluated at the run's first centre relative to the triangle's own origin (small
+/// exact offsets), then stepped along the run: over a run of a few dozen pixels the source
+/// position drifts by far less than 1/1000 px, invisible after 8- or 16-bit rounding.
+/// Interior pixels (full coverage, opaque source) skip the blend.
 #[inline(always)]
-fn shade_span<T: StoreTexel>(
+fn shade_span<T: StoreTexel, C: CoverageTexel>(
     setup: &TriangleSetup,
     sampler: &Sampler,
-    span: &Span,
+    span: &Span<C>,
     pixels: &mut [[T; 4]],
 ) -> usize {
-    let (cx, cy) = (f64::from(span.x0) + 0.5, f64::from(span.y) + 0.5);
-    let (rx, ry) = (setup.rest_x, setup.rest_y);
-    let u_first = (rx[0] + rx[1] * cx + rx[2] * cy) as f32;
-    let v_first = (ry[0] + ry[1] * cx + ry[2] * cy) as f32;
-    let (u_step, v_step) = (rx[1] as f32, ry[1] as f32);
-    let channel = |k: usize| {
-        let m = &setup.membrane_affine;
-        Vec4::new(m[0][k], m[1][k], m[2][k], 0.0)
-    };
-    let m_step = channel(1);
-    let m_first = channel(0) + m_step * cx as f32 + channel(2) * cy as f32;
+    let maps = &setup.span;
+    let dx = (span.x0 - maps.origin[0]) as f32;
+    let dy = (span.y - maps.origin[1]) as f32;
+    let at = |m: &[f32; 3]| m[0] + m[1] * dx + m[2] * dy;
+    let (mut u, mut v) = (at(&maps.texel_x), at(&maps.texel_y));
+    let (u_step, v_step) = (maps.texel_x[1], maps.texel_y[1]);
+    let [m_origin, m_step, m_step_y] = maps.membrane;
+    let mut membrane = m_origin + m_step * dx + m_step_y * dy;
     let mut written = 0;
-    let mut t = 0.0f32;
-    for (&coverage, pixel) in span.coverage.iter().zip(pixels.iter_mut()) {
-        if coverage > 0.0 {
-            let sample = sampler.sample_f32(u_first + u_step * t, v_first + v_step * t);
+    for (&texel, pixel) in span.coverage.iter().zip(pixels.iter_mut()) {
+        if texel.is_covered() {
+            let sample = sampler.sample_texel_space(u, v);
             // The membrane's alpha lane is 0, so an opaque sample clamps to alpha 1 here.
-            let mut colour = (sample + m_first + m_step * t).clamp(Vec4::ZERO, Vec4::ONE);
-            written += if coverage >= 1.0 && sample.w >= 1.0 {
+            let mut colour = (sample + membrane).clamp(Vec4::ZERO, Vec4::ONE);
+            written += if texel.is_full() && sample.w >= 1.0 {
                 *pixel = T::store_unit(colour);
                 1
             } else {
                 colour.w = sample.w;
-                usize::from(composite(pixel, colour.to_array(), coverage))
+                usize::from(composite(pixel, colour.to_array(), texel.unit()))
             };
         }
-        t += 1.0;
+        u += u_step;
+        v += v_step;
+        membrane += m_step;
     }
     written
 }
 
 /// Shades a run of pixels whose centres miss every triangle (the anti-aliased fringe).
-fn shade_fringe<T: Texel>(input: &ShadeInput, span: &Span, pixels: &mut [[T; 4]]) -> usize {
+fn shade_fringe<T: Texel, C: CoverageTexel>(
+    input: &ShadeInput<C>,
+    span: &Span<C>,
+    pixels: &mut [[T; 4]],
+) -> usize {
     let cy = f64::from(span.y) + 0.5;
     let mut written = 0;
-    for (k, (&coverage, pixel)) in span.coverage.iter().zip(pixels.iter_mut()).enumerate() {
+    for (k, (&texel, pixel)) in span.coverage.iter().zip(pixels.iter_mut()).enumerate() {
+        let coverage = texel.unit();
         if coverage <= 0.0 {
             continue;
         }
@@ -247,19 +301,19 @@ fn patch_colour(setup: &TriangleSetup, source: &FloatImage, x: f64, y: f64) -> [
 
 /// The triangle at the pixel's centre, or the nearest hit neighbour's.
 #[inline]
-fn owning_triangle(input: &ShadeInput, x: i32, y: i32) -> Option<u32> {
-    let work = input.work;
-    let width = work.width();
-    let id = input.ids[(y - work.y0) as usize * width + (x - work.x0) as usize];
+fn owning_triangle<C>(input: &ShadeInput<C>, x: i32, y: i32) -> Option<u32> {
+    let rect = input.ids_rect;
+    let width = rect.width();
+    let id = input.ids[(y - rect.y0) as usize * width + (x - rect.x0) as usize];
     if id != NO_TRIANGLE {
         return Some(id);
     }
     NEIGHBOURS.iter().find_map(|&(dx, dy)| {
         let (nx, ny) = (x + dx, y + dy);
-        if nx < work.x0 || ny < work.y0 || nx >= work.x1 || ny >= work.y1 {
+        if nx < rect.x0 || ny < rect.y0 || nx >= rect.x1 || ny >= rect.y1 {
             return None;
         }
-        let id = input.ids[(ny - work.y0) as usize * width + (nx - work.x0) as usize];
+        let id = input.ids[(ny - rect.y0) as usize * width + (nx - rect.x0) as usize];
         (id != NO_TRIANGLE).then_some(id)
     })
 }

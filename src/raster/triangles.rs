@@ -17,10 +17,13 @@ use super::PixelRect;
 
 pub(crate) const NO_TRIANGLE: u32 = u32::MAX;
 
-/// Fills `ids` (and `depths` when `use_depth`) over `work`, both `work.area()` long.
+/// Fills `ids` (and `depths` when `use_depth`) over `rect`, both `rect.area()` long, drawing
+/// the triangles listed in `order` (ascending indices into `setups`, so on equal depth the
+/// later triangle still wins).
 pub(crate) fn rasterise_triangles(
     setups: &[TriangleSetup],
-    work: PixelRect,
+    order: impl IntoIterator<Item = u32>,
+    rect: PixelRect,
     use_depth: bool,
     ids: &mut [u32],
     depths: &mut [f32],
@@ -29,11 +32,18 @@ pub(crate) fn rasterise_triangles(
     if use_depth {
         depths.fill(f32::NEG_INFINITY);
     }
-    for (index, setup) in setups.iter().enumerate() {
+    for index in order {
+        let setup = &setups[index as usize];
         if setup.drawable {
-            rasterise_one(setup, index as u32, work, use_depth, ids, depths);
+            rasterise_one(setup, index, rect, use_depth, ids, depths);
         }
     }
+}
+
+/// The canvas rows `[first, last)` whose pixel centres a drawable triangle may own.
+pub(crate) fn centre_rows(setup: &TriangleSetup) -> (i64, i64) {
+    let [a, b, c] = setup.fixed;
+    centre_range(a[1].min(b[1]).min(c[1]), a[1].max(b[1]).max(c[1]))
 }
 
 /// Whether the edge a→b of a positively oriented triangle is a top or left edge.
@@ -68,10 +78,10 @@ fn rasterise_one(
             ids[cells].fill(index);
             return;
         }
-        let cy = f64::from(y) + 0.5;
+        let (first_depth, step) = setup.depth_along_row(x0, y);
         let cell_ids = &mut ids[cells.clone()];
-        for ((x, id), stored) in (x0..x1).zip(cell_ids).zip(&mut depths[cells]) {
-            let depth = setup.depth_at(f64::from(x) + 0.5, cy);
+        for (k, (id, stored)) in cell_ids.iter_mut().zip(&mut depths[cells]).enumerate() {
+            let depth = first_depth + step * k as f32;
             if depth >= *stored {
                 *stored = depth;
                 *id = index;
