@@ -63,9 +63,12 @@ impl<'a> Sampler<'a> {
         // SAFETY: the taps are ≤ last_x < width and ≤ last_y < height (see `taps_f32`), and
         // `pixels` holds width · height ≥ 1 texels (a FloatImage is never empty).
         let texel = |i: usize| Vec4::from_array(unsafe { *self.pixels.get_unchecked(i) });
-        let top = texel(row0 + x0).lerp(texel(row0 + x1), tx);
-        let bottom = texel(row1 + x0).lerp(texel(row1 + x1), tx);
-        top.lerp(bottom, ty)
+        // a + (b − a)·t: one multiply fewer than glam's `lerp` (a·(1 − t) + b·t); differs
+        // from the f64 reference only in the last bits.
+        let lerp = |a: Vec4, b: Vec4, t: f32| a + (b - a) * t;
+        let top = lerp(texel(row0 + x0), texel(row0 + x1), tx);
+        let bottom = lerp(texel(row1 + x0), texel(row1 + x1), tx);
+        lerp(top, bottom, ty)
     }
 }
 

@@ -80,12 +80,12 @@ fn rasterise_one(
         }
         let (first_depth, step) = setup.depth_along_row(x0, y);
         let cell_ids = &mut ids[cells.clone()];
+        // Branch-free selects, so the loop vectorises.
         for (k, (id, stored)) in cell_ids.iter_mut().zip(&mut depths[cells]).enumerate() {
-            let depth = first_depth + step * k as f32;
-            if depth >= *stored {
-                *stored = depth;
-                *id = index;
-            }
+            let depth = first_depth + step * k as i32 as f32;
+            let wins = depth >= *stored;
+            *stored = if wins { depth } else { *stored };
+            *id = if wins { index } else { *id };
         }
     });
 }
