@@ -144,10 +144,8 @@ impl PatchCloner {
         canvas: &mut Canvas,
         placement: &Placement,
     ) -> Result<CloneStats, CloneError> {
-        check_placement(placement)?;
-        placement.apply(&self.mesh.positions, &mut self.placed);
-        self.hidden.fill(false);
-        self.clone_placed(canvas, None)
+        self.prepare_rigid(placement)?;
+        self.clone_prepared(canvas, None)
     }
 
     /// Clones the patch with its vertices moved to `deformed` (rest frame) and then placed.
@@ -160,14 +158,34 @@ impl PatchCloner {
         deformed: &[DVec2],
         depth: Option<&[f32]>,
     ) -> Result<CloneStats, CloneError> {
+        self.prepare_deformed(placement, deformed, depth)?;
+        self.clone_prepared(canvas, depth)
+    }
+
+    /// The canvas-independent half of [`clone_onto`](Self::clone_onto): places the vertices.
+    /// Patches of one frame can prepare in parallel, then clone in layer order.
+    pub fn prepare_rigid(&mut self, placement: &Placement) -> Result<(), CloneError> {
+        check_placement(placement)?;
+        placement.apply(&self.mesh.positions, &mut self.placed);
+        self.hidden.fill(false);
+        Ok(())
+    }
+
+    /// The canvas-independent half of [`clone_deformed`](Self::clone_deformed): places the
+    /// deformed vertices and finds the boundary vertices hidden under the patch itself.
+    pub fn prepare_deformed(
+        &mut self,
+        placement: &Placement,
+        deformed: &[DVec2],
+        depth: Option<&[f32]>,
+    ) -> Result<(), CloneError> {
         check_placement(placement)?;
         let n = self.mesh.vertex_count();
         if deformed.len() != n || depth.is_some_and(|d| d.len() != n) {
             return Err(CloneError::VertexCountMismatch(deformed.len(), n));
         }
         placement.apply(deformed, &mut self.placed);
-        self.mark_hidden(depth)?;
-        self.clone_placed(canvas, depth)
+        self.mark_hidden(depth)
     }
 
     fn mark_hidden(&mut self, depth: Option<&[f32]>) -> Result<(), CloneError> {
@@ -189,11 +207,17 @@ impl PatchCloner {
         Ok(())
     }
 
-    fn clone_placed(
+    /// The canvas half: membrane constraints from `canvas` under the prepared placement, the
+    /// membrane solve and the raster. `depth` must be the one given to the preparation.
+    pub fn clone_prepared(
         &mut self,
         canvas: &mut Canvas,
         depth: Option<&[f32]>,
     ) -> Result<CloneStats, CloneError> {
+        let n = self.mesh.vertex_count();
+        if self.placed.len() != n || depth.is_some_and(|d| d.len() != n) {
+            return Err(CloneError::VertexCountMismatch(self.placed.len(), n));
+        }
         let started = Instant::now();
         let membrane = self
             .membrane

@@ -100,12 +100,9 @@ impl Layer {
         })
     }
 
-    /// Clones this patch, in its state at this frame, onto `canvas`.
-    pub fn draw(
-        &mut self,
-        state: &PatchState,
-        canvas: &mut Canvas,
-    ) -> Result<(CloneStats, DeformStats), RenderError> {
+    /// The canvas-independent part of cloning this patch, in its state at this frame:
+    /// deformation, placement and self-occlusion. Layers of one frame may prepare in parallel.
+    pub fn prepare(&mut self, state: &PatchState) -> Result<DeformStats, RenderError> {
         let placement = Placement {
             pivot: self.pivot,
             at: state.position.unwrap_or(self.pivot),
@@ -113,20 +110,41 @@ impl Layer {
             rotation_deg: state.rotation,
         };
         let deform_stats = self.deform(state)?;
-        let result = match (&self.rig, self.deforms) {
-            (Some(_), true) => self.cloner.clone_deformed(
-                canvas,
+        let result = if self.deforming() {
+            self.cloner.prepare_deformed(
                 &placement,
                 &self.deformed.positions,
                 Some(&self.deformed.depth),
-            ),
-            _ => self.cloner.clone_onto(canvas, &placement),
+            )
+        } else {
+            self.cloner.prepare_rigid(&placement)
         };
-        let clone_stats = result.map_err(|source| RenderError::Clone {
+        result.map_err(|source| self.clone_error(source))?;
+        Ok(deform_stats)
+    }
+
+    /// After [`prepare`](Self::prepare): clones onto `canvas` (the composite of the layers
+    /// below).
+    pub fn composite(&mut self, canvas: &mut Canvas) -> Result<CloneStats, RenderError> {
+        let depth = self.deforming().then_some(&self.deformed.depth[..]);
+        let result = self.cloner.clone_prepared(canvas, depth);
+        result.map_err(|source| self.clone_error(source))
+    }
+
+    fn deforming(&self) -> bool {
+        self.rig.is_some() && self.deforms
+    }
+
+    /// Whether this layer deforms in the current version of its patch.
+    pub fn deforms(&self) -> bool {
+        self.deforming()
+    }
+
+    fn clone_error(&self, source: crate::clone::CloneError) -> RenderError {
+        RenderError::Clone {
             patch: self.name.clone(),
             source,
-        })?;
-        Ok((clone_stats, deform_stats))
+        }
     }
 
     fn deform(&mut self, state: &PatchState) -> Result<DeformStats, RenderError> {

@@ -214,14 +214,16 @@ impl Renderer {
             time: t,
             ..FrameStats::default()
         };
+        let prepare_started = Instant::now();
+        stats.deform_switches = self.prepare_layers()?;
+        stats.deform_ms = millis(prepare_started.elapsed());
         for &index in &self.state.draw_order {
-            let deform_started = Instant::now();
-            let (clone, deform) =
-                self.layers[index].draw(&self.state.patches[index], &mut self.frame)?;
-            stats.deform_ms += millis(deform_started.elapsed()) - clone.solve_ms - clone.raster_ms;
+            let composite_started = Instant::now();
+            let clone = self.layers[index].composite(&mut self.frame)?;
+            stats.deform_ms +=
+                millis(composite_started.elapsed()) - clone.solve_ms - clone.raster_ms;
             stats.solve_ms += clone.solve_ms;
             stats.raster_ms += clone.raster_ms;
-            stats.deform_switches += deform.switches();
             let switches = clone.membrane.switches;
             stats.clone_switches += switches.updates + switches.downdates;
             stats.hidden += clone.membrane.hidden;
@@ -232,6 +234,51 @@ impl Renderer {
         stats.total_ms = millis(started.elapsed());
         self.stats = stats;
         Ok(&self.frame)
+    }
+
+    /// Deforms and places every drawn layer (they do not read the canvas): in parallel when
+    /// several deform and there are cores for them, else in order. Gives the deformation
+    /// constraint switches; on failure, the error of the first failing layer in draw order.
+    fn prepare_layers(&mut self) -> Result<usize, RenderError> {
+        let order = &self.state.draw_order;
+        let patches = &self.state.patches;
+        let deforming = order.iter().filter(|&&i| self.layers[i].deforms()).count();
+        if deforming < 2 || available_cores() < 2 {
+            let mut switches = 0;
+            for &index in order {
+                switches += self.layers[index].prepare(&patches[index])?.switches();
+            }
+            return Ok(switches);
+        }
+        let mut drawn = vec![false; self.layers.len()];
+        order.iter().for_each(|&i| drawn[i] = true);
+        type Job<'a> = (usize, &'a mut Layer, Option<Result<usize, RenderError>>);
+        let mut jobs: Vec<Job> = self
+            .layers
+            .iter_mut()
+            .enumerate()
+            .filter(|(index, _)| drawn[*index])
+            .map(|(index, layer)| (index, layer, None))
+            .collect();
+        let queue = std::sync::Mutex::new(jobs.iter_mut());
+        std::thread::scope(|scope| {
+            for _ in 0..available_cores().min(deforming) {
+                scope.spawn(|| loop {
+                    let job = queue.lock().unwrap_or_else(|e| e.into_inner()).next();
+                    let Some((index, layer, result)) = job else {
+                        break;
+                    };
+                    *result = Some(layer.prepare(&patches[*index]).map(|d| d.switches()));
+                });
+            }
+        });
+        let mut switches = 0;
+        for &index in order {
+            if let Some((_, _, Some(result))) = jobs.iter_mut().find(|job| job.0 == index) {
+                switches += std::mem::replace(result, Ok(0))?;
+            }
+        }
+        Ok(switches)
     }
 
     /// Resets the frame to the background: only the rectangles the last frame drew into when
@@ -319,4 +366,10 @@ fn background_canvas(scene: &Scene) -> Result<Canvas, RenderError> {
 
 fn millis(duration: std::time::Duration) -> f64 {
     duration.as_secs_f64() * 1e3
+}
+
+/// Cores available to this process (1 if unknown), looked up once.
+fn available_cores() -> usize {
+    static CORES: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
+    *CORES.get_or_init(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
 }
