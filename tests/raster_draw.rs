@@ -463,3 +463,88 @@ fn every_thread_count_draws_the_same_pixels() {
         }
     }
 }
+
+#[test]
+fn whole_pixel_moves_replay_the_same_bytes_as_fresh_draws() {
+    let source = raster_meshes::pattern_image(120, 100);
+    let mesh = raster_meshes::grid(DVec2::new(3.0, 4.0), 5.5, 18, 15);
+    let base: Vec<DVec2> = mesh
+        .positions
+        .iter()
+        .map(|p| DVec2::new(1.2 * p.x - 0.3 * p.y + 60.25, 0.3 * p.x + 1.2 * p.y + 11.5))
+        .collect();
+    // Moves and whether each replays: the first draw records; whole-pixel shifts from the
+    // record replay; a fractional shift draws fresh without recording; a whole-pixel move
+    // after it records again, so the next whole-pixel move replays; a move across the
+    // canvas edge draws fresh.
+    let shifts = [
+        ((0.0, 0.0), false),
+        ((3.0, 2.0), true),
+        ((3.0, 2.0), true),
+        ((-4.0, 7.0), true),
+        ((0.5, 0.0), false),
+        ((1.5, 0.0), false),
+        ((2.5, 1.0), true),
+        ((-45.0, 0.0), false),
+    ];
+    for (anti_alias, format) in [
+        (true, PixelFormat::RGBA8),
+        (false, PixelFormat::RGBA8),
+        (true, PixelFormat::RGBA16),
+    ] {
+        let mut replaying = RasterScratch::new();
+        for (k, &((dx, dy), replays)) in shifts.iter().enumerate() {
+            let placed: Vec<DVec2> = base.iter().map(|p| *p + DVec2::new(dx, dy)).collect();
+            // The membrane changes every frame, as the target under a moving patch does.
+            let membrane: Vec<[f32; 3]> = mesh
+                .positions
+                .iter()
+                .map(|p| {
+                    [
+                        (p.x * 0.003) as f32 + k as f32 * 0.02,
+                        -0.05,
+                        (p.y * 0.002) as f32,
+                    ]
+                })
+                .collect();
+            let patch = Patch {
+                rest: &mesh.positions,
+                placed: &placed,
+                triangles: &mesh.triangles,
+                membrane: &membrane,
+                depth: None,
+                loops: &mesh.loops,
+                source: &source,
+            };
+            let draw = |scratch: &mut RasterScratch, replay: bool| {
+                let background = FloatImage::from_fn(190, 170, format, |i, j| {
+                    [0.2, (i % 7) as f32 / 7.0, (j % 5) as f32 / 5.0, 1.0]
+                })
+                .unwrap();
+                let mut canvas = Canvas::from_image(&background);
+                let options = RasterOptions {
+                    anti_alias,
+                    replay,
+                    ..RasterOptions::default()
+                };
+                let stats = draw_patch(&mut canvas, &patch, &options, scratch).unwrap();
+                (canvas.to_float_image(format), stats)
+            };
+            let (image, stats) = draw(&mut replaying, true);
+            let (fresh, fresh_stats) = draw(&mut RasterScratch::new(), false);
+            assert!(
+                image.pixels() == fresh.pixels(),
+                "move {k} ({dx}, {dy}), anti-alias {anti_alias}: replay differs from a fresh draw"
+            );
+            assert_eq!(
+                (stats.centre_hits, stats.written, stats.work),
+                (
+                    fresh_stats.centre_hits,
+                    fresh_stats.written,
+                    fresh_stats.work
+                )
+            );
+            assert_eq!(stats.replayed, replays, "move {k}");
+        }
+    }
+}

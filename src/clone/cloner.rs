@@ -110,6 +110,8 @@ impl PatchCloner {
             membrane,
             raster_options: RasterOptions {
                 feather: options.feather,
+                // The cloner owns its source and mesh: a drag by whole pixels replays.
+                replay: true,
                 ..RasterOptions::default()
             },
             placed: Vec::with_capacity(n),

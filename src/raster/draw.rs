@@ -10,7 +10,9 @@ use super::coverage::fill_silhouette;
 use super::feather::apply_feather;
 use super::scratch::BandScratch;
 use super::setup::{TriangleSetup, MAX_COORDINATE};
-use super::shade::{shade_and_composite, CoverageTexel, ShadeInput, StoreTexel};
+use super::shade::{
+    shade_and_composite, CoverageTexel, NoRecorder, Recorder, ShadeInput, StoreTexel,
+};
 use super::triangles::{rasterise_triangles, NO_TRIANGLE};
 use super::{Patch, PixelRect, RasterError, RasterScratch};
 use crate::pixels::{Canvas, CanvasPixels};
@@ -24,6 +26,10 @@ pub struct RasterOptions {
     pub anti_alias: bool,
     /// Threads drawing one large patch (0: one per core). Any count gives the same pixels.
     pub threads: usize,
+    /// Replay the previous draw when the patch only moved by whole pixels (see
+    /// [`replay`](super::replay)). Only for a scratch that stays with one patch whose
+    /// source and mesh are not modified in place between draws.
+    pub replay: bool,
 }
 
 impl Default for RasterOptions {
@@ -32,6 +38,7 @@ impl Default for RasterOptions {
             feather: 0.0,
             anti_alias: true,
             threads: 0,
+            replay: false,
         }
     }
 }
@@ -45,6 +52,9 @@ pub struct RasterStats {
     pub centre_hits: usize,
     /// Canvas pixels written.
     pub written: usize,
+    /// Whether the draw replayed the previous one moved by whole pixels (see
+    /// [`RasterOptions::replay`]).
+    pub replayed: bool,
 }
 
 /// Composites `patch` over `canvas`. Allocates nothing once `scratch` has grown (apart from
@@ -62,6 +72,9 @@ pub fn draw_patch(
     let Some(work) = work_rect(patch, canvas, options.feather) else {
         return Ok(RasterStats::default());
     };
+    if let Some(stats) = try_replay(canvas, patch, options, work, scratch) {
+        return Ok(stats);
+    }
     build_setups(patch, &mut scratch.setups);
     let mask_stride = options.anti_alias.then(|| {
         fill_silhouette(
@@ -72,22 +85,81 @@ pub fn draw_patch(
             &mut scratch.mask,
         )
     });
+    let canvas_bounds = canvas_rect(canvas);
     let frame = Frame {
         patch,
         work,
-        target: work.intersect(&canvas_rect(canvas)),
+        target: work.intersect(&canvas_bounds),
         mask_stride,
         use_depth: patch.depth.is_some(),
     };
+    let replayable = options.replay && patch.depth.is_none() && options.feather == 0.0;
+    let record = replayable
+        && frame.target == work
+        && scratch.replay.wants_record(patch, options.anti_alias, work);
+    let mut replay = std::mem::take(&mut scratch.replay);
     let canvas_width = canvas.width() as usize;
-    let (centre_hits, written) = match canvas.pixels_mut() {
-        CanvasPixels::Eight(p) => draw_frame(&frame, options, scratch, p, canvas_width),
-        CanvasPixels::Sixteen(p) => draw_frame(&frame, options, scratch, p, canvas_width),
+    let (centre_hits, written) = if record {
+        let mut recording = replay.start(patch, options.anti_alias, work);
+        match canvas.pixels_mut() {
+            CanvasPixels::Eight(p) => {
+                draw_frame(&frame, options, scratch, p, canvas_width, &mut recording)
+            }
+            CanvasPixels::Sixteen(p) => {
+                draw_frame(&frame, options, scratch, p, canvas_width, &mut recording)
+            }
+        }
+    } else {
+        let mut none = NoRecorder;
+        match canvas.pixels_mut() {
+            CanvasPixels::Eight(p) => {
+                draw_frame(&frame, options, scratch, p, canvas_width, &mut none)
+            }
+            CanvasPixels::Sixteen(p) => {
+                draw_frame(&frame, options, scratch, p, canvas_width, &mut none)
+            }
+        }
     };
+    if replayable {
+        replay.remember(patch, options.anti_alias);
+    }
+    scratch.replay = replay;
     Ok(RasterStats {
         work,
         centre_hits,
         written,
+        replayed: false,
+    })
+}
+
+/// Replays the scratch's record when `patch` is it moved by whole pixels (see
+/// [`replay`](super::replay)); `None` when a fresh draw is needed.
+fn try_replay(
+    canvas: &mut Canvas,
+    patch: &Patch,
+    options: &RasterOptions,
+    work: PixelRect,
+    scratch: &mut RasterScratch,
+) -> Option<RasterStats> {
+    if !options.replay || patch.depth.is_some() || options.feather != 0.0 {
+        return None;
+    }
+    let shift = scratch
+        .replay
+        .shift_for(patch, options.anti_alias, canvas_rect(canvas), work)?;
+    build_setups(patch, &mut scratch.setups);
+    let canvas_width = canvas.width() as usize;
+    let replay = &scratch.replay;
+    let (centre_hits, written) = match canvas.pixels_mut() {
+        CanvasPixels::Eight(p) => replay.draw(shift, &scratch.setups, p, canvas_width),
+        CanvasPixels::Sixteen(p) => replay.draw(shift, &scratch.setups, p, canvas_width),
+    };
+    scratch.replay.remember(patch, options.anti_alias);
+    Some(RasterStats {
+        work,
+        centre_hits,
+        written,
+        replayed: true,
     })
 }
 
@@ -103,12 +175,13 @@ struct Frame<'a> {
 }
 
 /// Draws over the canvas pixels; gives (centre hits, pixels written).
-fn draw_frame<T: StoreTexel + Send>(
+fn draw_frame<T: StoreTexel + Send, R: Recorder<u8>>(
     frame: &Frame,
     options: &RasterOptions,
     scratch: &mut RasterScratch,
     canvas: &mut [[T; 4]],
     canvas_width: usize,
+    recorder: &mut R,
 ) -> (usize, usize) {
     if options.feather > 0.0 {
         return draw_feathered(frame, options.feather, scratch, canvas, canvas_width);
@@ -120,7 +193,9 @@ fn draw_frame<T: StoreTexel + Send>(
         target.width(),
         scratch.band_pixels,
     );
-    let threads = worker_threads(options.threads, target.area(), scratch.bands.count());
+    // A recording takes the bands in order, on this thread.
+    let requested = if R::ACTIVE { 1 } else { options.threads };
+    let threads = worker_threads(requested, target.area(), scratch.bands.count());
     if scratch.workers.len() < threads {
         scratch.workers.resize_with(threads, BandScratch::default);
     }
@@ -137,7 +212,7 @@ fn draw_frame<T: StoreTexel + Send>(
     if threads == 1 {
         let worker = &mut workers[0];
         return jobs.fold((0, 0), |(hits, written), (band, rows)| {
-            let (h, w) = draw_band(&shared, band, rows, canvas_width, worker);
+            let (h, w) = draw_band(&shared, band, rows, canvas_width, worker, recorder);
             (hits + h, written + w)
         });
     }
@@ -149,7 +224,7 @@ fn draw_frame<T: StoreTexel + Send>(
             scope.spawn(move || loop {
                 let job = queue.lock().unwrap_or_else(|e| e.into_inner()).next();
                 let Some((band, rows)) = job else { break };
-                let (h, w) = draw_band(shared, band, rows, canvas_width, worker);
+                let (h, w) = draw_band(shared, band, rows, canvas_width, worker, &mut NoRecorder);
                 *total = (total.0 + h, total.1 + w);
             });
         }
@@ -184,12 +259,13 @@ struct BandInput<'a> {
 
 /// Rasterises one band's triangles over the band and its apron, then shades the band's
 /// rows (`canvas_rows`: those canvas rows, whole). Gives (centre hits, pixels written).
-fn draw_band<T: StoreTexel>(
+fn draw_band<T: StoreTexel, R: Recorder<u8>>(
     input: &BandInput,
     band: usize,
     canvas_rows: &mut [[T; 4]],
     canvas_width: usize,
     scratch: &mut BandScratch,
+    recorder: &mut R,
 ) -> (usize, usize) {
     let frame = input.frame;
     let (work, target) = (frame.work, frame.target);
@@ -232,7 +308,7 @@ fn draw_band<T: StoreTexel>(
         coverage_origin,
         source: frame.patch.source,
     };
-    shade_and_composite(&shade, rows, canvas_rows, canvas_width)
+    shade_and_composite(&shade, rows, canvas_rows, canvas_width, recorder)
 }
 
 /// The feathered draw, in one piece: the feather's distance transform needs the ids of the
@@ -294,7 +370,7 @@ fn draw_feathered<T: StoreTexel>(
         source: frame.patch.source,
     };
     let rows = &mut canvas[target.y0 as usize * canvas_width..];
-    shade_and_composite(&shade, target, rows, canvas_width)
+    shade_and_composite(&shade, target, rows, canvas_width, &mut NoRecorder)
 }
 
 fn canvas_rect(canvas: &Canvas) -> PixelRect {

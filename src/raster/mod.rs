@@ -37,6 +37,7 @@ mod feather;
 pub mod overlay;
 mod patch;
 mod rect;
+mod replay;
 mod sampler;
 mod scratch;
 mod setup;

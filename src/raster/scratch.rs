@@ -4,6 +4,7 @@
 //! nothing.
 
 use super::bands::{Bands, BAND_PIXELS};
+use super::replay::Replay;
 use super::setup::TriangleSetup;
 
 /// Scratch buffers for [`draw_patch`](super::draw_patch); keep one per patch (or per thread)
@@ -20,6 +21,7 @@ pub struct RasterScratch {
     pub(crate) mask: Option<tiny_skia::Mask>,
     /// Pixels per row band (tests vary it to prove it changes nothing).
     pub(crate) band_pixels: usize,
+    pub(crate) replay: Replay,
 }
 
 impl Default for RasterScratch {
@@ -34,6 +36,7 @@ impl Default for RasterScratch {
             path_builder: None,
             mask: None,
             band_pixels: BAND_PIXELS,
+            replay: Replay::default(),
         }
     }
 }

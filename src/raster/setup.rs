@@ -27,13 +27,8 @@ pub(crate) struct TriangleSetup {
     pub depth_affine: [f64; 3],
     /// Signed placed area ×2 (negative: inverted).
     pub signed_area2: f64,
-    /// Rest x and y as affine functions of the canvas position: `[constant, d/dx, d/dy]`.
-    pub rest_x: [f64; 3],
-    pub rest_y: [f64; 3],
-    /// Membrane channels as affine functions of the canvas position: `[constant, d/dx, d/dy]`.
-    pub membrane_affine: [[f32; 3]; 3],
-    /// The same maps in single precision relative to a pixel centre near the triangle,
-    /// for the shading loop.
+    /// Rest position (source texel space) and membrane as single-precision affine maps
+    /// relative to a pixel centre near the triangle, for shading.
     pub span: SpanSetup,
 }
 
@@ -49,13 +44,6 @@ pub(crate) struct SpanSetup {
     pub texel_y: [f32; 3],
     /// Membrane (RGB, alpha lane 0) at the origin and its steps along x and y.
     pub membrane: [Vec4; 3],
-}
-
-/// Barycentric-derived values at one canvas position.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Interpolated {
-    pub rest: DVec2,
-    pub membrane: [f32; 3],
 }
 
 impl TriangleSetup {
@@ -82,26 +70,25 @@ impl TriangleSetup {
         // Barycentric gradients: λ1 = g1·(p − a), λ2 = g2·(p − a).
         let g1 = DVec2::new(e2.y * inv, -e2.x * inv);
         let g2 = DVec2::new(-e1.y * inv, e1.x * inv);
+        let gradient = |edge1: f64, edge2: f64| g1 * edge1 + g2 * edge2;
         let affine = |at_a: f64, edge1: f64, edge2: f64| {
-            let gradient = g1 * edge1 + g2 * edge2;
+            let gradient = gradient(edge1, edge2);
             [at_a - gradient.dot(a), gradient.x, gradient.y]
         };
         let (r1, r2) = (rest[1] - rest[0], rest[2] - rest[0]);
-        let membrane_affine = [0, 1, 2].map(|c| {
+        let channel = |c: usize| {
             let m = |k: usize| f64::from(membrane[k][c]);
-            affine(m(0), m(1) - m(0), m(2) - m(0)).map(|v| v as f32)
-        });
-        let rest_x = affine(rest[0].x, r1.x, r2.x);
-        let rest_y = affine(rest[0].y, r1.y, r2.y);
-        let membrane_f64 = [0, 1, 2].map(|c| {
-            let m = |k: usize| f64::from(membrane[k][c]);
-            affine(m(0), m(1) - m(0), m(2) - m(0))
-        });
+            (m(0), gradient(m(1) - m(0), m(2) - m(0)))
+        };
+        let maps = [
+            (rest[0].x, gradient(r1.x, r2.x)),
+            (rest[0].y, gradient(r1.y, r2.y)),
+            channel(0),
+            channel(1),
+            channel(2),
+        ];
         TriangleSetup {
-            span: SpanSetup::new(a, rest_x, rest_y, membrane_f64),
-            rest_x,
-            rest_y,
-            membrane_affine,
+            span: SpanSetup::new(a, maps),
             fixed,
             drawable,
             depth_affine: affine(
@@ -123,42 +110,53 @@ impl TriangleSetup {
         let (cx, cy) = (f64::from(x) + 0.5, f64::from(y) + 0.5);
         ((d[0] + d[1] * cx + d[2] * cy) as f32, d[1] as f32)
     }
-
-    /// Rest position and membrane at a canvas position (extrapolated outside the triangle).
-    #[inline(always)]
-    pub fn interpolate(&self, x: f64, y: f64) -> Interpolated {
-        let rest = DVec2::new(
-            self.rest_x[0] + self.rest_x[1] * x + self.rest_x[2] * y,
-            self.rest_y[0] + self.rest_y[1] * x + self.rest_y[2] * y,
-        );
-        let (xf, yf) = (x as f32, y as f32);
-        let membrane = self.membrane_affine.map(|m| m[0] + m[1] * xf + m[2] * yf);
-        Interpolated { rest, membrane }
-    }
 }
 
 impl SpanSetup {
-    /// Re-bases the affine maps `[constant, d/dx, d/dy]` at the pixel centre nearest `near`.
-    fn new(near: DVec2, rest_x: [f64; 3], rest_y: [f64; 3], membrane: [[f64; 3]; 3]) -> Self {
+    /// Re-bases affine maps, each given by its value at vertex `a` and its gradient (rest x,
+    /// rest y, then the three membrane channels), at the pixel centre nearest `a`. Only
+    /// differences from `a` enter, so a patch moved by whole pixels gets bit-identical span
+    /// maps (the replay of [`replay`](super::replay) relies on it).
+    fn new(a: DVec2, maps: [(f64, DVec2); 5]) -> Self {
         let clamp = |v: f64| v.floor().clamp(-MAX_COORDINATE, MAX_COORDINATE) as i32;
-        let origin = [clamp(near.x), clamp(near.y)];
-        let (cx, cy) = (f64::from(origin[0]) + 0.5, f64::from(origin[1]) + 0.5);
-        let at = |m: [f64; 3]| m[0] + m[1] * cx + m[2] * cy;
-        let texel = |m: [f64; 3]| [(at(m) - 0.5) as f32, m[1] as f32, m[2] as f32];
-        let lanes = |value: &dyn Fn([f64; 3]) -> f64| {
+        let origin = [clamp(a.x), clamp(a.y)];
+        let offset = DVec2::new(f64::from(origin[0]) + 0.5, f64::from(origin[1]) + 0.5) - a;
+        let at_origin = |(value, gradient): (f64, DVec2)| value + gradient.dot(offset);
+        let texel = |(value, gradient): (f64, DVec2)| {
+            [
+                (at_origin((value, gradient)) - 0.5) as f32,
+                gradient.x as f32,
+                gradient.y as f32,
+            ]
+        };
+        let lanes = |value: &dyn Fn((f64, DVec2)) -> f64| {
             Vec4::new(
-                value(membrane[0]) as f32,
-                value(membrane[1]) as f32,
-                value(membrane[2]) as f32,
+                value(maps[2]) as f32,
+                value(maps[3]) as f32,
+                value(maps[4]) as f32,
                 0.0,
             )
         };
         SpanSetup {
             origin,
-            texel_x: texel(rest_x),
-            texel_y: texel(rest_y),
-            membrane: [lanes(&at), lanes(&|m| m[1]), lanes(&|m| m[2])],
+            texel_x: texel(maps[0]),
+            texel_y: texel(maps[1]),
+            membrane: [lanes(&at_origin), lanes(&|m| m.1.x), lanes(&|m| m.1.y)],
         }
+    }
+
+    /// The source position (texel space) and membrane at pixel `(x, y)`'s centre.
+    #[inline(always)]
+    pub fn at_pixel(&self, x: i32, y: i32) -> (f32, f32, Vec4) {
+        let dx = (x - self.origin[0]) as f32;
+        let dy = (y - self.origin[1]) as f32;
+        let at = |m: &[f32; 3]| m[0] + m[1] * dx + m[2] * dy;
+        let [m_origin, m_x, m_y] = self.membrane;
+        (
+            at(&self.texel_x),
+            at(&self.texel_y),
+            m_origin + m_x * dx + m_y * dy,
+        )
     }
 }
 

@@ -102,11 +102,12 @@ pub(crate) struct ShadeInput<'a, C> {
 ///
 /// Each row is walked in runs of equal triangle id, so a run reads its triangle's setup
 /// once; only the fringe (coverage without a triangle at the centre) looks at neighbours.
-pub(crate) fn shade_and_composite<T: StoreTexel, C: CoverageTexel>(
+pub(crate) fn shade_and_composite<T: StoreTexel, C: CoverageTexel, R: Recorder<C>>(
     input: &ShadeInput<C>,
     rows: PixelRect,
     canvas: &mut [[T; 4]],
     canvas_width: usize,
+    recorder: &mut R,
 ) -> (usize, usize) {
     let ids_rect = input.ids_rect;
     let ids_width = ids_rect.width();
@@ -141,12 +142,14 @@ pub(crate) fn shade_and_composite<T: StoreTexel, C: CoverageTexel>(
                 y,
                 coverage: &coverage[start..end],
             };
+            recorder.run(x0, y, end - start, id);
+            let pixels = &mut row[start..end];
             written += if id == NO_TRIANGLE {
-                shade_fringe(input, &span, &mut row[start..end])
+                shade_fringe(input, &sampler, &span, pixels, recorder)
             } else {
                 hits += end - start;
                 let setup = &input.setups[id as usize];
-                shade_span(setup, &sampler, &span, &mut row[start..end])
+                shade_span(setup, &sampler, &span, pixels, recorder)
             };
             start = end;
         }
@@ -167,33 +170,24 @@ struct Span<'a, C> {
 /// position drifts by far less than 1/1000 px, invisible after 8- or 16-bit rounding.
 /// Interior pixels (full coverage, opaque source) skip the blend.
 #[inline(always)]
-fn shade_span<T: StoreTexel, C: CoverageTexel>(
+fn shade_span<T: StoreTexel, C: CoverageTexel, R: Recorder<C>>(
     setup: &TriangleSetup,
     sampler: &Sampler,
     span: &Span<C>,
     pixels: &mut [[T; 4]],
+    recorder: &mut R,
 ) -> usize {
     let maps = &setup.span;
-    let dx = (span.x0 - maps.origin[0]) as f32;
-    let dy = (span.y - maps.origin[1]) as f32;
-    let at = |m: &[f32; 3]| m[0] + m[1] * dx + m[2] * dy;
-    let (mut u, mut v) = (at(&maps.texel_x), at(&maps.texel_y));
-    let (u_step, v_step) = (maps.texel_x[1], maps.texel_y[1]);
-    let [m_origin, m_step, m_step_y] = maps.membrane;
-    let mut membrane = m_origin + m_step * dx + m_step_y * dy;
+    let (mut u, mut v, mut membrane) = maps.at_pixel(span.x0, span.y);
+    let (u_step, v_step, m_step) = (maps.texel_x[1], maps.texel_y[1], maps.membrane[1]);
     let mut written = 0;
     for (&texel, pixel) in span.coverage.iter().zip(pixels.iter_mut()) {
         if texel.is_covered() {
             let sample = sampler.sample_texel_space(u, v);
-            // The membrane's alpha lane is 0, so an opaque sample clamps to alpha 1 here.
-            let mut colour = (sample + membrane).clamp(Vec4::ZERO, Vec4::ONE);
-            written += if texel.is_full() && sample.w >= 1.0 {
-                *pixel = T::store_unit(colour);
-                1
-            } else {
-                colour.w = sample.w;
-                usize::from(composite(pixel, colour.to_array(), texel.unit()))
-            };
+            recorder.pixel(Some(sample), texel);
+            written += usize::from(shade_pixel(pixel, sample, membrane, texel));
+        } else {
+            recorder.pixel(None, texel);
         }
         u += u_step;
         v += v_step;
@@ -202,28 +196,74 @@ fn shade_span<T: StoreTexel, C: CoverageTexel>(
     written
 }
 
-/// Shades a run of pixels whose centres miss every triangle (the anti-aliased fringe).
-fn shade_fringe<T: Texel, C: CoverageTexel>(
+/// Source sample plus membrane, composited with the pixel's coverage; whether it changed.
+#[inline(always)]
+pub(crate) fn shade_pixel<T: StoreTexel, C: CoverageTexel>(
+    pixel: &mut [T; 4],
+    sample: Vec4,
+    membrane: Vec4,
+    coverage: C,
+) -> bool {
+    // The membrane's alpha lane is 0, so an opaque sample clamps to alpha 1 here.
+    let mut colour = (sample + membrane).clamp(Vec4::ZERO, Vec4::ONE);
+    if coverage.is_full() && sample.w >= 1.0 {
+        *pixel = T::store_unit(colour);
+        true
+    } else {
+        colour.w = sample.w;
+        composite(pixel, colour.to_array(), coverage.unit())
+    }
+}
+
+/// Shades a run of pixels whose centres miss every triangle (the anti-aliased fringe): each
+/// extrapolates the maps of its owning triangle (see [`owning_triangle`]).
+fn shade_fringe<T: StoreTexel, C: CoverageTexel, R: Recorder<C>>(
     input: &ShadeInput<C>,
+    sampler: &Sampler,
     span: &Span<C>,
     pixels: &mut [[T; 4]],
+    recorder: &mut R,
 ) -> usize {
-    let cy = f64::from(span.y) + 0.5;
     let mut written = 0;
     for (k, (&texel, pixel)) in span.coverage.iter().zip(pixels.iter_mut()).enumerate() {
-        let coverage = texel.unit();
-        if coverage <= 0.0 {
+        if !texel.is_covered() {
             continue;
         }
         let x = span.x0 + k as i32;
         let Some(triangle) = owning_triangle(input, x, span.y) else {
             continue;
         };
-        let cx = f64::from(x) + 0.5;
-        let colour = patch_colour(&input.setups[triangle as usize], input.source, cx, cy);
-        written += usize::from(composite(pixel, colour, coverage));
+        let (u, v, membrane) = input.setups[triangle as usize].span.at_pixel(x, span.y);
+        let sample = sampler.sample_texel_space(u, v);
+        recorder.fringe(x, triangle, sample, texel);
+        written += usize::from(shade_pixel(pixel, sample, membrane, texel));
     }
     written
+}
+
+/// Watches shading (for [`replay`](super::replay)): runs, the source sample and coverage
+/// of every covered pixel, in shading order. [`NoRecorder`] compiles to nothing.
+pub(crate) trait Recorder<C> {
+    /// Whether anything is recorded (a recording draw runs on one thread, in band order).
+    const ACTIVE: bool = true;
+    /// A run of `len` pixels from `(x0, y)` owned by triangle `id`.
+    fn run(&mut self, x0: i32, y: i32, len: usize, id: u32);
+    /// The next pixel of the current triangle run, with its sample when covered.
+    fn pixel(&mut self, sample: Option<Vec4>, coverage: C);
+    /// A covered fringe pixel at column `x` of the current row, extrapolating `owner`.
+    fn fringe(&mut self, x: i32, owner: u32, sample: Vec4, coverage: C);
+}
+
+pub(crate) struct NoRecorder;
+
+impl<C> Recorder<C> for NoRecorder {
+    const ACTIVE: bool = false;
+    #[inline(always)]
+    fn run(&mut self, _: i32, _: i32, _: usize, _: u32) {}
+    #[inline(always)]
+    fn pixel(&mut self, _: Option<Vec4>, _: C) {}
+    #[inline(always)]
+    fn fringe(&mut self, _: i32, _: u32, _: Vec4, _: C) {}
 }
 
 /// Canvas texels with a fast store for the interior path (8-bit on x86_64: SSE2 packs).
@@ -285,18 +325,6 @@ fn composite<T: Texel>(pixel: &mut [T; 4], colour: [f32; 4], coverage: f32) -> b
     let out = crate::pixels::canvas_composite_over(premultiplied, alpha, under);
     *pixel = out.map(T::from_unit);
     true
-}
-
-#[inline(always)]
-fn patch_colour(setup: &TriangleSetup, source: &FloatImage, x: f64, y: f64) -> [f32; 4] {
-    let values = setup.interpolate(x, y);
-    let sample = source.sample_bilinear(values.rest.x, values.rest.y);
-    [
-        (sample[0] + values.membrane[0]).clamp(0.0, 1.0),
-        (sample[1] + values.membrane[1]).clamp(0.0, 1.0),
-        (sample[2] + values.membrane[2]).clamp(0.0, 1.0),
-        sample[3],
-    ]
 }
 
 /// The triangle at the pixel's centre, or the nearest hit neighbour's.

@@ -1,0 +1,230 @@
+//! Replaying a draw for a patch moved by whole pixels: takes the record of an earlier draw
+//! (pixel runs, source samples and coverage, in shading order) and a patch whose placed
+//! vertices are the recorded ones shifted by an integer vector, and composites it with this
+//! frame's membrane — no rasterising, no silhouette fill, no source sampling. This is the
+//! interactive drag of an undeformed patch (and any layer that holds still).
+//!
+//! A replay gives the same bytes as a fresh draw: triangle ownership, the silhouette mask
+//! and the span maps of [`setup`](super::setup) depend only on differences between placed
+//! positions, which an exact integer shift leaves unchanged; the membrane is evaluated by
+//! the same formulas, run by run. It is used only when neither the recorded nor the shifted
+//! work rectangle is clipped by the canvas (clipping changes where runs start), without
+//! depth, without feather, and for the same mesh and source.
+//!
+//! When to record: a fresh draw records when it is the scratch's first draw or when the
+//! patch moved by whole pixels since the previous draw (so a continuously, fractionally
+//! moving patch never pays for recording).
+
+use glam::{DVec2, Vec4};
+
+use super::setup::TriangleSetup;
+use super::shade::{shade_pixel, Recorder, StoreTexel};
+use super::triangles::NO_TRIANGLE;
+use super::{Patch, PixelRect};
+
+/// Largest shift replayed (px): far below the fixed-point range, so shifted coordinates stay
+/// exact.
+const MAX_SHIFT: f64 = (1u64 << 20) as f64;
+
+/// Largest recorded area (px): the record holds 17 bytes per covered pixel.
+const MAX_RECORDED_AREA: usize = 4 << 20;
+
+/// What identifies the patch a record belongs to (addresses and sizes of the mesh and
+/// source slices the draw read; the scratch belongs to one patch).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+struct ReplayKey {
+    rest: (usize, usize),
+    triangles: (usize, usize),
+    source: (usize, u32, u32),
+    anti_alias: bool,
+}
+
+impl ReplayKey {
+    fn of(patch: &Patch, anti_alias: bool) -> ReplayKey {
+        ReplayKey {
+            rest: (patch.rest.as_ptr() as usize, patch.rest.len()),
+            triangles: (patch.triangles.as_ptr() as usize, patch.triangles.len()),
+            source: (
+                patch.source.pixels().as_ptr() as usize,
+                patch.source.width(),
+                patch.source.height(),
+            ),
+            anti_alias,
+        }
+    }
+}
+
+/// One run of the record: `len` pixels from `(x0, y)`, owned by triangle `id` or, for
+/// [`NO_TRIANGLE`], fringe pixels each with its own owner.
+#[derive(Clone, Copy, Debug)]
+struct RecordedRun {
+    x0: i32,
+    y: i32,
+    len: u32,
+    id: u32,
+    /// Fringe runs: how many of their pixels were drawn (and recorded).
+    fringe_pixels: u32,
+}
+
+/// The record of one draw, and the placement of the last draw.
+#[derive(Default)]
+pub(crate) struct Replay {
+    key: ReplayKey,
+    /// Placed positions of the recorded draw (empty: nothing recorded).
+    recorded: Vec<DVec2>,
+    work: PixelRect,
+    runs: Vec<RecordedRun>,
+    /// Per pixel of triangle runs (covered or not) and per covered fringe pixel.
+    coverage: Vec<u8>,
+    /// Per covered pixel, in order.
+    samples: Vec<Vec4>,
+    /// Per covered fringe pixel: column and owning triangle.
+    fringe: Vec<(i32, u32)>,
+    /// Placed positions of the last draw through this scratch.
+    last: Vec<DVec2>,
+    last_key: ReplayKey,
+}
+
+impl Replay {
+    /// The whole-pixel shift from the recorded draw to `patch`, when it can be replayed
+    /// onto a canvas of `canvas` pixels.
+    pub fn shift_for(
+        &self,
+        patch: &Patch,
+        anti_alias: bool,
+        canvas: PixelRect,
+        work: PixelRect,
+    ) -> Option<(i32, i32)> {
+        if self.recorded.is_empty() || self.key != ReplayKey::of(patch, anti_alias) {
+            return None;
+        }
+        let (dx, dy) = whole_pixel_shift(&self.recorded, patch.placed)?;
+        let moved = PixelRect {
+            x0: self.work.x0 + dx,
+            y0: self.work.y0 + dy,
+            x1: self.work.x1 + dx,
+            y1: self.work.y1 + dy,
+        };
+        (moved == work && moved.intersect(&canvas) == moved).then_some((dx, dy))
+    }
+
+    /// Whether a fresh draw of `patch` into `work` (unclipped, inside the canvas) should
+    /// be recorded.
+    pub fn wants_record(&self, patch: &Patch, anti_alias: bool, work: PixelRect) -> bool {
+        let first_draw = self.last.is_empty();
+        let same_patch = self.last_key == ReplayKey::of(patch, anti_alias);
+        work.area() <= MAX_RECORDED_AREA
+            && (first_draw || (same_patch && whole_pixel_shift(&self.last, patch.placed).is_some()))
+    }
+
+    /// Notes the placement of a draw (recorded or not).
+    pub fn remember(&mut self, patch: &Patch, anti_alias: bool) {
+        self.last.clear();
+        self.last.extend_from_slice(patch.placed);
+        self.last_key = ReplayKey::of(patch, anti_alias);
+    }
+
+    /// Clears the record and starts recording a draw of `patch` over `work`.
+    pub fn start(&mut self, patch: &Patch, anti_alias: bool, work: PixelRect) -> Recording<'_> {
+        self.key = ReplayKey::of(patch, anti_alias);
+        self.recorded.clear();
+        self.recorded.extend_from_slice(patch.placed);
+        self.work = work;
+        self.runs.clear();
+        self.coverage.clear();
+        self.samples.clear();
+        self.fringe.clear();
+        Recording { replay: self }
+    }
+
+    /// Composites the record shifted by `(dx, dy)` with the membrane in `setups` (built for
+    /// the shifted patch). Gives (centre hits, pixels written), as a fresh draw would.
+    pub fn draw<T: StoreTexel>(
+        &self,
+        (dx, dy): (i32, i32),
+        setups: &[TriangleSetup],
+        canvas: &mut [[T; 4]],
+        canvas_width: usize,
+    ) -> (usize, usize) {
+        let (mut hits, mut written) = (0, 0);
+        let (mut coverage, mut samples, mut fringe) = (
+            self.coverage.iter(),
+            self.samples.iter(),
+            self.fringe.iter(),
+        );
+        for run in &self.runs {
+            let (x0, y) = (run.x0 + dx, run.y + dy);
+            let start = y as usize * canvas_width + x0 as usize;
+            let pixels = &mut canvas[start..start + run.len as usize];
+            if run.id == NO_TRIANGLE {
+                for _ in 0..run.fringe_pixels {
+                    let (Some(&(x, owner)), Some(&cover), Some(&sample)) =
+                        (fringe.next(), coverage.next(), samples.next())
+                    else {
+                        break;
+                    };
+                    let membrane = setups[owner as usize].span.at_pixel(x + dx, y).2;
+                    let pixel = &mut pixels[(x - run.x0) as usize];
+                    written += usize::from(shade_pixel(pixel, sample, membrane, cover));
+                }
+                continue;
+            }
+            hits += run.len as usize;
+            let maps = &setups[run.id as usize].span;
+            let mut membrane = maps.at_pixel(x0, y).2;
+            for (pixel, &cover) in pixels.iter_mut().zip(coverage.by_ref()) {
+                if cover > 0 {
+                    let Some(&sample) = samples.next() else { break };
+                    written += usize::from(shade_pixel(pixel, sample, membrane, cover));
+                }
+                membrane += maps.membrane[1];
+            }
+        }
+        (hits, written)
+    }
+}
+
+/// Records a draw into a [`Replay`].
+pub(crate) struct Recording<'a> {
+    replay: &'a mut Replay,
+}
+
+impl Recorder<u8> for Recording<'_> {
+    fn run(&mut self, x0: i32, y: i32, len: usize, id: u32) {
+        let len = u32::try_from(len).unwrap_or(u32::MAX);
+        self.replay.runs.push(RecordedRun {
+            x0,
+            y,
+            len,
+            id,
+            fringe_pixels: 0,
+        });
+    }
+
+    fn pixel(&mut self, sample: Option<Vec4>, coverage: u8) {
+        self.replay.coverage.push(coverage);
+        self.replay.samples.extend(sample);
+    }
+
+    fn fringe(&mut self, x: i32, owner: u32, sample: Vec4, coverage: u8) {
+        if let Some(run) = self.replay.runs.last_mut() {
+            run.fringe_pixels += 1;
+        }
+        self.replay.fringe.push((x, owner));
+        self.replay.coverage.push(coverage);
+        self.replay.samples.push(sample);
+    }
+}
+
+/// `(dx, dy)` when every `now[i]` is exactly `before[i] + (dx, dy)` with whole dx, dy.
+fn whole_pixel_shift(before: &[DVec2], now: &[DVec2]) -> Option<(i32, i32)> {
+    let (first_before, first_now) = (before.first()?, now.first()?);
+    // The nearest whole shift; the exact test below decides whether it is the move.
+    let shift = (*first_now - *first_before).round();
+    let in_range = shift.abs().max_element() <= MAX_SHIFT; // false for NaN
+    if before.len() != now.len() || !in_range {
+        return None;
+    }
+    let exact = before.iter().zip(now).all(|(b, n)| *b + shift == *n);
+    exact.then_some((shift.x as i32, shift.y as i32))
+}
