@@ -9,7 +9,7 @@ use super::bands::{Bands, APRON};
 use super::coverage::fill_silhouette;
 use super::feather::apply_feather;
 use super::scratch::BandScratch;
-use super::setup::{TriangleSetup, MAX_COORDINATE};
+use super::setup::{MembraneSpan, TriangleSetup, MAX_COORDINATE};
 use super::shade::{
     shade_and_composite, CoverageTexel, NoRecorder, Recorder, ShadeInput, StoreTexel,
 };
@@ -147,12 +147,20 @@ fn try_replay(
     let shift = scratch
         .replay
         .shift_for(patch, options.anti_alias, canvas_rect(canvas), work)?;
-    build_setups(patch, &mut scratch.setups);
+    let spans = &mut scratch.membrane_spans;
+    spans.clear();
+    spans.extend(patch.triangles.iter().map(|tri| {
+        let [a, b, c] = tri.map(|v| v as usize);
+        MembraneSpan::of_triangle(
+            [patch.placed[a], patch.placed[b], patch.placed[c]],
+            [patch.membrane[a], patch.membrane[b], patch.membrane[c]],
+        )
+    }));
     let canvas_width = canvas.width() as usize;
     let replay = &scratch.replay;
     let (centre_hits, written) = match canvas.pixels_mut() {
-        CanvasPixels::Eight(p) => replay.draw(shift, &scratch.setups, p, canvas_width),
-        CanvasPixels::Sixteen(p) => replay.draw(shift, &scratch.setups, p, canvas_width),
+        CanvasPixels::Eight(p) => replay.draw(shift, spans, p, canvas_width),
+        CanvasPixels::Sixteen(p) => replay.draw(shift, spans, p, canvas_width),
     };
     scratch.replay.remember(patch, options.anti_alias);
     Some(RasterStats {

@@ -17,7 +17,7 @@
 
 use glam::{DVec2, Vec4};
 
-use super::setup::TriangleSetup;
+use super::setup::MembraneSpan;
 use super::shade::{shade_pixel, Recorder, StoreTexel};
 use super::triangles::NO_TRIANGLE;
 use super::{Patch, PixelRect};
@@ -137,12 +137,13 @@ impl Replay {
         Recording { replay: self }
     }
 
-    /// Composites the record shifted by `(dx, dy)` with the membrane in `setups` (built for
-    /// the shifted patch). Gives (centre hits, pixels written), as a fresh draw would.
+    /// Composites the record shifted by `(dx, dy)` with the membrane maps `spans` (one per
+    /// triangle of the shifted patch). Gives (centre hits, pixels written), as a fresh draw
+    /// would.
     pub fn draw<T: StoreTexel>(
         &self,
         (dx, dy): (i32, i32),
-        setups: &[TriangleSetup],
+        spans: &[MembraneSpan],
         canvas: &mut [[T; 4]],
         canvas_width: usize,
     ) -> (usize, usize) {
@@ -163,21 +164,21 @@ impl Replay {
                     else {
                         break;
                     };
-                    let membrane = setups[owner as usize].span.at_pixel(x + dx, y).2;
+                    let membrane = spans[owner as usize].at_pixel(x + dx, y);
                     let pixel = &mut pixels[(x - run.x0) as usize];
                     written += usize::from(shade_pixel(pixel, sample, membrane, cover));
                 }
                 continue;
             }
             hits += run.len as usize;
-            let maps = &setups[run.id as usize].span;
-            let mut membrane = maps.at_pixel(x0, y).2;
+            let maps = &spans[run.id as usize];
+            let mut membrane = maps.at_pixel(x0, y);
             for (pixel, &cover) in pixels.iter_mut().zip(coverage.by_ref()) {
                 if cover > 0 {
                     let Some(&sample) = samples.next() else { break };
                     written += usize::from(shade_pixel(pixel, sample, membrane, cover));
                 }
-                membrane += maps.membrane[1];
+                membrane += maps.maps[1];
             }
         }
         (hits, written)

@@ -5,7 +5,7 @@
 
 use super::bands::{Bands, BAND_PIXELS};
 use super::replay::Replay;
-use super::setup::TriangleSetup;
+use super::setup::{MembraneSpan, TriangleSetup};
 
 /// Scratch buffers for [`draw_patch`](super::draw_patch); keep one per patch (or per thread)
 /// and pass it every frame.
@@ -22,6 +22,8 @@ pub struct RasterScratch {
     /// Pixels per row band (tests vary it to prove it changes nothing).
     pub(crate) band_pixels: usize,
     pub(crate) replay: Replay,
+    /// Per-triangle membrane maps of a replayed draw.
+    pub(crate) membrane_spans: Vec<MembraneSpan>,
 }
 
 impl Default for RasterScratch {
@@ -37,6 +39,7 @@ impl Default for RasterScratch {
             mask: None,
             band_pixels: BAND_PIXELS,
             replay: Replay::default(),
+            membrane_spans: Vec::new(),
         }
     }
 }

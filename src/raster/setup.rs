@@ -37,13 +37,93 @@ pub(crate) struct TriangleSetup {
 /// no precision even far from the canvas origin.
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct SpanSetup {
-    pub origin: [i32; 2],
-    /// Rest x − ½ and rest y − ½ (the sampler's texel-centre shift, folded in):
-    /// `[at origin, d/dx, d/dy]`.
+    /// Rest x − ½ and rest y − ½ (the sampler's texel-centre shift, folded in), relative to
+    /// `membrane.origin`: `[at origin, d/dx, d/dy]`.
     pub texel_x: [f32; 3],
     pub texel_y: [f32; 3],
+    pub membrane: MembraneSpan,
+}
+
+/// The membrane part of [`SpanSetup`], all a replay needs (see [`replay`](super::replay)).
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct MembraneSpan {
+    pub origin: [i32; 2],
     /// Membrane (RGB, alpha lane 0) at the origin and its steps along x and y.
-    pub membrane: [Vec4; 3],
+    pub maps: [Vec4; 3],
+}
+
+/// A triangle's barycentric gradients and the pixel centre near vertex `a` that the span
+/// maps are based at. Only differences from `a` enter, so a patch moved by whole pixels
+/// gets bit-identical span maps (the replay of [`replay`](super::replay) relies on it).
+struct LocalFrame {
+    g1: DVec2,
+    g2: DVec2,
+    origin: [i32; 2],
+    /// Origin centre − a.
+    offset: DVec2,
+}
+
+impl LocalFrame {
+    /// `usable`: the gradients are wanted (else zero, for triangles never drawn).
+    fn new([a, b, c]: [DVec2; 3], usable: bool) -> LocalFrame {
+        let (e1, e2) = (b - a, c - a);
+        let inv = if usable { 1.0 / e1.perp_dot(e2) } else { 0.0 };
+        // Barycentric gradients: λ1 = g1·(p − a), λ2 = g2·(p − a).
+        let clamp = |v: f64| v.floor().clamp(-MAX_COORDINATE, MAX_COORDINATE) as i32;
+        let origin = [clamp(a.x), clamp(a.y)];
+        LocalFrame {
+            g1: DVec2::new(e2.y * inv, -e2.x * inv),
+            g2: DVec2::new(-e1.y * inv, e1.x * inv),
+            origin,
+            offset: DVec2::new(f64::from(origin[0]) + 0.5, f64::from(origin[1]) + 0.5) - a,
+        }
+    }
+
+    /// Gradient of the affine map with these increments along a→b and a→c.
+    fn gradient(&self, edge1: f64, edge2: f64) -> DVec2 {
+        self.g1 * edge1 + self.g2 * edge2
+    }
+
+    fn at_origin(&self, at_a: f64, gradient: DVec2) -> f64 {
+        at_a + gradient.dot(self.offset)
+    }
+}
+
+impl MembraneSpan {
+    fn new(frame: &LocalFrame, membrane: [[f32; 3]; 3]) -> MembraneSpan {
+        let channel = |c: usize| {
+            let m = |k: usize| f64::from(membrane[k][c]);
+            let gradient = frame.gradient(m(1) - m(0), m(2) - m(0));
+            (frame.at_origin(m(0), gradient), gradient)
+        };
+        let [r, g, b] = [channel(0), channel(1), channel(2)];
+        let lanes =
+            |f: &dyn Fn((f64, DVec2)) -> f64| Vec4::new(f(r) as f32, f(g) as f32, f(b) as f32, 0.0);
+        MembraneSpan {
+            origin: frame.origin,
+            maps: [lanes(&|m| m.0), lanes(&|m| m.1.x), lanes(&|m| m.1.y)],
+        }
+    }
+
+    /// The membrane maps of a placed triangle alone: for a triangle that a full
+    /// [`TriangleSetup`] finds drawable, bit for bit its `span.membrane`.
+    pub fn of_triangle(placed: [DVec2; 3], membrane: [[f32; 3]; 3]) -> MembraneSpan {
+        let [a, b, c] = placed;
+        let det = (b - a).perp_dot(c - a);
+        MembraneSpan::new(
+            &LocalFrame::new(placed, det != 0.0 && det.is_finite()),
+            membrane,
+        )
+    }
+
+    /// The membrane at pixel `(x, y)`'s centre.
+    #[inline(always)]
+    pub fn at_pixel(&self, x: i32, y: i32) -> Vec4 {
+        let dx = (x - self.origin[0]) as f32;
+        let dy = (y - self.origin[1]) as f32;
+        let [m_origin, m_x, m_y] = self.maps;
+        m_origin + m_x * dx + m_y * dy
+    }
 }
 
 impl TriangleSetup {
@@ -66,29 +146,26 @@ impl TriangleSetup {
             .iter()
             .all(|p| p.abs().max_element() <= MAX_COORDINATE);
         let drawable = in_range && fixed_area != 0 && det != 0.0 && det.is_finite();
-        let inv = if drawable { 1.0 / det } else { 0.0 };
-        // Barycentric gradients: λ1 = g1·(p − a), λ2 = g2·(p − a).
-        let g1 = DVec2::new(e2.y * inv, -e2.x * inv);
-        let g2 = DVec2::new(-e1.y * inv, e1.x * inv);
-        let gradient = |edge1: f64, edge2: f64| g1 * edge1 + g2 * edge2;
+        let frame = LocalFrame::new(placed, drawable);
+        let (r1, r2) = (rest[1] - rest[0], rest[2] - rest[0]);
+        let texel = |at_a: f64, edge1: f64, edge2: f64| {
+            let gradient = frame.gradient(edge1, edge2);
+            [
+                (frame.at_origin(at_a, gradient) - 0.5) as f32,
+                gradient.x as f32,
+                gradient.y as f32,
+            ]
+        };
         let affine = |at_a: f64, edge1: f64, edge2: f64| {
-            let gradient = gradient(edge1, edge2);
+            let gradient = frame.gradient(edge1, edge2);
             [at_a - gradient.dot(a), gradient.x, gradient.y]
         };
-        let (r1, r2) = (rest[1] - rest[0], rest[2] - rest[0]);
-        let channel = |c: usize| {
-            let m = |k: usize| f64::from(membrane[k][c]);
-            (m(0), gradient(m(1) - m(0), m(2) - m(0)))
-        };
-        let maps = [
-            (rest[0].x, gradient(r1.x, r2.x)),
-            (rest[0].y, gradient(r1.y, r2.y)),
-            channel(0),
-            channel(1),
-            channel(2),
-        ];
         TriangleSetup {
-            span: SpanSetup::new(a, maps),
+            span: SpanSetup {
+                texel_x: texel(rest[0].x, r1.x, r2.x),
+                texel_y: texel(rest[0].y, r1.y, r2.y),
+                membrane: MembraneSpan::new(&frame, membrane),
+            },
             fixed,
             drawable,
             depth_affine: affine(
@@ -113,49 +190,16 @@ impl TriangleSetup {
 }
 
 impl SpanSetup {
-    /// Re-bases affine maps, each given by its value at vertex `a` and its gradient (rest x,
-    /// rest y, then the three membrane channels), at the pixel centre nearest `a`. Only
-    /// differences from `a` enter, so a patch moved by whole pixels gets bit-identical span
-    /// maps (the replay of [`replay`](super::replay) relies on it).
-    fn new(a: DVec2, maps: [(f64, DVec2); 5]) -> Self {
-        let clamp = |v: f64| v.floor().clamp(-MAX_COORDINATE, MAX_COORDINATE) as i32;
-        let origin = [clamp(a.x), clamp(a.y)];
-        let offset = DVec2::new(f64::from(origin[0]) + 0.5, f64::from(origin[1]) + 0.5) - a;
-        let at_origin = |(value, gradient): (f64, DVec2)| value + gradient.dot(offset);
-        let texel = |(value, gradient): (f64, DVec2)| {
-            [
-                (at_origin((value, gradient)) - 0.5) as f32,
-                gradient.x as f32,
-                gradient.y as f32,
-            ]
-        };
-        let lanes = |value: &dyn Fn((f64, DVec2)) -> f64| {
-            Vec4::new(
-                value(maps[2]) as f32,
-                value(maps[3]) as f32,
-                value(maps[4]) as f32,
-                0.0,
-            )
-        };
-        SpanSetup {
-            origin,
-            texel_x: texel(maps[0]),
-            texel_y: texel(maps[1]),
-            membrane: [lanes(&at_origin), lanes(&|m| m.1.x), lanes(&|m| m.1.y)],
-        }
-    }
-
     /// The source position (texel space) and membrane at pixel `(x, y)`'s centre.
     #[inline(always)]
     pub fn at_pixel(&self, x: i32, y: i32) -> (f32, f32, Vec4) {
-        let dx = (x - self.origin[0]) as f32;
-        let dy = (y - self.origin[1]) as f32;
+        let dx = (x - self.membrane.origin[0]) as f32;
+        let dy = (y - self.membrane.origin[1]) as f32;
         let at = |m: &[f32; 3]| m[0] + m[1] * dx + m[2] * dy;
-        let [m_origin, m_x, m_y] = self.membrane;
         (
             at(&self.texel_x),
             at(&self.texel_y),
-            m_origin + m_x * dx + m_y * dy,
+            self.membrane.at_pixel(x, y),
         )
     }
 }

@@ -179,7 +179,7 @@ fn shade_span<T: StoreTexel, C: CoverageTexel, R: Recorder<C>>(
 ) -> usize {
     let maps = &setup.span;
     let (mut u, mut v, mut membrane) = maps.at_pixel(span.x0, span.y);
-    let (u_step, v_step, m_step) = (maps.texel_x[1], maps.texel_y[1], maps.membrane[1]);
+    let (u_step, v_step, m_step) = (maps.texel_x[1], maps.texel_y[1], maps.membrane.maps[1]);
     let mut written = 0;
     for (&texel, pixel) in span.coverage.iter().zip(pixels.iter_mut()) {
         if texel.is_covered() {
