@@ -13,6 +13,12 @@ pub enum MeshError {
         #[source]
         source: image::ImageError,
     },
+    #[error("mask {path}: {source}")]
+    MaskTooLarge {
+        path: PathBuf,
+        #[source]
+        source: crate::limits::LimitError,
+    },
     #[error("mask has no inside pixels")]
     EmptyMask,
     #[error(

@@ -104,7 +104,7 @@ pub fn validate_scene(loaded: &LoadedScene) -> Result<CheckSummary, SceneError> 
 }
 
 fn decode(path: &Path) -> Result<image::DynamicImage, String> {
-    image::open(path).map_err(|e| format!("cannot decode {}: {e}", path.display()))
+    crate::limits::open_image(path).map_err(|e| format!("cannot decode {}: {e}", path.display()))
 }
 
 fn ring_area(ring: &[glam::DVec2]) -> f64 {
