@@ -42,7 +42,9 @@ pub fn expand_boundary(mesh: &mut Mesh, by: f64) -> usize {
         }
         for lp in &mesh.loops {
             let area = |p: &[DVec2]| loop_area(lp.vertices.iter().map(|&v| p[v as usize]));
-            if area(&mesh.positions).abs() <= 0.1 * area(&rest).abs() {
+            let rest_area = area(&rest);
+            // Same orientation, and not squashed below a tenth of its rest area.
+            if area(&mesh.positions) * rest_area.signum() <= 0.1 * rest_area.abs() {
                 spoilt.extend_from_slice(&lp.vertices);
             }
         }

@@ -63,8 +63,9 @@ pub fn mesh_mask(mask: &BitMask, options: &MeshOptions) -> Result<MeshResult, Me
     };
     if !complete {
         warnings.push(format!(
-            "vertex budget of {} reached before refinement finished",
-            options.max_vertices
+            "refinement stopped at its vertex budget (max_vertices {}, or the size-based bound) \
+             before every angle reached {}°",
+            options.max_vertices, options.min_angle_deg
         ));
     }
     let stats = stats_of(
@@ -110,8 +111,9 @@ pub fn mesh_polygons(polygons: &[Polygon], options: &MeshOptions) -> Result<Mesh
     let mut warnings = Vec::new();
     if !t.refinement_complete {
         warnings.push(format!(
-            "vertex budget of {} reached before refinement finished",
-            options.max_vertices
+            "refinement stopped at its vertex budget (max_vertices {}, or the size-based bound) \
+             before every angle reached {}°",
+            options.max_vertices, options.min_angle_deg
         ));
     }
     let stats = stats_of(&t.mesh, 0.0, false, t.refinement_complete, 0, 0);
