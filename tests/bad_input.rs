@@ -793,7 +793,9 @@ fn odd_masks() -> Vec<(&'static str, Mask)> {
         ("checker", Mask::new(W, H, |x, y| (x + y) % 2 == 0)),
         (
             "corners",
-            Mask::new(W, H, |x, y| (x < 2 || x >= W - 2) && (y < 2 || y >= H - 2)),
+            Mask::new(W, H, |x, y| {
+                !(2..W - 2).contains(&x) && !(2..H - 2).contains(&y)
+            }),
         ),
         (
             "speckle",

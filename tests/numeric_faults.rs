@@ -393,4 +393,3 @@ fn rendered_frames_hold_no_nan_even_for_degenerate_patches() {
         }
     }
 }
-

@@ -83,7 +83,10 @@ pub fn run(args: MeshBenchArgs) -> anyhow::Result<()> {
             let path = dir.join(format!("{name}.png"));
             let mut bytes = Vec::new();
             mask.to_image()
-                .write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
+                .write_to(
+                    &mut std::io::Cursor::new(&mut bytes),
+                    image::ImageFormat::Png,
+                )
                 .with_context(|| format!("encoding {}", path.display()))?;
             lapclone::util::write_atomic(&path, &bytes)
                 .with_context(|| format!("cannot write {}", path.display()))?;
