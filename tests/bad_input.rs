@@ -597,6 +597,8 @@ fn hostile_scenes_fail_at_a_position_without_output() {
         ("flat_polygon", "canvas(8, 8);\npatch(\"p\", #{ source: \"../in/src.png\", polygons: [[[1, 1], [6, 1], [3, 1]]] });\n".into(), "polygon"),
         ("bowtie_polygon", "canvas(8, 8);\npatch(\"p\", #{ source: \"../in/src.png\", polygons: [[[1, 1], [9, 9], [9, 1], [1, 9]]] });\n".into(), "polygon"),
         ("nan_polygon", "canvas(8, 8);\npatch(\"p\", #{ source: \"../in/src.png\", polygons: [[[1, 1], [0.0 / 0.0, 1], [1, 6]]] });\n".into(), "finite"),
+        ("far_polygon", "canvas(8, 8);\npatch(\"p\", #{ source: \"../in/src.png\", polygons: [[[1, 1], [1e308, 1], [1, 6]]] });\n".into(), "beyond"),
+        ("long_polygon", "canvas(8, 8);\npatch(\"p\", #{ source: \"../in/src.png\", density: 0.05, polygons: [[[1, 1], [1.6e7, 1], [1, 6]]] });\n".into(), "vertex budget"),
         ("duplicate_patch", with_head("patch(\"p\", #{ source: \"../in/src.png\", mask: \"../in/mask.png\" });\n"), "already exists"),
         ("wrong_types", with_head("p.at(\"soon\", [1, 2]);\n"), "at"),
         ("throw", with_head("throw \"custom failure\";\n"), "custom failure"),

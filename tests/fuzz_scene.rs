@@ -3,7 +3,7 @@
 //! or duplicated, tokens from a dictionary of scene syntax and hostile values inserted,
 //! numbers replaced by extreme ones — and run through the whole front end: parse, evaluate,
 //! validate, and for small canvases build the renderer and render frames. Nothing may
-//! panic; every error must name the scene file, and syntax, runtime and limit errors must
+//! panic; every error must name the scene file (or the imported module it arose in), and syntax, runtime and limit errors must
 //! carry a line and column.
 //!
 //! The small fixed-seed run is part of the normal suite. The long run is opt-in:
@@ -254,7 +254,9 @@ fn check(world: &World, text: &str) -> Result<(), TestCaseError> {
 
 fn check_error(file: &Path, error: &lapclone::script::SceneError) -> Result<(), TestCaseError> {
     let shown = error.to_string();
+    // Errors inside an imported module name that module's file (and position) instead.
     let named = shown.starts_with(&file.display().to_string())
+        || (error.file.is_file() && shown.starts_with(&error.file.display().to_string()))
         || matches!(error.kind, ErrorKind::Validation);
     prop_assert!(named, "error does not name the scene: {}", shown);
     if matches!(
@@ -290,6 +292,10 @@ fn run(world: &World, cases: u32, seed: u64) -> u32 {
         for m in &mutations {
             apply(&mut text, m);
         }
+        // For hunting inputs that kill the process (out of memory): the last case run.
+        if let Ok(trace) = std::env::var("LAPCLONE_FUZZ_TRACE") {
+            let _ = std::fs::write(trace, &text);
+        }
         check(world, &text).map_err(|e| TestCaseError::fail(format!("{e}\n--- scene ---\n{text}")))
     });
     if let Err(e) = outcome {
@@ -307,6 +313,31 @@ fn every_seed_scene_is_valid_before_mutation() {
         let loaded = loaded.unwrap_or_else(|e| panic!("{e}\n{text}"));
         validate_scene(&loaded).unwrap_or_else(|e| panic!("{e}\n{text}"));
     }
+}
+
+/// Inputs the fuzzer found failing, kept as explicit cases (docs/robustness.md).
+#[test]
+fn regressions_found_by_fuzzing() {
+    let world = World::new();
+    let found = [
+        // A polygon vertex at 1e308 px: the boundary subdivision allocated until the
+        // process was killed for lack of memory.
+        "canvas(24, 20, #{ fps: 4, duration: 1, background: \"#203040\" });\n\
+         let b = patch(\"b\", #{ source: \"src.png\", polygons: [#{ outer: [[1, 1], [1e308, 1], [22, 18], [1, 18]], holes: [[[8, 6], [14, 6], [14, 12], [8, 12]]] }] });\n",
+        // An error inside an imported module names the module, not the scene.
+        "import \"shapes\" as s;\ncanvas(24, 20);\nlet r = patch(\"r\", #{ source: \"src.png\", polygons: [#{ outer: s::circle(10, 10, 8, 1e308) }] });\n",
+    ];
+    for text in found {
+        if let Err(e) = check(&world, text) {
+            panic!("{e}\n{text}");
+        }
+    }
+    let file = world.scene_path();
+    let loaded = parse_scene(found[0], &file, &ScriptOptions::for_scene_file(&file)).unwrap();
+    let error = Renderer::new(loaded.scene)
+        .err()
+        .expect("a 1e308 px polygon must be refused");
+    assert!(error.to_string().contains("beyond"), "{error}");
 }
 
 #[test]
