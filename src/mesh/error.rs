@@ -43,7 +43,7 @@ pub enum MeshError {
     VertexBudget { max_vertices: usize, needed: usize },
     #[error(
         "the mask's boundary has {edges} pixel edges, more than the {max_edges} the vertex \
-         budget allows (16 per vertex); use a smoother mask or raise max_vertices"
+         budget allows (16 per vertex, at least 2^20); use a smoother mask or raise max_vertices"
     )]
     BoundaryTooLong { edges: usize, max_edges: usize },
     #[error("triangulation failed: {0}")]

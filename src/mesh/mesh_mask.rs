@@ -35,7 +35,9 @@ pub fn mesh_mask(mask: &BitMask, options: &MeshOptions) -> Result<MeshResult, Me
     }
     let kept_mask = kept.as_ref().unwrap_or(mask);
     let edges = crack_edge_count(kept_mask);
-    let max_edges = MAX_CRACK_EDGES_PER_VERTEX.saturating_mul(options.max_vertices);
+    let max_edges = MAX_CRACK_EDGES_PER_VERTEX
+        .saturating_mul(options.max_vertices)
+        .max(MIN_CRACK_EDGE_LIMIT);
     if edges > max_edges {
         return Err(MeshError::BoundaryTooLong { edges, max_edges });
     }
@@ -238,6 +240,9 @@ fn sample_crack_loops(
 /// Crack tracing keeps every pixel edge of the boundary; this many per budgeted vertex is
 /// the most a mask may have (a 64 Mi px checkerboard has 268 M).
 const MAX_CRACK_EDGES_PER_VERTEX: usize = 16;
+/// Below this many edges tracing is cheap (16 MiB of points): small budgets then fail with
+/// the more useful `VertexBudget` error instead.
+const MIN_CRACK_EDGE_LIMIT: usize = 1 << 20;
 
 /// Pixel edges between inside and outside (the image border counts as outside), counted
 /// without allocating.
@@ -318,9 +323,9 @@ mod tests {
 
     #[test]
     fn masks_with_too_long_a_boundary_are_refused_before_tracing() {
-        let checker = BitMask::from_fn(64, 64, |x, y| (x + y) % 2 == 0);
+        let checker = BitMask::from_fn(1024, 1024, |x, y| (x + y) % 2 == 0);
         let options = MeshOptions {
-            max_vertices: 100,
+            max_vertices: 3,
             ..MeshOptions::default()
         };
         let error = mesh_mask(&checker, &options).unwrap_err();
@@ -328,8 +333,8 @@ mod tests {
             matches!(
                 error,
                 MeshError::BoundaryTooLong {
-                    edges: 8192,
-                    max_edges: 1600
+                    edges: 2_097_152,
+                    max_edges: 1_048_576
                 }
             ),
             "{error}"
