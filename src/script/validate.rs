@@ -74,7 +74,13 @@ pub fn validate_scene(loaded: &LoadedScene) -> Result<CheckSummary, SceneError> 
                 .round() as u64,
         };
         if inside == 0 {
-            return Err(named("the mask is empty (no inside pixels)".into()));
+            let what = match &patch.shape {
+                Shape::Polygons(_) => {
+                    "the polygons are empty: they enclose no area (less than half a pixel)"
+                }
+                _ => "the mask is empty (no inside pixels)",
+            };
+            return Err(named(what.into()));
         }
         inside_pixels.push(inside);
     }
