@@ -5,10 +5,12 @@
 //!
 //! The modules follow the pipeline: [`mesh`] → [`solve`] → [`clone`] / [`deform`] →
 //! [`raster`], driven per frame by [`scene`]. [`pixels`] holds the float image type shared by
-//! all stages; [`reference`] holds the pixel-grid and MVC baselines used by tests and benches.
+//! all stages; [`reference`] holds the pixel-grid and MVC baselines used by tests and benches;
+//! [`limits`] the documented resource limits every input is checked against.
 
 pub mod clone;
 pub mod deform;
+pub mod limits;
 pub mod mesh;
 pub mod output;
 pub mod pixels;

@@ -81,8 +81,14 @@ pub fn run(args: MeshBenchArgs) -> anyhow::Result<()> {
         }
         if let Some(dir) = &args.save_masks {
             let path = dir.join(format!("{name}.png"));
+            let mut bytes = Vec::new();
             mask.to_image()
-                .save(&path)
+                .write_to(
+                    &mut std::io::Cursor::new(&mut bytes),
+                    image::ImageFormat::Png,
+                )
+                .with_context(|| format!("encoding {}", path.display()))?;
+            lapclone::util::write_atomic(&path, &bytes)
                 .with_context(|| format!("cannot write {}", path.display()))?;
         }
         let mut times = Vec::with_capacity(repeat);

@@ -44,17 +44,17 @@ pub struct CloneArgs {
     #[arg(long, value_enum, default_value_t = AnchorArg::Centre)]
     pub anchor: AnchorArg,
     /// Maximum boundary edge length in pixels.
-    #[arg(long, value_parser = finite_f64)]
+    #[arg(long, value_parser = finite_f64, allow_hyphen_values = true)]
     pub density: Option<f64>,
     /// Inside threshold of the mask in [0, 1].
-    #[arg(long, default_value_t = 0.5, value_parser = finite_f64)]
+    #[arg(long, default_value_t = 0.5, value_parser = finite_f64, allow_hyphen_values = true)]
     pub threshold: f64,
     #[arg(long, value_enum, default_value_t = LaplacianArg::Combinatorial)]
     pub laplacian: LaplacianArg,
     #[arg(long, value_enum, default_value_t = ModeArg::Normal)]
     pub mode: ModeArg,
     /// Soften the patch's outer edge over this many pixels.
-    #[arg(long, default_value_t = 0.0, value_parser = finite_f64)]
+    #[arg(long, default_value_t = 0.0, value_parser = finite_f64, allow_hyphen_values = true)]
     pub feather: f64,
     /// Drag X0,Y0:X1,Y1[:R] in the source's frame (repeatable); R defaults to a quarter of
     /// the mask's larger bounding-box side.
@@ -221,8 +221,17 @@ fn check_arguments(args: &CloneArgs) -> anyhow::Result<()> {
     if args.feather < 0.0 {
         return Err(UsageError(format!("--feather must be ≥ 0, not {}", args.feather)).into());
     }
-    if args.density.is_some_and(|d| d <= 0.0) {
-        return Err(UsageError("--density must be positive".into()).into());
+    if let Some(density) = args.density {
+        if density <= 0.0 {
+            return Err(UsageError("--density must be positive".into()).into());
+        }
+        let options = MeshOptions {
+            density,
+            ..MeshOptions::default()
+        };
+        options
+            .validate()
+            .map_err(|e| UsageError(format!("--density: {e}")))?;
     }
     check_output_folder(&args.output)
 }

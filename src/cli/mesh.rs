@@ -14,16 +14,16 @@ pub struct MeshArgs {
     /// Mask image (any format the `image` crate reads).
     pub mask: PathBuf,
     /// Maximum boundary edge length in pixels (seam quality knob).
-    #[arg(long, value_parser = super::finite_f64)]
+    #[arg(long, value_parser = super::finite_f64, allow_hyphen_values = true)]
     pub density: Option<f64>,
     /// Minimum angle for refinement, degrees.
-    #[arg(long = "min-angle", value_parser = super::finite_f64)]
+    #[arg(long = "min-angle", value_parser = super::finite_f64, allow_hyphen_values = true)]
     pub min_angle: Option<f64>,
     /// Vertex budget.
-    #[arg(long = "max-vertices")]
+    #[arg(long = "max-vertices", allow_hyphen_values = true)]
     pub max_vertices: Option<usize>,
     /// Inside threshold in [0, 1] (alpha if the image has alpha, else luminance).
-    #[arg(long, value_parser = super::finite_f64)]
+    #[arg(long, value_parser = super::finite_f64, allow_hyphen_values = true)]
     pub threshold: Option<f64>,
     /// Draw the mesh over the mask into this PNG.
     #[arg(short = 'o', long = "output")]

@@ -58,12 +58,12 @@ pub struct RenderArgs {
     #[arg(short = 'o', long = "output", default_value = "frames")]
     pub output: PathBuf,
     /// Inclusive frame numbers to render, e.g. 1..24 (default: all).
-    #[arg(long, value_parser = frame_range)]
+    #[arg(long, value_parser = frame_range, allow_hyphen_values = true)]
     pub frames: Option<FrameRange>,
     #[arg(long, value_enum, default_value = "png")]
     pub format: OutputFormat,
     /// PNG encoder threads (default: available cores).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub jobs: Option<usize>,
 }
 
@@ -72,10 +72,10 @@ pub struct RenderArgs {
 pub struct PreviewArgs {
     pub scene: PathBuf,
     /// Time in seconds.
-    #[arg(long = "t", value_parser = crate::cli::finite_f64)]
+    #[arg(long = "t", value_parser = crate::cli::finite_f64, allow_hyphen_values = true)]
     pub t: Option<f64>,
     /// Frame number (from 1).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub frame: Option<u64>,
     #[arg(short = 'o', long = "output")]
     pub output: PathBuf,

@@ -28,22 +28,32 @@ pub fn expand_boundary(mesh: &mut Mesh, by: f64) -> usize {
             mesh.positions[v] = *p;
         }
     }
-    // Undo moves that spoil a triangle; undoing can only help its neighbours, so this ends.
+    // Undo moves that spoil a triangle or collapse a loop (a hole 1 px wide shrinks to a
+    // segment or a point); undoing can only help the neighbours, so this ends.
     loop {
-        let mut undone = false;
+        let mut spoilt: Vec<u32> = Vec::new();
         for t in &mesh.triangles {
-            if is_healthy(
+            if !is_healthy(
                 t.map(|v| mesh.positions[v as usize]),
                 t.map(|v| rest[v as usize]),
             ) {
-                continue;
+                spoilt.extend_from_slice(t);
             }
-            for &v in t {
-                if moved[v as usize] {
-                    moved[v as usize] = false;
-                    mesh.positions[v as usize] = rest[v as usize];
-                    undone = true;
-                }
+        }
+        for lp in &mesh.loops {
+            let area = |p: &[DVec2]| loop_area(lp.vertices.iter().map(|&v| p[v as usize]));
+            let rest_area = area(&rest);
+            // Same orientation, and not squashed below a tenth of its rest area.
+            if area(&mesh.positions) * rest_area.signum() <= 0.1 * rest_area.abs() {
+                spoilt.extend_from_slice(&lp.vertices);
+            }
+        }
+        let mut undone = false;
+        for v in spoilt {
+            if moved[v as usize] {
+                moved[v as usize] = false;
+                mesh.positions[v as usize] = rest[v as usize];
+                undone = true;
             }
         }
         if !undone {
@@ -51,6 +61,18 @@ pub fn expand_boundary(mesh: &mut Mesh, by: f64) -> usize {
         }
     }
     moved.iter().filter(|&&m| m).count()
+}
+
+/// Twice the signed area of a closed loop (shoelace).
+fn loop_area(points: impl Iterator<Item = DVec2> + Clone) -> f64 {
+    let first = points.clone().next().unwrap_or_default();
+    let mut previous = first;
+    let mut twice = 0.0;
+    for p in points.skip(1).chain(std::iter::once(first)) {
+        twice += previous.perp_dot(p);
+        previous = p;
+    }
+    twice
 }
 
 /// Where each boundary vertex on exactly one loop would go.
@@ -112,6 +134,31 @@ mod tests {
         for v in 0..mesh.vertex_count() {
             if !mesh.is_boundary[v] {
                 assert_eq!(mesh.positions[v], before.positions[v]);
+            }
+        }
+    }
+
+    /// Found by tests/fuzz_mesh.rs: with a fine density the edges of a 1-px-wide hole are
+    /// subdivided, every hole vertex moved onto the hole's centre lines, and the hole loop
+    /// was left with zero area (the mesh failed its sanity check).
+    #[test]
+    fn one_pixel_wide_holes_do_not_collapse() {
+        let fuzz_mask = ["###.", "#.##", "###.", "##.#"];
+        let found = BitMask::from_fn(4, 4, |x, y| fuzz_mask[y].as_bytes()[x] == b'#');
+        let slot = BitMask::from_fn(10, 11, |x, y| {
+            (1..9).contains(&x) && (1..10).contains(&y) && !((3..7).contains(&x) && y == 4)
+        });
+        for mask in [found, slot] {
+            for density in [0.3, 0.5, 1.0, 3.0] {
+                let options = MeshOptions {
+                    density,
+                    ..MeshOptions::default()
+                };
+                let mut mesh = mesh_mask(&mask, &options).unwrap().mesh;
+                assert_eq!(mesh.hole_count(), 1);
+                expand_boundary(&mut mesh, HALF_PIXEL);
+                mesh.sanity_check()
+                    .unwrap_or_else(|e| panic!("density {density}: {e}"));
             }
         }
     }

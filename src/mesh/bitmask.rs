@@ -57,11 +57,25 @@ impl BitMask {
         }
     }
 
-    /// Reads a mask image; the error names the path.
+    /// Reads a mask image; the error names the path. Masks over the size limits of
+    /// [`crate::limits`] are refused from their header, before decoding.
     pub fn load(path: &Path, threshold: f32) -> Result<Self, MeshError> {
-        let image = image::open(path).map_err(|source| MeshError::MaskRead {
-            path: path.to_path_buf(),
-            source,
+        use crate::limits::{open_image, ImageOpenError};
+        let image = open_image(path).map_err(|error| {
+            let source = match error {
+                ImageOpenError::Read(io) => image::ImageError::IoError(io),
+                ImageOpenError::Decode(decode) => decode,
+                ImageOpenError::TooLarge(source) => {
+                    return MeshError::MaskTooLarge {
+                        path: path.to_path_buf(),
+                        source,
+                    }
+                }
+            };
+            MeshError::MaskRead {
+                path: path.to_path_buf(),
+                source,
+            }
         })?;
         Ok(Self::from_image(&image, threshold))
     }

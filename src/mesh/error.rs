@@ -13,6 +13,12 @@ pub enum MeshError {
         #[source]
         source: image::ImageError,
     },
+    #[error("mask {path}: {source}")]
+    MaskTooLarge {
+        path: PathBuf,
+        #[source]
+        source: crate::limits::LimitError,
+    },
     #[error("mask has no inside pixels")]
     EmptyMask,
     #[error(
@@ -35,6 +41,11 @@ pub enum MeshError {
          raise max_vertices or the density (max boundary edge length)"
     )]
     VertexBudget { max_vertices: usize, needed: usize },
+    #[error(
+        "the mask's boundary has {edges} pixel edges, more than the {max_edges} the vertex \
+         budget allows (16 per vertex, at least 2^20); use a smoother mask or raise max_vertices"
+    )]
+    BoundaryTooLong { edges: usize, max_edges: usize },
     #[error("triangulation failed: {0}")]
     Triangulation(String),
     #[error("the mesh failed its sanity check")]

@@ -8,7 +8,7 @@ use glam::DVec2;
 
 use super::contour::{label_pieces, trace_crack_loops, CrackLoop};
 use super::options::min_angle_deg;
-use super::simplify::{doubled_signed_area, simplify_loop, subdivide_loop};
+use super::simplify::{doubled_signed_area, simplify_loop, subdivide_loop, subdivided_len};
 use super::triangulate::triangulate_loops;
 use super::{BitMask, Mesh, MeshError, MeshOptions, MeshResult, MeshStats};
 
@@ -33,10 +33,18 @@ pub fn mesh_mask(mask: &BitMask, options: &MeshOptions) -> Result<MeshResult, Me
             min_piece_area: options.min_piece_area,
         });
     }
-    let crack = trace_crack_loops(kept.as_ref().unwrap_or(mask));
+    let kept_mask = kept.as_ref().unwrap_or(mask);
+    let edges = crack_edge_count(kept_mask);
+    let max_edges = MAX_CRACK_EDGES_PER_VERTEX
+        .saturating_mul(options.max_vertices)
+        .max(MIN_CRACK_EDGE_LIMIT);
+    if edges > max_edges {
+        return Err(MeshError::BoundaryTooLong { edges, max_edges });
+    }
+    let crack = trace_crack_loops(kept_mask);
     let expected_holes = crack.iter().filter(|l| l.is_hole()).count();
     let attempt = |tolerance: f64| -> Result<(Mesh, bool, f64), MeshError> {
-        let (loops, deviation) = sample_crack_loops(&crack, tolerance, options.density);
+        let (loops, deviation) = sample_crack_loops(&crack, tolerance, options)?;
         let t = triangulate_loops(&loops, options.min_angle_deg, options.max_vertices)?;
         // The full check costs about as much as the refinement; the tests run it on every
         // shape family, so release builds rely on the topology counts below.
@@ -63,8 +71,9 @@ pub fn mesh_mask(mask: &BitMask, options: &MeshOptions) -> Result<MeshResult, Me
     };
     if !complete {
         warnings.push(format!(
-            "vertex budget of {} reached before refinement finished",
-            options.max_vertices
+            "refinement stopped at its vertex budget (max_vertices {}, or the size-based bound) \
+             before every angle reached {}°",
+            options.max_vertices, options.min_angle_deg
         ));
     }
     let stats = stats_of(
@@ -82,6 +91,10 @@ pub fn mesh_mask(mask: &BitMask, options: &MeshOptions) -> Result<MeshResult, Me
     })
 }
 
+/// Polygon coordinates are bounded so that spade's predicates and the raster's fixed point
+/// stay exact (2^24 px, far beyond any image: see `crate::limits`).
+pub const MAX_POLYGON_COORDINATE: f64 = 16_777_216.0;
+
 /// Meshes polygons with holes (not simplified; edges subdivided to `density`).
 pub fn mesh_polygons(polygons: &[Polygon], options: &MeshOptions) -> Result<MeshResult, MeshError> {
     options.validate()?;
@@ -90,6 +103,7 @@ pub fn mesh_polygons(polygons: &[Polygon], options: &MeshOptions) -> Result<Mesh
     }
     let mut loops = Vec::new();
     let mut scratch = Vec::new();
+    let mut boundary_len = 0.0;
     for (index, polygon) in polygons.iter().enumerate() {
         let rings =
             std::iter::once((&polygon.outer, true)).chain(polygon.holes.iter().map(|h| (h, false)));
@@ -101,6 +115,14 @@ pub fn mesh_polygons(polygons: &[Polygon], options: &MeshOptions) -> Result<Mesh
             if (doubled_signed_area(&ring) > 0.0) != outer {
                 ring.reverse();
             }
+            // Refuse before allocating: a vertex at 1e9 px would need 3e8 boundary points.
+            boundary_len += subdivided_len(&ring, options.density);
+            if boundary_len > options.max_vertices as f64 {
+                return Err(MeshError::VertexBudget {
+                    max_vertices: options.max_vertices,
+                    needed: boundary_len.min(usize::MAX as f64) as usize,
+                });
+            }
             subdivide_loop(&ring, options.density, &mut scratch);
             loops.push(scratch.clone());
         }
@@ -110,8 +132,9 @@ pub fn mesh_polygons(polygons: &[Polygon], options: &MeshOptions) -> Result<Mesh
     let mut warnings = Vec::new();
     if !t.refinement_complete {
         warnings.push(format!(
-            "vertex budget of {} reached before refinement finished",
-            options.max_vertices
+            "refinement stopped at its vertex budget (max_vertices {}, or the size-based bound) \
+             before every angle reached {}°",
+            options.max_vertices, options.min_angle_deg
         ));
     }
     let stats = stats_of(&t.mesh, 0.0, false, t.refinement_complete, 0, 0);
@@ -126,6 +149,15 @@ pub fn mesh_polygons(polygons: &[Polygon], options: &MeshOptions) -> Result<Mesh
 fn clean_ring(ring: &[DVec2]) -> Result<Vec<DVec2>, String> {
     if ring.iter().any(|p| !p.is_finite()) {
         return Err("has a non-finite point".into());
+    }
+    if let Some(p) = ring
+        .iter()
+        .find(|p| p.abs().max_element() > MAX_POLYGON_COORDINATE)
+    {
+        return Err(format!(
+            "point ({}, {}) lies beyond ±{MAX_POLYGON_COORDINATE} px",
+            p.x, p.y
+        ));
     }
     let mut out: Vec<DVec2> = Vec::with_capacity(ring.len());
     for &p in ring {
@@ -178,19 +210,56 @@ fn drop_small_pieces(
     (Some(kept), dropped_pieces, dropped_pixels, kept_pieces)
 }
 
-fn sample_crack_loops(crack: &[CrackLoop], tolerance: f64, density: f64) -> (Vec<Vec<DVec2>>, f64) {
+/// Simplified and subdivided loops with the largest simplification deviation; refuses
+/// (before subdividing) boundaries that would exceed the vertex budget.
+fn sample_crack_loops(
+    crack: &[CrackLoop],
+    tolerance: f64,
+    options: &MeshOptions,
+) -> Result<(Vec<Vec<DVec2>>, f64), MeshError> {
     let mut deviation = 0.0f64;
-    let loops = crack
-        .iter()
-        .map(|c| {
-            let s = simplify_loop(&c.points, &c.anchor, tolerance);
-            deviation = deviation.max(s.max_deviation);
-            let mut out = Vec::new();
-            subdivide_loop(&s.points, density, &mut out);
-            out
-        })
-        .collect();
-    (loops, deviation)
+    let mut points = 0.0;
+    let mut loops = Vec::with_capacity(crack.len());
+    for c in crack {
+        let s = simplify_loop(&c.points, &c.anchor, tolerance);
+        deviation = deviation.max(s.max_deviation);
+        points += subdivided_len(&s.points, options.density);
+        if points > options.max_vertices as f64 {
+            return Err(MeshError::VertexBudget {
+                max_vertices: options.max_vertices,
+                needed: points as usize,
+            });
+        }
+        let mut out = Vec::new();
+        subdivide_loop(&s.points, options.density, &mut out);
+        loops.push(out);
+    }
+    Ok((loops, deviation))
+}
+
+/// Crack tracing keeps every pixel edge of the boundary; this many per budgeted vertex is
+/// the most a mask may have (a 64 Mi px checkerboard has 268 M).
+const MAX_CRACK_EDGES_PER_VERTEX: usize = 16;
+/// Below this many edges tracing is cheap (16 MiB of points): small budgets then fail with
+/// the more useful `VertexBudget` error instead.
+const MIN_CRACK_EDGE_LIMIT: usize = 1 << 20;
+
+/// Pixel edges between inside and outside (the image border counts as outside), counted
+/// without allocating.
+fn crack_edge_count(mask: &BitMask) -> usize {
+    let (w, h) = (mask.width as i64, mask.height as i64);
+    let mut edges = 0;
+    for y in 0..h {
+        for x in 0..w {
+            if mask.get(x, y) {
+                edges += [(-1, 0), (1, 0), (0, -1), (0, 1)]
+                    .iter()
+                    .filter(|(dx, dy)| !mask.get(x + dx, y + dy))
+                    .count();
+            }
+        }
+    }
+    edges
 }
 
 fn stats_of(
@@ -213,5 +282,73 @@ fn stats_of(
         refinement_complete: complete,
         dropped_pieces,
         dropped_pixels,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn triangle(far: f64) -> Vec<Polygon> {
+        vec![Polygon {
+            outer: vec![
+                DVec2::new(0.0, 0.0),
+                DVec2::new(far, 0.0),
+                DVec2::new(0.0, 5.0),
+            ],
+            holes: Vec::new(),
+        }]
+    }
+
+    /// Found by tests/fuzz_scene.rs: a polygon vertex at 1e308 px made the boundary
+    /// subdivision allocate without bound (the process was killed for lack of memory).
+    #[test]
+    fn far_polygon_vertices_are_refused_before_allocating() {
+        let options = MeshOptions::default();
+        for far in [1e308, 1e9] {
+            let error = mesh_polygons(&triangle(far), &options).unwrap_err();
+            assert!(error.to_string().contains("beyond"), "{error}");
+        }
+        let fine = MeshOptions {
+            density: 0.05,
+            ..MeshOptions::default()
+        };
+        // 1.6e7 px at 0.05 px per edge needs 3.2e8 boundary points: over the budget.
+        let error = mesh_polygons(&triangle(1.6e7), &fine).unwrap_err();
+        assert!(
+            matches!(error, MeshError::VertexBudget { needed, .. } if needed > 300_000_000),
+            "{error}"
+        );
+    }
+
+    #[test]
+    fn masks_with_too_long_a_boundary_are_refused_before_tracing() {
+        let checker = BitMask::from_fn(1024, 1024, |x, y| (x + y) % 2 == 0);
+        let options = MeshOptions {
+            max_vertices: 3,
+            ..MeshOptions::default()
+        };
+        let error = mesh_mask(&checker, &options).unwrap_err();
+        assert!(
+            matches!(
+                error,
+                MeshError::BoundaryTooLong {
+                    edges: 2_097_152,
+                    max_edges: 1_048_576
+                }
+            ),
+            "{error}"
+        );
+        // Within the edge bound but over the vertex budget once subdivided.
+        let disc = BitMask::from_fn(64, 64, |x, y| {
+            (x as i64 - 32).pow(2) + (y as i64 - 32).pow(2) < 600
+        });
+        let options = MeshOptions {
+            max_vertices: 200,
+            density: 0.05,
+            ..MeshOptions::default()
+        };
+        let error = mesh_mask(&disc, &options).unwrap_err();
+        assert!(matches!(error, MeshError::VertexBudget { .. }), "{error}");
     }
 }

@@ -31,8 +31,10 @@ pub use coverage::{
 };
 pub use error::{MeshError, SanityError};
 pub use laplacian_mtx::{boundary_list, boundary_path, laplacian_matrix_market, write_laplacian};
-pub use mesh_mask::{mesh_mask, mesh_polygons, Polygon};
+pub use mesh_mask::{mesh_mask, mesh_polygons, Polygon, MAX_POLYGON_COORDINATE};
 pub use options::{min_angle_deg, MeshOptions, MeshResult, MeshStats};
-pub use simplify::{doubled_signed_area, simplify_loop, subdivide_loop, Simplified};
+pub use simplify::{
+    doubled_signed_area, simplify_loop, subdivide_loop, subdivided_len, Simplified,
+};
 pub use triangulate::{assemble_mesh, triangulate_loops, Triangulated};
 pub use types::{BoundaryLoop, LoopKind, Mesh};

@@ -40,7 +40,7 @@ impl Default for MeshOptions {
             density: 3.0,
             simplify_tolerance: 0.9,
             min_angle_deg: 25.0,
-            max_vertices: 2_000_000,
+            max_vertices: crate::limits::MAX_MESH_VERTICES,
             min_piece_area: 4.0,
         }
     }

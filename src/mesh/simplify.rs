@@ -89,6 +89,19 @@ pub fn simplify_loop(points: &[DVec2], anchor: &[bool], tolerance: f64) -> Simpl
     }
 }
 
+/// How many points [`subdivide_loop`] would give (as a float: a loop reaching 1e308 px would
+/// overflow any integer), so callers can refuse before allocating.
+pub fn subdivided_len(points: &[DVec2], density: f64) -> f64 {
+    let n = points.len();
+    (0..n)
+        .map(|i| {
+            (points[i].distance(points[(i + 1) % n]) / density)
+                .ceil()
+                .max(1.0)
+        })
+        .sum()
+}
+
 /// Splits every edge of a closed loop into the fewest equal parts no longer than `density`.
 pub fn subdivide_loop(points: &[DVec2], density: f64, out: &mut Vec<DVec2>) {
     out.clear();

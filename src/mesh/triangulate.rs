@@ -13,6 +13,7 @@ use spade::{
     AngleLimit, ConstrainedDelaunayTriangulation, Point2, RefinementParameters, Triangulation,
 };
 
+use super::simplify::doubled_signed_area;
 use super::{BoundaryLoop, LoopKind, Mesh, MeshError};
 
 /// What the refinement produced, besides the mesh.
@@ -20,6 +21,24 @@ pub struct Triangulated {
     pub mesh: Mesh,
     /// spade's `refinement_complete`: false when the vertex budget ran out.
     pub refinement_complete: bool,
+}
+
+/// New vertices refinement may add per px² of region and per boundary vertex. A graded
+/// 25° mesh needs far fewer (the spiral: 0.02 per px² at density 3, 0.13 at 0.5); the
+/// bound only stops refinement that does not terminate — angle limits above 30°, where
+/// spade gives no guarantee, ran a 37 × 33 px box to the 2 M vertex budget in 70 s.
+const REFINEMENT_VERTICES_PER_PX2: f64 = 16.0;
+const REFINEMENT_VERTICES_PER_BOUNDARY_VERTEX: usize = 8;
+
+/// The most vertices refinement may add inside `loops` (see the constants above).
+fn refinement_budget(loops: &[Vec<DVec2>], boundary_vertices: usize) -> usize {
+    let area: f64 = loops
+        .iter()
+        .map(|l| doubled_signed_area(l).abs() / 2.0)
+        .sum();
+    (REFINEMENT_VERTICES_PER_PX2 * area) as usize
+        + REFINEMENT_VERTICES_PER_BOUNDARY_VERTEX * boundary_vertices
+        + 64
 }
 
 /// Triangulates the region bounded by `loops` and refines it to `min_angle_deg` within a
@@ -63,10 +82,11 @@ pub fn triangulate_loops(
             "spade merged boundary vertices".into(),
         ));
     }
+    let additional = (max_vertices - input_count).min(refinement_budget(loops, input_count));
     let parameters = RefinementParameters::<f64>::new()
         .with_angle_limit(AngleLimit::from_deg(min_angle_deg))
         .exclude_outer_faces(true)
-        .with_max_additional_vertices(max_vertices - input_count);
+        .with_max_additional_vertices(additional);
     let result = cdt.refine(parameters);
     let mut excluded = vec![false; cdt.num_all_faces()];
     for face in &result.excluded_faces {
@@ -331,6 +351,24 @@ fn sharpest_turn(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Found by tests/fuzz_mesh.rs: a 34.9° angle limit on a small box refined until the
+    /// 2 M vertex budget (70 s); the size-based bound now stops it at a few thousand.
+    #[test]
+    fn refinement_beyond_30_degrees_stops_at_the_size_bound() {
+        let mut boundary = Vec::new();
+        crate::mesh::subdivide_loop(&square(0.0, 0.0, 12.0), 0.45, &mut boundary);
+        let loops = vec![boundary];
+        let input = loops[0].len();
+        let t = triangulate_loops(&loops, 34.9, 2_000_000).unwrap();
+        t.mesh.sanity_check().unwrap();
+        let bound = input + refinement_budget(&loops, input);
+        assert!(
+            t.mesh.vertex_count() <= bound,
+            "{} vertices, bound {bound}",
+            t.mesh.vertex_count()
+        );
+    }
 
     fn square(x0: f64, y0: f64, s: f64) -> Vec<DVec2> {
         vec![

@@ -17,6 +17,12 @@ pub enum PixelError {
         #[source]
         source: image::ImageError,
     },
+    #[error("image {path}: {source}")]
+    TooLarge {
+        path: PathBuf,
+        #[source]
+        source: crate::limits::LimitError,
+    },
     #[error("image {path} is empty ({width}×{height})")]
     Empty {
         path: PathBuf,

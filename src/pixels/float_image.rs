@@ -60,21 +60,25 @@ impl FloatImage {
         FloatImage::new(width, height, pixels, format)
     }
 
-    /// Reads and decodes an image file (format guessed from its content).
+    /// Reads and decodes an image file (format guessed from its content); images over the
+    /// size limits of [`crate::limits`] are refused from their header, before decoding.
     pub fn load(path: &Path) -> Result<FloatImage, PixelError> {
-        let read_error = |source| PixelError::Read {
-            path: path.to_path_buf(),
-            source,
-        };
-        let decoded = image::ImageReader::open(path)
-            .map_err(read_error)?
-            .with_guessed_format()
-            .map_err(read_error)?
-            .decode()
-            .map_err(|source| PixelError::Decode {
-                path: path.to_path_buf(),
+        use crate::limits::{open_image, ImageOpenError};
+        let path_buf = || path.to_path_buf();
+        let decoded = open_image(path).map_err(|error| match error {
+            ImageOpenError::Read(source) => PixelError::Read {
+                path: path_buf(),
                 source,
-            })?;
+            },
+            ImageOpenError::Decode(source) => PixelError::Decode {
+                path: path_buf(),
+                source,
+            },
+            ImageOpenError::TooLarge(source) => PixelError::TooLarge {
+                path: path_buf(),
+                source,
+            },
+        })?;
         FloatImage::from_dynamic(&decoded).map_err(|err| match err {
             PixelError::EmptyImage { width, height } => PixelError::Empty {
                 path: path.to_path_buf(),

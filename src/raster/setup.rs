@@ -138,13 +138,19 @@ impl TriangleSetup {
         let e2 = c - a;
         let det = e1.perp_dot(e2);
         let mut fixed = placed.map(snap);
-        let fixed_area = edge_function(fixed[0], fixed[1], fixed[2]);
-        if fixed_area < 0 {
-            fixed.swap(1, 2);
-        }
+        // Out-of-range (or NaN) vertices snap to saturated values whose edge function would
+        // overflow i64: test the range first and never evaluate it for them.
         let in_range = placed
             .iter()
             .all(|p| p.abs().max_element() <= MAX_COORDINATE);
+        let fixed_area = if in_range {
+            edge_function(fixed[0], fixed[1], fixed[2])
+        } else {
+            0
+        };
+        if fixed_area < 0 {
+            fixed.swap(1, 2);
+        }
         let drawable = in_range && fixed_area != 0 && det != 0.0 && det.is_finite();
         let frame = LocalFrame::new(placed, drawable);
         let (r1, r2) = (rest[1] - rest[0], rest[2] - rest[0]);
@@ -237,6 +243,21 @@ pub(crate) fn edge_function(a: [i64; 2], b: [i64; 2], p: [i64; 2]) -> i64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn far_or_nan_vertices_are_not_drawable_and_never_overflow() {
+        let far = [1e300, -1e300, 1e7, f64::NAN, f64::INFINITY];
+        for value in far {
+            let placed = [
+                DVec2::new(0.0, 0.0),
+                DVec2::new(value, 1.0),
+                DVec2::new(3.0, value),
+            ];
+            let rest = [DVec2::ZERO, DVec2::X, DVec2::Y];
+            let setup = TriangleSetup::new(placed, rest, [[0.0; 3]; 3], [0.0; 3]);
+            assert!(!setup.drawable, "{value}");
+        }
+    }
 
     #[test]
     fn rounding_matches_f64_round() {

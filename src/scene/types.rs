@@ -139,6 +139,8 @@ impl Patch {
 pub enum ModelError {
     #[error("canvas size {0}×{1} must be between 1 and {MAX_CANVAS_SIDE} on each side")]
     CanvasSize(u32, u32),
+    #[error("canvas {0}×{1}: {2}")]
+    CanvasLimit(u32, u32, crate::limits::LimitError),
     #[error("fps {0} must be a finite number > 0")]
     Fps(f64),
     #[error("duration {0} must be a finite number > 0")]
@@ -174,6 +176,10 @@ impl Canvas {
         if !(self.duration.is_finite() && self.duration > 0.0) {
             return Err(ModelError::Duration(self.duration));
         }
+        let limit = |e| ModelError::CanvasLimit(self.width, self.height, e);
+        crate::limits::check_image_size(u64::from(self.width), u64::from(self.height))
+            .map_err(limit)?;
+        crate::limits::check_frame_count(self.frame_count()).map_err(limit)?;
         if let Background::Colour(c) = &self.background {
             if !c.iter().all(|v| v.is_finite() && (0.0..=1.0).contains(v)) {
                 return Err(ModelError::Colour);

@@ -141,13 +141,16 @@ fn parse_canvas(
             _ => Background::Colour(values::colour(v)?),
         },
     };
-    Ok(Canvas {
+    let canvas = Canvas {
         width,
         height,
         fps,
         duration,
         background,
-    })
+    };
+    // Pixel-count and frame limits, positioned at this call rather than at the end.
+    canvas.sanity_check().map_err(|e| e.to_string())?;
+    Ok(canvas)
 }
 
 const PATCH_OPTIONS: [&str; 7] = [

@@ -122,6 +122,7 @@ impl SandboxResolver {
         } else {
             relative.with_extension("rhai")
         };
+        let mut escaped = None;
         for root in &self.roots {
             let Ok(found) = root.join(&file_name).canonicalize() else {
                 continue;
@@ -129,10 +130,18 @@ impl SandboxResolver {
             if found.is_file() && found.starts_with(root) {
                 return Ok(found);
             }
+            escaped = escaped.or(Some(found));
         }
-        Err(format!(
-            "module `{name}` not found in the scene's folder or the project's scripts/ folder"
-        ))
+        Err(match escaped {
+            Some(target) => format!(
+                "module `{name}` is a link to {}, outside the scene's folder and the project's \
+                 scripts/ folder",
+                target.display()
+            ),
+            None => format!(
+                "module `{name}` not found in the scene's folder or the project's scripts/ folder"
+            ),
+        })
     }
 }
 

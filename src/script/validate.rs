@@ -74,7 +74,13 @@ pub fn validate_scene(loaded: &LoadedScene) -> Result<CheckSummary, SceneError> 
                 .round() as u64,
         };
         if inside == 0 {
-            return Err(named("the mask is empty (no inside pixels)".into()));
+            let what = match &patch.shape {
+                Shape::Polygons(_) => {
+                    "the polygons are empty: they enclose no area (less than half a pixel)"
+                }
+                _ => "the mask is empty (no inside pixels)",
+            };
+            return Err(named(what.into()));
         }
         inside_pixels.push(inside);
     }
@@ -104,7 +110,7 @@ pub fn validate_scene(loaded: &LoadedScene) -> Result<CheckSummary, SceneError> 
 }
 
 fn decode(path: &Path) -> Result<image::DynamicImage, String> {
-    image::open(path).map_err(|e| format!("cannot decode {}: {e}", path.display()))
+    crate::limits::open_image(path).map_err(|e| format!("cannot decode {}: {e}", path.display()))
 }
 
 fn ring_area(ring: &[glam::DVec2]) -> f64 {

@@ -1,0 +1,139 @@
+//! Resource limits: takes an image file (or a width and height, or a frame count) and gives
+//! an error *before* anything large is allocated when the input exceeds what lapclone will
+//! hold in memory. Images are checked from their header alone, so a 20000 × 20000 mask of a
+//! few kilobytes is refused without decoding 400 M pixels.
+//!
+//! Why these numbers (docs/robustness.md has the table): a source or target becomes a
+//! `FloatImage` of 16 bytes per pixel, so [`MAX_IMAGE_PIXELS`] (64 Mi px, e.g. 8192 × 8192)
+//! caps one image at 1 GiB of floats; the 2-core, 24 GiB reference machine holds a source,
+//! a target and the canvases of a render at that size. [`MAX_IMAGE_SIDE`] matches the scene
+//! canvas limit. The mesh vertex budget is `MeshOptions::max_vertices`
+//! ([`MAX_MESH_VERTICES`] by default).
+
+use std::path::Path;
+
+/// Largest width or height of any image lapclone reads or any canvas it renders.
+pub const MAX_IMAGE_SIDE: u32 = 16_384;
+/// Largest number of pixels (width × height) of any image read or canvas rendered.
+pub const MAX_IMAGE_PIXELS: u64 = 64 * 1024 * 1024;
+/// Default mesh vertex budget (`MeshOptions::max_vertices`): refinement stops there, and a
+/// mask whose boundary alone needs more vertices is refused.
+pub const MAX_MESH_VERTICES: usize = 2_000_000;
+/// Most frames a scene may have (`check` evaluates every one of them).
+pub const MAX_FRAMES: u64 = 1_000_000;
+/// Heap the image decoder may allocate for one image: an RGBA 16-bit image at the pixel
+/// limit (8 bytes per pixel) plus slack for the decoder's own buffers.
+const MAX_DECODER_ALLOC: u64 = MAX_IMAGE_PIXELS * 8 + (64 << 20);
+
+/// An input larger than the documented limits.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum LimitError {
+    #[error(
+        "{width}×{height} image exceeds the size limit (at most {MAX_IMAGE_SIDE} px per side \
+         and {MAX_IMAGE_PIXELS} pixels; see docs/robustness.md)"
+    )]
+    ImageTooLarge { width: u64, height: u64 },
+    #[error("{frames} frames exceed the limit of {MAX_FRAMES} frames per scene")]
+    TooManyFrames { frames: u64 },
+}
+
+/// Why [`open_image`] failed.
+#[derive(Debug, thiserror::Error)]
+pub enum ImageOpenError {
+    #[error("{0}")]
+    Read(#[from] std::io::Error),
+    #[error("{0}")]
+    Decode(#[from] image::ImageError),
+    #[error(transparent)]
+    TooLarge(#[from] LimitError),
+}
+
+/// Refuses images wider or taller than [`MAX_IMAGE_SIDE`] or with more than
+/// [`MAX_IMAGE_PIXELS`] pixels.
+pub fn check_image_size(width: u64, height: u64) -> Result<(), LimitError> {
+    let side = u64::from(MAX_IMAGE_SIDE);
+    if width > side || height > side || width.saturating_mul(height) > MAX_IMAGE_PIXELS {
+        return Err(LimitError::ImageTooLarge { width, height });
+    }
+    Ok(())
+}
+
+/// Refuses scenes with more than [`MAX_FRAMES`] frames.
+pub fn check_frame_count(frames: u64) -> Result<(), LimitError> {
+    if frames > MAX_FRAMES {
+        return Err(LimitError::TooManyFrames { frames });
+    }
+    Ok(())
+}
+
+/// The width and height in an image file's header (format guessed from its content),
+/// without decoding its pixels.
+pub fn image_dimensions(path: &Path) -> Result<(u32, u32), ImageOpenError> {
+    let reader = image::ImageReader::open(path)?.with_guessed_format()?;
+    Ok(reader.into_dimensions()?)
+}
+
+/// Reads an image file whose header passes [`check_image_size`]; the decoder runs with
+/// matching allocation limits, so a header that lies cannot make it allocate more.
+pub fn open_image(path: &Path) -> Result<image::DynamicImage, ImageOpenError> {
+    let (width, height) = image_dimensions(path)?;
+    check_image_size(u64::from(width), u64::from(height))?;
+    let mut reader = image::ImageReader::open(path)?.with_guessed_format()?;
+    let mut limits = image::Limits::default();
+    limits.max_image_width = Some(MAX_IMAGE_SIDE);
+    limits.max_image_height = Some(MAX_IMAGE_SIDE);
+    limits.max_alloc = Some(MAX_DECODER_ALLOC);
+    reader.limits(limits);
+    Ok(reader.decode()?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes_at_the_limits_pass_and_one_more_fails() {
+        let side = u64::from(MAX_IMAGE_SIDE);
+        assert!(check_image_size(8192, 8192).is_ok());
+        assert!(check_image_size(side, MAX_IMAGE_PIXELS / side).is_ok());
+        assert!(check_image_size(side + 1, 1).is_err());
+        assert!(check_image_size(1, side + 1).is_err());
+        assert!(check_image_size(side, MAX_IMAGE_PIXELS / side + 1).is_err());
+        assert!(check_image_size(u64::MAX, u64::MAX).is_err());
+        assert!(check_frame_count(MAX_FRAMES).is_ok());
+        assert!(check_frame_count(MAX_FRAMES + 1).is_err());
+    }
+
+    #[test]
+    fn the_message_names_size_and_limit() {
+        let message = check_image_size(20_000, 20_000).unwrap_err().to_string();
+        assert!(
+            message.contains("20000×20000") && message.contains("size limit"),
+            "{message}"
+        );
+    }
+
+    #[test]
+    fn a_big_header_is_refused_before_decoding() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("big.png");
+        write_blank_grey_png(&path, 20_000, 3);
+        assert_eq!(image_dimensions(&path).unwrap(), (20_000, 3));
+        assert!(open_image(&path).is_err());
+        let small = dir.path().join("small.png");
+        write_blank_grey_png(&small, 5, 4);
+        let image = open_image(&small).unwrap();
+        assert_eq!((image.width(), image.height()), (5, 4));
+    }
+
+    fn write_blank_grey_png(path: &Path, width: u32, height: u32) {
+        let file = std::fs::File::create(path).unwrap();
+        let mut encoder = png::Encoder::new(file, width, height);
+        encoder.set_color(png::ColorType::Grayscale);
+        encoder.set_depth(png::BitDepth::Eight);
+        let mut writer = encoder.write_header().unwrap();
+        writer
+            .write_image_data(&vec![0; (width * height) as usize])
+            .unwrap();
+    }
+}
