@@ -129,11 +129,23 @@ pub fn run_render(args: RenderArgs) -> anyhow::Result<()> {
             .render_frame(number - 1)
             .map_err(|e| positioned(&loaded, e))?;
         compute_ms += renderer.last_stats().total_ms;
-        sink.push(number, renderer.frame())?;
+        if let Err(error) = sink.push(number, renderer.frame()) {
+            // The writers see Ctrl-C too: report the interruption, not their refusal.
+            if cancel.load(Ordering::Relaxed) {
+                sink.abandon();
+                anyhow::bail!("interrupted: stopped after frame {}", number - 1);
+            }
+            return Err(error);
+        }
         progress.inc(1);
     }
     progress.finish_and_clear();
-    let written = sink.finish()?;
+    let written = match sink.finish() {
+        Err(_) if cancel.load(Ordering::Relaxed) => {
+            anyhow::bail!("interrupted: stopped while writing the last frames")
+        }
+        result => result?,
+    };
     let frames = range.last - range.first + 1;
     let seconds = started.elapsed().as_secs_f64();
     println!(
