@@ -30,12 +30,15 @@
 pub mod csc;
 #[doc(hidden)]
 pub mod fixtures;
+mod lanes;
 pub mod laplacian;
 pub mod matrix_market;
 pub mod numeric;
 pub mod penalty;
 #[allow(clippy::module_inception)]
 pub mod solve;
+pub mod solve_supernodal;
+pub mod supernodes;
 pub mod symbolic;
 pub mod update;
 

@@ -21,7 +21,7 @@
 //! Updates alone never trigger a refactor: they add positive terms and are stable.
 
 use super::numeric::{factor_numeric, NumericWorkspace};
-use super::solve::ldlt_solve_interleaved;
+use super::solve_supernodal::{lanes_for, ldlt_solve_supernodal};
 use super::symbolic::{FactorMethod, SymbolicFactor};
 use super::update::{pivot_from_row, rank1_diagonal, Rank1Outcome, RowScratch};
 use super::{SolveError, SymmetricCsc};
@@ -57,6 +57,62 @@ pub const DEFAULT_EPSILON_RELATIVE: f64 = 1e-12;
 pub const DEFAULT_DRIFT_BUDGET: f64 = 1e-11;
 const UNIT_ROUNDOFF: f64 = f64::EPSILON / 2.0;
 
+/// How [`PenaltyFactor::solve_channels`] reads its right-hand side.
+#[derive(Clone, Copy)]
+enum RhsKind {
+    /// As given.
+    Plain,
+    /// `α · value` at constrained vertices, 0 elsewhere (the input there is ignored).
+    Dirichlet,
+}
+
+/// `x[position[v]][c] = rhs[c][v]` (or the Dirichlet right-hand side `α · rhs[c][v]` at
+/// constrained vertices, 0 elsewhere, when `dirichlet` is given) for `c < channels`, and 0
+/// in the padding lanes. Walks the vertices in order: `rhs` streams, one random row per
+/// vertex.
+fn permute_in<const L: usize>(
+    rhs: &[f64],
+    n: usize,
+    channels: usize,
+    position: &[u32],
+    dirichlet: Option<(&[bool], f64)>,
+    x: &mut [f64],
+) {
+    let columns: [&[f64]; L] = std::array::from_fn(|c| {
+        if c < channels {
+            &rhs[c * n..(c + 1) * n]
+        } else {
+            &[]
+        }
+    });
+    for (v, &p) in position.iter().enumerate() {
+        let mut row = [0.0; L];
+        match dirichlet {
+            None => (0..channels).for_each(|c| row[c] = columns[c][v]),
+            Some((constrained, alpha)) if constrained[v] => {
+                (0..channels).for_each(|c| row[c] = alpha * columns[c][v])
+            }
+            Some(_) => {}
+        }
+        x[p as usize * L..][..L].copy_from_slice(&row);
+    }
+}
+
+/// `rhs[c][v] = x[position[v]][c]` for `c < channels`.
+fn permute_out<const L: usize>(
+    x: &[f64],
+    position: &[u32],
+    rhs: &mut [f64],
+    n: usize,
+    channels: usize,
+) {
+    for (c, column) in rhs.chunks_exact_mut(n.max(1)).take(channels).enumerate() {
+        for (value, &p) in column.iter_mut().zip(position) {
+            *value = x[p as usize * L + c];
+        }
+    }
+}
+
 /// What one batch of switches did.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct SwitchStats {
@@ -83,7 +139,7 @@ pub struct PenaltyFactor {
     refactor_count: usize,
     /// Rank-1 kernel scratch, all zero between calls.
     update_scratch: Vec<f64>,
-    /// Interleaved permuted right-hand sides.
+    /// Permuted right-hand sides, rows of up to 4 channels.
     solve_scratch: Vec<f64>,
     /// Per-vertex pending state of the current batch: 0 none, 1 on, 2 off.
     pending: Vec<u8>,
@@ -126,7 +182,7 @@ impl PenaltyFactor {
             drift: 0.0,
             refactor_count: 0,
             update_scratch: vec![0.0; n],
-            solve_scratch: Vec::new(),
+            solve_scratch: vec![0.0; 4 * n],
             pending: vec![0; n],
             touched: Vec::new(),
             row_scratch: RowScratch::new(n),
@@ -223,57 +279,66 @@ impl PenaltyFactor {
         self.factor_current()
     }
 
-    /// Solves `(L + P + εI) X = B` in place; `rhs` is column-major n×k. Allocates only the
-    /// first time a given `k` exceeds every earlier one (scratch is kept).
+    /// Solves `(L + P + εI) X = B` in place; `rhs` is column-major n×k. Channels go through
+    /// the supernodal kernel in groups of up to 4, each group as one SIMD row per unknown
+    /// (scratch for 4 channels is allocated with the factor, so no solve allocates).
     ///
     /// # Panics
     /// If `rhs.len() != n * k` (a programming error, not an input error).
     pub fn solve_in_place(&mut self, rhs: &mut [f64], k: usize) {
-        let n = self.n();
         assert_eq!(
             rhs.len(),
-            n * k,
+            self.n() * k,
             "solve_in_place: rhs must be n×k column-major"
         );
-        if self.solve_scratch.len() < n * k {
-            self.solve_scratch.resize(n * k, 0.0);
-        }
-        let x = &mut self.solve_scratch[..n * k];
-        let fwd = &self.symbolic.perm_fwd;
-        for (pos, &v) in fwd.iter().enumerate() {
-            for c in 0..k {
-                x[pos * k + c] = rhs[c * n + v as usize];
-            }
-        }
-        ldlt_solve_interleaved(
-            self.symbolic.col_ptr(),
-            self.symbolic.row_idx(),
-            &self.factor_values[..self.symbolic.nnz_factor()],
-            x,
-            k,
-        );
-        for (pos, &v) in fwd.iter().enumerate() {
-            for c in 0..k {
-                rhs[c * n + v as usize] = x[pos * k + c];
-            }
-        }
+        self.solve_channels(rhs, k, RhsKind::Plain);
     }
 
     /// Dirichlet convenience: on entry `values` (column-major n×k) holds the wanted value at
     /// constrained rows (other rows ignored); on exit the membrane, ≈ those values there.
     pub fn solve_dirichlet(&mut self, values: &mut [f64], k: usize) {
-        let n = self.n();
         assert_eq!(
             values.len(),
-            n * k,
+            self.n() * k,
             "solve_dirichlet: values must be n×k column-major"
         );
-        for column in values.chunks_exact_mut(n.max(1)) {
-            for (value, &on) in column.iter_mut().zip(&self.constrained) {
-                *value = if on { self.alpha * *value } else { 0.0 };
+        self.solve_channels(values, k, RhsKind::Dirichlet);
+    }
+
+    /// Permutes `rhs` (column-major n×k) into rows of up to 4 channels, solves, and
+    /// permutes the solution back.
+    fn solve_channels(&mut self, rhs: &mut [f64], k: usize, kind: RhsKind) {
+        let n = self.n();
+        for group in (0..k).step_by(4) {
+            let channels = (k - group).min(4);
+            let lanes = lanes_for(channels);
+            if self.solve_scratch.len() < n * lanes {
+                self.solve_scratch.resize(n * lanes, 0.0);
+            }
+            let x = &mut self.solve_scratch[..n * lanes];
+            let rhs = &mut rhs[group * n..(group + channels) * n];
+            let (position, constrained) = (&self.symbolic.perm_inv[..], &self.constrained[..]);
+            let kind = match kind {
+                RhsKind::Plain => None,
+                RhsKind::Dirichlet => Some((constrained, self.alpha)),
+            };
+            match lanes {
+                1 => permute_in::<1>(rhs, n, channels, position, kind, x),
+                2 => permute_in::<2>(rhs, n, channels, position, kind, x),
+                _ => permute_in::<4>(rhs, n, channels, position, kind, x),
+            }
+            ldlt_solve_supernodal(
+                &self.symbolic,
+                &self.factor_values[..self.symbolic.nnz_factor()],
+                x,
+                lanes,
+            );
+            match lanes {
+                1 => permute_out::<1>(x, position, rhs, n, channels),
+                2 => permute_out::<2>(x, position, rhs, n, channels),
+                _ => permute_out::<4>(x, position, rhs, n, channels),
             }
         }
-        self.solve_in_place(values, k);
     }
 
     fn factor_current(&mut self) -> Result<(), SolveError> {

@@ -1,0 +1,460 @@
+//! Supernodal forward and back substitution with an LDLᵀ factor: takes the factor pattern
+//! ([`SymbolicFactor`]: column layout and [`SupernodePartition`](super::supernodes::SupernodePartition), both validated once by
+//! [`SymbolicFactor::check_layout`]), the factor values, and right-hand
+//! sides stored as rows of `lanes` ∈ {1, 2, 4} channels (`x[i * lanes + c]`, already
+//! permuted; 3 channels are padded to 4), and overwrites `x` with the solution of
+//! `L D Lᵀ x = b` in every lane. Same result as
+//! [`ldlt_solve_interleaved`](super::solve::ldlt_solve_interleaved) to rounding; no
+//! allocation, no scratch.
+//!
+//! A supernode `b..e` is a dense panel (see [`supernodes`](super::supernodes)): its rows
+//! `b..e` then the shared pattern `P`, its columns stored contiguously with per-column
+//! offsets. Both sweeps take the panel's columns in blocks of up to [`BLOCK`] and walk the
+//! panel's rows once per block: one row index, one load and (forward) one store of `x`
+//! per row and block instead of per entry, the block's factor entries read as contiguous
+//! streams, and each row of `x` (all its channels) one SIMD register. A supernode of width 1
+//! runs a plain column kernel. Narrow backward blocks keep two independent accumulators
+//! per column (even and odd rows) to hide the multiply-add latency. Because the pattern was
+//! validated at analysis, the sweeps index without bounds checks.
+//!
+//! SIMD: on x86_64 the sweeps are compiled twice, portable (baseline ISA, separate multiply
+//! and add) and with AVX2+FMA, chosen at run time by [`SimdLevel::detect`]. The arithmetic
+//! order is fixed by the code, never by the data or the thread count, so a given binary on a
+//! given CPU gives bit-identical results; the two levels differ from each other by rounding.
+
+#[cfg(target_arch = "x86_64")]
+use super::lanes::{Avx4, Fma1, Fma2};
+use super::lanes::{Lanes, Portable};
+use super::symbolic::SymbolicFactor;
+
+/// Columns of a panel taken together per pass over its rows.
+pub static MODE: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+pub const BLOCK: usize = 8;
+
+/// Instruction-set level of the solve kernels.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SimdLevel {
+    /// Baseline code, separate multiply and add (any target).
+    Portable,
+    /// AVX2 with fused multiply-add (x86_64 CPUs that have both).
+    Avx2Fma,
+}
+
+impl SimdLevel {
+    /// The best level this CPU supports.
+    pub fn detect() -> Self {
+        #[cfg(target_arch = "x86_64")]
+        {
+            if is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma") {
+                return SimdLevel::Avx2Fma;
+            }
+        }
+        SimdLevel::Portable
+    }
+
+    /// Whether this CPU can run the level.
+    pub fn is_supported(self) -> bool {
+        match self {
+            SimdLevel::Portable => true,
+            SimdLevel::Avx2Fma => SimdLevel::detect() == SimdLevel::Avx2Fma,
+        }
+    }
+}
+
+/// Row stride for `k` channels: 1, 2 or 4 (3 is padded to 4; more than 4 channels are
+/// solved in groups of 4).
+pub fn lanes_for(k: usize) -> usize {
+    match k {
+        0 | 1 => 1,
+        2 => 2,
+        _ => 4,
+    }
+}
+
+/// Solves in place at the best [`SimdLevel`] of this CPU. `values` are the factor values of
+/// `symbolic` ([`SymbolicFactor::nnz_factor`] of them), `x` holds n rows of `lanes`
+/// channels.
+///
+/// # Panics
+/// If `lanes` is not 1, 2 or 4, or if `x` or `values` have the wrong length.
+pub fn ldlt_solve_supernodal(
+    symbolic: &SymbolicFactor,
+    values: &[f64],
+    x: &mut [f64],
+    lanes: usize,
+) {
+    ldlt_solve_supernodal_at(SimdLevel::detect(), symbolic, values, x, lanes);
+}
+
+/// [`ldlt_solve_supernodal`] at a chosen level (tests compare the levels).
+///
+/// # Panics
+/// As [`ldlt_solve_supernodal`], and if this CPU does not support `level`.
+pub fn ldlt_solve_supernodal_at(
+    level: SimdLevel,
+    symbolic: &SymbolicFactor,
+    values: &[f64],
+    x: &mut [f64],
+    lanes: usize,
+) {
+    let n = symbolic.n();
+    assert!(matches!(lanes, 1 | 2 | 4), "lanes must be 1, 2 or 4");
+    assert!(
+        x.len() == n * lanes,
+        "x must hold n rows of `lanes` channels"
+    );
+    assert!(
+        values.len() == symbolic.nnz_factor(),
+        "values must match the pattern"
+    );
+    assert!(level.is_supported(), "SIMD level {level:?} not supported");
+    // Every unchecked access below relies on what `check_layout` verified when `symbolic`
+    // was built: col_ptr has n + 1 increasing entries ending at nnz, every row index is < n,
+    // and every supernode b..e is a panel whose column b + t holds exactly h − t entries.
+    let factor = Factor {
+        col_ptr: symbolic.col_ptr(),
+        row_idx: symbolic.row_idx(),
+        values,
+        begins: symbolic.supernodes().begins(),
+    };
+    match (level, lanes) {
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: `is_supported` checked the CPU features above.
+        (SimdLevel::Avx2Fma, _) => unsafe { solve_avx2(&factor, x, lanes) },
+        (_, 1) => solve::<Portable<1>>(&factor, x),
+        (_, 2) => solve::<Portable<2>>(&factor, x),
+        _ => solve::<Portable<4>>(&factor, x),
+    }
+}
+
+/// # Safety
+/// The CPU must have AVX2 and FMA.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn solve_avx2(factor: &Factor, x: &mut [f64], lanes: usize) {
+    match lanes {
+        1 => solve::<Fma1>(factor, x),
+        2 => solve::<Fma2>(factor, x),
+        _ => solve::<Avx4>(factor, x),
+    }
+}
+
+/// The factor as the sweeps read it.
+struct Factor<'a> {
+    col_ptr: &'a [u32],
+    row_idx: &'a [u32],
+    values: &'a [f64],
+    begins: &'a [u32],
+}
+
+#[inline(always)]
+fn solve<V: Lanes>(factor: &Factor, x: &mut [f64]) {
+    let supernodes = factor.begins.len() - 1;
+    let mut rhs = Rows::<V>::new(x);
+    for s in 0..supernodes {
+        let panel = Panel::new(factor, s);
+        if panel.w == 1 {
+            column_forward(factor, panel.b, &mut rhs);
+        } else {
+            panel_forward(factor, &panel, &mut rhs);
+        }
+    }
+    for s in (0..supernodes).rev() {
+        let panel = Panel::new(factor, s);
+        if panel.w == 1 {
+            column_backward(factor, panel.b, &mut rhs);
+        } else {
+            panel_backward(factor, &panel, &mut rhs);
+        }
+    }
+}
+
+/// The right-hand sides as rows of `V`, indexed without bounds checks: every index passed
+/// is a column or a row index of the validated pattern, hence < n.
+struct Rows<'a, V> {
+    x: &'a mut [f64],
+    lanes: std::marker::PhantomData<V>,
+}
+
+impl<'a, V: Lanes> Rows<'a, V> {
+    #[inline(always)]
+    fn new(x: &'a mut [f64]) -> Self {
+        Self {
+            x,
+            lanes: std::marker::PhantomData,
+        }
+    }
+
+    #[inline(always)]
+    fn get(&self, i: usize) -> V {
+        debug_assert!(i * V::S + V::S <= self.x.len());
+        // SAFETY: i < n (see the type doc) and x.len() = n · S (asserted at the entry).
+        unsafe { V::load(self.x.as_ptr().add(i * V::S)) }
+    }
+
+    #[inline(always)]
+    fn set(&mut self, i: usize, v: V) {
+        debug_assert!(i * V::S + V::S <= self.x.len());
+        // SAFETY: as in `get`.
+        unsafe { v.store(self.x.as_mut_ptr().add(i * V::S)) }
+    }
+}
+
+impl Factor<'_> {
+    /// Row index `p` of the pattern (p < nnz).
+    #[inline(always)]
+    fn row(&self, p: usize) -> usize {
+        debug_assert!(p < self.row_idx.len());
+        // SAFETY: callers pass positions inside a column of the validated pattern.
+        unsafe { *self.row_idx.get_unchecked(p) as usize }
+    }
+
+    /// Factor value `p` (p < nnz).
+    #[inline(always)]
+    fn value(&self, p: usize) -> f64 {
+        debug_assert!(p < self.values.len());
+        // SAFETY: as in `row`; values.len() = nnz was asserted at the entry.
+        unsafe { *self.values.get_unchecked(p) }
+    }
+
+    /// `col_ptr[j]` (j ≤ n).
+    #[inline(always)]
+    fn start(&self, j: usize) -> usize {
+        debug_assert!(j < self.col_ptr.len());
+        // SAFETY: callers pass columns of supernodes, ≤ n.
+        unsafe { *self.col_ptr.get_unchecked(j) as usize }
+    }
+}
+
+/// Forward step of a single column j: `x_i −= l_ij x_j` for the rows i > j.
+#[inline(always)]
+fn column_forward<V: Lanes>(factor: &Factor, j: usize, x: &mut Rows<V>) {
+    let xj = x.get(j);
+    for p in factor.start(j) + 1..factor.start(j + 1) {
+        let i = factor.row(p);
+        x.set(i, x.get(i).mul_sub(factor.value(p), xj));
+    }
+}
+
+/// Backward step of a single column j: `x_j = y_j / d_j − Σ_{i>j} l_ij x_i`.
+#[inline(always)]
+fn column_backward<V: Lanes>(factor: &Factor, j: usize, x: &mut Rows<V>) {
+    let (start, end) = (factor.start(j), factor.start(j + 1));
+    let (mut even, mut odd) = (V::zero(), V::zero());
+    let mut p = start + 1;
+    while p + 2 <= end {
+        even = even.mul_add(factor.value(p), x.get(factor.row(p)));
+        odd = odd.mul_add(factor.value(p + 1), x.get(factor.row(p + 1)));
+        p += 2;
+    }
+    if p < end {
+        even = even.mul_add(factor.value(p), x.get(factor.row(p)));
+    }
+    let inv_d = 1.0 / factor.value(start);
+    x.set(j, x.get(j).scale_sub(inv_d, even.add(odd)));
+}
+
+/// One supernode's panel.
+struct Panel<'a> {
+    /// Panel rows: `b..e`, then the shared pattern.
+    rows: &'a [u32],
+    b: usize,
+    w: usize,
+}
+
+impl<'a> Panel<'a> {
+    #[inline(always)]
+    fn new(factor: &Factor<'a>, s: usize) -> Self {
+        debug_assert!(s + 1 < factor.begins.len());
+        // SAFETY: s < number of supernodes.
+        let (b, e) = unsafe {
+            (
+                *factor.begins.get_unchecked(s) as usize,
+                *factor.begins.get_unchecked(s + 1) as usize,
+            )
+        };
+        let (start, end) = (factor.start(b), factor.start(b + 1));
+        debug_assert!(start <= end && end <= factor.row_idx.len());
+        // SAFETY: column b's range lies inside row_idx (validated pattern).
+        let rows = unsafe { factor.row_idx.get_unchecked(start..end) };
+        Self { rows, b, w: e - b }
+    }
+
+    /// Panel height `w + |P|`.
+    #[inline(always)]
+    fn h(&self) -> usize {
+        self.rows.len()
+    }
+
+    /// Row index of panel row r (r < h).
+    #[inline(always)]
+    fn row(&self, r: usize) -> usize {
+        debug_assert!(r < self.rows.len());
+        // SAFETY: callers pass r < h.
+        unsafe { *self.rows.get_unchecked(r) as usize }
+    }
+
+    /// Entry (r, t) of the panel, r ≥ t, is `values[base(t) + r]`.
+    #[inline(always)]
+    fn base(&self, factor: &Factor, t: usize) -> usize {
+        factor.start(self.b + t) - t
+    }
+
+    /// Factor entry (r, t), `t ≤ r < h`, given `base = base(t)`.
+    #[inline(always)]
+    fn entry(&self, factor: &Factor, base: usize, r: usize) -> f64 {
+        // Column b + t of a validated panel holds h − t entries, so base(t) + r lies in it.
+        factor.value(base + r)
+    }
+}
+
+/// Forward substitution through one panel (unit lower L), column blocks in order.
+#[inline(always)]
+fn panel_forward<V: Lanes>(factor: &Factor, panel: &Panel, x: &mut Rows<V>) {
+    let mut tb = 0;
+    while tb < panel.w {
+        let te = (tb + BLOCK).min(panel.w);
+        match te - tb {
+            1 => forward_block::<V, 1>(factor, panel, x, tb),
+            2 => forward_block::<V, 2>(factor, panel, x, tb),
+            3 => forward_block::<V, 3>(factor, panel, x, tb),
+            4 => forward_block::<V, 4>(factor, panel, x, tb),
+            5 => forward_block::<V, 5>(factor, panel, x, tb),
+            6 => forward_block::<V, 6>(factor, panel, x, tb),
+            7 => forward_block::<V, 7>(factor, panel, x, tb),
+            _ => forward_block::<V, BLOCK>(factor, panel, x, tb),
+        }
+        tb = te;
+    }
+}
+
+/// Columns `tb..tb + NB`: their triangle, then `x_r −= Σ_t L[r][t] x_t` for every row below.
+#[inline(always)]
+fn forward_block<V: Lanes, const NB: usize>(
+    factor: &Factor,
+    panel: &Panel,
+    x: &mut Rows<V>,
+    tb: usize,
+) {
+    let first = panel.b + tb;
+    let bases: [usize; NB] = std::array::from_fn(|t| panel.base(factor, tb + t));
+    let mut pivots = [V::zero(); NB];
+    for t in 0..NB {
+        let mut value = x.get(first + t);
+        for u in 0..t {
+            value = value.mul_sub(panel.entry(factor, bases[u], tb + t), pivots[u]);
+        }
+        pivots[t] = value;
+        x.set(first + t, value);
+    }
+    for r in tb + NB..panel.h() {
+        let i = panel.row(r);
+        let mut value = x.get(i);
+        for t in 0..NB {
+            value = value.mul_sub(panel.entry(factor, bases[t], r), pivots[t]);
+        }
+        x.set(i, value);
+    }
+}
+
+/// Backward substitution through one panel: `x_t = y_t / d_t − Σ_{r>t} L[r][t] x_r`,
+/// column blocks from the last.
+#[inline(always)]
+fn panel_backward<V: Lanes>(factor: &Factor, panel: &Panel, x: &mut Rows<V>) {
+    let mut te = panel.w;
+    while te > 0 {
+        let tb = te.saturating_sub(BLOCK);
+        match te - tb {
+            1 => backward_block::<V, 1>(factor, panel, x, tb),
+            2 => backward_block::<V, 2>(factor, panel, x, tb),
+            3 => backward_block::<V, 3>(factor, panel, x, tb),
+            4 => backward_block::<V, 4>(factor, panel, x, tb),
+            5 => backward_block_single::<V, 5>(factor, panel, x, tb),
+            6 => backward_block_single::<V, 6>(factor, panel, x, tb),
+            7 => backward_block_single::<V, 7>(factor, panel, x, tb),
+            _ => backward_block_single::<V, BLOCK>(factor, panel, x, tb),
+        }
+        te = tb;
+    }
+}
+
+/// Columns `tb..tb + NB`: dot products with every row below the block (even and odd rows
+/// in separate accumulators), then the block's triangle from its last column.
+#[inline(always)]
+fn backward_block<V: Lanes, const NB: usize>(
+    factor: &Factor,
+    panel: &Panel,
+    x: &mut Rows<V>,
+    tb: usize,
+) {
+    let h = panel.h();
+    let bases: [usize; NB] = std::array::from_fn(|t| panel.base(factor, tb + t));
+    let mut even = [V::zero(); NB];
+    let mut odd = [V::zero(); NB];
+    let mut r = tb + NB;
+    while r + 2 <= h {
+        let (x0, x1) = (x.get(panel.row(r)), x.get(panel.row(r + 1)));
+        for t in 0..NB {
+            even[t] = even[t].mul_add(panel.entry(factor, bases[t], r), x0);
+            odd[t] = odd[t].mul_add(panel.entry(factor, bases[t], r + 1), x1);
+        }
+        r += 2;
+    }
+    if r < h {
+        let x0 = x.get(panel.row(r));
+        for t in 0..NB {
+            even[t] = even[t].mul_add(panel.entry(factor, bases[t], r), x0);
+        }
+    }
+    finish_backward_block(
+        factor,
+        panel,
+        x,
+        tb,
+        &bases,
+        std::array::from_fn(|t| even[t].add(odd[t])),
+    );
+}
+
+/// As [`backward_block`] with one accumulator per column (enough independent chains once
+/// the block is wide).
+#[inline(always)]
+fn backward_block_single<V: Lanes, const NB: usize>(
+    factor: &Factor,
+    panel: &Panel,
+    x: &mut Rows<V>,
+    tb: usize,
+) {
+    let bases: [usize; NB] = std::array::from_fn(|t| panel.base(factor, tb + t));
+    let mut acc = [V::zero(); NB];
+    for r in tb + NB..panel.h() {
+        let xr = x.get(panel.row(r));
+        for t in 0..NB {
+            acc[t] = acc[t].mul_add(panel.entry(factor, bases[t], r), xr);
+        }
+    }
+    finish_backward_block(factor, panel, x, tb, &bases, acc);
+}
+
+/// `x_t = y_t / d_t − below[t] − Σ_{u ∈ t+1..NB} L[u][t] x_u` from the block's last column.
+#[inline(always)]
+fn finish_backward_block<V: Lanes, const NB: usize>(
+    factor: &Factor,
+    panel: &Panel,
+    x: &mut Rows<V>,
+    tb: usize,
+    bases: &[usize; NB],
+    below: [V; NB],
+) {
+    let first = panel.b + tb;
+    let mut solved = [V::zero(); NB];
+    for t in (0..NB).rev() {
+        let inv_d = 1.0 / panel.entry(factor, bases[t], tb + t);
+        let mut value = x.get(first + t).scale_sub(inv_d, below[t]);
+        for u in t + 1..NB {
+            value = value.mul_sub(panel.entry(factor, bases[t], tb + u), solved[u]);
+        }
+        solved[t] = value;
+        x.set(first + t, value);
+    }
+}
