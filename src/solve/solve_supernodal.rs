@@ -28,7 +28,6 @@ use super::lanes::{Lanes, Portable};
 use super::symbolic::SymbolicFactor;
 
 /// Columns of a panel taken together per pass over its rows.
-pub static MODE: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
 pub const BLOCK: usize = 8;
 
 /// Instruction-set level of the solve kernels.
@@ -73,7 +72,7 @@ pub fn lanes_for(k: usize) -> usize {
 
 /// Solves in place at the best [`SimdLevel`] of this CPU. `values` are the factor values of
 /// `symbolic` ([`SymbolicFactor::nnz_factor`] of them), `x` holds n rows of `lanes`
-/// channels.
+/// channels, already in factor order.
 ///
 /// # Panics
 /// If `lanes` is not 1, 2 or 4, or if `x` or `values` have the wrong length.
@@ -97,30 +96,12 @@ pub fn ldlt_solve_supernodal_at(
     x: &mut [f64],
     lanes: usize,
 ) {
-    let n = symbolic.n();
     assert!(matches!(lanes, 1 | 2 | 4), "lanes must be 1, 2 or 4");
-    assert!(
-        x.len() == n * lanes,
-        "x must hold n rows of `lanes` channels"
-    );
-    assert!(
-        values.len() == symbolic.nnz_factor(),
-        "values must match the pattern"
-    );
-    assert!(level.is_supported(), "SIMD level {level:?} not supported");
-    // Every unchecked access below relies on what `check_layout` verified when `symbolic`
-    // was built: col_ptr has n + 1 increasing entries ending at nnz, every row index is < n,
-    // and every supernode b..e is a panel whose column b + t holds exactly h − t entries.
-    let factor = Factor {
-        col_ptr: symbolic.col_ptr(),
-        row_idx: symbolic.row_idx(),
-        values,
-        begins: symbolic.supernodes().begins(),
-    };
+    let factor = Factor::new(level, symbolic, values, x, lanes);
     match (level, lanes) {
         #[cfg(target_arch = "x86_64")]
-        // SAFETY: `is_supported` checked the CPU features above.
-        (SimdLevel::Avx2Fma, _) => unsafe { solve_avx2(&factor, x, lanes) },
+        // SAFETY: `Factor::new` checked the CPU features.
+        (SimdLevel::Avx2Fma, _) => unsafe { in_place_avx2(&factor, x, lanes) },
         (_, 1) => solve::<Portable<1>>(&factor, x),
         (_, 2) => solve::<Portable<2>>(&factor, x),
         _ => solve::<Portable<4>>(&factor, x),
@@ -131,7 +112,7 @@ pub fn ldlt_solve_supernodal_at(
 /// The CPU must have AVX2 and FMA.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-unsafe fn solve_avx2(factor: &Factor, x: &mut [f64], lanes: usize) {
+unsafe fn in_place_avx2(factor: &Factor, x: &mut [f64], lanes: usize) {
     match lanes {
         1 => solve::<Fma1>(factor, x),
         2 => solve::<Fma2>(factor, x),
@@ -141,10 +122,53 @@ unsafe fn solve_avx2(factor: &Factor, x: &mut [f64], lanes: usize) {
 
 /// The factor as the sweeps read it.
 struct Factor<'a> {
+    prefetched: std::cell::Cell<usize>,
+    distance: usize,
     col_ptr: &'a [u32],
     row_idx: &'a [u32],
     values: &'a [f64],
     begins: &'a [u32],
+    /// Compact panel rows (see [`SupernodePartition`](super::supernodes::SupernodePartition)).
+    row_begin: &'a [u32],
+    panel_rows: &'a [u32],
+}
+
+impl<'a> Factor<'a> {
+    /// Checks what the unchecked sweeps rely on beyond what `check_layout` verified when
+    /// `symbolic` was built (col_ptr has n + 1 increasing entries ending at nnz, every row
+    /// index is < n, every supernode b..e is a panel whose column b + t holds h − t
+    /// entries): the lengths of `values` and `x`, and the CPU level.
+    fn new(
+        level: SimdLevel,
+        symbolic: &'a SymbolicFactor,
+        values: &'a [f64],
+        x: &[f64],
+        lanes: usize,
+    ) -> Self {
+        assert!(
+            x.len() == symbolic.n() * lanes,
+            "x must hold n rows of `lanes` values"
+        );
+        assert!(
+            values.len() == symbolic.nnz_factor(),
+            "values must match the pattern"
+        );
+        assert!(level.is_supported(), "SIMD level {level:?} not supported");
+        Self {
+            prefetched: std::cell::Cell::new(0),
+            distance: if values.len() * size_of::<f64>() >= PREFETCH_MIN_BYTES {
+                PREFETCH_DISTANCE
+            } else {
+                0
+            },
+            col_ptr: symbolic.col_ptr(),
+            row_idx: symbolic.row_idx(),
+            values,
+            begins: symbolic.supernodes().begins(),
+            row_begin: symbolic.supernodes().panel_row_begins(),
+            panel_rows: symbolic.supernodes().all_panel_rows(),
+        }
+    }
 }
 
 #[inline(always)]
@@ -159,6 +183,7 @@ fn solve<V: Lanes>(factor: &Factor, x: &mut [f64]) {
             panel_forward(factor, &panel, &mut rhs);
         }
     }
+    factor.prefetched.set(factor.values.len());
     for s in (0..supernodes).rev() {
         let panel = Panel::new(factor, s);
         if panel.w == 1 {
@@ -167,6 +192,31 @@ fn solve<V: Lanes>(factor: &Factor, x: &mut [f64]) {
             panel_backward(factor, &panel, &mut rhs);
         }
     }
+}
+
+/// Software prefetch of the factor values, this many values ahead of the sweep. The sweeps
+/// read the values in (reverse) storage order, but as short interleaved column streams
+/// (a block's columns) that the hardware prefetcher follows poorly: measured at 52k vertices
+/// (18.5 MB of values) the solve gains ≈ 10 %, flat from 128 to 512 values ahead.
+const PREFETCH_DISTANCE: usize = 256;
+
+/// Factors smaller than this (a few times the L2 cache) stay cached between solves, where
+/// the prefetch instructions only cost time (≈ 12 % at 2k vertices).
+const PREFETCH_MIN_BYTES: usize = 2 << 20;
+
+/// A hint to load the cache line of `values[p]` (a no-op off x86_64).
+#[inline(always)]
+fn prefetch(values: &[f64], p: usize) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: prefetching never faults; p < values.len() keeps the address in bounds anyway.
+    unsafe {
+        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+        _mm_prefetch::<_MM_HINT_T0>(
+            values.as_ptr().add(p.min(values.len().saturating_sub(1))) as *const i8
+        );
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = (values, p);
 }
 
 /// The right-hand sides as rows of `V`, indexed without bounds checks: every index passed
@@ -201,6 +251,35 @@ impl<'a, V: Lanes> Rows<'a, V> {
 }
 
 impl Factor<'_> {
+    /// Prefetch values up to `until + distance` (forward sweep).
+    #[inline(always)]
+    fn prefetch_up(&self, until: usize) {
+        if self.distance == 0 {
+            return;
+        }
+        let until = (until + self.distance).min(self.values.len());
+        let mut p = self.prefetched.get();
+        while p < until {
+            prefetch(self.values, p);
+            p += 8;
+        }
+        self.prefetched.set(p);
+    }
+
+    /// Prefetch values down to `until − distance` (backward sweep).
+    #[inline(always)]
+    fn prefetch_down(&self, until: usize) {
+        if self.distance == 0 {
+            return;
+        }
+        let until = until.saturating_sub(self.distance);
+        let mut p = self.prefetched.get();
+        while p > until {
+            p = p.saturating_sub(8);
+            prefetch(self.values, p);
+        }
+        self.prefetched.set(p);
+    }
     /// Row index `p` of the pattern (p < nnz).
     #[inline(always)]
     fn row(&self, p: usize) -> usize {
@@ -229,6 +308,7 @@ impl Factor<'_> {
 /// Forward step of a single column j: `x_i −= l_ij x_j` for the rows i > j.
 #[inline(always)]
 fn column_forward<V: Lanes>(factor: &Factor, j: usize, x: &mut Rows<V>) {
+    factor.prefetch_up(factor.start(j + 1));
     let xj = x.get(j);
     for p in factor.start(j) + 1..factor.start(j + 1) {
         let i = factor.row(p);
@@ -239,6 +319,7 @@ fn column_forward<V: Lanes>(factor: &Factor, j: usize, x: &mut Rows<V>) {
 /// Backward step of a single column j: `x_j = y_j / d_j − Σ_{i>j} l_ij x_i`.
 #[inline(always)]
 fn column_backward<V: Lanes>(factor: &Factor, j: usize, x: &mut Rows<V>) {
+    factor.prefetch_down(factor.start(j));
     let (start, end) = (factor.start(j), factor.start(j + 1));
     let (mut even, mut odd) = (V::zero(), V::zero());
     let mut p = start + 1;
@@ -265,18 +346,20 @@ struct Panel<'a> {
 impl<'a> Panel<'a> {
     #[inline(always)]
     fn new(factor: &Factor<'a>, s: usize) -> Self {
-        debug_assert!(s + 1 < factor.begins.len());
-        // SAFETY: s < number of supernodes.
-        let (b, e) = unsafe {
+        debug_assert!(s + 1 < factor.begins.len() && s + 1 < factor.row_begin.len());
+        // SAFETY: s < number of supernodes, and begins / row_begin both have one entry per
+        // supernode plus one (validated with the pattern).
+        let (b, e, start, end) = unsafe {
             (
                 *factor.begins.get_unchecked(s) as usize,
                 *factor.begins.get_unchecked(s + 1) as usize,
+                *factor.row_begin.get_unchecked(s) as usize,
+                *factor.row_begin.get_unchecked(s + 1) as usize,
             )
         };
-        let (start, end) = (factor.start(b), factor.start(b + 1));
-        debug_assert!(start <= end && end <= factor.row_idx.len());
-        // SAFETY: column b's range lies inside row_idx (validated pattern).
-        let rows = unsafe { factor.row_idx.get_unchecked(start..end) };
+        debug_assert!(start <= end && end <= factor.panel_rows.len());
+        // SAFETY: the row offsets are increasing and end at panel_rows.len() (validated).
+        let rows = unsafe { factor.panel_rows.get_unchecked(start..end) };
         Self { rows, b, w: e - b }
     }
 
@@ -337,6 +420,7 @@ fn forward_block<V: Lanes, const NB: usize>(
     tb: usize,
 ) {
     let first = panel.b + tb;
+    factor.prefetch_up(factor.start(first + NB));
     let bases: [usize; NB] = std::array::from_fn(|t| panel.base(factor, tb + t));
     let mut pivots = [V::zero(); NB];
     for t in 0..NB {
@@ -388,6 +472,7 @@ fn backward_block<V: Lanes, const NB: usize>(
     tb: usize,
 ) {
     let h = panel.h();
+    factor.prefetch_down(factor.start(panel.b + tb));
     let bases: [usize; NB] = std::array::from_fn(|t| panel.base(factor, tb + t));
     let mut even = [V::zero(); NB];
     let mut odd = [V::zero(); NB];
@@ -425,6 +510,7 @@ fn backward_block_single<V: Lanes, const NB: usize>(
     x: &mut Rows<V>,
     tb: usize,
 ) {
+    factor.prefetch_down(factor.start(panel.b + tb));
     let bases: [usize; NB] = std::array::from_fn(|t| panel.base(factor, tb + t));
     let mut acc = [V::zero(); NB];
     for r in tb + NB..panel.h() {
