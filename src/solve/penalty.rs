@@ -21,7 +21,7 @@
 //! Updates alone never trigger a refactor: they add positive terms and are stable.
 
 use super::numeric::{factor_numeric, NumericWorkspace};
-use super::solve_supernodal::{lanes_for, ldlt_solve_supernodal};
+use super::solve_supernodal::{inverse_diagonal, lanes_for, ldlt_solve_supernodal};
 use super::symbolic::{FactorMethod, SymbolicFactor};
 use super::update::{pivot_from_row, rank1_diagonal, Rank1Outcome, RowScratch};
 use super::{SolveError, SymmetricCsc};
@@ -67,48 +67,49 @@ enum RhsKind {
 }
 
 /// `x[position[v]][c] = rhs[c][v]` (or the Dirichlet right-hand side `α · rhs[c][v]` at
-/// constrained vertices, 0 elsewhere, when `dirichlet` is given) for `c < channels`, and 0
-/// in the padding lanes. Walks the vertices in order: `rhs` streams, one random row per
-/// vertex.
-fn permute_in<const L: usize>(
+/// constrained vertices, 0 elsewhere, when `dirichlet` is given) for the `K` channels, and 0
+/// in the padding lanes of rows of `L`. Walks the vertices in order: `rhs` streams, one
+/// random row per vertex (measured at 52k vertices: 0.11 ms, against 0.15 ms walking the
+/// positions with random reads of `rhs`).
+fn permute_in<const K: usize, const L: usize>(
     rhs: &[f64],
-    n: usize,
-    channels: usize,
     position: &[u32],
     dirichlet: Option<(&[bool], f64)>,
     x: &mut [f64],
 ) {
-    let columns: [&[f64]; L] = std::array::from_fn(|c| {
-        if c < channels {
-            &rhs[c * n..(c + 1) * n]
-        } else {
-            &[]
-        }
-    });
+    let n = position.len();
+    let columns: [&[f64]; K] = std::array::from_fn(|c| &rhs[c * n..(c + 1) * n]);
+    assert!(x.len() == n * L && dirichlet.is_none_or(|(constrained, _)| constrained.len() == n));
     for (v, &p) in position.iter().enumerate() {
-        let mut row = [0.0; L];
-        match dirichlet {
-            None => (0..channels).for_each(|c| row[c] = columns[c][v]),
-            Some((constrained, alpha)) if constrained[v] => {
-                (0..channels).for_each(|c| row[c] = alpha * columns[c][v])
-            }
-            Some(_) => {}
+        let scale = match dirichlet {
+            None => 1.0,
+            Some((constrained, alpha)) if constrained[v] => alpha,
+            Some(_) => 0.0,
+        };
+        let row = &mut x[p as usize * L..][..L];
+        for c in 0..L {
+            // The Dirichlet input is ignored, not scaled, where unconstrained (it may be NaN).
+            row[c] = if c < K && scale != 0.0 {
+                scale * columns[c][v]
+            } else {
+                0.0
+            };
         }
-        x[p as usize * L..][..L].copy_from_slice(&row);
     }
 }
 
-/// `rhs[c][v] = x[position[v]][c]` for `c < channels`.
-fn permute_out<const L: usize>(
-    x: &[f64],
-    position: &[u32],
-    rhs: &mut [f64],
-    n: usize,
-    channels: usize,
-) {
-    for (c, column) in rhs.chunks_exact_mut(n.max(1)).take(channels).enumerate() {
-        for (value, &p) in column.iter_mut().zip(position) {
-            *value = x[p as usize * L + c];
+/// `rhs[c][v] = x[position[v]][c]` for the `K` channels: one pass over the vertices, one
+/// random row of `x` each, `rhs` written as `K` streams.
+fn permute_out<const K: usize, const L: usize>(x: &[f64], position: &[u32], rhs: &mut [f64]) {
+    let n = position.len();
+    let mut columns: [&mut [f64]; K] = std::array::from_fn(|_| -> &mut [f64] { &mut [] });
+    for (slot, column) in columns.iter_mut().zip(rhs.chunks_exact_mut(n.max(1))) {
+        *slot = column;
+    }
+    for (v, &p) in position.iter().enumerate() {
+        let row = &x[p as usize * L..][..L];
+        for c in 0..K {
+            columns[c][v] = row[c];
         }
     }
 }
@@ -132,6 +133,8 @@ pub struct PenaltyFactor {
     /// Scratch for `L + εI + P` at refactorisation.
     work_values: Vec<f64>,
     factor_values: Vec<f64>,
+    /// `1 / d_j` of the current factor, for the solve.
+    inv_diagonal: Vec<f64>,
     workspace: NumericWorkspace,
     constrained: Vec<bool>,
     constrained_count: usize,
@@ -170,6 +173,7 @@ impl PenaltyFactor {
         let workspace = NumericWorkspace::new(&symbolic);
         let mut this = Self {
             factor_values: vec![0.0; symbolic.factor_buffer_len()],
+            inv_diagonal: vec![0.0; n],
             work_values: base_values.clone(),
             base_values,
             symbolic,
@@ -322,21 +326,24 @@ impl PenaltyFactor {
                 RhsKind::Plain => None,
                 RhsKind::Dirichlet => Some((constrained, self.alpha)),
             };
-            match lanes {
-                1 => permute_in::<1>(rhs, n, channels, position, kind, x),
-                2 => permute_in::<2>(rhs, n, channels, position, kind, x),
-                _ => permute_in::<4>(rhs, n, channels, position, kind, x),
+            match channels {
+                1 => permute_in::<1, 1>(rhs, position, kind, x),
+                2 => permute_in::<2, 2>(rhs, position, kind, x),
+                3 => permute_in::<3, 4>(rhs, position, kind, x),
+                _ => permute_in::<4, 4>(rhs, position, kind, x),
             }
             ldlt_solve_supernodal(
                 &self.symbolic,
                 &self.factor_values[..self.symbolic.nnz_factor()],
+                &self.inv_diagonal,
                 x,
                 lanes,
             );
-            match lanes {
-                1 => permute_out::<1>(x, position, rhs, n, channels),
-                2 => permute_out::<2>(x, position, rhs, n, channels),
-                _ => permute_out::<4>(x, position, rhs, n, channels),
+            match channels {
+                1 => permute_out::<1, 1>(x, position, rhs),
+                2 => permute_out::<2, 2>(x, position, rhs),
+                3 => permute_out::<3, 4>(x, position, rhs),
+                _ => permute_out::<4, 4>(x, position, rhs),
             }
         }
     }
@@ -355,7 +362,28 @@ impl PenaltyFactor {
             &mut self.factor_values,
             self.epsilon,
             &mut self.workspace,
-        )
+        )?;
+        inverse_diagonal(
+            &self.symbolic,
+            &self.factor_values[..self.symbolic.nnz_factor()],
+            &mut self.inv_diagonal,
+        );
+        Ok(())
+    }
+
+    /// Refreshes `inv_diagonal` along the elimination-tree path from position `p` (the
+    /// pivots a rank-1 modification at `p` changed).
+    fn refresh_inverse_pivots(&mut self, p: usize) {
+        let (col_ptr, row_idx) = (self.symbolic.col_ptr(), self.symbolic.row_idx());
+        let mut j = p;
+        loop {
+            let (start, end) = (col_ptr[j] as usize, col_ptr[j + 1] as usize);
+            self.inv_diagonal[j] = 1.0 / self.factor_values[start];
+            if end == start + 1 {
+                return;
+            }
+            j = row_idx[start + 1] as usize;
+        }
     }
 
     /// Applies the batch recorded in `pending`/`touched`, then clears them.
@@ -451,6 +479,7 @@ impl PenaltyFactor {
                 if !on {
                     self.drift += UNIT_ROUNDOFF * amplification;
                 }
+                self.refresh_inverse_pivots(p);
                 true
             }
             Rank1Outcome::PivotLost => false,
