@@ -203,7 +203,7 @@ impl<'a> Factor<'a> {
         assert!(level.is_supported(), "SIMD level {level:?} not supported");
         Self {
             prefetched: std::cell::Cell::new(0),
-            distance: if values.len() * size_of::<f64>() >= PREFETCH_MIN_BYTES {
+            distance: if size_of_val(values) >= PREFETCH_MIN_BYTES {
                 PREFETCH_DISTANCE
             } else {
                 0
@@ -592,8 +592,8 @@ fn finish_backward_block<V: Lanes, const NB: usize>(
     for t in (0..NB).rev() {
         let inv_d = factor.inv_pivot(first + t);
         let mut value = x.get(first + t).scale_sub(inv_d, below[t]);
-        for u in t + 1..NB {
-            value = value.mul_sub(panel.entry(factor, bases[t], tb + u), solved[u]);
+        for (u, &later) in solved.iter().enumerate().skip(t + 1) {
+            value = value.mul_sub(panel.entry(factor, bases[t], tb + u), later);
         }
         solved[t] = value;
         x.set(first + t, value);
