@@ -95,6 +95,25 @@ fn best_ms(runs: usize, mut work: impl FnMut()) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
+/// Best of at least `RUNS * 4` runs, more for short work: runs until [`SOLVE_BUDGET_MS`]
+/// are spent (at most 5,000), so a sub-millisecond solve on a shared machine gets enough
+/// tries to catch an undisturbed one.
+fn best_ms_budgeted(mut work: impl FnMut()) -> f64 {
+    let started = Instant::now();
+    let mut best = f64::INFINITY;
+    let mut runs = 0;
+    while runs < RUNS * 4
+        || (runs < 5_000 && started.elapsed().as_secs_f64() * 1e3 < SOLVE_BUDGET_MS)
+    {
+        best = best.min(best_ms(1, &mut work));
+        runs += 1;
+    }
+    best
+}
+
+/// Time budget of [`best_ms_budgeted`].
+const SOLVE_BUDGET_MS: f64 = 300.0;
+
 fn measure(
     l: &SymmetricCsc,
     constrained: &[usize],
@@ -127,7 +146,7 @@ fn measure(
         .map(|i| ((i * 7919) % 1000) as f64 / 1000.0)
         .collect();
     let mut work = rhs.clone();
-    let solve3_ms = best_ms(RUNS * 4, || {
+    let solve3_ms = best_ms_budgeted(|| {
         work.copy_from_slice(&rhs);
         factor.solve_dirichlet(&mut work, 3);
     });
@@ -184,12 +203,12 @@ fn kernel_ms(factor: &PenaltyFactor, rhs: &[f64]) -> (f64, f64) {
         })
         .collect();
     let mut x = rows.clone();
-    let supernodal = best_ms(RUNS * 4, || {
+    let supernodal = best_ms_budgeted(|| {
         x.copy_from_slice(&rows);
         ldlt_solve_supernodal(symbolic, values, &inv_diagonal, &mut x, 4);
     });
     let mut x = rhs.to_vec();
-    let column = best_ms(RUNS * 4, || {
+    let column = best_ms_budgeted(|| {
         x.copy_from_slice(rhs);
         ldlt_solve_interleaved(symbolic.col_ptr(), symbolic.row_idx(), values, &mut x, 3);
     });
