@@ -2,10 +2,13 @@
 //! and gives a factored penalised Laplacian `L + P + εI` whose constraints switch on and off
 //! by rank-1 updates/downdates of the factor, with multi-RHS in-place solves.
 //!
-//! Work is split as in faer: [`symbolic`] (AMD ordering, elimination tree, factor pattern —
-//! once per mesh), [`numeric`] (LDLᵀ values — once, and again only when a guard fires),
-//! [`update`] (the rank-1 kernel, per constraint change) and [`solve`](mod@solve) (forward/back
-//! substitution, per frame). [`penalty`] ties them together in [`PenaltyFactor`].
+//! Work is split as in faer: [`symbolic`] (AMD ordering, elimination tree, factor pattern,
+//! its [`supernodes`] — once per mesh), [`numeric`] (LDLᵀ values — once, and again only when
+//! a guard fires), [`update`] (the rank-1 kernel, per constraint change) and
+//! [`solve_supernodal`] (forward/back substitution over dense supernode panels, per frame;
+//! [`solve`](mod@solve) keeps the column-by-column reference). [`penalty`] ties them
+//! together in [`PenaltyFactor`]. One value array serves all kernels: the supernodal solve
+//! reads the column layout the rank-1 kernel updates, so no conversion follows a switch.
 //!
 //! # Numerical rules (documented here once, used throughout)
 //! * **Penalty α.** Default `α = 1e8 · s`, `s = max |l_ii|` (1 if the matrix is zero). At a
@@ -30,12 +33,15 @@
 pub mod csc;
 #[doc(hidden)]
 pub mod fixtures;
+mod lanes;
 pub mod laplacian;
 pub mod matrix_market;
 pub mod numeric;
 pub mod penalty;
 #[allow(clippy::module_inception)]
 pub mod solve;
+pub mod solve_supernodal;
+pub mod supernodes;
 pub mod symbolic;
 pub mod update;
 

@@ -21,7 +21,7 @@
 //! Updates alone never trigger a refactor: they add positive terms and are stable.
 
 use super::numeric::{factor_numeric, NumericWorkspace};
-use super::solve::ldlt_solve_interleaved;
+use super::solve_supernodal::{inverse_diagonal, lanes_for, ldlt_solve_supernodal};
 use super::symbolic::{FactorMethod, SymbolicFactor};
 use super::update::{pivot_from_row, rank1_diagonal, Rank1Outcome, RowScratch};
 use super::{SolveError, SymmetricCsc};
@@ -57,6 +57,63 @@ pub const DEFAULT_EPSILON_RELATIVE: f64 = 1e-12;
 pub const DEFAULT_DRIFT_BUDGET: f64 = 1e-11;
 const UNIT_ROUNDOFF: f64 = f64::EPSILON / 2.0;
 
+/// How [`PenaltyFactor::solve_channels`] reads its right-hand side.
+#[derive(Clone, Copy)]
+enum RhsKind {
+    /// As given.
+    Plain,
+    /// `α · value` at constrained vertices, 0 elsewhere (the input there is ignored).
+    Dirichlet,
+}
+
+/// `x[position[v]][c] = rhs[c][v]` (or the Dirichlet right-hand side `α · rhs[c][v]` at
+/// constrained vertices, 0 elsewhere, when `dirichlet` is given) for the `K` channels, and 0
+/// in the padding lanes of rows of `L`. Walks the vertices in order: `rhs` streams, one
+/// random row per vertex (measured at 52k vertices: 0.11 ms, against 0.15 ms walking the
+/// positions with random reads of `rhs`).
+fn permute_in<const K: usize, const L: usize>(
+    rhs: &[f64],
+    position: &[u32],
+    dirichlet: Option<(&[bool], f64)>,
+    x: &mut [f64],
+) {
+    let n = position.len();
+    let columns: [&[f64]; K] = std::array::from_fn(|c| &rhs[c * n..(c + 1) * n]);
+    assert!(x.len() == n * L && dirichlet.is_none_or(|(constrained, _)| constrained.len() == n));
+    for (v, &p) in position.iter().enumerate() {
+        let scale = match dirichlet {
+            None => 1.0,
+            Some((constrained, alpha)) if constrained[v] => alpha,
+            Some(_) => 0.0,
+        };
+        let row = &mut x[p as usize * L..][..L];
+        for c in 0..L {
+            // The Dirichlet input is ignored, not scaled, where unconstrained (it may be NaN).
+            row[c] = if c < K && scale != 0.0 {
+                scale * columns[c][v]
+            } else {
+                0.0
+            };
+        }
+    }
+}
+
+/// `rhs[c][v] = x[position[v]][c]` for the `K` channels: one pass over the vertices, one
+/// random row of `x` each, `rhs` written as `K` streams.
+fn permute_out<const K: usize, const L: usize>(x: &[f64], position: &[u32], rhs: &mut [f64]) {
+    let n = position.len();
+    let mut columns: [&mut [f64]; K] = std::array::from_fn(|_| -> &mut [f64] { &mut [] });
+    for (slot, column) in columns.iter_mut().zip(rhs.chunks_exact_mut(n.max(1))) {
+        *slot = column;
+    }
+    for (v, &p) in position.iter().enumerate() {
+        let row = &x[p as usize * L..][..L];
+        for c in 0..K {
+            columns[c][v] = row[c];
+        }
+    }
+}
+
 /// What one batch of switches did.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct SwitchStats {
@@ -76,6 +133,8 @@ pub struct PenaltyFactor {
     /// Scratch for `L + εI + P` at refactorisation.
     work_values: Vec<f64>,
     factor_values: Vec<f64>,
+    /// `1 / d_j` of the current factor, for the solve.
+    inv_diagonal: Vec<f64>,
     workspace: NumericWorkspace,
     constrained: Vec<bool>,
     constrained_count: usize,
@@ -83,7 +142,7 @@ pub struct PenaltyFactor {
     refactor_count: usize,
     /// Rank-1 kernel scratch, all zero between calls.
     update_scratch: Vec<f64>,
-    /// Interleaved permuted right-hand sides.
+    /// Permuted right-hand sides, rows of up to 4 channels.
     solve_scratch: Vec<f64>,
     /// Per-vertex pending state of the current batch: 0 none, 1 on, 2 off.
     pending: Vec<u8>,
@@ -114,6 +173,7 @@ impl PenaltyFactor {
         let workspace = NumericWorkspace::new(&symbolic);
         let mut this = Self {
             factor_values: vec![0.0; symbolic.factor_buffer_len()],
+            inv_diagonal: vec![0.0; n],
             work_values: base_values.clone(),
             base_values,
             symbolic,
@@ -126,7 +186,7 @@ impl PenaltyFactor {
             drift: 0.0,
             refactor_count: 0,
             update_scratch: vec![0.0; n],
-            solve_scratch: Vec::new(),
+            solve_scratch: vec![0.0; 4 * n],
             pending: vec![0; n],
             touched: Vec::new(),
             row_scratch: RowScratch::new(n),
@@ -223,57 +283,69 @@ impl PenaltyFactor {
         self.factor_current()
     }
 
-    /// Solves `(L + P + εI) X = B` in place; `rhs` is column-major n×k. Allocates only the
-    /// first time a given `k` exceeds every earlier one (scratch is kept).
+    /// Solves `(L + P + εI) X = B` in place; `rhs` is column-major n×k. Channels go through
+    /// the supernodal kernel in groups of up to 4, each group as one SIMD row per unknown
+    /// (scratch for 4 channels is allocated with the factor, so no solve allocates).
     ///
     /// # Panics
     /// If `rhs.len() != n * k` (a programming error, not an input error).
     pub fn solve_in_place(&mut self, rhs: &mut [f64], k: usize) {
-        let n = self.n();
         assert_eq!(
             rhs.len(),
-            n * k,
+            self.n() * k,
             "solve_in_place: rhs must be n×k column-major"
         );
-        if self.solve_scratch.len() < n * k {
-            self.solve_scratch.resize(n * k, 0.0);
-        }
-        let x = &mut self.solve_scratch[..n * k];
-        let fwd = &self.symbolic.perm_fwd;
-        for (pos, &v) in fwd.iter().enumerate() {
-            for c in 0..k {
-                x[pos * k + c] = rhs[c * n + v as usize];
-            }
-        }
-        ldlt_solve_interleaved(
-            self.symbolic.col_ptr(),
-            self.symbolic.row_idx(),
-            &self.factor_values[..self.symbolic.nnz_factor()],
-            x,
-            k,
-        );
-        for (pos, &v) in fwd.iter().enumerate() {
-            for c in 0..k {
-                rhs[c * n + v as usize] = x[pos * k + c];
-            }
-        }
+        self.solve_channels(rhs, k, RhsKind::Plain);
     }
 
     /// Dirichlet convenience: on entry `values` (column-major n×k) holds the wanted value at
     /// constrained rows (other rows ignored); on exit the membrane, ≈ those values there.
     pub fn solve_dirichlet(&mut self, values: &mut [f64], k: usize) {
-        let n = self.n();
         assert_eq!(
             values.len(),
-            n * k,
+            self.n() * k,
             "solve_dirichlet: values must be n×k column-major"
         );
-        for column in values.chunks_exact_mut(n.max(1)) {
-            for (value, &on) in column.iter_mut().zip(&self.constrained) {
-                *value = if on { self.alpha * *value } else { 0.0 };
+        self.solve_channels(values, k, RhsKind::Dirichlet);
+    }
+
+    /// Permutes `rhs` (column-major n×k) into rows of up to 4 channels, solves, and
+    /// permutes the solution back.
+    fn solve_channels(&mut self, rhs: &mut [f64], k: usize, kind: RhsKind) {
+        let n = self.n();
+        for group in (0..k).step_by(4) {
+            let channels = (k - group).min(4);
+            let lanes = lanes_for(channels);
+            if self.solve_scratch.len() < n * lanes {
+                self.solve_scratch.resize(n * lanes, 0.0);
+            }
+            let x = &mut self.solve_scratch[..n * lanes];
+            let rhs = &mut rhs[group * n..(group + channels) * n];
+            let (position, constrained) = (&self.symbolic.perm_inv[..], &self.constrained[..]);
+            let kind = match kind {
+                RhsKind::Plain => None,
+                RhsKind::Dirichlet => Some((constrained, self.alpha)),
+            };
+            match channels {
+                1 => permute_in::<1, 1>(rhs, position, kind, x),
+                2 => permute_in::<2, 2>(rhs, position, kind, x),
+                3 => permute_in::<3, 4>(rhs, position, kind, x),
+                _ => permute_in::<4, 4>(rhs, position, kind, x),
+            }
+            ldlt_solve_supernodal(
+                &self.symbolic,
+                &self.factor_values[..self.symbolic.nnz_factor()],
+                &self.inv_diagonal,
+                x,
+                lanes,
+            );
+            match channels {
+                1 => permute_out::<1, 1>(x, position, rhs),
+                2 => permute_out::<2, 2>(x, position, rhs),
+                3 => permute_out::<3, 4>(x, position, rhs),
+                _ => permute_out::<4, 4>(x, position, rhs),
             }
         }
-        self.solve_in_place(values, k);
     }
 
     fn factor_current(&mut self) -> Result<(), SolveError> {
@@ -290,7 +362,28 @@ impl PenaltyFactor {
             &mut self.factor_values,
             self.epsilon,
             &mut self.workspace,
-        )
+        )?;
+        inverse_diagonal(
+            &self.symbolic,
+            &self.factor_values[..self.symbolic.nnz_factor()],
+            &mut self.inv_diagonal,
+        );
+        Ok(())
+    }
+
+    /// Refreshes `inv_diagonal` along the elimination-tree path from position `p` (the
+    /// pivots a rank-1 modification at `p` changed).
+    fn refresh_inverse_pivots(&mut self, p: usize) {
+        let (col_ptr, row_idx) = (self.symbolic.col_ptr(), self.symbolic.row_idx());
+        let mut j = p;
+        loop {
+            let (start, end) = (col_ptr[j] as usize, col_ptr[j + 1] as usize);
+            self.inv_diagonal[j] = 1.0 / self.factor_values[start];
+            if end == start + 1 {
+                return;
+            }
+            j = row_idx[start + 1] as usize;
+        }
     }
 
     /// Applies the batch recorded in `pending`/`touched`, then clears them.
@@ -386,6 +479,7 @@ impl PenaltyFactor {
                 if !on {
                     self.drift += UNIT_ROUNDOFF * amplification;
                 }
+                self.refresh_inverse_pivots(p);
                 true
             }
             Rank1Outcome::PivotLost => false,

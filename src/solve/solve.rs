@@ -2,7 +2,8 @@
 //! see [`symbolic`](super::symbolic)) and `k` right-hand sides stored *interleaved*
 //! (`x[i * k + c]`, row-major n×k, already permuted), and overwrites them with the solution of
 //! `L D Lᵀ x = b`. Interleaving makes each factor entry drive all k channels at once.
-//! No allocation.
+//! No allocation. The reference kernel: [`PenaltyFactor`](super::PenaltyFactor) solves with
+//! [`solve_supernodal`](super::solve_supernodal), which tests compare against this one.
 
 /// Solves in place. The pattern must satisfy the layout contract checked by
 /// [`SymbolicFactor::check_layout`](super::symbolic::SymbolicFactor::check_layout).

@@ -21,6 +21,7 @@
 //! indexing in the kernels cannot go out of bounds, and [`numeric`](super::numeric) compacts
 //! faer's supernodal values into this layout in place after each factorisation.
 
+use super::supernodes::SupernodePartition;
 use super::{SolveError, SymmetricCsc};
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, supernodal::SymbolicSupernodalCholesky, CholeskySymbolicParams,
@@ -81,6 +82,8 @@ pub struct SymbolicFactor {
     /// neighbours of position p are `adj_idx[adj_ptr[p]..adj_ptr[p + 1]]`.
     pub(crate) adj_ptr: Vec<u32>,
     pub(crate) adj_idx: Vec<u32>,
+    /// Supernodes of the factor pattern, for the supernodal solve.
+    pub(crate) supernodes: SupernodePartition,
 }
 
 impl SymbolicFactor {
@@ -141,7 +144,9 @@ impl SymbolicFactor {
             &col_ptr,
             matches!(faer.raw(), SymbolicCholeskyRaw::Supernodal(_)),
         );
+        let supernodes = SupernodePartition::detect(&col_ptr, &row_idx);
         let this = Self {
+            supernodes,
             refactor_cost,
             col_ptr,
             row_idx,
@@ -205,6 +210,12 @@ impl SymbolicFactor {
         }
     }
 
+    /// Supernodes of the factor pattern (detected from `col_ptr`/`row_idx`, see
+    /// [`supernodes`](super::supernodes)).
+    pub fn supernodes(&self) -> &SupernodePartition {
+        &self.supernodes
+    }
+
     /// Whether faer factors this pattern supernodally.
     pub fn is_supernodal(&self) -> bool {
         matches!(self.faer.raw(), SymbolicCholeskyRaw::Supernodal(_))
@@ -266,6 +277,7 @@ impl SymbolicFactor {
                 return broken("permutation is not a bijection".into());
             }
         }
+        self.supernodes.sanity_check(col_ptr, row_idx)?;
         if let SymbolicCholeskyRaw::Supernodal(s) = self.faer.raw() {
             for sn in 0..s.n_supernodes() {
                 let (begin, end) = (
