@@ -19,6 +19,12 @@
 //! per column (even and odd rows) to hide the multiply-add latency. Because the pattern was
 //! validated at analysis, the sweeps index without bounds checks.
 //!
+//! The forward sweep skips a supernode whose rows of `x` are all zero when it is reached:
+//! its panel would subtract exact zeros. Dirichlet right-hand sides are zero off the
+//! constrained boundary, so the sweep touches only the elimination-tree reach of the
+//! boundary (measured with `bench factor`: solve3 0.052 → 0.046 ms at 2k vertices, about
+//! 10 % at 52k). Skipping changes at most the sign of a zero, never a value.
+//!
 //! SIMD: on x86_64 the sweeps are compiled twice, portable (baseline ISA, separate multiply
 //! and add) and with AVX2+FMA, chosen at run time by [`SimdLevel::detect`]. The arithmetic
 //! order is fixed by the code, never by the data or the thread count, so a given binary on a
@@ -225,6 +231,9 @@ fn solve<V: Lanes>(factor: &Factor, x: &mut [f64]) {
     let mut rhs = Rows::<V>::new(x);
     for s in 0..supernodes {
         let panel = Panel::new(factor, s);
+        if rhs.all_zero(panel.b, panel.w) {
+            continue;
+        }
         if panel.w == 1 {
             column_forward(factor, panel.b, &mut rhs);
         } else {
@@ -288,6 +297,12 @@ impl<'a, V: Lanes> Rows<'a, V> {
         debug_assert!(i * V::S + V::S <= self.x.len());
         // SAFETY: i < n (see the type doc) and x.len() = n · S (asserted at the entry).
         unsafe { V::load(self.x.as_ptr().add(i * V::S)) }
+    }
+
+    /// Whether rows `b..b + w` are all zero (then a forward panel step changes nothing).
+    #[inline(always)]
+    fn all_zero(&self, b: usize, w: usize) -> bool {
+        self.x[b * V::S..(b + w) * V::S].iter().all(|&v| v == 0.0)
     }
 
     #[inline(always)]
