@@ -116,6 +116,8 @@ fn main() {
             let options = RasterOptions {
                 feather,
                 threads,
+                // LAPCLONE_RASTER_SCALAR: the scalar shading path, for comparisons.
+                simd: std::env::var_os("LAPCLONE_RASTER_SCALAR").is_none(),
                 ..RasterOptions::default()
             };
             dirty = draw_patch(&mut canvas, &patch, &options, &mut scratch)

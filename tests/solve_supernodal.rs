@@ -260,7 +260,13 @@ fn sparse_dirichlet_right_hand_sides_match_a_dense_solve() {
             for c in 0..k {
                 let column = &targets[c * n..(c + 1) * n];
                 let pb: Vec<f64> = (0..n)
-                    .map(|v| if wanted[v] { f.alpha() * column[v] } else { 0.0 })
+                    .map(|v| {
+                        if wanted[v] {
+                            f.alpha() * column[v]
+                        } else {
+                            0.0
+                        }
+                    })
                     .collect();
                 let diff = rel_diff(&x[c * n..(c + 1) * n], &dense_solve(&a, &pb));
                 assert!(diff <= 1e-10, "{method:?} channel {c}: {diff}");

@@ -42,6 +42,7 @@ mod sampler;
 mod scratch;
 mod setup;
 mod shade;
+mod shade_simd;
 mod triangles;
 
 pub use covered::{covered_boundary_vertices, CoverageGrid};

@@ -172,13 +172,12 @@ impl Replay {
             }
             hits += run.len as usize;
             let maps = &spans[run.id as usize];
-            let mut membrane = maps.at_pixel(x0, y);
-            for (pixel, &cover) in pixels.iter_mut().zip(coverage.by_ref()) {
+            for (x, (pixel, &cover)) in (x0..).zip(pixels.iter_mut().zip(coverage.by_ref())) {
                 if cover > 0 {
                     let Some(&sample) = samples.next() else { break };
+                    let membrane = maps.at_pixel(x, y);
                     written += usize::from(shade_pixel(pixel, sample, membrane, cover));
                 }
-                membrane += maps.maps[1];
             }
         }
         (hits, written)

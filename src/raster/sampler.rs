@@ -11,12 +11,12 @@ use crate::pixels::FloatImage;
 
 /// A borrowed view of the source, set up once per draw.
 pub(crate) struct Sampler<'a> {
-    pixels: &'a [[f32; 4]],
-    width: usize,
-    last_x: usize,
-    last_y: usize,
-    last_x_f32: f32,
-    last_y_f32: f32,
+    pub(super) pixels: &'a [[f32; 4]],
+    pub(super) width: usize,
+    pub(super) last_x: usize,
+    pub(super) last_y: usize,
+    pub(super) last_x_f32: f32,
+    pub(super) last_y_f32: f32,
 }
 
 impl<'a> Sampler<'a> {

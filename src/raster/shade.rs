@@ -11,6 +11,9 @@ use glam::Vec4;
 
 use super::sampler::Sampler;
 use super::setup::TriangleSetup;
+#[cfg(target_arch = "x86_64")]
+use super::shade_simd::shade_run_rgba8;
+use super::shade_simd::Kernel;
 use super::triangles::NO_TRIANGLE;
 use super::PixelRect;
 use crate::pixels::{FloatImage, Texel};
@@ -50,6 +53,8 @@ pub(crate) trait CoverageTexel: Copy {
     fn is_covered(self) -> bool;
     /// `unit() >= 1`, without the conversion.
     fn is_full(self) -> bool;
+    /// The texels as bytes when they are 8-bit (the SIMD kernel's input).
+    fn as_bytes(texels: &[Self]) -> Option<&[u8]>;
 }
 
 impl CoverageTexel for u8 {
@@ -64,6 +69,10 @@ impl CoverageTexel for u8 {
     #[inline(always)]
     fn is_full(self) -> bool {
         self == u8::MAX
+    }
+    #[inline(always)]
+    fn as_bytes(texels: &[u8]) -> Option<&[u8]> {
+        Some(texels)
     }
 }
 
@@ -80,6 +89,10 @@ impl CoverageTexel for f32 {
     fn is_full(self) -> bool {
         self >= 1.0
     }
+    #[inline(always)]
+    fn as_bytes(_: &[f32]) -> Option<&[u8]> {
+        None
+    }
 }
 
 /// Everything shading reads, bundled to keep signatures short.
@@ -94,6 +107,8 @@ pub(crate) struct ShadeInput<'a, C> {
     pub coverage_stride: usize,
     pub coverage_origin: (i32, i32),
     pub source: &'a FloatImage,
+    /// The span kernel (SIMD or scalar; same bytes either way).
+    pub kernel: Kernel,
 }
 
 /// Composites the patch over `canvas` inside `rows` (a rectangle of the canvas inside
@@ -120,6 +135,13 @@ pub(crate) fn shade_and_composite<T: StoreTexel, C: CoverageTexel, R: Recorder<C
         (rows.x1 - input.coverage_origin.0) as usize,
     );
     let sampler = Sampler::new(input.source);
+    // A recording draw stays scalar: replays must agree with it byte for byte, and the
+    // scalar path is the one that reports every sample.
+    let kernel = if R::ACTIVE {
+        Kernel::Scalar
+    } else {
+        input.kernel
+    };
     let (mut hits, mut written) = (0, 0);
     for y in rows.y0..rows.y1 {
         let ids_row = (y - ids_rect.y0) as usize * ids_width;
@@ -149,7 +171,10 @@ pub(crate) fn shade_and_composite<T: StoreTexel, C: CoverageTexel, R: Recorder<C
             } else {
                 hits += end - start;
                 let setup = &input.setups[id as usize];
-                shade_span(setup, &sampler, &span, pixels, recorder)
+                match simd_run(kernel, setup, &sampler, &span, pixels) {
+                    Some(written) => written,
+                    None => shade_span(setup, &sampler, &span, pixels, recorder),
+                }
             };
             start = end;
         }
@@ -165,9 +190,9 @@ struct Span<'a, C> {
 }
 
 /// Shades a run of pixels whose centres all lie in `setup`'s triangle. The single-precision
-/// maps are evaluated at the run's first centre relative to the triangle's own origin (small
-/// exact offsets), then stepped along the run: over a run of a few dozen pixels the source
-/// position drifts by far less than 1/1000 px, invisible after 8- or 16-bit rounding.
+/// maps are evaluated at every pixel centre relative to the triangle's own origin (small
+/// exact offsets), the same formula the fringe, the replay and the SIMD kernel
+/// ([`shade_simd`](super::shade_simd)) use, so every path gives the same bytes.
 /// Interior pixels (full coverage, opaque source) skip the blend.
 #[inline(always)]
 fn shade_span<T: StoreTexel, C: CoverageTexel, R: Recorder<C>>(
@@ -177,23 +202,46 @@ fn shade_span<T: StoreTexel, C: CoverageTexel, R: Recorder<C>>(
     pixels: &mut [[T; 4]],
     recorder: &mut R,
 ) -> usize {
-    let maps = &setup.span;
-    let (mut u, mut v, mut membrane) = maps.at_pixel(span.x0, span.y);
-    let (u_step, v_step, m_step) = (maps.texel_x[1], maps.texel_y[1], maps.membrane.maps[1]);
     let mut written = 0;
-    for (&texel, pixel) in span.coverage.iter().zip(pixels.iter_mut()) {
+    for (x, (&texel, pixel)) in (span.x0..).zip(span.coverage.iter().zip(pixels.iter_mut())) {
         if texel.is_covered() {
+            let (u, v, membrane) = setup.span.at_pixel(x, span.y);
             let sample = sampler.sample_texel_space(u, v);
             recorder.pixel(Some(sample), texel);
             written += usize::from(shade_pixel(pixel, sample, membrane, texel));
         } else {
             recorder.pixel(None, texel);
         }
-        u += u_step;
-        v += v_step;
-        membrane += m_step;
     }
     written
+}
+
+/// The run shaded by the SIMD kernel when there is one for this CPU and these texel types
+/// (8-bit canvas and coverage); `None`: the caller shades it the scalar way.
+#[inline(always)]
+fn simd_run<T: StoreTexel, C: CoverageTexel>(
+    kernel: Kernel,
+    setup: &TriangleSetup,
+    sampler: &Sampler,
+    span: &Span<C>,
+    pixels: &mut [[T; 4]],
+) -> Option<usize> {
+    #[cfg(target_arch = "x86_64")]
+    if kernel != Kernel::Scalar {
+        if let (Some(coverage), Some(pixels)) = (C::as_bytes(span.coverage), T::as_rgba8(pixels)) {
+            let at = (span.x0, span.y);
+            return Some(shade_run_rgba8(
+                kernel,
+                &setup.span,
+                sampler,
+                at,
+                coverage,
+                pixels,
+            ));
+        }
+    }
+    let _ = (kernel, setup, sampler, span, pixels);
+    None
 }
 
 /// Source sample plus membrane, composited with the pixel's coverage; whether it changed.
@@ -270,9 +318,16 @@ impl<C> Recorder<C> for NoRecorder {
 pub(crate) trait StoreTexel: Texel {
     /// `from_unit` of each channel of a colour already clamped to [0, 1].
     fn store_unit(colour: Vec4) -> [Self; 4];
+    /// The pixels as 8-bit RGBA when they are (the SIMD kernel's output).
+    fn as_rgba8(pixels: &mut [[Self; 4]]) -> Option<&mut [[u8; 4]]>;
 }
 
 impl StoreTexel for u8 {
+    #[inline(always)]
+    fn as_rgba8(pixels: &mut [[u8; 4]]) -> Option<&mut [[u8; 4]]> {
+        Some(pixels)
+    }
+
     /// SSE2: one truncating conversion and two saturating packs — exactly `from_unit` per
     /// channel for values in [0, 1] (the packs saturate nothing; NaN was clamped to 0 by
     /// SSE max/min, and even a NaN would only give a wrong byte, never UB).
@@ -302,6 +357,11 @@ impl StoreTexel for u8 {
 }
 
 impl StoreTexel for u16 {
+    #[inline(always)]
+    fn as_rgba8(_: &mut [[u16; 4]]) -> Option<&mut [[u8; 4]]> {
+        None
+    }
+
     #[inline(always)]
     fn store_unit(colour: Vec4) -> [u16; 4] {
         // The saturating cast: a NaN channel may survive the clamp on some SIMD backends.

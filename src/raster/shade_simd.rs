@@ -1,0 +1,353 @@
+//! AVX2 shading of one triangle run into an 8-bit canvas: takes a run of pixels whose
+//! centres lie in one triangle (its [`SpanSetup`], the row, the run's 8-bit coverage and
+//! canvas pixels) and the source [`Sampler`], and composites the run exactly as the scalar
+//! [`shade_span`](super::shade) does — the same bytes, not merely close ones.
+//!
+//! Why the bytes agree: every value is computed by the same IEEE operations in the same
+//! order as the scalar code, lane by lane — the affine maps `m₀ + m_x·dx + m_y·dy` at each
+//! pixel centre, the clamped bilinear taps, the lerps `a + (b − a)·t` (separate multiply
+//! and add, never fused), `clamp(sample + membrane, 0, 1)` by max then min, and the store
+//! `trunc(255·c + ½)` with saturating packs. Only the grouping differs: tap positions for
+//! eight pixels at once, then two pixels per 256-bit register for the texel blend and the
+//! store. Pixels that need a blend (partial coverage or a translucent source) take the
+//! scalar [`shade_pixel`] with the vector's own sample and membrane.
+//!
+//! Dispatch: [`Kernel::detect`] once per draw (unless `RasterOptions::simd` is off); without AVX2 (or off x86_64) the scalar path
+//! runs. The recording draw of a replay always runs the scalar path, which is why equality
+//! matters.
+
+use super::sampler::Sampler;
+use super::setup::SpanSetup;
+
+/// Which span kernel a draw uses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Kernel {
+    Scalar,
+    #[cfg(target_arch = "x86_64")]
+    Avx2,
+}
+
+impl Kernel {
+    /// The fastest kernel this CPU runs.
+    pub fn detect() -> Kernel {
+        #[cfg(target_arch = "x86_64")]
+        if is_x86_feature_detected!("avx2") {
+            return Kernel::Avx2;
+        }
+        Kernel::Scalar
+    }
+}
+
+/// Shades the run starting at canvas column `x0` of row `y` with the kernel's SIMD path.
+/// Gives the number of pixels written. `coverage` and `pixels` have the run's length.
+#[cfg(target_arch = "x86_64")]
+pub(crate) fn shade_run_rgba8(
+    kernel: Kernel,
+    setup: &SpanSetup,
+    sampler: &Sampler,
+    (x0, y): (i32, i32),
+    coverage: &[u8],
+    pixels: &mut [[u8; 4]],
+) -> usize {
+    assert_eq!(coverage.len(), pixels.len(), "one coverage texel per pixel");
+    match kernel {
+        // SAFETY: `Kernel::Avx2` is only ever detected on CPUs with AVX2.
+        Kernel::Avx2 => unsafe { avx2::shade_run(setup, sampler, (x0, y), coverage, pixels) },
+        Kernel::Scalar => unreachable!("the scalar kernel has no SIMD run"),
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+mod avx2 {
+    use std::arch::x86_64::*;
+
+    use glam::Vec4;
+
+    use super::super::sampler::Sampler;
+    use super::super::setup::SpanSetup;
+    use super::super::shade::shade_pixel;
+
+    /// The run's constant parts, as vectors.
+    struct RunMaps {
+        texel_x: [__m256; 2],
+        texel_y: [__m256; 2],
+        /// The y terms `m_y·dy` of the texel maps, per lane.
+        texel_y_terms: [__m256; 2],
+        /// Membrane at the origin, its x step and its y term, twice (two pixels).
+        membrane: [__m256; 3],
+    }
+
+    /// Clamped taps of eight texel-space coordinates: first tap, second tap, fraction
+    /// (the scalar `taps_shifted`, lane by lane).
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    fn taps(shifted: __m256, last: i32, last_f32: f32) -> (__m256i, __m256i, __m256) {
+        // max(x, 0) gives 0 for NaN and −0 (second operand), like `x > 0 ? x : 0`.
+        let low = _mm256_max_ps(shifted, _mm256_setzero_ps());
+        let u = _mm256_min_ps(low, _mm256_set1_ps(last_f32));
+        let whole = _mm256_cvttps_epi32(u);
+        let fraction = _mm256_sub_ps(u, _mm256_cvtepi32_ps(whole));
+        // whole < last: the compare gives −1, so subtracting it adds one.
+        let next = _mm256_sub_epi32(whole, _mm256_cmpgt_epi32(_mm256_set1_epi32(last), whole));
+        (whole, next, fraction)
+    }
+
+    /// Texel indices of the four taps of eight pixels, and their fractions.
+    struct Taps {
+        index: [[i32; 8]; 4],
+        fraction_x: __m256,
+        fraction_y: __m256,
+    }
+
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    fn taps_of_eight(sampler: &Sampler, maps: &RunMaps, dx: __m256) -> Taps {
+        let u = affine(maps.texel_x, dx, maps.texel_y_terms[0]);
+        let v = affine(maps.texel_y, dx, maps.texel_y_terms[1]);
+        // Sizes are bounded by `limits` (16,384 px a side), so every index fits i32.
+        let (x0, x1, fraction_x) = taps(u, sampler.last_x as i32, sampler.last_x_f32);
+        let (y0, y1, fraction_y) = taps(v, sampler.last_y as i32, sampler.last_y_f32);
+        let width = _mm256_set1_epi32(sampler.width as i32);
+        let (row0, row1) = (_mm256_mullo_epi32(y0, width), _mm256_mullo_epi32(y1, width));
+        let mut index = [[0i32; 8]; 4];
+        for (slot, value) in index.iter_mut().zip([
+            _mm256_add_epi32(row0, x0),
+            _mm256_add_epi32(row0, x1),
+            _mm256_add_epi32(row1, x0),
+            _mm256_add_epi32(row1, x1),
+        ]) {
+            // SAFETY: `slot` is eight i32, written unaligned.
+            unsafe { _mm256_storeu_si256(slot.as_mut_ptr() as *mut __m256i, value) };
+        }
+        Taps {
+            index,
+            fraction_x,
+            fraction_y,
+        }
+    }
+
+    /// `(m₀ + m_x·dx) + term`, the scalar `at_pixel`'s order.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    fn affine([origin, step]: [__m256; 2], dx: __m256, term: __m256) -> __m256 {
+        _mm256_add_ps(_mm256_add_ps(origin, _mm256_mul_ps(step, dx)), term)
+    }
+
+    /// Lanes `[K ×4, K+1 ×4]` of `v`: a per-pixel scalar spread over a pixel pair.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    fn pair_of<const K: i32>(v: __m256) -> __m256 {
+        let spread = _mm256_setr_epi32(K, K, K, K, K + 1, K + 1, K + 1, K + 1);
+        _mm256_permutevar8x32_ps(v, spread)
+    }
+
+    /// Texels of tap `tap` of pixels k and k + 1.
+    ///
+    /// # Safety
+    /// The indices are taps of `sampler` (clamped into the image).
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    unsafe fn texel_pair(sampler: &Sampler, taps: &Taps, tap: usize, k: usize) -> __m256 {
+        let base = sampler.pixels.as_ptr() as *const f32;
+        let (a, b) = (taps.index[tap][k] as usize, taps.index[tap][k + 1] as usize);
+        // SAFETY: the caller's contract; a texel is four f32.
+        unsafe { _mm256_set_m128(_mm_loadu_ps(base.add(b * 4)), _mm_loadu_ps(base.add(a * 4))) }
+    }
+
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    fn lerp(a: __m256, b: __m256, t: __m256) -> __m256 {
+        _mm256_add_ps(a, _mm256_mul_ps(_mm256_sub_ps(b, a), t))
+    }
+
+    /// Bilinear samples of pixels k and k + 1 (lanes 0–3 and 4–7).
+    ///
+    /// # Safety
+    /// As [`texel_pair`].
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    unsafe fn sample_pair<const K: i32>(sampler: &Sampler, taps: &Taps) -> __m256 {
+        let k = K as usize;
+        let (tx, ty) = (pair_of::<K>(taps.fraction_x), pair_of::<K>(taps.fraction_y));
+        // SAFETY: the caller's contract.
+        let (t00, t01, t10, t11) = unsafe {
+            (
+                texel_pair(sampler, taps, 0, k),
+                texel_pair(sampler, taps, 1, k),
+                texel_pair(sampler, taps, 2, k),
+                texel_pair(sampler, taps, 3, k),
+            )
+        };
+        lerp(lerp(t00, t01, tx), lerp(t10, t11, tx), ty)
+    }
+
+    /// Stores two clamped colours as 8-bit texels (the scalar `store_unit`, twice).
+    ///
+    /// # Safety
+    /// `out` must have room for two pixels.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    unsafe fn store_pair(colour: __m256, out: *mut [u8; 4]) {
+        let scaled = _mm256_add_ps(
+            _mm256_mul_ps(colour, _mm256_set1_ps(255.0)),
+            _mm256_set1_ps(0.5),
+        );
+        let words = _mm256_cvttps_epi32(scaled);
+        let halves = _mm_packs_epi32(
+            _mm256_castsi256_si128(words),
+            _mm256_extracti128_si256::<1>(words),
+        );
+        // SAFETY: the caller's contract: 8 writable bytes.
+        unsafe { _mm_storel_epi64(out as *mut __m128i, _mm_packus_epi16(halves, halves)) };
+    }
+
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    fn low(v: __m256) -> Vec4 {
+        Vec4::from(_mm256_castps256_ps128(v))
+    }
+
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    fn high(v: __m256) -> Vec4 {
+        Vec4::from(_mm256_extractf128_ps::<1>(v))
+    }
+
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    fn splat_pair(v: Vec4) -> __m256 {
+        let v: __m128 = v.into();
+        _mm256_set_m128(v, v)
+    }
+
+    /// Shades one pixel of a pair the scalar way (partial coverage or translucent source).
+    #[inline]
+    fn shade_single(pixel: &mut [u8; 4], cover: u8, sample: Vec4, membrane: Vec4) -> usize {
+        if cover > 0 {
+            usize::from(shade_pixel(pixel, sample, membrane, cover))
+        } else {
+            0
+        }
+    }
+
+    impl RunMaps {
+        #[target_feature(enable = "avx2")]
+        fn new(maps: &SpanSetup, dy: f32) -> RunMaps {
+            let [m_origin, m_x, m_y] = maps.membrane.maps;
+            RunMaps {
+                texel_x: [
+                    _mm256_set1_ps(maps.texel_x[0]),
+                    _mm256_set1_ps(maps.texel_x[1]),
+                ],
+                texel_y: [
+                    _mm256_set1_ps(maps.texel_y[0]),
+                    _mm256_set1_ps(maps.texel_y[1]),
+                ],
+                texel_y_terms: [
+                    _mm256_set1_ps(maps.texel_x[2] * dy),
+                    _mm256_set1_ps(maps.texel_y[2] * dy),
+                ],
+                membrane: [splat_pair(m_origin), splat_pair(m_x), splat_pair(m_y * dy)],
+            }
+        }
+    }
+
+    /// Eight pixels of a run (the last block may be shorter).
+    struct Block {
+        taps: Taps,
+        dx: __m256,
+        len: usize,
+    }
+
+    /// Shades pixels K and K + 1 of `block` (K + 1 only when the block has it); gives the
+    /// number written.
+    ///
+    /// # Safety
+    /// `block.taps` are taps of `sampler`; `K < block.len` = `coverage.len()` = `pixels.len()`.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    unsafe fn shade_pair<const K: i32>(
+        sampler: &Sampler,
+        maps: &RunMaps,
+        block: &Block,
+        coverage: &[u8],
+        pixels: &mut [[u8; 4]],
+    ) -> usize {
+        let at = K as usize;
+        // SAFETY: the caller's contract.
+        let sample = unsafe { sample_pair::<K>(sampler, &block.taps) };
+        let [m_origin, m_x, m_y_term] = maps.membrane;
+        let scaled_dx = _mm256_mul_ps(m_x, pair_of::<K>(block.dx));
+        let membrane = _mm256_add_ps(_mm256_add_ps(m_origin, scaled_dx), m_y_term);
+        let both = at + 1 < block.len;
+        let opaque = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_GE_OQ>(sample, _mm256_set1_ps(1.0)));
+        if both && coverage[at] & coverage[at + 1] == u8::MAX && opaque & 0x88 == 0x88 {
+            let colour = _mm256_min_ps(
+                _mm256_max_ps(_mm256_add_ps(sample, membrane), _mm256_setzero_ps()),
+                _mm256_set1_ps(1.0),
+            );
+            // SAFETY: pixels at and at + 1 exist (both).
+            unsafe { store_pair(colour, pixels.as_mut_ptr().add(at)) };
+            return 2;
+        }
+        let mut written = shade_single(&mut pixels[at], coverage[at], low(sample), low(membrane));
+        if both {
+            written += shade_single(
+                &mut pixels[at + 1],
+                coverage[at + 1],
+                high(sample),
+                high(membrane),
+            );
+        }
+        written
+    }
+
+    /// # Safety
+    /// The CPU must have AVX2; `coverage` and `pixels` have the same length.
+    #[target_feature(enable = "avx2")]
+    pub(super) unsafe fn shade_run(
+        setup: &SpanSetup,
+        sampler: &Sampler,
+        (x0, y): (i32, i32),
+        coverage: &[u8],
+        pixels: &mut [[u8; 4]],
+    ) -> usize {
+        let n = pixels.len();
+        let dy = (y - setup.membrane.origin[1]) as f32;
+        let maps = RunMaps::new(setup, dy);
+        let first_dx = x0 - setup.membrane.origin[0];
+        let lanes = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+        let mut written = 0;
+        let mut k0 = 0;
+        while k0 < n {
+            let dx = _mm256_cvtepi32_ps(_mm256_add_epi32(
+                _mm256_set1_epi32(first_dx + k0 as i32),
+                lanes,
+            ));
+            let block = Block {
+                taps: taps_of_eight(sampler, &maps, dx),
+                dx,
+                len: (n - k0).min(8),
+            };
+            let (coverage, pixels) = (
+                &coverage[k0..k0 + block.len],
+                &mut pixels[k0..k0 + block.len],
+            );
+            // SAFETY (each pair): taps are clamped into the image, lanes past the run included.
+            unsafe {
+                written += shade_pair::<0>(sampler, &maps, &block, coverage, pixels);
+                if block.len > 2 {
+                    written += shade_pair::<2>(sampler, &maps, &block, coverage, pixels);
+                }
+                if block.len > 4 {
+                    written += shade_pair::<4>(sampler, &maps, &block, coverage, pixels);
+                }
+                if block.len > 6 {
+                    written += shade_pair::<6>(sampler, &maps, &block, coverage, pixels);
+                }
+            }
+            k0 += 8;
+        }
+        written
+    }
+}
