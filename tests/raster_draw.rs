@@ -487,10 +487,11 @@ fn whole_pixel_moves_replay_the_same_bytes_as_fresh_draws() {
         ((2.5, 1.0), true),
         ((-45.0, 0.0), false),
     ];
-    for (anti_alias, format) in [
-        (true, PixelFormat::RGBA8),
-        (false, PixelFormat::RGBA8),
-        (true, PixelFormat::RGBA16),
+    for (anti_alias, format, simd) in [
+        (true, PixelFormat::RGBA8, true),
+        (true, PixelFormat::RGBA8, false),
+        (false, PixelFormat::RGBA8, true),
+        (true, PixelFormat::RGBA16, true),
     ] {
         let mut replaying = RasterScratch::new();
         for (k, &((dx, dy), replays)) in shifts.iter().enumerate() {
@@ -525,6 +526,7 @@ fn whole_pixel_moves_replay_the_same_bytes_as_fresh_draws() {
                 let options = RasterOptions {
                     anti_alias,
                     replay,
+                    simd,
                     ..RasterOptions::default()
                 };
                 let stats = draw_patch(&mut canvas, &patch, &options, scratch).unwrap();
