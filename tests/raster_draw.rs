@@ -619,3 +619,60 @@ fn simd_and_scalar_shading_give_the_same_bytes() {
         }
     }
 }
+
+/// A replay large enough to be split across two threads (half the rows each) gives the same
+/// bytes and counts as a one-thread replay and as a fresh draw.
+#[test]
+fn threaded_replays_match_one_thread_and_fresh_draws() {
+    let source = raster_meshes::pattern_image(330, 300);
+    let mesh = raster_meshes::grid(DVec2::new(2.0, 3.0), 6.0, 50, 45);
+    let membrane: Vec<[f32; 3]> = mesh
+        .positions
+        .iter()
+        .map(|p| [(p.x * 0.002) as f32, -0.04, (p.y * 0.001) as f32])
+        .collect();
+    let placed_at = |dx: f64, dy: f64| -> Vec<DVec2> {
+        mesh.positions
+            .iter()
+            .map(|p| {
+                DVec2::new(
+                    0.9 * p.x + 0.2 * p.y + 20.3 + dx,
+                    -0.2 * p.x + 0.9 * p.y + 70.6 + dy,
+                )
+            })
+            .collect()
+    };
+    let draw = |scratch: &mut RasterScratch, placed: &[DVec2], threads: usize, replay: bool| {
+        let patch = Patch {
+            rest: &mesh.positions,
+            placed,
+            triangles: &mesh.triangles,
+            membrane: &membrane,
+            depth: None,
+            loops: &mesh.loops,
+            source: &source,
+        };
+        let mut canvas = opaque_canvas(400, 400, 0.25);
+        let options = RasterOptions {
+            threads,
+            replay,
+            ..RasterOptions::default()
+        };
+        let stats = draw_patch(&mut canvas, &patch, &options, scratch).unwrap();
+        (canvas.to_float_image(PixelFormat::RGBA8), stats)
+    };
+    let (first, moved) = (placed_at(0.0, 0.0), placed_at(7.0, -5.0));
+    let (fresh, fresh_stats) = draw(&mut RasterScratch::new(), &moved, 1, false);
+    assert!(fresh_stats.written > 20_000, "large enough to split");
+    for threads in [1, 2, 3] {
+        let mut scratch = RasterScratch::new();
+        draw(&mut scratch, &first, threads, true);
+        let (replayed, stats) = draw(&mut scratch, &moved, threads, true);
+        assert!(stats.replayed, "{threads} threads");
+        assert_eq!(
+            (stats.centre_hits, stats.written),
+            (fresh_stats.centre_hits, fresh_stats.written)
+        );
+        assert!(replayed.pixels() == fresh.pixels(), "{threads} threads");
+    }
+}

@@ -137,15 +137,26 @@ pub fn covered_boundary_vertices(
 }
 
 /// Interpolated depth at `p` when it lies strictly inside the (either-oriented) triangle.
+///
+/// Most triangles near a vertex do not contain it, so the three edge functions are tested
+/// against the area's sign first, without dividing: `e / area > 0` needs `e` and `area` of
+/// the same strict sign. Only then are the barycentric weights formed and tested exactly as
+/// before (a quotient can still underflow to 0), so the answer is the same as testing the
+/// weights alone (tests compare with a brute force).
+#[inline]
 fn depth_if_strictly_inside(corners: [DVec2; 3], depth: [f32; 3], p: DVec2) -> Option<f64> {
     let [a, b, c] = corners;
     let area = (b - a).perp_dot(c - a);
-    if area == 0.0 {
+    let edges = [
+        (c - b).perp_dot(p - b),
+        (a - c).perp_dot(p - c),
+        (b - a).perp_dot(p - a),
+    ];
+    let same_sign = |e: f64| if area > 0.0 { e > 0.0 } else { e < 0.0 };
+    if area == 0.0 || !edges.iter().all(|&e| same_sign(e)) {
         return None;
     }
-    let wa = (c - b).perp_dot(p - b) / area;
-    let wb = (a - c).perp_dot(p - c) / area;
-    let wc = (b - a).perp_dot(p - a) / area;
+    let [wa, wb, wc] = edges.map(|e| e / area);
     (wa > 0.0 && wb > 0.0 && wc > 0.0)
         .then(|| wa * f64::from(depth[0]) + wb * f64::from(depth[1]) + wc * f64::from(depth[2]))
 }

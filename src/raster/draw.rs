@@ -168,9 +168,10 @@ fn try_replay(
     }));
     let canvas_width = canvas.width() as usize;
     let replay = &scratch.replay;
+    let threads = worker_threads(options.threads, work.area(), 2);
     let (centre_hits, written) = match canvas.pixels_mut() {
-        CanvasPixels::Eight(p) => replay.draw(shift, spans, p, canvas_width),
-        CanvasPixels::Sixteen(p) => replay.draw(shift, spans, p, canvas_width),
+        CanvasPixels::Eight(p) => replay.draw(shift, spans, p, canvas_width, threads),
+        CanvasPixels::Sixteen(p) => replay.draw(shift, spans, p, canvas_width, threads),
     };
     scratch.replay.remember(patch, options.anti_alias);
     Some(RasterStats {

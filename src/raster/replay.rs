@@ -29,6 +29,10 @@ const MAX_SHIFT: f64 = (1u64 << 20) as f64;
 /// Largest recorded area (px): the record holds 17 bytes per covered pixel.
 const MAX_RECORDED_AREA: usize = 4 << 20;
 
+/// Recorded pixels from which a second thread replays half the rows (a thread costs tens
+/// of microseconds; a replay of this many pixels about 0.15 ms).
+const THREADED_PIXELS: usize = 16 * 1024;
+
 /// What identifies the patch a record belongs to (addresses and sizes of the mesh and
 /// source slices the draw read; the scratch belongs to one patch).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -64,6 +68,9 @@ struct RecordedRun {
     id: u32,
     /// Fringe runs: how many of their pixels were drawn (and recorded).
     fringe_pixels: u32,
+    /// Where the run's data starts in the record's `coverage`, `samples` and `fringe`, so
+    /// a replay can start at any run (two threads each take half the rows).
+    data: [u32; 3],
 }
 
 /// The record of one draw, and the placement of the last draw.
@@ -138,24 +145,69 @@ impl Replay {
     }
 
     /// Composites the record shifted by `(dx, dy)` with the membrane maps `spans` (one per
-    /// triangle of the shifted patch). Gives (centre hits, pixels written), as a fresh draw
-    /// would.
-    pub fn draw<T: StoreTexel>(
+    /// triangle of the shifted patch), on up to `threads` threads (at most two: the rows
+    /// are cut in two halves). Gives (centre hits, pixels written), as a fresh draw would;
+    /// any thread count gives the same bytes (each pixel is written by one run).
+    pub fn draw<T: StoreTexel + Send>(
         &self,
+        shift: (i32, i32),
+        spans: &[MembraneSpan],
+        canvas: &mut [[T; 4]],
+        canvas_width: usize,
+        threads: usize,
+    ) -> (usize, usize) {
+        let split = (threads >= 2 && self.samples.len() >= THREADED_PIXELS)
+            .then(|| self.row_split())
+            .flatten();
+        let Some(k) = split else {
+            return self.draw_runs(&self.runs, shift, 0, spans, canvas, canvas_width);
+        };
+        let (top_runs, bottom_runs) = self.runs.split_at(k);
+        let first_row = (bottom_runs[0].y + shift.1) as usize;
+        let (top, bottom) = canvas.split_at_mut(first_row * canvas_width);
+        std::thread::scope(|scope| {
+            let lower = scope.spawn(move || {
+                self.draw_runs(bottom_runs, shift, first_row, spans, bottom, canvas_width)
+            });
+            let upper = self.draw_runs(top_runs, shift, 0, spans, top, canvas_width);
+            let lower = lower
+                .join()
+                .unwrap_or_else(|e| std::panic::resume_unwind(e));
+            (upper.0 + lower.0, upper.1 + lower.1)
+        })
+    }
+
+    /// A run index near the middle where a new row starts (runs are in row order), or
+    /// `None` when there is none.
+    fn row_split(&self) -> Option<usize> {
+        let half = self.runs.len() / 2;
+        (half.max(1)..self.runs.len()).find(|&k| self.runs[k].y != self.runs[k - 1].y)
+    }
+
+    /// Replays `runs` (consecutive runs of the record) into `canvas`, which starts at canvas
+    /// row `first_row`.
+    fn draw_runs<T: StoreTexel>(
+        &self,
+        runs: &[RecordedRun],
         (dx, dy): (i32, i32),
+        first_row: usize,
         spans: &[MembraneSpan],
         canvas: &mut [[T; 4]],
         canvas_width: usize,
     ) -> (usize, usize) {
         let (mut hits, mut written) = (0, 0);
+        let Some(first) = runs.first() else {
+            return (0, 0);
+        };
+        let [c, s, f] = first.data.map(|at| at as usize);
         let (mut coverage, mut samples, mut fringe) = (
-            self.coverage.iter(),
-            self.samples.iter(),
-            self.fringe.iter(),
+            self.coverage[c..].iter(),
+            self.samples[s..].iter(),
+            self.fringe[f..].iter(),
         );
-        for run in &self.runs {
+        for run in runs {
             let (x0, y) = (run.x0 + dx, run.y + dy);
-            let start = y as usize * canvas_width + x0 as usize;
+            let start = (y as usize - first_row) * canvas_width + x0 as usize;
             let pixels = &mut canvas[start..start + run.len as usize];
             if run.id == NO_TRIANGLE {
                 for _ in 0..run.fringe_pixels {
@@ -192,12 +244,21 @@ pub(crate) struct Recording<'a> {
 impl Recorder<u8> for Recording<'_> {
     fn run(&mut self, x0: i32, y: i32, len: usize, id: u32) {
         let len = u32::try_from(len).unwrap_or(u32::MAX);
-        self.replay.runs.push(RecordedRun {
+        let replay = &mut *self.replay;
+        // The record holds at most MAX_RECORDED_AREA pixels, so offsets fit u32.
+        let at = |n: usize| u32::try_from(n).unwrap_or(u32::MAX);
+        let data = [
+            at(replay.coverage.len()),
+            at(replay.samples.len()),
+            at(replay.fringe.len()),
+        ];
+        replay.runs.push(RecordedRun {
             x0,
             y,
             len,
             id,
             fringe_pixels: 0,
+            data,
         });
     }
 
