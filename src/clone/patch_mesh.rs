@@ -5,7 +5,9 @@
 use glam::DVec2;
 
 use super::{expand_boundary, CloneError, HALF_PIXEL};
-use crate::mesh::{mesh_mask, mesh_polygons, BitMask, MeshOptions, MeshResult, Polygon};
+use crate::mesh::{
+    mesh_mask, mesh_polygons, BitMask, BoundaryPlacement, MeshOptions, MeshResult, Polygon,
+};
 
 /// A patch mesh in source coordinates, with its mask's bounding box.
 #[derive(Clone, Debug)]
@@ -17,8 +19,9 @@ pub struct PatchMesh {
 }
 
 /// Meshes `mask`, whose pixel (0, 0) sits at `offset` in a source of `source_size`.
-/// Without an offset the mask must have the source's size. The boundary is moved half a
-/// pixel out, onto the outside pixel centres ([`expand_boundary`]).
+/// Without an offset the mask must have the source's size. The boundary ends on the outside
+/// pixel centres: meshed there ([`BoundaryPlacement::OutsideCentres`]), or meshed on the
+/// cracks and moved half a pixel out ([`expand_boundary`]).
 pub fn mesh_from_mask(
     mask: &BitMask,
     offset: Option<DVec2>,
@@ -42,7 +45,9 @@ pub fn mesh_from_mask(
     for p in &mut result.mesh.positions {
         *p += offset;
     }
-    expand_boundary(&mut result.mesh, HALF_PIXEL);
+    if result.stats.boundary == BoundaryPlacement::Cracks {
+        expand_boundary(&mut result.mesh, HALF_PIXEL);
+    }
     let (min, max) = inside_bbox(mask);
     Ok(PatchMesh {
         result,

@@ -12,6 +12,7 @@
 //! `coverage`; the Laplacian export in `laplacian_mtx`; test/bench masks in [`synth`].
 
 mod bitmask;
+mod centre_loops;
 mod contour;
 mod coverage;
 mod error;
@@ -32,9 +33,11 @@ pub use coverage::{
 pub use error::{MeshError, SanityError};
 pub use laplacian_mtx::{boundary_list, boundary_path, laplacian_matrix_market, write_laplacian};
 pub use mesh_mask::{mesh_mask, mesh_polygons, Polygon, MAX_POLYGON_COORDINATE};
-pub use options::{min_angle_deg, MeshOptions, MeshResult, MeshStats};
+pub use options::{
+    min_angle_deg, BoundaryPlacement, MeshOptions, MeshResult, MeshStats, MIN_MAX_AREA,
+};
 pub use simplify::{
     doubled_signed_area, simplify_loop, subdivide_loop, subdivided_len, Simplified,
 };
-pub use triangulate::{assemble_mesh, triangulate_loops, Triangulated};
+pub use triangulate::{assemble_mesh, triangulate_loops, Refinement, Triangulated};
 pub use types::{BoundaryLoop, LoopKind, Mesh};

@@ -20,7 +20,45 @@ pub struct MeshOptions {
     pub max_vertices: usize,
     /// Pieces (8-connected) with fewer pixels than this are dropped with a warning.
     pub min_piece_area: f64,
+    /// Where a mask mesh's boundary runs (polygon input ignores it).
+    pub boundary: BoundaryPlacement,
+    /// Largest triangle area refinement leaves, px²; `None`: only the angle bound grades
+    /// the interior (dense at the boundary, coarse inside).
+    pub max_area: Option<f64>,
 }
+
+/// Where [`super::mesh_mask`] puts the boundary of a mask mesh.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum BoundaryPlacement {
+    /// The pixel cracks, simplified by `simplify_tolerance` and subdivided to `density`.
+    /// The clone stage then moves it half a pixel out (`clone::expand_boundary`).
+    #[default]
+    Cracks,
+    /// Exactly the centres of the outside 4-neighbours of the mask, the pixels where the
+    /// pixel-grid clone fixes its values, in crack order: with `density` ≤ √2 px every such
+    /// pixel is a boundary vertex; coarser densities drop centres where the boundary is
+    /// straight to within half a pixel (`simplify_tolerance` does not apply).
+    OutsideCentres,
+}
+
+impl std::str::FromStr for BoundaryPlacement {
+    type Err = String;
+
+    fn from_str(text: &str) -> Result<Self, Self::Err> {
+        match text {
+            "cracks" => Ok(Self::Cracks),
+            "outside-centres" | "outside-centers" => Ok(Self::OutsideCentres),
+            other => Err(format!(
+                "unknown boundary placement {other:?} (expected cracks or outside-centres)"
+            )),
+        }
+    }
+}
+
+/// The smallest `max_area` accepted, px²: below it refinement would need more vertices than
+/// its size-based budget allows.
+pub const MIN_MAX_AREA: f64 = 0.25;
 
 impl Default for MeshOptions {
     /// - `density` 3 px: on the spiral, PSNR against the pixel-grid clone saturates with
@@ -42,6 +80,8 @@ impl Default for MeshOptions {
             min_angle_deg: 25.0,
             max_vertices: crate::limits::MAX_MESH_VERTICES,
             min_piece_area: 4.0,
+            boundary: BoundaryPlacement::Cracks,
+            max_area: None,
         }
     }
 }
@@ -79,6 +119,13 @@ impl MeshOptions {
                 self.min_piece_area
             ));
         }
+        if let Some(area) = self.max_area {
+            if !(area.is_finite() && area >= MIN_MAX_AREA) {
+                return bad(format!(
+                    "max_area must be an area ≥ {MIN_MAX_AREA} px², got {area}"
+                ));
+            }
+        }
         Ok(())
     }
 }
@@ -101,6 +148,12 @@ pub struct MeshStats {
     pub refinement_complete: bool,
     pub dropped_pieces: usize,
     pub dropped_pixels: usize,
+    /// Where the boundary ended up (`OutsideCentres` falls back to `Cracks` when the centre
+    /// loops cannot be meshed, with a warning).
+    pub boundary: BoundaryPlacement,
+    /// With `OutsideCentres`: boundary vertices a quarter pixel outside a crack instead of on
+    /// an outside centre (pixels reached from two sides of a 1-px notch, gap or hole).
+    pub off_centre_boundary_vertices: usize,
 }
 
 /// A mesh with warnings (dropped pieces, budget exhausted, fallbacks) and statistics.

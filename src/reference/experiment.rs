@@ -32,7 +32,7 @@ use super::{
     PoissonError,
 };
 use crate::clone::{CloneError, CloneOptions, MembraneSolver, PatchCloner, Placement};
-use crate::mesh::{mesh_mask, BitMask, Mesh, MeshError, MeshOptions};
+use crate::mesh::{mesh_mask, BitMask, BoundaryPlacement, Mesh, MeshError, MeshOptions};
 use crate::pixels::{Canvas, FloatImage};
 use crate::solve::LaplacianKind;
 
@@ -256,15 +256,20 @@ impl Experiment {
             self.inside[y * self.width + x]
         });
         let mut mesh_ms = f64::INFINITY;
-        let mut mesh = Mesh::default();
+        let mut result = None;
         for _ in 0..run.repeats {
             let started = Instant::now();
-            mesh = mesh_mask(&bits, mesh_options)?.mesh;
+            let fresh = mesh_mask(&bits, mesh_options)?;
             mesh_ms = mesh_ms.min(millis(started.elapsed()));
+            result = Some(fresh);
         }
+        let result = result.expect("repeats ≥ 1"); // invariant: repeats ≥ 1 was checked, so the loop ran at least once.
+        let mut mesh = result.mesh;
         // The product's clone uses the mask mesh with its boundary on the outside pixel
-        // centres (clone::expand_boundary); measure exactly that.
-        crate::clone::expand_boundary(&mut mesh, crate::clone::HALF_PIXEL);
+        // centres (clone::mesh_from_mask); measure exactly that.
+        if result.stats.boundary == BoundaryPlacement::Cracks {
+            crate::clone::expand_boundary(&mut mesh, crate::clone::HALF_PIXEL);
+        }
         self.run_on_mesh(mesh, mesh_ms, run)
     }
 
