@@ -184,3 +184,64 @@ proptest! {
         }
     }
 }
+
+/// Σ_j (x_j − x_i) over the neighbours of every interior vertex: the combinatorial
+/// Laplacian's defect on linear functions.
+fn first_moment_defect(mesh: &lapclone::mesh::Mesh) -> f64 {
+    let n = mesh.vertex_count();
+    let mut sum = vec![glam::DVec2::ZERO; n];
+    for (a, b) in mesh.edges() {
+        let d = mesh.positions[b as usize] - mesh.positions[a as usize];
+        sum[a as usize] += d;
+        sum[b as usize] -= d;
+    }
+    (0..n)
+        .filter(|&v| !mesh.is_boundary[v])
+        .map(|v| sum[v].length())
+        .sum::<f64>()
+}
+
+#[test]
+fn relaxation_keeps_the_boundary_and_the_triangles_and_shrinks_the_linear_defect() {
+    for mask in [
+        synth::spiral(160, 150),
+        synth::two_holes(90, 70),
+        synth::comb(120, 90, 6, 4),
+    ] {
+        let before = mesh_mask(&mask, &MeshOptions::default()).unwrap().mesh;
+        let mut after = before.clone();
+        lapclone::mesh::relax_interior(&mut after, 5);
+        after.sanity_check().unwrap();
+        assert_eq!(after.triangles, before.triangles);
+        for v in before.boundary_vertices() {
+            assert_eq!(after.positions[v as usize], before.positions[v as usize]);
+        }
+        for t in &after.triangles {
+            assert!(area(&after, t) > 0.0);
+        }
+        let (was, is) = (first_moment_defect(&before), first_moment_defect(&after));
+        assert!(is < 0.5 * was, "defect {was} → {is}");
+        // Deterministic: the same sweeps give the same bits.
+        let mut again = before.clone();
+        lapclone::mesh::relax_interior(&mut again, 5);
+        assert_eq!(again.positions, after.positions);
+    }
+}
+
+#[test]
+fn the_seam_quality_preset_is_valid_and_relaxes_in_the_clone_stage() {
+    let options = MeshOptions::seam_quality();
+    options.validate().unwrap();
+    let mask = synth::disc(40, 40, 15.0);
+    let raw = mesh_mask(&mask, &options).unwrap().mesh;
+    let patch = mesh_from_mask(&mask, None, (40, 40), &options).unwrap();
+    let mut relaxed = raw.clone();
+    lapclone::mesh::relax_interior(&mut relaxed, options.relax_sweeps);
+    assert_eq!(patch.result.mesh.positions, relaxed.positions);
+    assert_ne!(relaxed.positions, raw.positions);
+    let too_many = MeshOptions {
+        relax_sweeps: lapclone::mesh::MAX_RELAX_SWEEPS + 1,
+        ..MeshOptions::default()
+    };
+    assert!(mesh_mask(&mask, &too_many).is_err());
+}

@@ -19,6 +19,7 @@ mod error;
 mod laplacian_mtx;
 mod mesh_mask;
 mod options;
+mod relax;
 mod sanity;
 mod simplify;
 pub mod synth;
@@ -34,8 +35,10 @@ pub use error::{MeshError, SanityError};
 pub use laplacian_mtx::{boundary_list, boundary_path, laplacian_matrix_market, write_laplacian};
 pub use mesh_mask::{mesh_mask, mesh_polygons, Polygon, MAX_POLYGON_COORDINATE};
 pub use options::{
-    min_angle_deg, BoundaryPlacement, MeshOptions, MeshResult, MeshStats, MIN_MAX_AREA,
+    min_angle_deg, BoundaryPlacement, MeshOptions, MeshResult, MeshStats, MAX_RELAX_SWEEPS,
+    MIN_MAX_AREA, SEAM_QUALITY_MIN_ANGLE_DEG, SEAM_QUALITY_RELAX_SWEEPS,
 };
+pub use relax::relax_interior;
 pub use simplify::{
     doubled_signed_area, simplify_loop, subdivide_loop, subdivided_len, Simplified,
 };

@@ -32,7 +32,7 @@ use super::{
     PoissonError,
 };
 use crate::clone::{CloneError, CloneOptions, MembraneSolver, PatchCloner, Placement};
-use crate::mesh::{mesh_mask, BitMask, BoundaryPlacement, Mesh, MeshError, MeshOptions};
+use crate::mesh::{mesh_mask, BitMask, Mesh, MeshError, MeshOptions};
 use crate::pixels::{Canvas, FloatImage};
 use crate::solve::LaplacianKind;
 
@@ -263,14 +263,11 @@ impl Experiment {
             mesh_ms = mesh_ms.min(millis(started.elapsed()));
             result = Some(fresh);
         }
-        let result = result.expect("repeats ≥ 1"); // invariant: repeats ≥ 1 was checked, so the loop ran at least once.
-        let mut mesh = result.mesh;
-        // The product's clone uses the mask mesh with its boundary on the outside pixel
-        // centres (clone::mesh_from_mask); measure exactly that.
-        if result.stats.boundary == BoundaryPlacement::Cracks {
-            crate::clone::expand_boundary(&mut mesh, crate::clone::HALF_PIXEL);
-        }
-        self.run_on_mesh(mesh, mesh_ms, run)
+        let mut result = result.expect("repeats ≥ 1"); // invariant: repeats ≥ 1 was checked, so the loop ran at least once.
+                                                       // Measure the mesh the product's clone uses (clone::mesh_from_mask): boundary on the
+                                                       // outside pixel centres, interior relaxed as asked.
+        crate::clone::finish_mask_mesh(&mut result, mesh_options);
+        self.run_on_mesh(result.mesh, mesh_ms, run)
     }
 
     /// Runs all methods on a given mesh (pixel coordinates of the mask).
