@@ -13,7 +13,7 @@
 //! `preprocess_ms`, `membrane_ms` (MVC: `null` numbers and `not_run` = reason when it did not
 //! run); `figure` (path or null); `sweep[]` (with `--sweep`) with `density`, `vertices`,
 //! `mesh_ms`, `psnr_combinatorial_db`, `psnr_cotangent_db`, `uncovered`, `reclone_ms`,
-//! `boundary`, `min_angle_deg`, `max_area` (null: none). With `--rings`, every model also has
+//! `boundary`, `min_angle_deg`, `max_area` (null: none), `relax_sweeps`. With `--rings`, every model also has
 //! `rings[]`: `first`, `last` (ring band; `last` null = and beyond), `combinatorial_db`,
 //! `cotangent_db` — PSNR over the mask pixels that many 4-steps from the outside.
 
@@ -35,15 +35,21 @@ use lapclone::util::write_atomic;
 /// Densities (max boundary edge, px) of the default sweep.
 const SWEEP_DENSITIES: [f64; 7] = [4.0, 3.0, 2.0, 1.5, 1.0, 0.75, 0.5];
 /// Mesh configurations swept after the densities (boundary, density px, min angle °, max
-/// area px²): exact Dirichlet vertices, then grading limits (docs/quality.md).
-const SWEEP_QUALITY: [(BoundaryPlacement, f64, f64, Option<f64>); 7] = [
-    (BoundaryPlacement::OutsideCentres, 1.0, 25.0, None),
-    (BoundaryPlacement::OutsideCentres, 2.0, 28.0, None),
-    (BoundaryPlacement::OutsideCentres, 1.0, 28.0, None),
-    (BoundaryPlacement::OutsideCentres, 1.0, 30.0, None),
-    (BoundaryPlacement::OutsideCentres, 1.0, 30.0, Some(16.0)),
-    (BoundaryPlacement::OutsideCentres, 1.0, 31.0, None),
-    (BoundaryPlacement::OutsideCentres, 1.0, 32.0, None),
+/// area px², relaxation sweeps): exact Dirichlet vertices, grading limits, relaxation
+/// (docs/quality.md).
+type SweepConfig = (BoundaryPlacement, f64, f64, Option<f64>, usize);
+const SWEEP_QUALITY: [SweepConfig; 11] = [
+    (BoundaryPlacement::Cracks, 3.0, 25.0, None, 5),
+    (BoundaryPlacement::Cracks, 2.0, 25.0, None, 5),
+    (BoundaryPlacement::OutsideCentres, 1.0, 25.0, None, 0),
+    (BoundaryPlacement::OutsideCentres, 2.0, 28.0, None, 0),
+    (BoundaryPlacement::OutsideCentres, 1.0, 28.0, None, 0),
+    (BoundaryPlacement::OutsideCentres, 1.0, 30.0, None, 0),
+    (BoundaryPlacement::OutsideCentres, 1.0, 30.0, Some(16.0), 0),
+    (BoundaryPlacement::OutsideCentres, 1.0, 32.0, None, 0),
+    (BoundaryPlacement::OutsideCentres, 1.0, 25.0, None, 5),
+    (BoundaryPlacement::OutsideCentres, 1.0, 28.0, None, 5),
+    (BoundaryPlacement::OutsideCentres, 1.0, 29.0, None, 5),
 ];
 /// Ring bands of `--rings` (inclusive; `u32::MAX`: and beyond).
 const RING_BANDS: [(u32, u32); 6] = [(1, 1), (2, 2), (3, 3), (4, 7), (8, 15), (16, u32::MAX)];
@@ -147,6 +153,7 @@ struct SweepRow {
     boundary: BoundaryPlacement,
     min_angle_deg: f64,
     max_area: Option<f64>,
+    relax_sweeps: usize,
 }
 
 #[derive(serde::Serialize)]
@@ -160,10 +167,10 @@ struct Report {
 
 pub fn run(args: PaperBenchArgs) -> anyhow::Result<()> {
     let mut mesh_options = MeshOptions::default();
+    args.mesh.apply(&mut mesh_options);
     if let Some(density) = args.density {
         mesh_options.density = density;
     }
-    args.mesh.apply(&mut mesh_options);
     mesh_options
         .validate()
         .map_err(|e| super::UsageError(e.to_string()))?;
@@ -510,8 +517,8 @@ fn run_sweep(args: &PaperBenchArgs, run_options: &RunOptions) -> anyhow::Result<
         mvc_max_weights: 0,
         ..*run_options
     };
-    let quality: &[(BoundaryPlacement, f64, f64, Option<f64>)] = if args.quick {
-        &SWEEP_QUALITY[..1]
+    let quality: &[SweepConfig] = if args.quick {
+        &SWEEP_QUALITY[2..3]
     } else {
         &SWEEP_QUALITY
     };
@@ -522,11 +529,12 @@ fn run_sweep(args: &PaperBenchArgs, run_options: &RunOptions) -> anyhow::Result<
             ..MeshOptions::default()
         })
         .chain(quality.iter().map(
-            |&(boundary, density, min_angle_deg, max_area)| MeshOptions {
+            |&(boundary, density, min_angle_deg, max_area, relax_sweeps)| MeshOptions {
                 density,
                 boundary,
                 min_angle_deg,
                 max_area,
+                relax_sweeps,
                 ..MeshOptions::default()
             },
         ));
@@ -556,6 +564,7 @@ fn run_sweep(args: &PaperBenchArgs, run_options: &RunOptions) -> anyhow::Result<
             boundary: options.boundary,
             min_angle_deg: options.min_angle_deg,
             max_area: options.max_area,
+            relax_sweeps: options.relax_sweeps,
         });
     }
     if !args.quick {
@@ -572,9 +581,9 @@ fn run_sweep(args: &PaperBenchArgs, run_options: &RunOptions) -> anyhow::Result<
 
 fn sweep_markdown(rows: &[SweepRow]) -> String {
     let mut out = String::from(
-        "| boundary | density (px) | min angle (°) | max area (px²) | vertices | mesh (ms) \
-         | PSNR combinatorial (dB) | PSNR cotangent (dB) | uncovered px | re-clone (ms) |\n\
-         |:---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+        "| boundary | density (px) | min angle (°) | max area (px²) | relax | vertices \
+         | mesh (ms) | PSNR combinatorial (dB) | PSNR cotangent (dB) | uncovered px \
+         | re-clone (ms) |\n|:---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
     );
     for r in rows {
         let boundary = match r.boundary {
@@ -583,10 +592,11 @@ fn sweep_markdown(rows: &[SweepRow]) -> String {
         };
         let _ = writeln!(
             out,
-            "| {boundary} | {} | {} | {} | {} | {:.1} | {:.2} | {:.2} | {} | {:.2} |",
+            "| {boundary} | {} | {} | {} | {} | {} | {:.1} | {:.2} | {:.2} | {} | {:.2} |",
             r.density,
             r.min_angle_deg,
             r.max_area.map_or("–".into(), |a| a.to_string()),
+            r.relax_sweeps,
             r.vertices,
             r.mesh_ms,
             r.psnr_combinatorial_db,

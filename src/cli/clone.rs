@@ -134,10 +134,10 @@ pub fn run(args: CloneArgs) -> anyhow::Result<()> {
 
     let mesh_started = Instant::now();
     let mut mesh_options = MeshOptions::default();
+    args.mesh.apply(&mut mesh_options);
     if let Some(density) = args.density {
         mesh_options.density = density;
     }
-    args.mesh.apply(&mut mesh_options);
     mesh_options
         .validate()
         .map_err(|e| super::UsageError(e.to_string()))?;
