@@ -27,8 +27,8 @@ pub fn relax_interior(mesh: &mut Mesh, sweeps: usize) -> usize {
         return 0;
     }
     let n = mesh.vertex_count();
-    let (neighbour_start, neighbours) = neighbour_lists(mesh);
     let (triangle_start, incident) = incident_triangles(mesh);
+    let (neighbour_start, neighbours) = neighbour_lists(mesh, &triangle_start, &incident);
     let mut skipped = 0;
     for _ in 0..sweeps {
         for v in (0..n).filter(|&v| !mesh.is_boundary[v]) {
@@ -66,42 +66,56 @@ fn keeps_triangles(mesh: &Mesh, v: usize, target: DVec2, triangles: &[u32]) -> b
     })
 }
 
-/// Sorted, deduplicated neighbours of every vertex, in compressed rows.
-fn neighbour_lists(mesh: &Mesh) -> (Vec<usize>, Vec<u32>) {
-    let mut pairs: Vec<(u32, u32)> = mesh
-        .triangles
-        .iter()
-        .flat_map(|t| {
-            [(0, 1), (1, 2), (2, 0)]
-                .into_iter()
-                .flat_map(move |(a, b)| [(t[a], t[b]), (t[b], t[a])])
-        })
-        .collect();
-    pairs.sort_unstable();
-    pairs.dedup();
-    rows(mesh.vertex_count(), pairs)
+/// Sorted, deduplicated neighbours of every vertex, in compressed rows, read off the
+/// incident triangles (linear time; only the short per-vertex lists are sorted).
+fn neighbour_lists(
+    mesh: &Mesh,
+    triangle_start: &[usize],
+    incident: &[u32],
+) -> (Vec<usize>, Vec<u32>) {
+    let n = mesh.vertex_count();
+    let mut start = Vec::with_capacity(n + 1);
+    let mut neighbours = Vec::with_capacity(2 * incident.len());
+    start.push(0);
+    for v in 0..n {
+        let row = neighbours.len();
+        for &t in &incident[triangle_start[v]..triangle_start[v + 1]] {
+            let corners = mesh.triangles[t as usize];
+            neighbours.extend(corners.iter().copied().filter(|&c| c as usize != v));
+        }
+        neighbours[row..].sort_unstable();
+        let mut kept = row;
+        for k in row..neighbours.len() {
+            if k == row || neighbours[k] != neighbours[kept - 1] {
+                neighbours[kept] = neighbours[k];
+                kept += 1;
+            }
+        }
+        neighbours.truncate(kept);
+        start.push(neighbours.len());
+    }
+    (start, neighbours)
 }
 
-/// Triangles incident to every vertex, in compressed rows.
+/// Triangles incident to every vertex, in compressed rows (counting sort: linear time).
 fn incident_triangles(mesh: &Mesh) -> (Vec<usize>, Vec<u32>) {
-    let mut pairs: Vec<(u32, u32)> = mesh
-        .triangles
-        .iter()
-        .enumerate()
-        .flat_map(|(t, corners)| corners.map(|c| (c, t as u32)))
-        .collect();
-    pairs.sort_unstable();
-    rows(mesh.vertex_count(), pairs)
-}
-
-/// Compressed rows from sorted (row, value) pairs.
-fn rows(count: usize, pairs: Vec<(u32, u32)>) -> (Vec<usize>, Vec<u32>) {
-    let mut start = vec![0usize; count + 1];
-    for &(row, _) in &pairs {
-        start[row as usize + 1] += 1;
+    let n = mesh.vertex_count();
+    let mut start = vec![0usize; n + 1];
+    for t in &mesh.triangles {
+        for &c in t {
+            start[c as usize + 1] += 1;
+        }
     }
-    for i in 0..count {
-        start[i + 1] += start[i];
+    for v in 0..n {
+        start[v + 1] += start[v];
     }
-    (start, pairs.into_iter().map(|(_, value)| value).collect())
+    let mut fill = start.clone();
+    let mut incident = vec![0u32; start[n]];
+    for (index, t) in mesh.triangles.iter().enumerate() {
+        for &c in t {
+            incident[fill[c as usize]] = index as u32;
+            fill[c as usize] += 1;
+        }
+    }
+    (start, incident)
 }
