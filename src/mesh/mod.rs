@@ -8,7 +8,10 @@
 //!
 //! Pipeline ([`mesh_mask`]): [`BitMask`] → small pieces dropped → crack loops (`contour`) →
 //! Douglas–Peucker + subdivision to `density` (`simplify`) → spade CDT + refinement
-//! (`triangulate`) → [`Mesh`], verified by [`Mesh::sanity_check`]. Mask-aware checks are in
+//! (`triangulate`) → [`Mesh`], verified by [`Mesh::sanity_check`]. With
+//! [`BoundaryPlacement::OutsideCentres`] the loops run through the outside pixel centres
+//! instead (`centre_loops`); [`relax_interior`] evens out the interior for the combinatorial
+//! Laplacian (the clone stage applies it). Mask-aware checks are in
 //! `coverage`; the Laplacian export in `laplacian_mtx`; test/bench masks in [`synth`].
 
 mod bitmask;
