@@ -2,7 +2,9 @@
 //! mask (noise of any density, unions of boxes and discs, lines, checkerboards, at sizes
 //! down to 1 px) and random mesher options: meshing either succeeds or fails with one of the
 //! expected typed errors, never panics; a mesh passes `sanity_check`, covers every mask
-//! pixel except those of dropped specks (at simplification tolerances up to the default), stays valid after the half-pixel boundary
+//! pixel except those of dropped specks (at simplification tolerances up to the default), with
+//! the boundary on the cracks or on the outside pixel centres and with or without interior
+//! relaxation, stays valid after the half-pixel boundary
 //! expansion of the clone stage, and clones onto a canvas with a finite membrane.
 //!
 //! The small fixed-seed run is part of the normal suite. The long run is opt-in:
@@ -11,7 +13,9 @@
 
 use glam::DVec2;
 use lapclone::clone::{mesh_from_mask, CloneOptions, PatchCloner, Placement};
-use lapclone::mesh::{mesh_mask, uncovered_mask_pixels, BitMask, MeshError, MeshOptions};
+use lapclone::mesh::{
+    mesh_mask, uncovered_mask_pixels, BitMask, BoundaryPlacement, MeshError, MeshOptions,
+};
 use lapclone::pixels::{Canvas, FloatImage, PixelFormat};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed, TestCaseError, TestRunner};
@@ -35,6 +39,9 @@ struct Input {
     density: f64,
     min_angle_deg: f64,
     simplify_tolerance: f64,
+    /// Boundary on the outside pixel centres (else on the cracks) and relaxation sweeps.
+    centres: bool,
+    relax_sweeps: usize,
 }
 
 fn mask_of(input: &Input) -> BitMask {
@@ -84,15 +91,26 @@ fn input_strategy(max_side: usize) -> impl Strategy<Value = Input> {
         prop_oneof![Just(3.0), 0.3f64..8.0],
         prop_oneof![Just(25.0), 0.0f64..=35.0],
         prop_oneof![Just(0.9), 0.0f64..3.0],
+        (any::<bool>(), prop_oneof![Just(0usize), 1usize..8]),
     )
         .prop_map(
-            |(width, height, shape, density, min_angle_deg, simplify_tolerance)| Input {
+            |(
                 width,
                 height,
                 shape,
                 density,
                 min_angle_deg,
                 simplify_tolerance,
+                (centres, relax_sweeps),
+            )| Input {
+                width,
+                height,
+                shape,
+                density,
+                min_angle_deg,
+                simplify_tolerance,
+                centres,
+                relax_sweeps,
             },
         )
 }
@@ -104,6 +122,12 @@ fn check(input: &Input) -> Result<(), TestCaseError> {
         density: input.density,
         min_angle_deg: input.min_angle_deg,
         simplify_tolerance: input.simplify_tolerance,
+        boundary: if input.centres {
+            BoundaryPlacement::OutsideCentres
+        } else {
+            BoundaryPlacement::Cracks
+        },
+        relax_sweeps: input.relax_sweeps,
         ..MeshOptions::default()
     };
     let result = match mesh_mask(&mask, &options) {
@@ -209,6 +233,8 @@ fn regressions_found_by_fuzzing() {
             density: 0.3,
             min_angle_deg: 25.0,
             simplify_tolerance: 0.9,
+            centres: false,
+            relax_sweeps: 0,
         },
         // The same with a hole whose moved loop turned over (positive area for a hole).
         Input {
@@ -221,6 +247,8 @@ fn regressions_found_by_fuzzing() {
             density: 0.3,
             min_angle_deg: 25.0,
             simplify_tolerance: 0.9,
+            centres: false,
+            relax_sweeps: 0,
         },
         // Coarse simplification (2.7 px) may leave a pixel uncovered: coverage is promised
         // only up to the default tolerance.
@@ -231,6 +259,8 @@ fn regressions_found_by_fuzzing() {
             density: 3.0,
             min_angle_deg: 25.0,
             simplify_tolerance: 2.728_085_340_159_821_3,
+            centres: false,
+            relax_sweeps: 0,
         },
         // A 34.9° angle limit refined a small box until the 2 M vertex budget (70 s).
         Input {
@@ -240,6 +270,8 @@ fn regressions_found_by_fuzzing() {
             density: 0.449_984_178_999_891_7,
             min_angle_deg: 34.908_765_626_039_97,
             simplify_tolerance: 2.625_690_189_248_562_7,
+            centres: false,
+            relax_sweeps: 0,
         },
     ];
     for input in &found {

@@ -3,8 +3,8 @@
 
 use glam::DVec2;
 use lapclone::reference::{
-    composite, poisson_membrane, psnr, seam_step, uncovered_pixels, ComparisonInput, GridMask,
-    MembraneComparison, MetricError, MvcWeights,
+    composite, poisson_membrane, psnr, psnr_by_ring, ring_of_pixels, seam_step, uncovered_pixels,
+    ComparisonInput, GridMask, MembraneComparison, MetricError, MvcWeights,
 };
 
 /// 3×3 image, centre pixel inside.
@@ -179,4 +179,35 @@ fn mvc_membrane_is_close_to_the_grid_reference_on_a_small_square() {
         bad.psnr_db < 20.0 && bad.seam_step.mean_abs > 0.1,
         "{bad:?}"
     );
+}
+
+#[test]
+fn rings_count_four_steps_from_the_outside() {
+    // 7×5 image, inside the 5×3 block at (1..6, 1..4): its rim is ring 1, the centre row's
+    // middle three pixels ring 2; the image border row/column is outside.
+    let inside: Vec<bool> = (0..35)
+        .map(|p| (1..6).contains(&(p % 7)) && (1..4).contains(&(p / 7)))
+        .collect();
+    let mask = GridMask::new(7, 5, &inside).unwrap();
+    let ring = ring_of_pixels(mask);
+    #[rustfmt::skip]
+    let expected = [
+        0, 0, 0, 0, 0, 0, 0,
+        0, 1, 1, 1, 1, 1, 0,
+        0, 1, 2, 2, 2, 1, 0,
+        0, 1, 1, 1, 1, 1, 0,
+        0, 0, 0, 0, 0, 0, 0,
+    ];
+    assert_eq!(ring, expected);
+    // One channel: error 0.1 on ring 1 pixel (1, 1), 0.2 on ring 2 pixel (3, 2).
+    let a = vec![0.0f64; 35];
+    let mut b = vec![0.0f64; 35];
+    b[8] = 0.1;
+    b[17] = 0.2;
+    let by_ring = psnr_by_ring(&a, &b, 1, mask, &[(1, 1), (2, u32::MAX), (3, 3)]).unwrap();
+    let ring1 = 10.0 * (12.0 / 0.01f64).log10();
+    let ring2 = 10.0 * (3.0 / 0.04f64).log10();
+    assert!((by_ring[0].unwrap() - ring1).abs() < 1e-9, "{by_ring:?}");
+    assert!((by_ring[1].unwrap() - ring2).abs() < 1e-9, "{by_ring:?}");
+    assert_eq!(by_ring[2], None);
 }

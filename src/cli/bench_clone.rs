@@ -40,6 +40,11 @@ pub struct CloneBenchArgs {
     /// Print JSON instead of a table.
     #[arg(long)]
     pub json: bool,
+    /// Maximum boundary edge length of the spiral meshes in px (default: the library's).
+    #[arg(long, value_parser = super::finite_f64)]
+    pub density: Option<f64>,
+    #[command(flatten)]
+    pub mesh: super::mesh_args::MeshQualityArgs,
 }
 
 /// OpenCV 5.0 `seamlessClone` (NORMAL) on the spiral masks, ms (issue #4).
@@ -98,9 +103,23 @@ pub fn run(args: CloneBenchArgs) -> anyhow::Result<()> {
     }
     let target = load_or(asset("hubble_deep_field.jpg"), || synthetic(1000, 872, 0.3))?;
     let photo = load_or(asset("astronaut.png"), || synthetic(512, 512, 1.7))?;
+    let mut mesh_options = MeshOptions::default();
+    args.mesh.apply(&mut mesh_options);
+    if let Some(density) = args.density {
+        mesh_options.density = density;
+    }
+    mesh_options
+        .validate()
+        .map_err(|e| super::UsageError(e.to_string()))?;
     let mut spiral = Vec::new();
     for &size in &args.sizes {
-        spiral.push(bench_spiral(size, &photo, &target, args.repeats)?);
+        spiral.push(bench_spiral(
+            size,
+            &photo,
+            &target,
+            &mesh_options,
+            args.repeats,
+        )?);
     }
     let deform = bench_deform(args.vertices, args.frames)?;
     let report = Report { spiral, deform };
@@ -169,6 +188,7 @@ fn bench_spiral(
     size: usize,
     photo: &FloatImage,
     target: &FloatImage,
+    mesh_options: &MeshOptions,
     repeats: usize,
 ) -> anyhow::Result<SpiralRow> {
     let mask = synth::spiral(size, size);
@@ -186,12 +206,7 @@ fn bench_spiral(
         // The cloner owns its source; copying it is the caller's business, not timed.
         let owned_source = source.clone();
         let started = Instant::now();
-        let patch = mesh_from_mask(
-            &mask,
-            None,
-            (source.width(), source.height()),
-            &MeshOptions::default(),
-        )?;
+        let patch = mesh_from_mask(&mask, None, (source.width(), source.height()), mesh_options)?;
         let meshed = Instant::now();
         let mut fresh =
             PatchCloner::new(owned_source, patch.result.mesh, &CloneOptions::default())?;

@@ -12,25 +12,47 @@
 //! `cotangent`, `mvc` objects with `psnr_db`, `seam_step`, `reference_seam_step`,
 //! `preprocess_ms`, `membrane_ms` (MVC: `null` numbers and `not_run` = reason when it did not
 //! run); `figure` (path or null); `sweep[]` (with `--sweep`) with `density`, `vertices`,
-//! `mesh_ms`, `psnr_combinatorial_db`, `psnr_cotangent_db`, `uncovered`, `reclone_ms`.
+//! `mesh_ms`, `psnr_combinatorial_db`, `psnr_cotangent_db`, `uncovered`, `reclone_ms`,
+//! `boundary`, `min_angle_deg`, `max_area` (null: none), `relax_sweeps`. With `--rings`, every model also has
+//! `rings[]`: `first`, `last` (ring band; `last` null = and beyond), `combinatorial_db`,
+//! `cotangent_db` — PSNR over the mask pixels that many 4-steps from the outside.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use glam::DVec2;
-use lapclone::mesh::MeshOptions;
+use lapclone::mesh::{BoundaryPlacement, MeshOptions};
 use lapclone::reference::experiment::{
     reclone_ms, Experiment, MeshRun, MethodFigures, MvcOutcome, RunOptions,
 };
 use lapclone::reference::figure::comparison_figure;
 use lapclone::reference::paper_models::{paper_model, MODEL_NAMES};
-use lapclone::reference::GridMask;
+use lapclone::reference::{psnr_by_ring, GridMask};
 use lapclone::solve::LaplacianKind;
 use lapclone::util::write_atomic;
 
 /// Densities (max boundary edge, px) of the default sweep.
 const SWEEP_DENSITIES: [f64; 7] = [4.0, 3.0, 2.0, 1.5, 1.0, 0.75, 0.5];
+/// Mesh configurations swept after the densities (boundary, density px, min angle °, max
+/// area px², relaxation sweeps): exact Dirichlet vertices, grading limits, relaxation
+/// (docs/quality.md).
+type SweepConfig = (BoundaryPlacement, f64, f64, Option<f64>, usize);
+const SWEEP_QUALITY: [SweepConfig; 11] = [
+    (BoundaryPlacement::Cracks, 3.0, 25.0, None, 5),
+    (BoundaryPlacement::Cracks, 2.0, 25.0, None, 5),
+    (BoundaryPlacement::OutsideCentres, 1.0, 25.0, None, 0),
+    (BoundaryPlacement::OutsideCentres, 2.0, 28.0, None, 0),
+    (BoundaryPlacement::OutsideCentres, 1.0, 28.0, None, 0),
+    (BoundaryPlacement::OutsideCentres, 1.0, 30.0, None, 0),
+    (BoundaryPlacement::OutsideCentres, 1.0, 30.0, Some(16.0), 0),
+    (BoundaryPlacement::OutsideCentres, 1.0, 32.0, None, 0),
+    (BoundaryPlacement::OutsideCentres, 1.0, 25.0, None, 5),
+    (BoundaryPlacement::OutsideCentres, 1.0, 28.0, None, 5),
+    (BoundaryPlacement::OutsideCentres, 1.0, 29.0, None, 5),
+];
+/// Ring bands of `--rings` (inclusive; `u32::MAX`: and beyond).
+const RING_BANDS: [(u32, u32); 6] = [(1, 1), (2, 2), (3, 3), (4, 7), (8, 15), (16, u32::MAX)];
 /// Vertex counts of the Fig.-5 meshes (the paper's .5K, 1K, 3K).
 const FIGURE_VERTICES: [usize; 3] = [500, 1000, 3000];
 
@@ -73,6 +95,11 @@ pub struct PaperBenchArgs {
     /// `<!-- bench paper: begin -->` and `<!-- bench paper: end -->`), e.g. README.md.
     #[arg(long)]
     pub readme: Option<PathBuf>,
+    /// Also give PSNR by distance from the boundary (rings of 4-steps from the outside).
+    #[arg(long)]
+    pub rings: bool,
+    #[command(flatten)]
+    pub mesh: super::mesh_args::MeshQualityArgs,
 }
 
 #[derive(serde::Serialize)]
@@ -102,6 +129,16 @@ struct ModelJson {
     combinatorial: MethodJson,
     cotangent: MethodJson,
     mvc: MethodJson,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    rings: Option<Vec<RingJson>>,
+}
+
+#[derive(serde::Serialize)]
+struct RingJson {
+    first: u32,
+    last: Option<u32>,
+    combinatorial_db: Option<f64>,
+    cotangent_db: Option<f64>,
 }
 
 #[derive(serde::Serialize, Clone)]
@@ -113,6 +150,10 @@ struct SweepRow {
     psnr_cotangent_db: f64,
     uncovered: usize,
     reclone_ms: f64,
+    boundary: BoundaryPlacement,
+    min_angle_deg: f64,
+    max_area: Option<f64>,
+    relax_sweeps: usize,
 }
 
 #[derive(serde::Serialize)]
@@ -126,6 +167,7 @@ struct Report {
 
 pub fn run(args: PaperBenchArgs) -> anyhow::Result<()> {
     let mut mesh_options = MeshOptions::default();
+    args.mesh.apply(&mut mesh_options);
     if let Some(density) = args.density {
         mesh_options.density = density;
     }
@@ -148,13 +190,21 @@ pub fn run(args: PaperBenchArgs) -> anyhow::Result<()> {
     let mut models = Vec::new();
     for name in names {
         let experiment = load_experiment(&args.assets, name)?;
+        let table_options = RunOptions {
+            keep_membranes: args.rings,
+            ..run_options
+        };
         let run = experiment
-            .run(&mesh_options, &run_options)
+            .run(&mesh_options, &table_options)
             .with_context(|| format!("model {name}"))?;
         if !args.json {
             eprintln!("measured {name}");
         }
-        models.push(model_json(name, &experiment, &run));
+        let mut json = model_json(name, &experiment, &run);
+        if args.rings {
+            json.rings = Some(rings_json(&experiment, &run)?);
+        }
+        models.push(json);
     }
     let figure = if args.quick || args.no_figure {
         None
@@ -262,6 +312,57 @@ fn model_json(name: &str, experiment: &Experiment, run: &MeshRun) -> ModelJson {
         combinatorial: method_json(&run.combinatorial),
         cotangent: method_json(&run.cotangent),
         mvc: mvc_json(&run.mvc),
+        rings: None,
+    }
+}
+
+/// PSNR per ring band of both Laplacian membranes (kept in `run`).
+fn rings_json(experiment: &Experiment, run: &MeshRun) -> anyhow::Result<Vec<RingJson>> {
+    let by_ring = |membrane: &Option<Vec<f64>>| -> anyhow::Result<Vec<Option<f64>>> {
+        let membrane = membrane.as_ref().context("membrane not kept")?;
+        Ok(psnr_by_ring(
+            membrane,
+            experiment.reference(),
+            lapclone::reference::experiment::CHANNELS,
+            experiment.mask(),
+            &RING_BANDS,
+        )?)
+    };
+    let combinatorial = by_ring(&run.combinatorial.membrane)?;
+    let cotangent = by_ring(&run.cotangent.membrane)?;
+    Ok(RING_BANDS
+        .iter()
+        .enumerate()
+        .map(|(i, &(first, last))| RingJson {
+            first,
+            last: (last != u32::MAX).then_some(last),
+            combinatorial_db: combinatorial[i],
+            cotangent_db: cotangent[i],
+        })
+        .collect())
+}
+
+fn rings_text(out: &mut String, report: &Report) {
+    for m in &report.models {
+        let Some(rings) = &m.rings else { continue };
+        let _ = writeln!(
+            out,
+            "{}: PSNR (dB) by ring, combinatorial / cotangent",
+            m.model
+        );
+        for r in rings {
+            let band = match r.last {
+                Some(last) if last == r.first => format!("{}", r.first),
+                Some(last) => format!("{}-{last}", r.first),
+                None => format!("{}+", r.first),
+            };
+            let _ = writeln!(
+                out,
+                "  ring {band:>5}  {:>6} / {:>6}",
+                number(r.combinatorial_db, 2),
+                number(r.cotangent_db, 2)
+            );
+        }
     }
 }
 
@@ -321,6 +422,7 @@ fn table_text(report: &Report) -> String {
             m.uncovered,
         );
     }
+    rings_text(&mut out, report);
     if let Some(path) = &report.figure {
         let _ = writeln!(out, "comparison picture: {path}");
     }
@@ -415,12 +517,30 @@ fn run_sweep(args: &PaperBenchArgs, run_options: &RunOptions) -> anyhow::Result<
         mvc_max_weights: 0,
         ..*run_options
     };
-    let mut rows = Vec::new();
-    for &density in densities {
-        let options = MeshOptions {
+    let quality: &[SweepConfig] = if args.quick {
+        &SWEEP_QUALITY[2..3]
+    } else {
+        &SWEEP_QUALITY
+    };
+    let configurations = densities
+        .iter()
+        .map(|&density| MeshOptions {
             density,
             ..MeshOptions::default()
-        };
+        })
+        .chain(quality.iter().map(
+            |&(boundary, density, min_angle_deg, max_area, relax_sweeps)| MeshOptions {
+                density,
+                boundary,
+                min_angle_deg,
+                max_area,
+                relax_sweeps,
+                ..MeshOptions::default()
+            },
+        ));
+    let mut rows = Vec::new();
+    for options in configurations {
+        let density = options.density;
         let run = experiment.run(&options, &run_options)?;
         let reclone = reclone_ms(
             experiment.source(),
@@ -431,7 +551,7 @@ fn run_sweep(args: &PaperBenchArgs, run_options: &RunOptions) -> anyhow::Result<
             run_options.repeats.max(5),
         )?;
         if !args.json {
-            eprintln!("swept density {density}");
+            eprintln!("swept {:?} density {density}", options.boundary);
         }
         rows.push(SweepRow {
             density,
@@ -441,6 +561,10 @@ fn run_sweep(args: &PaperBenchArgs, run_options: &RunOptions) -> anyhow::Result<
             psnr_cotangent_db: run.cotangent.comparison.psnr_db,
             uncovered: run.uncovered,
             reclone_ms: reclone,
+            boundary: options.boundary,
+            min_angle_deg: options.min_angle_deg,
+            max_area: options.max_area,
+            relax_sweeps: options.relax_sweeps,
         });
     }
     if !args.quick {
@@ -457,14 +581,22 @@ fn run_sweep(args: &PaperBenchArgs, run_options: &RunOptions) -> anyhow::Result<
 
 fn sweep_markdown(rows: &[SweepRow]) -> String {
     let mut out = String::from(
-        "| density (px) | vertices | mesh (ms) | PSNR combinatorial (dB) | PSNR cotangent (dB) \
-         | uncovered px | re-clone (ms) |\n|---:|---:|---:|---:|---:|---:|---:|\n",
+        "| boundary | density (px) | min angle (°) | max area (px²) | relax | vertices \
+         | mesh (ms) | PSNR combinatorial (dB) | PSNR cotangent (dB) | uncovered px \
+         | re-clone (ms) |\n|:---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
     );
     for r in rows {
+        let boundary = match r.boundary {
+            BoundaryPlacement::Cracks => "cracks",
+            BoundaryPlacement::OutsideCentres => "outside centres",
+        };
         let _ = writeln!(
             out,
-            "| {} | {} | {:.1} | {:.2} | {:.2} | {} | {:.2} |",
+            "| {boundary} | {} | {} | {} | {} | {} | {:.1} | {:.2} | {:.2} | {} | {:.2} |",
             r.density,
+            r.min_angle_deg,
+            r.max_area.map_or("–".into(), |a| a.to_string()),
+            r.relax_sweeps,
             r.vertices,
             r.mesh_ms,
             r.psnr_combinatorial_db,
@@ -498,7 +630,9 @@ fn splice_generated(old: &str, generated: &str) -> String {
 fn sweep_document(experiment: &Experiment, rows: &[SweepRow]) -> String {
     format!(
         "Generated by `lapclone bench paper --sweep` (release build); do not edit by hand.\n\n\
-         Spiral model, {}×{} px, {} mask pixels, other mesh options at their defaults. \
+         Spiral model, {}×{} px, {} mask pixels, other mesh options at their defaults \
+         (`outside centres`: boundary vertices exactly on the outside pixel centres; at \
+         density 1 every one of them, coarser densities drop centres on straight runs). \
          PSNR of source + membrane against source + pixel-grid reference membrane over the \
          mask pixels (peak 1); uncovered = mask pixels whose centre is in no triangle; \
          re-clone = constraint switches + solve + raster via `PatchCloner` at a placement \

@@ -46,6 +46,8 @@ pub struct CloneArgs {
     /// Maximum boundary edge length in pixels.
     #[arg(long, value_parser = finite_f64, allow_hyphen_values = true)]
     pub density: Option<f64>,
+    #[command(flatten)]
+    pub mesh: super::mesh_args::MeshQualityArgs,
     /// Inside threshold of the mask in [0, 1].
     #[arg(long, default_value_t = 0.5, value_parser = finite_f64, allow_hyphen_values = true)]
     pub threshold: f64,
@@ -132,9 +134,13 @@ pub fn run(args: CloneArgs) -> anyhow::Result<()> {
 
     let mesh_started = Instant::now();
     let mut mesh_options = MeshOptions::default();
+    args.mesh.apply(&mut mesh_options);
     if let Some(density) = args.density {
         mesh_options.density = density;
     }
+    mesh_options
+        .validate()
+        .map_err(|e| super::UsageError(e.to_string()))?;
     let patch = mesh_from_mask(
         &mask,
         args.mask_offset.map(DVec2::from),

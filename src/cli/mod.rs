@@ -13,6 +13,7 @@ pub mod bench_render;
 pub mod bench_solver;
 pub mod clone;
 pub mod mesh;
+pub mod mesh_args;
 pub mod render;
 pub mod repl;
 

@@ -17,5 +17,5 @@ pub use cloner::{CloneMode, CloneOptions, CloneStats, PatchCloner};
 pub use error::CloneError;
 pub use expand::{expand_boundary, HALF_PIXEL};
 pub use membrane::{MembraneSolver, MembraneStats, MEMBRANE_CHANNELS};
-pub use patch_mesh::{mesh_from_mask, mesh_from_polygons, PatchMesh};
+pub use patch_mesh::{finish_mask_mesh, mesh_from_mask, mesh_from_polygons, PatchMesh};
 pub use placement::{Anchor, Placement};

@@ -5,7 +5,10 @@
 use glam::DVec2;
 
 use super::{expand_boundary, CloneError, HALF_PIXEL};
-use crate::mesh::{mesh_mask, mesh_polygons, BitMask, MeshOptions, MeshResult, Polygon};
+use crate::mesh::{
+    mesh_mask, mesh_polygons, relax_interior, BitMask, BoundaryPlacement, MeshOptions, MeshResult,
+    Polygon,
+};
 
 /// A patch mesh in source coordinates, with its mask's bounding box.
 #[derive(Clone, Debug)]
@@ -17,8 +20,9 @@ pub struct PatchMesh {
 }
 
 /// Meshes `mask`, whose pixel (0, 0) sits at `offset` in a source of `source_size`.
-/// Without an offset the mask must have the source's size. The boundary is moved half a
-/// pixel out, onto the outside pixel centres ([`expand_boundary`]).
+/// Without an offset the mask must have the source's size. The boundary ends on the outside
+/// pixel centres: meshed there ([`BoundaryPlacement::OutsideCentres`]), or meshed on the
+/// cracks and moved half a pixel out ([`expand_boundary`]).
 pub fn mesh_from_mask(
     mask: &BitMask,
     offset: Option<DVec2>,
@@ -42,7 +46,7 @@ pub fn mesh_from_mask(
     for p in &mut result.mesh.positions {
         *p += offset;
     }
-    expand_boundary(&mut result.mesh, HALF_PIXEL);
+    finish_mask_mesh(&mut result, options);
     let (min, max) = inside_bbox(mask);
     Ok(PatchMesh {
         result,
@@ -51,12 +55,22 @@ pub fn mesh_from_mask(
     })
 }
 
-/// Meshes polygons given in source coordinates.
+/// What the clone stage does to a fresh mask mesh: puts a crack boundary on the outside pixel
+/// centres ([`expand_boundary`]) and relaxes the interior (`options.relax_sweeps`).
+pub fn finish_mask_mesh(result: &mut MeshResult, options: &MeshOptions) {
+    if result.stats.boundary == BoundaryPlacement::Cracks {
+        expand_boundary(&mut result.mesh, HALF_PIXEL);
+    }
+    relax_interior(&mut result.mesh, options.relax_sweeps);
+}
+
+/// Meshes polygons given in source coordinates (interior relaxed as `options` asks).
 pub fn mesh_from_polygons(
     polygons: &[Polygon],
     options: &MeshOptions,
 ) -> Result<PatchMesh, CloneError> {
-    let result = mesh_polygons(polygons, options)?;
+    let mut result = mesh_polygons(polygons, options)?;
+    relax_interior(&mut result.mesh, options.relax_sweeps);
     let mut min = DVec2::splat(f64::INFINITY);
     let mut max = DVec2::splat(f64::NEG_INFINITY);
     for p in polygons.iter().flat_map(|p| &p.outer) {

@@ -2,14 +2,17 @@
 //! [`Polygon`]s; both give a [`MeshResult`]. Mask path: drop small pieces → crack loops →
 //! Douglas–Peucker (anchored at saddle corners) → subdivide to `density` → CDT + refinement.
 //! If simplification makes two loops touch or cross (a thin gap closed by the tolerance), the
-//! mask is meshed again from the raw crack loops, which never cross.
+//! mask is meshed again from the raw crack loops, which never cross. With
+//! [`BoundaryPlacement::OutsideCentres`] the loops run through the outside pixel centres
+//! instead (`centre_loops`); if those cannot be meshed, the crack path is taken.
 
 use glam::DVec2;
 
+use super::centre_loops::outside_centre_loops;
 use super::contour::{label_pieces, trace_crack_loops, CrackLoop};
-use super::options::min_angle_deg;
+use super::options::{min_angle_deg, BoundaryPlacement};
 use super::simplify::{doubled_signed_area, simplify_loop, subdivide_loop, subdivided_len};
-use super::triangulate::triangulate_loops;
+use super::triangulate::{triangulate_loops, Refinement};
 use super::{BitMask, Mesh, MeshError, MeshOptions, MeshResult, MeshStats};
 
 /// A polygon with holes in pixel coordinates; orientation does not matter (it is fixed up).
@@ -43,9 +46,13 @@ pub fn mesh_mask(mask: &BitMask, options: &MeshOptions) -> Result<MeshResult, Me
     }
     let crack = trace_crack_loops(kept_mask);
     let expected_holes = crack.iter().filter(|l| l.is_hole()).count();
-    let attempt = |tolerance: f64| -> Result<(Mesh, bool, f64), MeshError> {
-        let (loops, deviation) = sample_crack_loops(&crack, tolerance, options)?;
-        let t = triangulate_loops(&loops, options.min_angle_deg, options.max_vertices)?;
+    let attempt = |loops: &[Vec<DVec2>], keep_boundary: bool| -> Result<(Mesh, bool), MeshError> {
+        let refinement = Refinement {
+            max_area: options.max_area,
+            keep_boundary,
+            ..Refinement::new(options.min_angle_deg, options.max_vertices)
+        };
+        let t = triangulate_loops(loops, &refinement)?;
         // The full check costs about as much as the refinement; the tests run it on every
         // shape family, so release builds rely on the topology counts below.
         if cfg!(debug_assertions) {
@@ -54,20 +61,58 @@ pub fn mesh_mask(mask: &BitMask, options: &MeshOptions) -> Result<MeshResult, Me
         if t.mesh.hole_count() != expected_holes || t.mesh.piece_count as usize != pieces {
             return Err(MeshError::IntersectingBoundary { conflicts: 0 });
         }
-        Ok((t.mesh, t.refinement_complete, deviation))
+        Ok((t.mesh, t.refinement_complete))
     };
-    let mut simplified = options.simplify_tolerance > 0.0;
-    let (mesh, complete, deviation) = match attempt(options.simplify_tolerance) {
-        Ok(done) => done,
-        Err(MeshError::IntersectingBoundary { .. } | MeshError::Sanity(_)) if simplified => {
-            warnings.push(
-                "simplification made boundary loops touch; meshed the unsimplified crack boundary"
-                    .into(),
-            );
-            simplified = false;
-            attempt(0.0)?
+    let mut placement = options.boundary;
+    let mut off_centre = 0;
+    let mut centred = None;
+    if placement == BoundaryPlacement::OutsideCentres {
+        let (loops, fallbacks) = outside_centre_loops(&crack, options.density);
+        check_budget(loops.iter().map(Vec::len).sum::<usize>() as f64, options)?;
+        // Splitting a boundary edge would put a vertex between two centres, sampling mixed
+        // pixels: keep the edges as given.
+        match attempt(&loops, true) {
+            Ok(done) => {
+                off_centre = fallbacks;
+                centred = Some(done);
+            }
+            Err(MeshError::IntersectingBoundary { .. } | MeshError::Sanity(_)) => {
+                warnings.push(
+                    "the loops through the outside pixel centres touch or cross; meshed the \
+                     crack boundary instead"
+                        .into(),
+                );
+                placement = BoundaryPlacement::Cracks;
+            }
+            Err(e) => return Err(e),
         }
-        Err(e) => return Err(e),
+    }
+    let mut simplified = placement == BoundaryPlacement::Cracks && options.simplify_tolerance > 0.0;
+    let mut deviation = 0.0;
+    let (mesh, complete) = match centred {
+        Some(done) => done,
+        None => {
+            let mut on_cracks = |tolerance: f64| -> Result<(Mesh, bool), MeshError> {
+                let (loops, d) = sample_crack_loops(&crack, tolerance, options)?;
+                deviation = d;
+                attempt(&loops, false)
+            };
+            match on_cracks(options.simplify_tolerance) {
+                Ok(done) => done,
+                Err(MeshError::IntersectingBoundary { .. } | MeshError::Sanity(_))
+                    if simplified =>
+                {
+                    warnings.push(
+                        "simplification made boundary loops touch; meshed the unsimplified \
+                         crack boundary"
+                            .into(),
+                    );
+                    simplified = false;
+                    on_cracks(0.0)?
+                }
+                Err(e) => return Err(e),
+            }
+        }
     };
     if !complete {
         warnings.push(format!(
@@ -76,7 +121,7 @@ pub fn mesh_mask(mask: &BitMask, options: &MeshOptions) -> Result<MeshResult, Me
             options.max_vertices, options.min_angle_deg
         ));
     }
-    let stats = stats_of(
+    let mut stats = stats_of(
         &mesh,
         deviation,
         simplified,
@@ -84,6 +129,8 @@ pub fn mesh_mask(mask: &BitMask, options: &MeshOptions) -> Result<MeshResult, Me
         dropped_pieces,
         dropped_pixels,
     );
+    stats.boundary = placement;
+    stats.off_centre_boundary_vertices = off_centre;
     Ok(MeshResult {
         mesh,
         warnings,
@@ -127,7 +174,11 @@ pub fn mesh_polygons(polygons: &[Polygon], options: &MeshOptions) -> Result<Mesh
             loops.push(scratch.clone());
         }
     }
-    let t = triangulate_loops(&loops, options.min_angle_deg, options.max_vertices)?;
+    let refinement = Refinement {
+        max_area: options.max_area,
+        ..Refinement::new(options.min_angle_deg, options.max_vertices)
+    };
+    let t = triangulate_loops(&loops, &refinement)?;
     t.mesh.sanity_check()?;
     let mut warnings = Vec::new();
     if !t.refinement_complete {
@@ -224,17 +275,23 @@ fn sample_crack_loops(
         let s = simplify_loop(&c.points, &c.anchor, tolerance);
         deviation = deviation.max(s.max_deviation);
         points += subdivided_len(&s.points, options.density);
-        if points > options.max_vertices as f64 {
-            return Err(MeshError::VertexBudget {
-                max_vertices: options.max_vertices,
-                needed: points as usize,
-            });
-        }
+        check_budget(points, options)?;
         let mut out = Vec::new();
         subdivide_loop(&s.points, options.density, &mut out);
         loops.push(out);
     }
     Ok((loops, deviation))
+}
+
+/// Refuses boundaries of more than `max_vertices` points.
+fn check_budget(points: f64, options: &MeshOptions) -> Result<(), MeshError> {
+    if points > options.max_vertices as f64 {
+        return Err(MeshError::VertexBudget {
+            max_vertices: options.max_vertices,
+            needed: points as usize,
+        });
+    }
+    Ok(())
 }
 
 /// Crack tracing keeps every pixel edge of the boundary; this many per budgeted vertex is
@@ -282,6 +339,8 @@ fn stats_of(
         refinement_complete: complete,
         dropped_pieces,
         dropped_pixels,
+        boundary: BoundaryPlacement::Cracks,
+        off_centre_boundary_vertices: 0,
     }
 }
 

@@ -8,16 +8,21 @@
 //!
 //! Pipeline ([`mesh_mask`]): [`BitMask`] → small pieces dropped → crack loops (`contour`) →
 //! Douglas–Peucker + subdivision to `density` (`simplify`) → spade CDT + refinement
-//! (`triangulate`) → [`Mesh`], verified by [`Mesh::sanity_check`]. Mask-aware checks are in
+//! (`triangulate`) → [`Mesh`], verified by [`Mesh::sanity_check`]. With
+//! [`BoundaryPlacement::OutsideCentres`] the loops run through the outside pixel centres
+//! instead (`centre_loops`); [`relax_interior`] evens out the interior for the combinatorial
+//! Laplacian (the clone stage applies it). Mask-aware checks are in
 //! `coverage`; the Laplacian export in `laplacian_mtx`; test/bench masks in [`synth`].
 
 mod bitmask;
+mod centre_loops;
 mod contour;
 mod coverage;
 mod error;
 mod laplacian_mtx;
 mod mesh_mask;
 mod options;
+mod relax;
 mod sanity;
 mod simplify;
 pub mod synth;
@@ -32,9 +37,13 @@ pub use coverage::{
 pub use error::{MeshError, SanityError};
 pub use laplacian_mtx::{boundary_list, boundary_path, laplacian_matrix_market, write_laplacian};
 pub use mesh_mask::{mesh_mask, mesh_polygons, Polygon, MAX_POLYGON_COORDINATE};
-pub use options::{min_angle_deg, MeshOptions, MeshResult, MeshStats};
+pub use options::{
+    min_angle_deg, BoundaryPlacement, MeshOptions, MeshResult, MeshStats, MAX_RELAX_SWEEPS,
+    MIN_MAX_AREA, SEAM_QUALITY_MIN_ANGLE_DEG, SEAM_QUALITY_RELAX_SWEEPS,
+};
+pub use relax::relax_interior;
 pub use simplify::{
     doubled_signed_area, simplify_loop, subdivide_loop, subdivided_len, Simplified,
 };
-pub use triangulate::{assemble_mesh, triangulate_loops, Triangulated};
+pub use triangulate::{assemble_mesh, triangulate_loops, Refinement, Triangulated};
 pub use types::{BoundaryLoop, LoopKind, Mesh};

@@ -41,13 +41,42 @@ fn refinement_budget(loops: &[Vec<DVec2>], boundary_vertices: usize) -> usize {
         + 64
 }
 
-/// Triangulates the region bounded by `loops` and refines it to `min_angle_deg` within a
-/// budget of `max_vertices` (counting every vertex spade creates).
+/// How [`triangulate_loops`] refines.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Refinement {
+    pub min_angle_deg: f64,
+    /// Largest triangle area left, px² (`None`: no bound).
+    pub max_area: Option<f64>,
+    /// Budget counting every vertex spade creates.
+    pub max_vertices: usize,
+    /// Never split boundary edges, so every boundary vertex is an input point (angles next
+    /// to the boundary may then stay below `min_angle_deg`).
+    pub keep_boundary: bool,
+}
+
+impl Refinement {
+    /// Angle bound and budget only; boundary edges may be split.
+    pub fn new(min_angle_deg: f64, max_vertices: usize) -> Self {
+        Self {
+            min_angle_deg,
+            max_area: None,
+            max_vertices,
+            keep_boundary: false,
+        }
+    }
+}
+
+/// Triangulates the region bounded by `loops` and refines it as `refinement` asks.
 pub fn triangulate_loops(
     loops: &[Vec<DVec2>],
-    min_angle_deg: f64,
-    max_vertices: usize,
+    refinement: &Refinement,
 ) -> Result<Triangulated, MeshError> {
+    let Refinement {
+        min_angle_deg,
+        max_area,
+        max_vertices,
+        keep_boundary,
+    } = *refinement;
     let (points, edges) = dedup_loops(loops);
     if points.len() > max_vertices {
         return Err(MeshError::VertexBudget {
@@ -83,10 +112,16 @@ pub fn triangulate_loops(
         ));
     }
     let additional = (max_vertices - input_count).min(refinement_budget(loops, input_count));
-    let parameters = RefinementParameters::<f64>::new()
+    let mut parameters = RefinementParameters::<f64>::new()
         .with_angle_limit(AngleLimit::from_deg(min_angle_deg))
         .exclude_outer_faces(true)
         .with_max_additional_vertices(additional);
+    if let Some(area) = max_area {
+        parameters = parameters.with_max_allowed_area(area);
+    }
+    if keep_boundary {
+        parameters = parameters.keep_constraint_edges();
+    }
     let result = cdt.refine(parameters);
     let mut excluded = vec![false; cdt.num_all_faces()];
     for face in &result.excluded_faces {
@@ -360,7 +395,7 @@ mod tests {
         crate::mesh::subdivide_loop(&square(0.0, 0.0, 12.0), 0.45, &mut boundary);
         let loops = vec![boundary];
         let input = loops[0].len();
-        let t = triangulate_loops(&loops, 34.9, 2_000_000).unwrap();
+        let t = triangulate_loops(&loops, &Refinement::new(34.9, 2_000_000)).unwrap();
         t.mesh.sanity_check().unwrap();
         let bound = input + refinement_budget(&loops, input);
         assert!(
@@ -383,7 +418,11 @@ mod tests {
     fn square_with_hole_meshes_with_one_hole() {
         let mut hole = square(3.0, 3.0, 4.0);
         hole.reverse();
-        let t = triangulate_loops(&[square(0.0, 0.0, 10.0), hole], 25.0, 10_000).unwrap();
+        let t = triangulate_loops(
+            &[square(0.0, 0.0, 10.0), hole],
+            &Refinement::new(25.0, 10_000),
+        )
+        .unwrap();
         assert!(t.refinement_complete);
         t.mesh.sanity_check().unwrap();
         assert_eq!((t.mesh.piece_count, t.mesh.hole_count()), (1, 1));
@@ -401,8 +440,11 @@ mod tests {
 
     #[test]
     fn squares_touching_at_a_corner_share_a_vertex_and_one_loop() {
-        let t =
-            triangulate_loops(&[square(0.0, 0.0, 1.0), square(1.0, 1.0, 1.0)], 25.0, 1000).unwrap();
+        let t = triangulate_loops(
+            &[square(0.0, 0.0, 1.0), square(1.0, 1.0, 1.0)],
+            &Refinement::new(25.0, 1000),
+        )
+        .unwrap();
         t.mesh.sanity_check().unwrap();
         assert_eq!(t.mesh.vertex_count(), 7);
         assert_eq!((t.mesh.piece_count, t.mesh.loops.len()), (1, 1));
@@ -426,13 +468,16 @@ mod tests {
 
     #[test]
     fn crossing_loops_are_an_error() {
-        let err = triangulate_loops(&[square(0.0, 0.0, 4.0), square(2.0, 2.0, 4.0)], 25.0, 1000);
+        let err = triangulate_loops(
+            &[square(0.0, 0.0, 4.0), square(2.0, 2.0, 4.0)],
+            &Refinement::new(25.0, 1000),
+        );
         assert!(matches!(err, Err(MeshError::IntersectingBoundary { .. })));
     }
 
     #[test]
     fn budget_below_boundary_is_an_error() {
-        let err = triangulate_loops(&[square(0.0, 0.0, 4.0)], 25.0, 3);
+        let err = triangulate_loops(&[square(0.0, 0.0, 4.0)], &Refinement::new(25.0, 3));
         assert!(matches!(
             err,
             Err(MeshError::VertexBudget { needed: 4, .. })

@@ -86,6 +86,65 @@ pub fn psnr<A: Copy + Into<f64>, B: Copy + Into<f64>>(
     Ok(10.0 * (samples as f64 / squared).log10())
 }
 
+/// Ring of every mask pixel: 1 for pixels with an outside in-image 4-neighbour (the
+/// pixels next to the reference's Dirichlet values), k + 1 for pixels 4-adjacent to ring k;
+/// 0 outside the mask and for pieces with no outside neighbour in the image.
+pub fn ring_of_pixels(mask: GridMask<'_>) -> Vec<u32> {
+    let mut ring = vec![0u32; mask.pixel_count()];
+    let mut frontier: Vec<usize> = (0..mask.pixel_count())
+        .filter(|&p| mask.is_inside(p) && mask.neighbours(p).any(|q| !mask.is_inside(q)))
+        .collect();
+    let mut k = 1;
+    while !frontier.is_empty() {
+        for &p in &frontier {
+            ring[p] = k;
+        }
+        let mut next = Vec::new();
+        for &p in &frontier {
+            for q in mask.neighbours(p) {
+                if mask.is_inside(q) && ring[q] == 0 {
+                    ring[q] = u32::MAX; // claimed for the next ring
+                    next.push(q);
+                }
+            }
+        }
+        frontier = next;
+        k += 1;
+    }
+    ring
+}
+
+/// PSNR (peak 1.0) of `a` against `b` per ring band: `bands[i]` is the inclusive range of
+/// rings ([`ring_of_pixels`]) of band i. A band with no pixel gives `None`.
+pub fn psnr_by_ring<A: Copy + Into<f64>, B: Copy + Into<f64>>(
+    a: &[A],
+    b: &[B],
+    channels: usize,
+    mask: GridMask<'_>,
+    bands: &[(u32, u32)],
+) -> Result<Vec<Option<f64>>, MetricError> {
+    check_len("first image", a.len(), mask, channels)?;
+    check_len("second image", b.len(), mask, channels)?;
+    let ring = ring_of_pixels(mask);
+    let mut squared = vec![0.0; bands.len()];
+    let mut samples = vec![0usize; bands.len()];
+    for (p, &r) in ring.iter().enumerate().filter(|(_, &r)| r > 0) {
+        let Some(band) = bands.iter().position(|&(lo, hi)| (lo..=hi).contains(&r)) else {
+            continue;
+        };
+        for i in p * channels..(p + 1) * channels {
+            let d = a[i].into() - b[i].into();
+            squared[band] += d * d;
+            samples[band] += 1;
+        }
+    }
+    Ok(squared
+        .iter()
+        .zip(&samples)
+        .map(|(&sq, &n)| (n > 0).then(|| 10.0 * (n as f64 / sq).log10()))
+        .collect())
+}
+
 /// Mean `|result[p] − target[q]|` over 4-neighbour pairs `p` inside, `q` outside the mask.
 pub fn seam_step<R: Copy + Into<f64>, T: Copy + Into<f64>>(
     result: &[R],

@@ -30,8 +30,8 @@ pub mod synthetic;
 
 pub use grid_mask::{GridMask, MaskError};
 pub use metrics::{
-    composite, psnr, seam_step, uncovered_pixels, ComparisonInput, MembraneComparison, MetricError,
-    SeamStep,
+    composite, psnr, psnr_by_ring, ring_of_pixels, seam_step, uncovered_pixels, ComparisonInput,
+    MembraneComparison, MetricError, SeamStep,
 };
 pub use mvc::{mean_value_coordinates, MvcError, MvcWeights};
 pub use poisson_membrane::{poisson_membrane, GridMembrane, GridPoisson, PoissonError};
