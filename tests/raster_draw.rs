@@ -624,8 +624,8 @@ fn simd_and_scalar_shading_give_the_same_bytes() {
 /// bytes and counts as a one-thread replay and as a fresh draw.
 #[test]
 fn threaded_replays_match_one_thread_and_fresh_draws() {
-    let source = raster_meshes::pattern_image(330, 300);
-    let mesh = raster_meshes::grid(DVec2::new(2.0, 3.0), 6.0, 50, 45);
+    let source = raster_meshes::pattern_image(470, 420);
+    let mesh = raster_meshes::grid(DVec2::new(2.0, 3.0), 9.0, 50, 45);
     let membrane: Vec<[f32; 3]> = mesh
         .positions
         .iter()
@@ -637,7 +637,7 @@ fn threaded_replays_match_one_thread_and_fresh_draws() {
             .map(|p| {
                 DVec2::new(
                     0.9 * p.x + 0.2 * p.y + 20.3 + dx,
-                    -0.2 * p.x + 0.9 * p.y + 70.6 + dy,
+                    -0.2 * p.x + 0.9 * p.y + 110.6 + dy,
                 )
             })
             .collect()
@@ -652,7 +652,7 @@ fn threaded_replays_match_one_thread_and_fresh_draws() {
             loops: &mesh.loops,
             source: &source,
         };
-        let mut canvas = opaque_canvas(400, 400, 0.25);
+        let mut canvas = opaque_canvas(560, 520, 0.25);
         let options = RasterOptions {
             threads,
             replay,
@@ -663,7 +663,7 @@ fn threaded_replays_match_one_thread_and_fresh_draws() {
     };
     let (first, moved) = (placed_at(0.0, 0.0), placed_at(7.0, -5.0));
     let (fresh, fresh_stats) = draw(&mut RasterScratch::new(), &moved, 1, false);
-    assert!(fresh_stats.written > 20_000, "large enough to split");
+    assert!(fresh_stats.written > 140_000, "large enough to split");
     for threads in [1, 2, 3] {
         let mut scratch = RasterScratch::new();
         draw(&mut scratch, &first, threads, true);

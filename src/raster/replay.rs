@@ -29,9 +29,12 @@ const MAX_SHIFT: f64 = (1u64 << 20) as f64;
 /// Largest recorded area (px): the record holds 17 bytes per covered pixel.
 const MAX_RECORDED_AREA: usize = 4 << 20;
 
-/// Recorded pixels from which a second thread replays half the rows (a thread costs tens
-/// of microseconds; a replay of this many pixels about 0.15 ms).
-const THREADED_PIXELS: usize = 16 * 1024;
+/// Recorded pixels from which a second thread replays half the rows. Measured on the
+/// 2-core machines (`bench clone`): at 16K pixels the 400² spiral's replay (≈ 34K pixels in
+/// 2–3-pixel runs) got slower, 0.39 → 0.46–0.49 ms, and the 800² one moved within the noise
+/// (1.21–1.25 → 1.05–1.37 ms): the thread hand-off costs about what half of such a replay
+/// saves. Only larger patches split.
+const THREADED_PIXELS: usize = 128 * 1024;
 
 /// What identifies the patch a record belongs to (addresses and sizes of the mesh and
 /// source slices the draw read; the scratch belongs to one patch).
