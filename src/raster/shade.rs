@@ -137,7 +137,10 @@ pub(crate) fn shade_and_composite<T: StoreTexel, C: CoverageTexel, R: Recorder<C
     let sampler = Sampler::new(input.source);
     // A recording draw stays scalar: replays must agree with it byte for byte, and the
     // scalar path is the one that reports every sample.
-    let kernel = if R::ACTIVE {
+    // The SIMD kernel indexes texels with i32 lanes: sources beyond 2³¹ texels (far above
+    // `limits`, but a library caller may build one) take the scalar path.
+    let small_source = input.source.pixels().len() <= i32::MAX as usize;
+    let kernel = if R::ACTIVE || !small_source {
         Kernel::Scalar
     } else {
         input.kernel

@@ -43,7 +43,8 @@ impl Kernel {
 }
 
 /// Shades the run starting at canvas column `x0` of row `y` with the kernel's SIMD path.
-/// Gives the number of pixels written. `coverage` and `pixels` have the run's length.
+/// Gives the number of pixels written. `coverage` and `pixels` have the run's length, and
+/// the source at most `i32::MAX` texels.
 #[cfg(target_arch = "x86_64")]
 pub(crate) fn shade_run_rgba8(
     kernel: Kernel,
@@ -54,6 +55,11 @@ pub(crate) fn shade_run_rgba8(
     pixels: &mut [[u8; 4]],
 ) -> usize {
     assert_eq!(coverage.len(), pixels.len(), "one coverage texel per pixel");
+    // The kernel's texel indices are i32 lanes (callers route larger sources elsewhere).
+    assert!(
+        sampler.pixels.len() <= i32::MAX as usize,
+        "source too large for i32 indices"
+    );
     match kernel {
         // SAFETY: `Kernel::Avx2` is only ever detected on CPUs with AVX2.
         Kernel::Avx2 => unsafe { avx2::shade_run(setup, sampler, (x0, y), coverage, pixels) },
@@ -108,7 +114,8 @@ mod avx2 {
     fn taps_of_eight(sampler: &Sampler, maps: &RunMaps, dx: __m256) -> Taps {
         let u = affine(maps.texel_x, dx, maps.texel_y_terms[0]);
         let v = affine(maps.texel_y, dx, maps.texel_y_terms[1]);
-        // Sizes are bounded by `limits` (16,384 px a side), so every index fits i32.
+        // The caller keeps sources with more than i32::MAX texels on the scalar path, so
+        // every index fits i32.
         let (x0, x1, fraction_x) = taps(u, sampler.last_x as i32, sampler.last_x_f32);
         let (y0, y1, fraction_y) = taps(v, sampler.last_y as i32, sampler.last_y_f32);
         let width = _mm256_set1_epi32(sampler.width as i32);
