@@ -188,3 +188,38 @@ fn hard_masks_mesh_or_fail_cleanly() {
         assert!(json["triangles"].as_u64().unwrap() > 0, "{name}");
     }
 }
+
+/// The quality flags `clone` has work on `mesh` too: the exact boundary passes through
+/// pixel centres (zero deviation from them, more boundary vertices, nothing uncovered),
+/// relaxation keeps the vertex and triangle counts and reports the relaxed minimum angle,
+/// and a negative maximum area is a usage error naming it.
+#[test]
+fn quality_flags_shape_the_mask_mesh() {
+    let dir = tempfile::tempdir().unwrap();
+    let mask = save_mask(dir.path(), "ring.png", &synth::annulus(80, 80, 12.0, 35.0));
+    let stats = |extra: &[&str]| -> serde_json::Value {
+        let mut args = vec!["mesh", mask.as_str(), "--stats"];
+        args.extend_from_slice(extra);
+        let out = lapclone(&args);
+        assert!(
+            out.status.success(),
+            "{extra:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        serde_json::from_slice(&out.stdout).unwrap()
+    };
+    let plain = stats(&[]);
+    let exact = stats(&["--boundary", "outside-centres", "--density", "1"]);
+    assert_eq!(exact["max_boundary_deviation_px"], 0.0);
+    assert_eq!(exact["uncovered_mask_pixels"], 0);
+    assert!(exact["boundary_vertices"].as_u64() > plain["boundary_vertices"].as_u64());
+    let relaxed = stats(&["--relax", "5"]);
+    assert_eq!(relaxed["vertices"], plain["vertices"]);
+    assert_eq!(relaxed["triangles"], plain["triangles"]);
+    assert_ne!(relaxed["min_angle_deg"], plain["min_angle_deg"]);
+    let preset = stats(&["--seam-quality"]);
+    assert!(preset["vertices"].as_u64() > plain["vertices"].as_u64());
+    let out = lapclone(&["mesh", &mask, "--max-area", "-4"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("area"));
+}

@@ -7,6 +7,7 @@ use anyhow::Context;
 use lapclone::mesh::{self, BitMask, Mesh, MeshOptions};
 use lapclone::raster::overlay::{draw_mesh_overlay, OverlayStyle};
 
+use super::mesh_args::MeshQualityArgs;
 use super::UsageError;
 
 #[derive(clap::Args, Debug)]
@@ -16,9 +17,10 @@ pub struct MeshArgs {
     /// Maximum boundary edge length in pixels (seam quality knob).
     #[arg(long, value_parser = super::finite_f64, allow_hyphen_values = true)]
     pub density: Option<f64>,
-    /// Minimum angle for refinement, degrees.
-    #[arg(long = "min-angle", value_parser = super::finite_f64, allow_hyphen_values = true)]
-    pub min_angle: Option<f64>,
+    /// Boundary placement, minimum angle, maximum area, relaxation, or the seam-quality
+    /// preset (the same flags as `clone`).
+    #[command(flatten)]
+    pub quality: MeshQualityArgs,
     /// Vertex budget.
     #[arg(long = "max-vertices", allow_hyphen_values = true)]
     pub max_vertices: Option<usize>,
@@ -44,7 +46,13 @@ pub fn run(args: MeshArgs) -> anyhow::Result<()> {
     }
     let mask = BitMask::load(&args.mask, threshold as f32)?;
     let started = Instant::now();
-    let result = mesh::mesh_mask(&mask, &options)?;
+    let mut result = mesh::mesh_mask(&mask, &options)?;
+    // The raw mask mesh (boundary on the pixel cracks unless `--boundary outside-centres`);
+    // relaxation is the only finishing step that belongs to the mesh itself.
+    if options.relax_sweeps > 0 {
+        mesh::relax_interior(&mut result.mesh, options.relax_sweeps);
+        result.stats.min_angle_deg = mesh::min_angle_deg(&result.mesh);
+    }
     let mesh_ms = started.elapsed().as_secs_f64() * 1e3;
     for warning in &result.warnings {
         eprintln!("lapclone: warning: {warning}");
@@ -80,11 +88,9 @@ pub fn run(args: MeshArgs) -> anyhow::Result<()> {
 
 fn options_from(args: &MeshArgs) -> anyhow::Result<MeshOptions> {
     let mut options = MeshOptions::default();
+    args.quality.apply(&mut options);
     if let Some(density) = args.density {
         options.density = density;
-    }
-    if let Some(angle) = args.min_angle {
-        options.min_angle_deg = angle;
     }
     if let Some(max) = args.max_vertices {
         options.max_vertices = max;

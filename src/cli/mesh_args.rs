@@ -1,4 +1,4 @@
-//! Mesh-quality flags shared by `clone`, `bench clone` and `bench paper`: takes the parsed
+//! Mesh-quality flags shared by `mesh`, `clone`, `bench clone` and `bench paper`: takes the parsed
 //! flags and gives them applied to [`MeshOptions`] (unset flags keep the library defaults).
 
 use lapclone::mesh::{BoundaryPlacement, MeshOptions};
@@ -15,10 +15,10 @@ pub struct MeshQualityArgs {
     #[arg(long)]
     pub boundary: Option<BoundaryPlacement>,
     /// Minimum triangle angle of the refinement, degrees (0–35).
-    #[arg(long, value_parser = super::finite_f64)]
+    #[arg(long, value_parser = super::finite_f64, allow_hyphen_values = true)]
     pub min_angle: Option<f64>,
     /// Largest triangle area refinement leaves, px².
-    #[arg(long, value_parser = super::finite_f64)]
+    #[arg(long, value_parser = super::finite_f64, allow_hyphen_values = true)]
     pub max_area: Option<f64>,
     /// Sweeps moving interior vertices towards their neighbours' mean (combinatorial
     /// Laplacian accuracy; same vertex count).
