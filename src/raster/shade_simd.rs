@@ -20,7 +20,9 @@
 //! (the whole band draw by 29 %). Not done: replays (their runs on boundary-dense meshes
 //! are 2–3 px, where the SIMD kernel measured slower than the scalar loop).
 
+#[cfg(target_arch = "x86_64")]
 use super::sampler::Sampler;
+#[cfg(target_arch = "x86_64")]
 use super::setup::SpanSetup;
 
 /// Which span kernel a draw uses.
