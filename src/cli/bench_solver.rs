@@ -4,7 +4,9 @@
 
 use anyhow::Context;
 use lapclone::solve::solve::ldlt_solve_interleaved;
-use lapclone::solve::solve_supernodal::{inverse_diagonal, ldlt_solve_supernodal};
+use lapclone::solve::solve_supernodal::{
+    inverse_diagonal, ldlt_solve_scheduled, ldlt_solve_supernodal,
+};
 use lapclone::solve::{
     fixtures, laplacian, read_constrained_list, read_matrix_market, FactorMethod, LaplacianKind,
     PenaltyFactor, PenaltyOptions, SymmetricCsc,
@@ -73,9 +75,15 @@ struct Timings {
     nnz_factor: usize,
     analyze_ms: f64,
     factor_ms: f64,
+    /// Dirichlet right-hand sides (zero off the constrained vertices), as the cloning solves.
     solve3_ms: f64,
-    /// The supernodal kernel alone (right-hand sides already permuted, 3 channels in rows of 4).
+    /// Dense right-hand sides (every entry non-zero), as CHOLMOD's reference figures.
+    solve3_dense_ms: f64,
+    /// The supernodal kernel alone (dense right-hand sides already permuted, 3 channels in
+    /// rows of 4), following the factor's two-thread schedule if it has one.
     solve3_kernel_ms: f64,
+    /// The same kernel unscheduled, on one thread.
+    solve3_serial_ms: f64,
     /// The column-by-column kernel on the same factor (the pre-supernodal solve), for comparison.
     solve3_column_ms: f64,
     update_ms: f64,
@@ -150,7 +158,11 @@ fn measure(
         work.copy_from_slice(&rhs);
         factor.solve_dirichlet(&mut work, 3);
     });
-    let (solve3_kernel_ms, solve3_column_ms) = kernel_ms(&factor, &rhs);
+    let solve3_dense_ms = best_ms_budgeted(|| {
+        work.copy_from_slice(&rhs);
+        factor.solve_in_place(&mut work, 3);
+    });
+    let kernels = kernel_ms(&factor, &rhs);
     // One switch = a downdate plus the update restoring it, halved.
     let probe = constrained.get(constrained.len() / 2).copied().unwrap_or(0);
     let update_ms = best_ms(RUNS * 4, || {
@@ -177,17 +189,26 @@ fn measure(
         analyze_ms,
         factor_ms,
         solve3_ms,
-        solve3_kernel_ms,
-        solve3_column_ms,
+        solve3_dense_ms,
+        solve3_kernel_ms: kernels.scheduled,
+        solve3_serial_ms: kernels.serial,
+        solve3_column_ms: kernels.column,
         update_ms,
         switch100_ms,
         refactor_ms: factor_ms,
     })
 }
 
-/// Best-of timings of the two solve kernels on `factor` (3 right-hand sides, already in
-/// factor order): the supernodal one and the column one it replaced.
-fn kernel_ms(factor: &PenaltyFactor, rhs: &[f64]) -> (f64, f64) {
+/// Best-of timings of the solve kernels, ms.
+struct KernelTimings {
+    scheduled: f64,
+    serial: f64,
+    column: f64,
+}
+
+/// Best-of timings of the solve kernels on `factor` (3 right-hand sides, already in factor
+/// order): the supernodal one with and without its schedule, and the column one it replaced.
+fn kernel_ms(factor: &PenaltyFactor, rhs: &[f64]) -> KernelTimings {
     let symbolic = factor.symbolic();
     let values = factor.factor_values();
     let n = symbolic.n();
@@ -203,7 +224,21 @@ fn kernel_ms(factor: &PenaltyFactor, rhs: &[f64]) -> (f64, f64) {
         })
         .collect();
     let mut x = rows.clone();
-    let supernodal = best_ms_budgeted(|| {
+    let mut spill = vec![0.0; rows.len()];
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let scheduled = best_ms_budgeted(|| {
+        x.copy_from_slice(&rows);
+        ldlt_solve_scheduled(
+            symbolic,
+            values,
+            &inv_diagonal,
+            &mut x,
+            4,
+            &mut spill,
+            threads,
+        );
+    });
+    let serial = best_ms_budgeted(|| {
         x.copy_from_slice(&rows);
         ldlt_solve_supernodal(symbolic, values, &inv_diagonal, &mut x, 4);
     });
@@ -212,7 +247,11 @@ fn kernel_ms(factor: &PenaltyFactor, rhs: &[f64]) -> (f64, f64) {
         x.copy_from_slice(rhs);
         ldlt_solve_interleaved(symbolic.col_ptr(), symbolic.row_idx(), values, &mut x, 3);
     });
-    (supernodal, column)
+    KernelTimings {
+        scheduled,
+        serial,
+        column,
+    }
 }
 
 fn print(rows: &[Timings], json: bool) -> anyhow::Result<()> {
@@ -226,34 +265,40 @@ fn print(rows: &[Timings], json: bool) -> anyhow::Result<()> {
         return Ok(());
     }
     println!(
-        "{:>9} {:>11} {:>11} {:>11} {:>11} {:>11} {:>11} {:>11} {:>13}",
+        "{:>9} {:>11} {:>11} {:>11} {:>11} {:>11} {:>11} {:>11} {:>11} {:>11} {:>13}",
         "n",
         "nnz(L)",
         "analyse ms",
         "factor ms",
         "solve3 ms",
+        "dense3 ms",
         "kernel ms",
+        "1-thread ms",
         "column ms",
         "switch ms",
         "100 switch ms"
     );
     for t in rows {
         println!(
-            "{:>9} {:>11} {:>11.3} {:>11.3} {:>11.4} {:>11.4} {:>11.4} {:>11.4} {:>13.3}",
+            "{:>9} {:>11} {:>11.3} {:>11.3} {:>11.4} {:>11.4} {:>11.4} {:>11.4} {:>11.4} {:>11.4} {:>13.3}",
             t.n,
             t.nnz_factor,
             t.analyze_ms,
             t.factor_ms,
             t.solve3_ms,
+            t.solve3_dense_ms,
             t.solve3_kernel_ms,
+            t.solve3_serial_ms,
             t.solve3_column_ms,
             t.update_ms,
             t.switch100_ms
         );
     }
     println!(
-        "solve3 = PenaltyFactor::solve_dirichlet, 3 channels (permutations included); kernel = \
-         the supernodal sweeps alone; column = the column-by-column sweeps they replaced"
+        "solve3 = PenaltyFactor::solve_dirichlet, 3 channels (permutations included); dense3 = \
+         solve_in_place with a dense right-hand side; kernel = the supernodal sweeps alone \
+         (two-thread schedule where the factor has one); 1-thread = the unscheduled sweeps; \
+         column = the column-by-column sweeps they replaced"
     );
     Ok(())
 }

@@ -6,7 +6,8 @@
 //! its [`supernodes`] — once per mesh), [`numeric`] (LDLᵀ values — once, and again only when
 //! a guard fires), [`update`] (the rank-1 kernel, per constraint change) and
 //! [`solve_supernodal`] (forward/back substitution over dense supernode panels, per frame;
-//! [`solve`](mod@solve) keeps the column-by-column reference). [`penalty`] ties them
+//! [`solve`](mod@solve) keeps the column-by-column reference; large factors follow a
+//! [`schedule`] that sweeps two subtree groups on two threads). [`penalty`] ties them
 //! together in [`PenaltyFactor`]. One value array serves all kernels: the supernodal solve
 //! reads the column layout the rank-1 kernel updates, so no conversion follows a switch.
 //!
@@ -38,6 +39,7 @@ pub mod laplacian;
 pub mod matrix_market;
 pub mod numeric;
 pub mod penalty;
+pub mod schedule;
 #[allow(clippy::module_inception)]
 pub mod solve;
 pub mod solve_supernodal;
@@ -49,6 +51,7 @@ pub use csc::SymmetricCsc;
 pub use laplacian::{laplacian, LaplacianKind};
 pub use matrix_market::{read_constrained_list, read_matrix_market, write_matrix_market};
 pub use penalty::{PenaltyFactor, PenaltyOptions, SwitchStats};
+pub use schedule::SchedulePolicy;
 pub use symbolic::FactorMethod;
 
 use std::path::PathBuf;

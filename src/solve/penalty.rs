@@ -21,7 +21,8 @@
 //! Updates alone never trigger a refactor: they add positive terms and are stable.
 
 use super::numeric::{factor_numeric, NumericWorkspace};
-use super::solve_supernodal::{inverse_diagonal, lanes_for, ldlt_solve_supernodal};
+use super::schedule::SchedulePolicy;
+use super::solve_supernodal::{inverse_diagonal, lanes_for, ldlt_solve_scheduled};
 use super::symbolic::{FactorMethod, SymbolicFactor};
 use super::update::{pivot_from_row, rank1_diagonal, Rank1Outcome, RowScratch};
 use super::{SolveError, SymmetricCsc};
@@ -36,6 +37,8 @@ pub struct PenaltyOptions {
     pub drift_budget: f64,
     /// Simplicial or supernodal numeric factorisation (default: by size).
     pub method: FactorMethod,
+    /// Whether solves split into two subtree groups for two threads (default: by size).
+    pub schedule: SchedulePolicy,
 }
 
 impl Default for PenaltyOptions {
@@ -45,6 +48,7 @@ impl Default for PenaltyOptions {
             epsilon: None,
             drift_budget: DEFAULT_DRIFT_BUDGET,
             method: FactorMethod::Auto,
+            schedule: SchedulePolicy::Auto,
         }
     }
 }
@@ -114,6 +118,11 @@ fn permute_out<const K: usize, const L: usize>(x: &[f64], position: &[u32], rhs:
     }
 }
 
+/// Cores available, at most the two a [`SolveSchedule`](super::schedule::SolveSchedule) uses.
+fn default_solve_threads() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get().min(2))
+}
+
 /// What one batch of switches did.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct SwitchStats {
@@ -144,6 +153,10 @@ pub struct PenaltyFactor {
     update_scratch: Vec<f64>,
     /// Permuted right-hand sides, rows of up to 4 channels.
     solve_scratch: Vec<f64>,
+    /// All zero between solves: the second subtree group's spill (scheduled factors only).
+    spill: Vec<f64>,
+    /// Threads a scheduled solve may use (see [`set_solve_threads`](Self::set_solve_threads)).
+    solve_threads: usize,
     /// Per-vertex pending state of the current batch: 0 none, 1 on, 2 off.
     pending: Vec<u8>,
     touched: Vec<usize>,
@@ -153,7 +166,7 @@ pub struct PenaltyFactor {
 impl PenaltyFactor {
     /// Analyses and factors `l + εI` with no constraint on.
     pub fn new(l: &SymmetricCsc, opts: &PenaltyOptions) -> Result<Self, SolveError> {
-        let symbolic = SymbolicFactor::analyse_with(l, opts.method)?;
+        let symbolic = SymbolicFactor::analyse_scheduled(l, opts.method, opts.schedule)?;
         let scale = l.diagonal_scale();
         let alpha = opts.alpha.unwrap_or(DEFAULT_ALPHA_RELATIVE * scale);
         if !(alpha.is_finite() && alpha > 0.0) {
@@ -171,6 +184,7 @@ impl PenaltyFactor {
         }
         let n = l.n;
         let workspace = NumericWorkspace::new(&symbolic);
+        let symbolic_has_schedule = symbolic.schedule().is_some();
         let mut this = Self {
             factor_values: vec![0.0; symbolic.factor_buffer_len()],
             inv_diagonal: vec![0.0; n],
@@ -187,6 +201,12 @@ impl PenaltyFactor {
             refactor_count: 0,
             update_scratch: vec![0.0; n],
             solve_scratch: vec![0.0; 4 * n],
+            spill: if symbolic_has_schedule {
+                vec![0.0; 4 * n]
+            } else {
+                Vec::new()
+            },
+            solve_threads: default_solve_threads(),
             pending: vec![0; n],
             touched: Vec::new(),
             row_scratch: RowScratch::new(n),
@@ -197,6 +217,13 @@ impl PenaltyFactor {
 
     pub fn n(&self) -> usize {
         self.symbolic.n()
+    }
+
+    /// Threads a solve may use (default: the machine's cores, at most 2). Only factors with a
+    /// [`SolveSchedule`](super::schedule::SolveSchedule) use a second thread, and their
+    /// results are the same bits for every count.
+    pub fn set_solve_threads(&mut self, threads: usize) {
+        self.solve_threads = threads.max(1);
     }
 
     pub fn alpha(&self) -> f64 {
@@ -332,12 +359,14 @@ impl PenaltyFactor {
                 3 => permute_in::<3, 4>(rhs, position, kind, x),
                 _ => permute_in::<4, 4>(rhs, position, kind, x),
             }
-            ldlt_solve_supernodal(
+            ldlt_solve_scheduled(
                 &self.symbolic,
                 &self.factor_values[..self.symbolic.nnz_factor()],
                 &self.inv_diagonal,
                 x,
                 lanes,
+                &mut self.spill,
+                self.solve_threads,
             );
             match channels {
                 1 => permute_out::<1, 1>(x, position, rhs),

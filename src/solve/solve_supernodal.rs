@@ -47,6 +47,7 @@
 #[cfg(target_arch = "x86_64")]
 use super::lanes::{Avx4, Fma1, Fma2};
 use super::lanes::{Lanes, Portable};
+use super::schedule::SolveSchedule;
 use super::symbolic::SymbolicFactor;
 
 /// Columns of a panel taken together per pass over its rows.
@@ -144,14 +145,144 @@ pub fn ldlt_solve_supernodal_at(
     lanes: usize,
 ) {
     assert!(matches!(lanes, 1 | 2 | 4), "lanes must be 1, 2 or 4");
-    let factor = Factor::new(level, symbolic, values, inv_diagonal, x, lanes);
+    let factor = Factor::new(level, symbolic, values, inv_diagonal, x.len(), lanes);
+    let x = Shared::new(x);
+    sweep_at(level, lanes, &factor, Part::All, Sweep::Forward, x, x);
+    sweep_at(level, lanes, &factor, Part::All, Sweep::Backward, x, x);
+}
+
+/// As [`ldlt_solve_supernodal`], following the factor's [`SolveSchedule`] when it has one
+/// (see [`schedule`](super::schedule)): the two subtree groups of each sweep run on two
+/// threads when `threads ≥ 2`, one after the other otherwise — the same bits either way.
+/// `spill` holds at least `x.len()` values, all zero; they are zero again on return.
+///
+/// # Panics
+/// As [`ldlt_solve_supernodal`], and if `spill` is too short.
+pub fn ldlt_solve_scheduled(
+    symbolic: &SymbolicFactor,
+    values: &[f64],
+    inv_diagonal: &[f64],
+    x: &mut [f64],
+    lanes: usize,
+    spill: &mut [f64],
+    threads: usize,
+) {
+    let level = SimdLevel::detect();
+    ldlt_solve_scheduled_at(
+        level,
+        symbolic,
+        values,
+        inv_diagonal,
+        x,
+        lanes,
+        spill,
+        threads,
+    );
+}
+
+/// [`ldlt_solve_scheduled`] at a chosen level (tests compare the levels).
+///
+/// # Panics
+/// As [`ldlt_solve_scheduled`], and if this CPU does not support `level`.
+#[allow(clippy::too_many_arguments)]
+pub fn ldlt_solve_scheduled_at(
+    level: SimdLevel,
+    symbolic: &SymbolicFactor,
+    values: &[f64],
+    inv_diagonal: &[f64],
+    x: &mut [f64],
+    lanes: usize,
+    spill: &mut [f64],
+    threads: usize,
+) {
+    let Some(schedule) = symbolic.schedule() else {
+        return ldlt_solve_supernodal_at(level, symbolic, values, inv_diagonal, x, lanes);
+    };
+    assert!(matches!(lanes, 1 | 2 | 4), "lanes must be 1, 2 or 4");
+    assert!(
+        spill.len() >= x.len(),
+        "spill must hold as many values as x"
+    );
+    let len = x.len();
+    let (x, spill) = (Shared::new(x), Shared::new(&mut spill[..len]));
+    let factor = || Factor::new(level, symbolic, values, inv_diagonal, len, lanes);
+    let group = |g: usize| Part::Listed(schedule.group(g), schedule);
+    let top = Part::Listed(schedule.top(), schedule);
+    let phase = |part: Part, sweep: Sweep, to: Shared| {
+        sweep_at(level, lanes, &factor(), part, sweep, x, to)
+    };
+    both(
+        threads,
+        || phase(group(0), Sweep::Forward, x),
+        || phase(group(1), Sweep::Forward, spill),
+    );
+    merge_spill(schedule, symbolic, x, spill, lanes);
+    phase(top, Sweep::Forward, x);
+    phase(top, Sweep::Backward, x);
+    both(
+        threads,
+        || phase(group(0), Sweep::Backward, x),
+        || phase(group(1), Sweep::Backward, x),
+    );
+}
+
+/// Runs `first` and `second`, on two threads when `threads ≥ 2`.
+fn both(threads: usize, first: impl FnOnce(), second: impl FnOnce() + Send) {
+    if threads >= 2 {
+        std::thread::scope(|scope| {
+            scope.spawn(second);
+            first();
+        });
+    } else {
+        first();
+        second();
+    }
+}
+
+/// `x_r += spill_r`, then `spill_r = 0`, for every top row (the rows group 1 spilled to).
+fn merge_spill(
+    schedule: &SolveSchedule,
+    symbolic: &SymbolicFactor,
+    x: Shared,
+    spill: Shared,
+    lanes: usize,
+) {
+    let supernodes = symbolic.supernodes();
+    for &s in schedule.top() {
+        let columns = supernodes.columns(s as usize);
+        let values = columns.start * lanes..columns.end * lanes;
+        assert!(values.end <= x.len && values.end <= spill.len);
+        // SAFETY: in bounds (asserted); no other thread runs between the two phases.
+        let (x, spill) = unsafe {
+            (
+                std::slice::from_raw_parts_mut(x.ptr.add(values.start), values.len()),
+                std::slice::from_raw_parts_mut(spill.ptr.add(values.start), values.len()),
+            )
+        };
+        for (target, spilled) in x.iter_mut().zip(spill) {
+            *target += *spilled;
+            *spilled = 0.0;
+        }
+    }
+}
+
+/// One sweep over one part at the given level and lane count.
+fn sweep_at(
+    level: SimdLevel,
+    lanes: usize,
+    factor: &Factor,
+    part: Part,
+    sweep: Sweep,
+    x: Shared,
+    spill: Shared,
+) {
     match (level, lanes) {
         #[cfg(target_arch = "x86_64")]
         // SAFETY: `Factor::new` checked the CPU features.
-        (SimdLevel::Avx2Fma, _) => unsafe { in_place_avx2(&factor, x, lanes) },
-        (_, 1) => solve::<Portable<1>>(&factor, x),
-        (_, 2) => solve::<Portable<2>>(&factor, x),
-        _ => solve::<Portable<4>>(&factor, x),
+        (SimdLevel::Avx2Fma, _) => unsafe { sweep_avx2(factor, part, sweep, x, spill, lanes) },
+        (_, 1) => run::<Portable<1>>(factor, part, sweep, x, spill),
+        (_, 2) => run::<Portable<2>>(factor, part, sweep, x, spill),
+        _ => run::<Portable<4>>(factor, part, sweep, x, spill),
     }
 }
 
@@ -159,11 +290,18 @@ pub fn ldlt_solve_supernodal_at(
 /// The CPU must have AVX2 and FMA.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-unsafe fn in_place_avx2(factor: &Factor, x: &mut [f64], lanes: usize) {
+unsafe fn sweep_avx2(
+    factor: &Factor,
+    part: Part,
+    sweep: Sweep,
+    x: Shared,
+    spill: Shared,
+    lanes: usize,
+) {
     match lanes {
-        1 => solve::<Fma1>(factor, x),
-        2 => solve::<Fma2>(factor, x),
-        _ => solve::<Avx4>(factor, x),
+        1 => run::<Fma1>(factor, part, sweep, x, spill),
+        2 => run::<Fma2>(factor, part, sweep, x, spill),
+        _ => run::<Avx4>(factor, part, sweep, x, spill),
     }
 }
 
@@ -191,7 +329,7 @@ impl<'a> Factor<'a> {
         symbolic: &'a SymbolicFactor,
         values: &'a [f64],
         inv_diagonal: &'a [f64],
-        x: &[f64],
+        x_len: usize,
         lanes: usize,
     ) -> Self {
         assert!(
@@ -199,7 +337,7 @@ impl<'a> Factor<'a> {
             "one inverse pivot per unknown"
         );
         assert!(
-            x.len() == symbolic.n() * lanes,
+            x_len == symbolic.n() * lanes,
             "x must hold n rows of `lanes` values"
         );
         assert!(
@@ -225,29 +363,93 @@ impl<'a> Factor<'a> {
     }
 }
 
+/// Which supernodes a sweep takes, and where forward steps write the rows past a panel's
+/// own.
+#[derive(Clone, Copy)]
+enum Part<'a> {
+    /// Every supernode, every row to `x` (the unscheduled solve).
+    All,
+    /// The listed supernodes (ascending); forward steps write panel rows past
+    /// [`SolveSchedule::own_rows`] to the spill target.
+    Listed(&'a [u32], &'a SolveSchedule),
+}
+
+/// Direction of a sweep.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Sweep {
+    Forward,
+    Backward,
+}
+
 #[inline(always)]
-fn solve<V: Lanes>(factor: &Factor, x: &mut [f64]) {
+fn run<V: Lanes>(factor: &Factor, part: Part, sweep: Sweep, x: Shared, spill: Shared) {
+    let (mut x, mut spill) = (Rows::<V>::new(x), Rows::<V>::new(spill));
     let supernodes = factor.begins.len() - 1;
-    let mut rhs = Rows::<V>::new(x);
-    for s in 0..supernodes {
-        let panel = Panel::new(factor, s);
-        if rhs.all_zero(panel.b, panel.w) {
-            continue;
+    match (part, sweep) {
+        (Part::All, Sweep::Forward) => {
+            factor.prefetched.set(0);
+            for s in 0..supernodes {
+                let panel = Panel::new(factor, s);
+                let own = panel.h();
+                forward_step(factor, &panel, own, &mut x, &mut spill);
+            }
         }
-        if panel.w == 1 {
-            column_forward(factor, panel.b, &mut rhs);
-        } else {
-            panel_forward(factor, &panel, &mut rhs);
+        (Part::Listed(list, schedule), Sweep::Forward) => {
+            factor.prefetched.set(0);
+            for &s in list {
+                let panel = Panel::new(factor, s as usize);
+                let own = schedule.own_rows(s as usize);
+                forward_step(factor, &panel, own, &mut x, &mut spill);
+            }
+        }
+        (Part::All, Sweep::Backward) => {
+            factor.prefetched.set(factor.values.len());
+            for s in (0..supernodes).rev() {
+                backward_step(factor, &Panel::new(factor, s), &mut x);
+            }
+        }
+        (Part::Listed(list, _), Sweep::Backward) => {
+            factor.prefetched.set(factor.values.len());
+            for &s in list.iter().rev() {
+                backward_step(factor, &Panel::new(factor, s as usize), &mut x);
+            }
         }
     }
-    factor.prefetched.set(factor.values.len());
-    for s in (0..supernodes).rev() {
-        let panel = Panel::new(factor, s);
-        if panel.w == 1 {
-            column_backward(factor, panel.b, &mut rhs);
-        } else {
-            panel_backward(factor, &panel, &mut rhs);
-        }
+}
+
+/// One supernode of the forward sweep: panel rows `..own` to `x`, the rest to `spill`.
+#[inline(always)]
+fn forward_step<'a, V: Lanes>(
+    factor: &Factor,
+    panel: &Panel,
+    own: usize,
+    x: &mut Rows<'a, V>,
+    spill: &mut Rows<'a, V>,
+) {
+    // A listed part skips other supernodes' values: prefetch from this panel on.
+    factor
+        .prefetched
+        .set(factor.prefetched.get().max(factor.start(panel.b)));
+    if x.all_zero(panel.b, panel.w) {
+        return;
+    }
+    if panel.w == 1 {
+        column_forward(factor, panel.b, own, x, spill);
+    } else {
+        panel_forward(factor, panel, own, x, spill);
+    }
+}
+
+/// One supernode of the backward sweep.
+#[inline(always)]
+fn backward_step<V: Lanes>(factor: &Factor, panel: &Panel, x: &mut Rows<V>) {
+    factor
+        .prefetched
+        .set(factor.prefetched.get().min(factor.start(panel.b + panel.w)));
+    if panel.w == 1 {
+        column_backward(factor, panel.b, x);
+    } else {
+        panel_backward(factor, panel, x);
     }
 }
 
@@ -277,39 +479,80 @@ fn prefetch(values: &[f64], p: usize) {
 }
 
 /// The right-hand sides as rows of `V`, indexed without bounds checks: every index passed
-/// is a column or a row index of the validated pattern, hence < n.
+/// is a column or a row index of the validated pattern, hence < n. A raw view, so that the
+/// two threads of a scheduled sweep (and the spill target of a panel, which may be `x`
+/// itself) can hold it at once; who writes which rows is the schedule's contract.
 struct Rows<'a, V> {
-    x: &'a mut [f64],
-    lanes: std::marker::PhantomData<V>,
+    ptr: *mut f64,
+    len: usize,
+    lanes: std::marker::PhantomData<(Shared<'a>, V)>,
 }
+
+/// A buffer of right-hand-side rows that the threads of a scheduled solve share; it is
+/// only ever read and written through [`Rows`] views, under the schedule's contract.
+#[derive(Clone, Copy)]
+struct Shared<'a> {
+    ptr: *mut f64,
+    len: usize,
+    borrow: std::marker::PhantomData<&'a mut [f64]>,
+}
+
+// SAFETY: a `Shared` reaches the second thread of a scheduled sweep only, which writes rows
+// that no other thread touches during that phase (see [`SolveSchedule`]).
+unsafe impl Send for Shared<'_> {}
+// SAFETY: as for `Send`: the threads of one phase write disjoint rows.
+unsafe impl Sync for Shared<'_> {}
+
+impl<'a> Shared<'a> {
+    fn new(x: &'a mut [f64]) -> Self {
+        Self {
+            ptr: x.as_mut_ptr(),
+            len: x.len(),
+            borrow: std::marker::PhantomData,
+        }
+    }
+}
+
+impl<V> Clone for Rows<'_, V> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<V> Copy for Rows<'_, V> {}
 
 impl<'a, V: Lanes> Rows<'a, V> {
     #[inline(always)]
-    fn new(x: &'a mut [f64]) -> Self {
+    fn new(x: Shared<'a>) -> Self {
         Self {
-            x,
+            ptr: x.ptr,
+            len: x.len,
             lanes: std::marker::PhantomData,
         }
     }
 
     #[inline(always)]
     fn get(&self, i: usize) -> V {
-        debug_assert!(i * V::S + V::S <= self.x.len());
-        // SAFETY: i < n (see the type doc) and x.len() = n · S (asserted at the entry).
-        unsafe { V::load(self.x.as_ptr().add(i * V::S)) }
+        debug_assert!(i * V::S + V::S <= self.len);
+        // SAFETY: i < n (see the type doc) and len = n · S (asserted at the entry).
+        unsafe { V::load(self.ptr.add(i * V::S)) }
     }
 
     /// Whether rows `b..b + w` are all zero (then a forward panel step changes nothing).
     #[inline(always)]
     fn all_zero(&self, b: usize, w: usize) -> bool {
-        self.x[b * V::S..(b + w) * V::S].iter().all(|&v| v == 0.0)
+        debug_assert!((b + w) * V::S <= self.len);
+        // SAFETY: as in `get`; the rows are pivot rows of the running part, which no other
+        // thread writes.
+        let rows = unsafe { std::slice::from_raw_parts(self.ptr.add(b * V::S), w * V::S) };
+        rows.iter().all(|&v| v == 0.0)
     }
 
     #[inline(always)]
     fn set(&mut self, i: usize, v: V) {
-        debug_assert!(i * V::S + V::S <= self.x.len());
+        debug_assert!(i * V::S + V::S <= self.len);
         // SAFETY: as in `get`.
-        unsafe { v.store(self.x.as_mut_ptr().add(i * V::S)) }
+        unsafe { v.store(self.ptr.add(i * V::S)) }
     }
 }
 
@@ -376,14 +619,25 @@ impl Factor<'_> {
     }
 }
 
-/// Forward step of a single column j: `x_i −= l_ij x_j` for the rows i > j.
+/// Forward step of a single column j: `x_i −= l_ij x_j` for the rows i > j, the column's
+/// first `own` rows (j included) in `x`, the rest in `spill`.
 #[inline(always)]
-fn column_forward<V: Lanes>(factor: &Factor, j: usize, x: &mut Rows<V>) {
+fn column_forward<'a, V: Lanes>(
+    factor: &Factor,
+    j: usize,
+    own: usize,
+    x: &mut Rows<'a, V>,
+    spill: &mut Rows<'a, V>,
+) {
     factor.prefetch_up(factor.start(j + 1));
     let xj = x.get(j);
-    for p in factor.start(j) + 1..factor.start(j + 1) {
-        let i = factor.row(p);
-        x.set(i, x.get(i).mul_sub(factor.value(p), xj));
+    let (start, end) = (factor.start(j), factor.start(j + 1));
+    let split = start + own;
+    for (range, target) in [(start + 1..split, &mut *x), (split..end, spill)] {
+        for p in range {
+            let i = factor.row(p);
+            target.set(i, target.get(i).mul_sub(factor.value(p), xj));
+        }
     }
 }
 
@@ -461,24 +715,43 @@ impl<'a> Panel<'a> {
     }
 }
 
-/// Forward substitution through one panel (unit lower L), column blocks in order.
+/// Forward substitution through one panel (unit lower L), column blocks in order; panel
+/// rows `own..` go to `spill`.
 #[inline(always)]
-fn panel_forward<V: Lanes>(factor: &Factor, panel: &Panel, x: &mut Rows<V>) {
+fn panel_forward<'a, V: Lanes>(
+    factor: &Factor,
+    panel: &Panel,
+    own: usize,
+    x: &mut Rows<'a, V>,
+    spill: &mut Rows<'a, V>,
+) {
     let mut tb = 0;
     while tb < panel.w {
         let te = (tb + BLOCK).min(panel.w);
+        let target = Targets {
+            own,
+            x: &mut *x,
+            spill: &mut *spill,
+        };
         match te - tb {
-            1 => forward_block::<V, 1>(factor, panel, x, tb),
-            2 => forward_block::<V, 2>(factor, panel, x, tb),
-            3 => forward_block::<V, 3>(factor, panel, x, tb),
-            4 => forward_block::<V, 4>(factor, panel, x, tb),
-            5 => forward_block::<V, 5>(factor, panel, x, tb),
-            6 => forward_block::<V, 6>(factor, panel, x, tb),
-            7 => forward_block::<V, 7>(factor, panel, x, tb),
-            _ => forward_block::<V, BLOCK>(factor, panel, x, tb),
+            1 => forward_block::<V, 1>(factor, panel, target, tb),
+            2 => forward_block::<V, 2>(factor, panel, target, tb),
+            3 => forward_block::<V, 3>(factor, panel, target, tb),
+            4 => forward_block::<V, 4>(factor, panel, target, tb),
+            5 => forward_block::<V, 5>(factor, panel, target, tb),
+            6 => forward_block::<V, 6>(factor, panel, target, tb),
+            7 => forward_block::<V, 7>(factor, panel, target, tb),
+            _ => forward_block::<V, BLOCK>(factor, panel, target, tb),
         }
         tb = te;
     }
+}
+
+/// Where a forward block writes: panel rows before `own` to `x`, the rest to `spill`.
+struct Targets<'r, 'a, V> {
+    own: usize,
+    x: &'r mut Rows<'a, V>,
+    spill: &'r mut Rows<'a, V>,
 }
 
 /// Columns `tb..tb + NB`: their triangle, then `x_r −= Σ_t L[r][t] x_t` for every row below.
@@ -486,9 +759,10 @@ fn panel_forward<V: Lanes>(factor: &Factor, panel: &Panel, x: &mut Rows<V>) {
 fn forward_block<V: Lanes, const NB: usize>(
     factor: &Factor,
     panel: &Panel,
-    x: &mut Rows<V>,
+    target: Targets<V>,
     tb: usize,
 ) {
+    let Targets { own, x, spill } = target;
     let first = panel.b + tb;
     factor.prefetch_up(factor.start(first + NB));
     let bases: [usize; NB] = std::array::from_fn(|t| panel.base(factor, tb + t));
@@ -501,13 +775,15 @@ fn forward_block<V: Lanes, const NB: usize>(
         pivots[t] = value;
         x.set(first + t, value);
     }
-    for r in tb + NB..panel.h() {
-        let i = panel.row(r);
-        let mut value = x.get(i);
-        for t in 0..NB {
-            value = value.mul_sub(panel.entry(factor, bases[t], r), pivots[t]);
+    for (range, rows) in [(tb + NB..own, x), (own..panel.h(), spill)] {
+        for r in range {
+            let i = panel.row(r);
+            let mut value = rows.get(i);
+            for t in 0..NB {
+                value = value.mul_sub(panel.entry(factor, bases[t], r), pivots[t]);
+            }
+            rows.set(i, value);
         }
-        x.set(i, value);
     }
 }
 

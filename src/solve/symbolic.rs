@@ -21,6 +21,7 @@
 //! indexing in the kernels cannot go out of bounds, and [`numeric`](super::numeric) compacts
 //! faer's supernodal values into this layout in place after each factorisation.
 
+use super::schedule::{SchedulePolicy, SolveSchedule};
 use super::supernodes::SupernodePartition;
 use super::{SolveError, SymmetricCsc};
 use faer::sparse::linalg::cholesky::{
@@ -84,6 +85,8 @@ pub struct SymbolicFactor {
     pub(crate) adj_idx: Vec<u32>,
     /// Supernodes of the factor pattern, for the supernodal solve.
     pub(crate) supernodes: SupernodePartition,
+    /// Two-thread split of the solve, for large factors with a wide elimination tree.
+    pub(crate) schedule: Option<SolveSchedule>,
 }
 
 impl SymbolicFactor {
@@ -94,6 +97,16 @@ impl SymbolicFactor {
 
     /// AMD ordering plus symbolic factorisation of `a`'s pattern for the given method.
     pub fn analyse_with(a: &SymmetricCsc, method: FactorMethod) -> Result<Self, SolveError> {
+        Self::analyse_scheduled(a, method, SchedulePolicy::Auto)
+    }
+
+    /// As [`analyse_with`](Self::analyse_with), with the solve's two-thread split chosen by
+    /// `policy`.
+    pub fn analyse_scheduled(
+        a: &SymmetricCsc,
+        method: FactorMethod,
+        policy: SchedulePolicy,
+    ) -> Result<Self, SolveError> {
         a.sanity_check()?;
         let to_u32 = |v: usize| u32::try_from(v).map_err(|_| SolveError::TooLarge(a.n));
         let a_col_ptr: Vec<u32> = a
@@ -145,8 +158,10 @@ impl SymbolicFactor {
             matches!(faer.raw(), SymbolicCholeskyRaw::Supernodal(_)),
         );
         let supernodes = SupernodePartition::detect(&col_ptr, &row_idx);
+        let schedule = SolveSchedule::choose(policy, &supernodes, row_idx.len());
         let this = Self {
             supernodes,
+            schedule,
             refactor_cost,
             col_ptr,
             row_idx,
@@ -216,6 +231,12 @@ impl SymbolicFactor {
         &self.supernodes
     }
 
+    /// The two-thread split of the solve, if this factor has one (see
+    /// [`schedule`](super::schedule)).
+    pub fn schedule(&self) -> Option<&SolveSchedule> {
+        self.schedule.as_ref()
+    }
+
     /// Whether faer factors this pattern supernodally.
     pub fn is_supernodal(&self) -> bool {
         matches!(self.faer.raw(), SymbolicCholeskyRaw::Supernodal(_))
@@ -278,6 +299,9 @@ impl SymbolicFactor {
             }
         }
         self.supernodes.sanity_check(col_ptr, row_idx)?;
+        if let Some(schedule) = &self.schedule {
+            schedule.sanity_check(&self.supernodes)?;
+        }
         if let SymbolicCholeskyRaw::Supernodal(s) = self.faer.raw() {
             for sn in 0..s.n_supernodes() {
                 let (begin, end) = (
