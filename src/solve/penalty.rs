@@ -74,46 +74,107 @@ enum RhsKind {
 /// constrained vertices, 0 elsewhere, when `dirichlet` is given) for the `K` channels, and 0
 /// in the padding lanes of rows of `L`. Walks the vertices in order: `rhs` streams, one
 /// random row per vertex (measured at 52k vertices: 0.11 ms, against 0.15 ms walking the
-/// positions with random reads of `rhs`).
+/// positions with random reads of `rhs`). With two threads each takes half of the
+/// positions instead (so that each writes its own half of `x`).
 fn permute_in<const K: usize, const L: usize>(
     rhs: &[f64],
-    position: &[u32],
+    symbolic: &SymbolicFactor,
+    dirichlet: Option<(&[bool], f64)>,
+    x: &mut [f64],
+    threads: usize,
+) {
+    let n = symbolic.n();
+    let columns: [&[f64]; K] = std::array::from_fn(|c| &rhs[c * n..(c + 1) * n]);
+    assert!(x.len() == n * L && dirichlet.is_none_or(|(constrained, _)| constrained.len() == n));
+    if threads >= 2 && symbolic.schedule().is_some() {
+        let fwd = symbolic.perm_fwd();
+        let (front, back) = x.split_at_mut(n / 2 * L);
+        rayon::join(
+            || gather::<K, L>(&columns, &fwd[..n / 2], dirichlet, front),
+            || gather::<K, L>(&columns, &fwd[n / 2..], dirichlet, back),
+        );
+        return;
+    }
+    for (v, &p) in symbolic.perm_inv.iter().enumerate() {
+        fill_row::<K, L>(&mut x[p as usize * L..][..L], &columns, v, dirichlet);
+    }
+}
+
+/// Rows of `x` for the positions whose vertices `fwd` lists, in order.
+fn gather<const K: usize, const L: usize>(
+    columns: &[&[f64]; K],
+    fwd: &[u32],
     dirichlet: Option<(&[bool], f64)>,
     x: &mut [f64],
 ) {
-    let n = position.len();
-    let columns: [&[f64]; K] = std::array::from_fn(|c| &rhs[c * n..(c + 1) * n]);
-    assert!(x.len() == n * L && dirichlet.is_none_or(|(constrained, _)| constrained.len() == n));
-    for (v, &p) in position.iter().enumerate() {
-        let scale = match dirichlet {
-            None => 1.0,
-            Some((constrained, alpha)) if constrained[v] => alpha,
-            Some(_) => 0.0,
+    for (row, &v) in x.chunks_exact_mut(L).zip(fwd) {
+        fill_row::<K, L>(row, columns, v as usize, dirichlet);
+    }
+}
+
+/// One row of [`permute_in`]: vertex `v`'s channels, scaled for a Dirichlet right-hand side.
+#[inline(always)]
+fn fill_row<const K: usize, const L: usize>(
+    row: &mut [f64],
+    columns: &[&[f64]; K],
+    v: usize,
+    dirichlet: Option<(&[bool], f64)>,
+) {
+    let scale = match dirichlet {
+        None => 1.0,
+        Some((constrained, alpha)) if constrained[v] => alpha,
+        Some(_) => 0.0,
+    };
+    for c in 0..L {
+        // The Dirichlet input is ignored, not scaled, where unconstrained (it may be NaN).
+        row[c] = if c < K && scale != 0.0 {
+            scale * columns[c][v]
+        } else {
+            0.0
         };
-        let row = &mut x[p as usize * L..][..L];
-        for c in 0..L {
-            // The Dirichlet input is ignored, not scaled, where unconstrained (it may be NaN).
-            row[c] = if c < K && scale != 0.0 {
-                scale * columns[c][v]
-            } else {
-                0.0
-            };
-        }
     }
 }
 
 /// `rhs[c][v] = x[position[v]][c]` for the `K` channels: one pass over the vertices, one
-/// random row of `x` each, `rhs` written as `K` streams.
-fn permute_out<const K: usize, const L: usize>(x: &[f64], position: &[u32], rhs: &mut [f64]) {
+/// random row of `x` each, `rhs` written as `K` streams (with two threads, each takes half
+/// of the vertices).
+fn permute_out<const K: usize, const L: usize>(
+    x: &[f64],
+    symbolic: &SymbolicFactor,
+    rhs: &mut [f64],
+    threads: usize,
+) {
+    let position = &symbolic.perm_inv[..];
     let n = position.len();
     let mut columns: [&mut [f64]; K] = std::array::from_fn(|_| -> &mut [f64] { &mut [] });
     for (slot, column) in columns.iter_mut().zip(rhs.chunks_exact_mut(n.max(1))) {
         *slot = column;
     }
-    for (v, &p) in position.iter().enumerate() {
+    if threads >= 2 && symbolic.schedule().is_some() {
+        let mut front: [&mut [f64]; K] = std::array::from_fn(|_| -> &mut [f64] { &mut [] });
+        let mut back: [&mut [f64]; K] = std::array::from_fn(|_| -> &mut [f64] { &mut [] });
+        for (c, column) in columns.into_iter().enumerate() {
+            (front[c], back[c]) = column.split_at_mut(n / 2);
+        }
+        rayon::join(
+            || scatter::<K, L>(x, &position[..n / 2], &mut front),
+            || scatter::<K, L>(x, &position[n / 2..], &mut back),
+        );
+        return;
+    }
+    scatter::<K, L>(x, position, &mut columns);
+}
+
+/// `columns[c][i] = x[position[i]][c]`.
+fn scatter<const K: usize, const L: usize>(
+    x: &[f64],
+    position: &[u32],
+    columns: &mut [&mut [f64]; K],
+) {
+    for (i, &p) in position.iter().enumerate() {
         let row = &x[p as usize * L..][..L];
         for c in 0..K {
-            columns[c][v] = row[c];
+            columns[c][i] = row[c];
         }
     }
 }
@@ -348,16 +409,16 @@ impl PenaltyFactor {
             }
             let x = &mut self.solve_scratch[..n * lanes];
             let rhs = &mut rhs[group * n..(group + channels) * n];
-            let (position, constrained) = (&self.symbolic.perm_inv[..], &self.constrained[..]);
+            let (symbolic, threads) = (&self.symbolic, self.solve_threads);
             let kind = match kind {
                 RhsKind::Plain => None,
-                RhsKind::Dirichlet => Some((constrained, self.alpha)),
+                RhsKind::Dirichlet => Some((&self.constrained[..], self.alpha)),
             };
             match channels {
-                1 => permute_in::<1, 1>(rhs, position, kind, x),
-                2 => permute_in::<2, 2>(rhs, position, kind, x),
-                3 => permute_in::<3, 4>(rhs, position, kind, x),
-                _ => permute_in::<4, 4>(rhs, position, kind, x),
+                1 => permute_in::<1, 1>(rhs, symbolic, kind, x, threads),
+                2 => permute_in::<2, 2>(rhs, symbolic, kind, x, threads),
+                3 => permute_in::<3, 4>(rhs, symbolic, kind, x, threads),
+                _ => permute_in::<4, 4>(rhs, symbolic, kind, x, threads),
             }
             ldlt_solve_scheduled(
                 &self.symbolic,
@@ -369,10 +430,10 @@ impl PenaltyFactor {
                 self.solve_threads,
             );
             match channels {
-                1 => permute_out::<1, 1>(x, position, rhs),
-                2 => permute_out::<2, 2>(x, position, rhs),
-                3 => permute_out::<3, 4>(x, position, rhs),
-                _ => permute_out::<4, 4>(x, position, rhs),
+                1 => permute_out::<1, 1>(x, symbolic, rhs, threads),
+                2 => permute_out::<2, 2>(x, symbolic, rhs, threads),
+                3 => permute_out::<3, 4>(x, symbolic, rhs, threads),
+                _ => permute_out::<4, 4>(x, symbolic, rhs, threads),
             }
         }
     }
