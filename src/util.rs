@@ -41,6 +41,33 @@ fn temporary_sibling(path: &Path) -> PathBuf {
     }
 }
 
+/// Runs `work` once for every element of `workers` on rayon's pool, each element on its own
+/// task, and merges the results (`None` for no worker). The pool's threads persist, so a call
+/// spawns no thread and allocates nothing (measured on the 2-core machines: a scoped spawn
+/// cost ≈ 20 µs per thread, which ate the gain of splitting sub-millisecond work). Which
+/// thread runs which element is up to the pool: callers make the results independent of it.
+pub fn join_each<W: Send, R: Send>(
+    workers: &mut [W],
+    work: &(impl Fn(&mut W) -> R + Sync),
+    merge: &(impl Fn(R, R) -> R + Sync),
+) -> Option<R> {
+    match workers {
+        [] => None,
+        [one] => Some(work(one)),
+        _ => {
+            let (front, back) = workers.split_at_mut(workers.len() / 2);
+            let (a, b) = rayon::join(
+                || join_each(front, work, merge),
+                || join_each(back, work, merge),
+            );
+            match (a, b) {
+                (Some(a), Some(b)) => Some(merge(a, b)),
+                (a, b) => a.or(b),
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -68,32 +95,5 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("nope").join("out.bin");
         assert!(write_atomic(&path, b"x").is_err());
-    }
-}
-
-/// Runs `work` once for every element of `workers` on rayon's pool, each element on its own
-/// task, and merges the results (`None` for no worker). The pool's threads persist, so a call
-/// spawns no thread and allocates nothing (measured on the 2-core machines: a scoped spawn
-/// cost ≈ 20 µs per thread, which ate the gain of splitting sub-millisecond work). Which
-/// thread runs which element is up to the pool: callers make the results independent of it.
-pub fn join_each<W: Send, R: Send>(
-    workers: &mut [W],
-    work: &(impl Fn(&mut W) -> R + Sync),
-    merge: &(impl Fn(R, R) -> R + Sync),
-) -> Option<R> {
-    match workers {
-        [] => None,
-        [one] => Some(work(one)),
-        _ => {
-            let (front, back) = workers.split_at_mut(workers.len() / 2);
-            let (a, b) = rayon::join(
-                || join_each(front, work, merge),
-                || join_each(back, work, merge),
-            );
-            match (a, b) {
-                (Some(a), Some(b)) => Some(merge(a, b)),
-                (a, b) => a.or(b),
-            }
-        }
     }
 }
