@@ -25,6 +25,13 @@ fn brute_force(
                     return false;
                 }
                 let [a, b, c] = tri.map(|i| placed[i as usize]);
+                // Strictly inside the triangle implies strictly inside its bounding box; the
+                // query rejects by the box first, which also overrules edge functions that
+                // rounding pushed inside near a degenerate triangle's corner.
+                let (min, max) = (a.min(b).min(c), a.max(b).max(c));
+                if !(p.x > min.x && p.y > min.y && p.x < max.x && p.y < max.y) {
+                    return false;
+                }
                 let area = (b - a).perp_dot(c - a);
                 if area == 0.0 {
                     return false;

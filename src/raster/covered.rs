@@ -1,11 +1,16 @@
 //! The coverage query: takes the placed mesh, per-vertex depth and candidate (boundary)
 //! vertices and gives those lying under the patch's own front layer — strictly inside a
-//! placed triangle that does not contain the vertex, whose interpolated depth there is
+//! placed triangle that does not contain the vertex (strictly inside its bounding box, and
+//! all three edge functions of the triangle's sign), whose interpolated depth there is
 //! strictly greater than the vertex's own. Independent of the pixel grid; candidates are
 //! reported in the order given, so the answer is deterministic.
 //!
 //! A uniform grid over the placed bounding box, rebuilt per call into reusable buffers,
-//! makes each query look at the few triangles near the vertex.
+//! makes each query look at the few triangles near the vertex. Each triangle's bounding
+//! box and cell span are computed once per call (the grid's two passes and the queries
+//! share them), and a query rejects a triangle by its box before any edge function: on
+//! graded meshes a cell near the boundary lists dozens of small triangles, and most of
+//! them are rejected by two comparisons.
 
 use glam::DVec2;
 
@@ -17,6 +22,10 @@ pub struct CoverageGrid {
     cell_start: Vec<u32>,
     cell_triangles: Vec<u32>,
     cursor: Vec<u32>,
+    /// Per triangle: bounding box `[min x, min y, max x, max y]`.
+    boxes: Vec<[f64; 4]>,
+    /// Per triangle: cell span `[first column, first row, last column, last row]`.
+    spans: Vec<[u32; 4]>,
     origin: DVec2,
     inverse_cell: f64,
     columns: usize,
@@ -29,7 +38,13 @@ impl CoverageGrid {
     }
 
     fn build(&mut self, placed: &[DVec2], triangles: &[[u32; 3]]) {
-        let (min, max) = bounds(placed, triangles);
+        self.boxes.clear();
+        self.boxes.extend(triangles.iter().map(|tri| {
+            let [a, b, c] = tri.map(|v| placed[v as usize]);
+            let (min, max) = (a.min(b).min(c), a.max(b).max(c));
+            [min.x, min.y, max.x, max.y]
+        }));
+        let (min, max) = bounds(&self.boxes);
         let extent = (max - min).max(DVec2::splat(1e-9));
         // About one triangle per cell on average.
         let cell = ((extent.x * extent.y) / triangles.len().max(1) as f64)
@@ -42,11 +57,19 @@ impl CoverageGrid {
         let cells = self.columns * self.rows;
         self.cell_start.clear();
         self.cell_start.resize(cells + 1, 0);
-        for tri in triangles {
-            let (c0, r0, c1, r1) = self.cell_span(tri, placed);
+        let mut spans = std::mem::take(&mut self.spans);
+        spans.clear();
+        spans.extend(self.boxes.iter().map(|b| {
+            let (c0, r0) = self.cell_of(DVec2::new(b[0], b[1]));
+            let (c1, r1) = self.cell_of(DVec2::new(b[2], b[3]));
+            // Cells are at most 4096 per side, so the indices fit u32.
+            [c0, r0, c1, r1].map(|i| i as u32)
+        }));
+        for &[c0, r0, c1, r1] in &spans {
             for r in r0..=r1 {
+                let row = r as usize * self.columns;
                 for c in c0..=c1 {
-                    self.cell_start[r * self.columns + c + 1] += 1;
+                    self.cell_start[row + c as usize + 1] += 1;
                 }
             }
         }
@@ -58,16 +81,17 @@ impl CoverageGrid {
         self.cell_triangles.clear();
         self.cell_triangles
             .resize(self.cell_start[cells] as usize, 0);
-        for (index, tri) in triangles.iter().enumerate() {
-            let (c0, r0, c1, r1) = self.cell_span(tri, placed);
+        for (index, &[c0, r0, c1, r1]) in spans.iter().enumerate() {
             for r in r0..=r1 {
+                let row = r as usize * self.columns;
                 for c in c0..=c1 {
-                    let slot = &mut self.cursor[r * self.columns + c];
+                    let slot = &mut self.cursor[row + c as usize];
                     self.cell_triangles[*slot as usize] = index as u32;
                     *slot += 1;
                 }
             }
         }
+        self.spans = spans;
     }
 
     fn cell_of(&self, p: DVec2) -> (usize, usize) {
@@ -77,26 +101,28 @@ impl CoverageGrid {
         (c, r)
     }
 
-    fn cell_span(&self, tri: &[u32; 3], placed: &[DVec2]) -> (usize, usize, usize, usize) {
-        let [a, b, c] = tri.map(|v| placed[v as usize]);
-        let (c0, r0) = self.cell_of(a.min(b).min(c));
-        let (c1, r1) = self.cell_of(a.max(b).max(c));
-        (c0, r0, c1, r1)
-    }
-
     fn triangles_near(&self, p: DVec2) -> &[u32] {
         let (c, r) = self.cell_of(p);
         let cell = r * self.columns + c;
         &self.cell_triangles[self.cell_start[cell] as usize..self.cell_start[cell + 1] as usize]
     }
+
+    /// Whether `p` lies strictly inside triangle `t`'s bounding box (a strictly inside
+    /// point always does).
+    #[inline]
+    fn box_holds(&self, t: usize, p: DVec2) -> bool {
+        let b = &self.boxes[t];
+        p.x > b[0] && p.y > b[1] && p.x < b[2] && p.y < b[3]
+    }
 }
 
-fn bounds(placed: &[DVec2], triangles: &[[u32; 3]]) -> (DVec2, DVec2) {
+/// Bounding box of the triangles' boxes.
+fn bounds(boxes: &[[f64; 4]]) -> (DVec2, DVec2) {
     let mut min = DVec2::splat(f64::INFINITY);
     let mut max = DVec2::splat(f64::NEG_INFINITY);
-    for &v in triangles.iter().flatten() {
-        min = min.min(placed[v as usize]);
-        max = max.max(placed[v as usize]);
+    for b in boxes {
+        min = min.min(DVec2::new(b[0], b[1]));
+        max = max.max(DVec2::new(b[2], b[3]));
     }
     (min, max)
 }
@@ -121,7 +147,8 @@ pub fn covered_boundary_vertices(
         let own = depth[v as usize];
         let covered = grid.triangles_near(p).iter().any(|&t| {
             let tri = triangles[t as usize];
-            !tri.contains(&v)
+            grid.box_holds(t as usize, p)
+                && !tri.contains(&v)
                 && depth_if_strictly_inside(
                     tri.map(|i| placed[i as usize]),
                     tri.map(|i| depth[i as usize]),
