@@ -1,6 +1,5 @@
 //! Small helpers shared by every stage: atomic file output (write to a temporary file in the
-//! destination folder, then rename, so a failure never leaves a partial file), and running
-//! per-frame work on several threads without spawning any ([`join_each`]).
+//! destination folder, then rename, so a failure never leaves a partial file).
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -38,33 +37,6 @@ fn temporary_sibling(path: &Path) -> PathBuf {
     match path.parent() {
         Some(dir) if !dir.as_os_str().is_empty() => dir.join(tmp_name),
         _ => PathBuf::from(tmp_name),
-    }
-}
-
-/// Runs `work` once for every element of `workers` on rayon's pool, each element on its own
-/// task, and merges the results (`None` for no worker). The pool's threads persist, so a call
-/// spawns no thread and allocates nothing (measured on the 2-core machines: a scoped spawn
-/// cost ≈ 20 µs per thread, which ate the gain of splitting sub-millisecond work). Which
-/// thread runs which element is up to the pool: callers make the results independent of it.
-pub fn join_each<W: Send, R: Send>(
-    workers: &mut [W],
-    work: &(impl Fn(&mut W) -> R + Sync),
-    merge: &(impl Fn(R, R) -> R + Sync),
-) -> Option<R> {
-    match workers {
-        [] => None,
-        [one] => Some(work(one)),
-        _ => {
-            let (front, back) = workers.split_at_mut(workers.len() / 2);
-            let (a, b) = rayon::join(
-                || join_each(front, work, merge),
-                || join_each(back, work, merge),
-            );
-            match (a, b) {
-                (Some(a), Some(b)) => Some(merge(a, b)),
-                (a, b) => a.or(b),
-            }
-        }
     }
 }
 

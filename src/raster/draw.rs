@@ -237,19 +237,19 @@ fn draw_frame<T: StoreTexel + Send, R: Recorder<u8>>(
         });
     }
     let queue = Mutex::new(&mut jobs);
-    let drain = |worker: &mut BandScratch| {
-        let mut total = (0, 0);
-        loop {
-            let job = queue.lock().unwrap_or_else(|e| e.into_inner()).next();
-            let Some((band, rows)) = job else {
-                return total;
-            };
-            let (h, w) = draw_band(&shared, band, rows, canvas_width, worker, &mut NoRecorder);
-            total = (total.0 + h, total.1 + w);
+    let mut totals = [(0usize, 0usize); MAX_THREADS];
+    std::thread::scope(|scope| {
+        for (worker, total) in workers.iter_mut().zip(&mut totals) {
+            let (queue, shared) = (&queue, &shared);
+            scope.spawn(move || loop {
+                let job = queue.lock().unwrap_or_else(|e| e.into_inner()).next();
+                let Some((band, rows)) = job else { break };
+                let (h, w) = draw_band(shared, band, rows, canvas_width, worker, &mut NoRecorder);
+                *total = (total.0 + h, total.1 + w);
+            });
         }
-    };
-    let sum = |a: (usize, usize), b: (usize, usize)| (a.0 + b.0, a.1 + b.1);
-    crate::util::join_each(workers, &drain, &sum).unwrap_or((0, 0))
+    });
+    totals.iter().fold((0, 0), |(h, w), t| (h + t.0, w + t.1))
 }
 
 /// At most this many threads draw one patch.

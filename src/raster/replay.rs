@@ -168,11 +168,16 @@ impl Replay {
         let (top_runs, bottom_runs) = self.runs.split_at(k);
         let first_row = (bottom_runs[0].y + shift.1) as usize;
         let (top, bottom) = canvas.split_at_mut(first_row * canvas_width);
-        let (upper, lower) = rayon::join(
-            || self.draw_runs(top_runs, shift, 0, spans, top, canvas_width),
-            || self.draw_runs(bottom_runs, shift, first_row, spans, bottom, canvas_width),
-        );
-        (upper.0 + lower.0, upper.1 + lower.1)
+        std::thread::scope(|scope| {
+            let lower = scope.spawn(move || {
+                self.draw_runs(bottom_runs, shift, first_row, spans, bottom, canvas_width)
+            });
+            let upper = self.draw_runs(top_runs, shift, 0, spans, top, canvas_width);
+            let lower = lower
+                .join()
+                .unwrap_or_else(|e| std::panic::resume_unwind(e));
+            (upper.0 + lower.0, upper.1 + lower.1)
+        })
     }
 
     /// A run index near the middle where a new row starts (runs are in row order), or

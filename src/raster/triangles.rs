@@ -79,55 +79,15 @@ fn rasterise_one(
             return;
         }
         let (first_depth, step) = setup.depth_along_row(x0, y);
-        depth_test_span(
-            first_depth,
-            step,
-            index,
-            &mut ids[cells.clone()],
-            &mut depths[cells],
-        );
-    });
-}
-
-/// Pixels per chunk of [`depth_test_span`]: fixed-size chunks of branch-free selects are
-/// what LLVM vectorises (a plain loop over the span compiled to scalar compares and
-/// branches, measured ≈ 15 % of the deform frame's samples).
-const DEPTH_CHUNK: usize = 8;
-
-/// The depth test along a span: pixel k's depth is `first + step·k` (multiply, then add),
-/// and the triangle `index` wins the pixels where that is ≥ the stored depth.
-#[inline]
-fn depth_test_span(first: f32, step: f32, index: u32, ids: &mut [u32], depths: &mut [f32]) {
-    let test = |k: usize, id: &mut u32, stored: &mut f32| {
-        let depth = first + step * k as i32 as f32;
-        let wins = depth >= *stored;
-        *stored = if wins { depth } else { *stored };
-        *id = if wins { index } else { *id };
-    };
-    let mut id_chunks = ids.chunks_exact_mut(DEPTH_CHUNK);
-    let mut depth_chunks = depths.chunks_exact_mut(DEPTH_CHUNK);
-    let mut base = 0;
-    for (id_chunk, depth_chunk) in id_chunks.by_ref().zip(depth_chunks.by_ref()) {
-        let id_chunk: &mut [u32; DEPTH_CHUNK] = id_chunk
-            .try_into()
-            .unwrap_or_else(|_| unreachable!("chunks_exact_mut gives whole chunks"));
-        let depth_chunk: &mut [f32; DEPTH_CHUNK] = depth_chunk
-            .try_into()
-            .unwrap_or_else(|_| unreachable!("chunks_exact_mut gives whole chunks"));
-        // Whole-chunk reads and writes: per-lane conditional stores would not vectorise.
-        let (old_ids, old_depths) = (*id_chunk, *depth_chunk);
-        let mut new_ids = old_ids;
-        let mut new_depths = old_depths;
-        for l in 0..DEPTH_CHUNK {
-            test(base + l, &mut new_ids[l], &mut new_depths[l]);
+        let cell_ids = &mut ids[cells.clone()];
+        // Branch-free selects, so the loop vectorises.
+        for (k, (id, stored)) in cell_ids.iter_mut().zip(&mut depths[cells]).enumerate() {
+            let depth = first_depth + step * k as i32 as f32;
+            let wins = depth >= *stored;
+            *stored = if wins { depth } else { *stored };
+            *id = if wins { index } else { *id };
         }
-        (*id_chunk, *depth_chunk) = (new_ids, new_depths);
-        base += DEPTH_CHUNK;
-    }
-    let rest = id_chunks.into_remainder().iter_mut();
-    for (l, (id, stored)) in rest.zip(depth_chunks.into_remainder()).enumerate() {
-        test(base + l, id, stored);
-    }
+    });
 }
 
 /// Calls `visit(x, y)` for every pixel of `clip` whose centre the placed triangle owns under
@@ -167,75 +127,22 @@ fn scan_spans(fixed: [[i64; 2]; 3], clip: PixelRect, mut visit: impl FnMut(i32, 
     for k in 0..3 {
         row_w[k] = edge_function(edges[k].0, edges[k].1, start) + bias[k];
     }
-    // Each edge's bound on the span is ⌊−w / |step_x|⌋, and −w steps by −step_y per row:
-    // walked exactly without a division per row (three divisions per row were the largest
-    // per-row cost of the deform frame's coverage pass).
-    let mut bounds: [FloorWalk; 3] =
-        std::array::from_fn(|k| FloorWalk::new(-row_w[k], step_x[k].abs().max(1), -step_y[k]));
-    let len = x1 - x0;
     for y in y0..y1 {
-        let (mut lo, mut hi) = (0, len);
-        for k in 0..3 {
-            match step_x[k].signum() {
-                1 => lo = lo.max(bounds[k].quotient + 1),
-                -1 => hi = hi.min(-bounds[k].quotient),
-                _ if row_w[k] <= 0 => hi = 0,
-                _ => {}
-            }
-        }
-        debug_assert_eq!(
-            if lo < hi { (lo, hi) } else { (0, 0) },
-            row_span(row_w, step_x, len)
-        );
+        let (lo, hi) = row_span(row_w, step_x, x1 - x0);
         if lo < hi {
             // All lie inside `clip`, whose bounds are i32.
             visit(y as i32, (x0 + lo) as i32, (x0 + hi) as i32);
         }
         for k in 0..3 {
             row_w[k] += step_y[k];
-            bounds[k].advance();
-        }
-    }
-}
-
-/// `⌊N / d⌋` along the arithmetic progression `N, N + D, N + 2D, …` (`d > 0`), stepped
-/// exactly with a remainder instead of a division per term.
-#[derive(Clone, Copy)]
-struct FloorWalk {
-    quotient: i64,
-    remainder: i64,
-    divisor: i64,
-    quotient_step: i64,
-    remainder_step: i64,
-}
-
-impl FloorWalk {
-    fn new(numerator: i64, divisor: i64, step: i64) -> Self {
-        Self {
-            quotient: numerator.div_euclid(divisor),
-            remainder: numerator.rem_euclid(divisor),
-            divisor,
-            quotient_step: step.div_euclid(divisor),
-            remainder_step: step.rem_euclid(divisor),
-        }
-    }
-
-    /// On to the next term: `0 ≤ remainder < divisor` holds again after one carry.
-    #[inline]
-    fn advance(&mut self) {
-        self.quotient += self.quotient_step;
-        self.remainder += self.remainder_step;
-        if self.remainder >= self.divisor {
-            self.remainder -= self.divisor;
-            self.quotient += 1;
         }
     }
 }
 
 /// The exact range `[lo, hi)` of steps `t ∈ [0, len)` with `w[k] + t·step[k] > 0` for all
 /// three edges: each edge bounds t from one side by an exact integer division, so the span
-/// is precisely the set of pixels the per-pixel test would accept. The reference for
-/// [`scan_spans`]' division-free walk (checked against it in debug builds).
+/// is precisely the set of pixels the per-pixel test would accept.
+#[inline]
 fn row_span(w: [i64; 3], step: [i64; 3], len: i64) -> (i64, i64) {
     let (mut lo, mut hi) = (0, len);
     for k in 0..3 {
@@ -267,75 +174,6 @@ mod tests {
         assert_eq!(centre_range(128, 384), (0, 2));
         assert_eq!(centre_range(129, 383), (1, 1));
         assert_eq!(centre_range(-128, 128), (-1, 1));
-    }
-
-    #[test]
-    fn chunked_depth_test_matches_the_pixel_by_pixel_test() {
-        let mut state = 0x0de9_u64;
-        let mut next = || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 40) as u32
-        };
-        for case in 0..500 {
-            let len = case % 41;
-            let (first, step) = (
-                (next() % 64) as f32 / 8.0 - 4.0,
-                (next() % 32) as f32 / 64.0 - 0.25,
-            );
-            let stored: Vec<f32> = (0..len)
-                .map(|k| match next() % 4 {
-                    0 => f32::NEG_INFINITY,
-                    // Exactly the incoming depth: the later triangle must win the tie.
-                    1 => first + step * k as i32 as f32,
-                    _ => (next() % 64) as f32 / 8.0 - 4.0,
-                })
-                .collect();
-            let old_ids: Vec<u32> = (0..len).map(|_| next() % 7).collect();
-            let (mut ids, mut depths) = (old_ids.clone(), stored.clone());
-            depth_test_span(first, step, 9, &mut ids, &mut depths);
-            for k in 0..len {
-                let depth = first + step * k as i32 as f32;
-                let wins = depth >= stored[k];
-                assert_eq!(
-                    ids[k],
-                    if wins { 9 } else { old_ids[k] },
-                    "case {case}, pixel {k}"
-                );
-                let expected = if wins { depth } else { stored[k] };
-                assert_eq!(
-                    depths[k].to_bits(),
-                    expected.to_bits(),
-                    "case {case}, pixel {k}"
-                );
-            }
-        }
-    }
-
-    #[test]
-    fn floor_walks_match_division_at_every_term() {
-        let mut state = 0xf100_u64;
-        let mut next = |range: i64| {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 20) as i64 % (2 * range + 1) - range
-        };
-        for _ in 0..2000 {
-            let (start, step) = (next(1 << 40), next(1 << 30));
-            let divisor = next(1 << 20).abs().max(1);
-            let mut walk = FloorWalk::new(start, divisor, step);
-            for term in 0..50 {
-                let n = start + term * step;
-                assert_eq!(
-                    walk.quotient,
-                    n.div_euclid(divisor),
-                    "{start} {step} {divisor} {term}"
-                );
-                walk.advance();
-            }
-        }
     }
 
     /// The per-pixel edge test the spans replace.

@@ -260,11 +260,18 @@ impl Renderer {
             .filter(|(index, _)| drawn[*index])
             .map(|(index, layer)| (index, layer, None))
             .collect();
-        // One pool task per layer (rayon's persistent threads: no spawn per frame).
-        let prepare = |(index, layer, result): &mut Job| {
-            *result = Some(layer.prepare(&patches[*index]).map(|d| d.switches()));
-        };
-        crate::util::join_each(&mut jobs, &prepare, &|(), ()| ());
+        let queue = std::sync::Mutex::new(jobs.iter_mut());
+        std::thread::scope(|scope| {
+            for _ in 0..available_cores().min(deforming) {
+                scope.spawn(|| loop {
+                    let job = queue.lock().unwrap_or_else(|e| e.into_inner()).next();
+                    let Some((index, layer, result)) = job else {
+                        break;
+                    };
+                    *result = Some(layer.prepare(&patches[*index]).map(|d| d.switches()));
+                });
+            }
+        });
         let mut switches = 0;
         for &index in order {
             if let Some((_, _, Some(result))) = jobs.iter_mut().find(|job| job.0 == index) {
