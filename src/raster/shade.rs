@@ -219,6 +219,13 @@ fn shade_span<T: StoreTexel, C: CoverageTexel, R: Recorder<C>>(
     written
 }
 
+/// Runs shorter than this take the scalar path even with a SIMD kernel: the kernel's per-run
+/// set-up (maps as vectors, eight tap positions) outweighs its per-pixel gain on 1–2 pixel
+/// runs, which meshes with a 1 px boundary are full of. Measured on `bench render` (A/B,
+/// three rounds): raster mean 4.89–5.07 → 4.59–4.82 ms, callgrind −4.3 % in the band draw;
+/// 4 and 5 were no better. Both paths write the same bytes.
+const SIMD_MIN_RUN: usize = 3;
+
 /// The run shaded by the SIMD kernel when there is one for this CPU and these texel types
 /// (8-bit canvas and coverage); `None`: the caller shades it the scalar way.
 #[inline(always)]
@@ -230,7 +237,7 @@ fn simd_run<T: StoreTexel, C: CoverageTexel>(
     pixels: &mut [[T; 4]],
 ) -> Option<usize> {
     #[cfg(target_arch = "x86_64")]
-    if kernel != Kernel::Scalar {
+    if kernel != Kernel::Scalar && span.coverage.len() >= SIMD_MIN_RUN {
         if let (Some(coverage), Some(pixels)) = (C::as_bytes(span.coverage), T::as_rgba8(pixels)) {
             let at = (span.x0, span.y);
             return Some(shade_run_rgba8(
