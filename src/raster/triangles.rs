@@ -127,21 +127,74 @@ fn scan_spans(fixed: [[i64; 2]; 3], clip: PixelRect, mut visit: impl FnMut(i32, 
     for k in 0..3 {
         row_w[k] = edge_function(edges[k].0, edges[k].1, start) + bias[k];
     }
+    // Each edge's bound on the span is ⌊−w / |step_x|⌋, and −w steps by −step_y per row:
+    // walked exactly with a remainder instead of three 64-bit divisions per row.
+    let mut bounds: [FloorWalk; 3] =
+        std::array::from_fn(|k| FloorWalk::new(-row_w[k], step_x[k].abs().max(1), -step_y[k]));
+    let len = x1 - x0;
     for y in y0..y1 {
-        let (lo, hi) = row_span(row_w, step_x, x1 - x0);
+        let (mut lo, mut hi) = (0, len);
+        for k in 0..3 {
+            match step_x[k].signum() {
+                1 => lo = lo.max(bounds[k].quotient + 1),
+                -1 => hi = hi.min(-bounds[k].quotient),
+                _ if row_w[k] <= 0 => hi = 0,
+                _ => {}
+            }
+        }
+        debug_assert_eq!(
+            if lo < hi { (lo, hi) } else { (0, 0) },
+            row_span(row_w, step_x, len)
+        );
         if lo < hi {
             // All lie inside `clip`, whose bounds are i32.
             visit(y as i32, (x0 + lo) as i32, (x0 + hi) as i32);
         }
         for k in 0..3 {
             row_w[k] += step_y[k];
+            bounds[k].advance();
+        }
+    }
+}
+
+/// `⌊N / d⌋` along the arithmetic progression `N, N + D, N + 2D, …` (`d > 0`), stepped
+/// exactly with a remainder instead of a division per term.
+#[derive(Clone, Copy)]
+struct FloorWalk {
+    quotient: i64,
+    remainder: i64,
+    divisor: i64,
+    quotient_step: i64,
+    remainder_step: i64,
+}
+
+impl FloorWalk {
+    fn new(numerator: i64, divisor: i64, step: i64) -> Self {
+        Self {
+            quotient: numerator.div_euclid(divisor),
+            remainder: numerator.rem_euclid(divisor),
+            divisor,
+            quotient_step: step.div_euclid(divisor),
+            remainder_step: step.rem_euclid(divisor),
+        }
+    }
+
+    /// On to the next term: `0 ≤ remainder < divisor` holds again after one carry.
+    #[inline]
+    fn advance(&mut self) {
+        self.quotient += self.quotient_step;
+        self.remainder += self.remainder_step;
+        if self.remainder >= self.divisor {
+            self.remainder -= self.divisor;
+            self.quotient += 1;
         }
     }
 }
 
 /// The exact range `[lo, hi)` of steps `t ∈ [0, len)` with `w[k] + t·step[k] > 0` for all
 /// three edges: each edge bounds t from one side by an exact integer division, so the span
-/// is precisely the set of pixels the per-pixel test would accept.
+/// is precisely the set of pixels the per-pixel test would accept. The reference for
+/// [`scan_spans`]' division-free walk (checked against it in debug builds).
 #[inline]
 fn row_span(w: [i64; 3], step: [i64; 3], len: i64) -> (i64, i64) {
     let (mut lo, mut hi) = (0, len);
@@ -174,6 +227,31 @@ mod tests {
         assert_eq!(centre_range(128, 384), (0, 2));
         assert_eq!(centre_range(129, 383), (1, 1));
         assert_eq!(centre_range(-128, 128), (-1, 1));
+    }
+
+    #[test]
+    fn floor_walks_match_division_at_every_term() {
+        let mut state = 0xf100_u64;
+        let mut next = |range: i64| {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 20) as i64 % (2 * range + 1) - range
+        };
+        for _ in 0..2000 {
+            let (start, step) = (next(1 << 40), next(1 << 30));
+            let divisor = next(1 << 20).abs().max(1);
+            let mut walk = FloorWalk::new(start, divisor, step);
+            for term in 0..50 {
+                let n = start + term * step;
+                assert_eq!(
+                    walk.quotient,
+                    n.div_euclid(divisor),
+                    "{start} {step} {divisor} {term}"
+                );
+                walk.advance();
+            }
+        }
     }
 
     /// The per-pixel edge test the spans replace.
