@@ -2,7 +2,7 @@
 
 use lapclone::mesh::Mesh;
 use lapclone::solve::{
-    fixtures, laplacian, LaplacianKind, PenaltyFactor, PenaltyOptions, SymmetricCsc,
+    fixtures, laplacian, LaplacianKind, PenaltyFactor, PenaltyOptions, SchedulePolicy, SymmetricCsc,
 };
 
 /// Dense Cholesky solve of a small SPD system (reference).
@@ -308,6 +308,16 @@ fn unconstrained_piece_gives_zero_membrane() {
 
 #[test]
 fn one_and_three_vertex_meshes() {
+    // With and without a two-thread solve schedule (forced on these tiny factors).
+    for schedule in [SchedulePolicy::Auto, SchedulePolicy::Always] {
+        one_and_three_vertex_meshes_with(PenaltyOptions {
+            schedule,
+            ..Default::default()
+        });
+    }
+}
+
+fn one_and_three_vertex_meshes_with(opts: PenaltyOptions) {
     let one = Mesh {
         positions: vec![glam::DVec2::new(0.5, 0.5)],
         is_boundary: vec![true],
@@ -317,7 +327,7 @@ fn one_and_three_vertex_meshes() {
     };
     let l = laplacian(&one, LaplacianKind::Combinatorial);
     assert_eq!((l.n, l.nnz(), l.values[0]), (1, 1, 0.0));
-    let mut f = PenaltyFactor::new(&l, &PenaltyOptions::default()).unwrap();
+    let mut f = PenaltyFactor::new(&l, &opts).unwrap();
     let mut x = vec![0.0];
     f.solve_in_place(&mut x, 1);
     assert_eq!(x, [0.0]);
@@ -336,7 +346,7 @@ fn one_and_three_vertex_meshes() {
     three.loops[0].vertices = vec![0, 1, 2];
     for kind in [LaplacianKind::Combinatorial, LaplacianKind::Cotangent] {
         let l = laplacian(&three, kind);
-        let mut f = PenaltyFactor::new(&l, &PenaltyOptions::default()).unwrap();
+        let mut f = PenaltyFactor::new(&l, &opts).unwrap();
         f.switch(&[(0, true), (2, true)]).unwrap();
         let mut x = vec![1.0, 0.0, 3.0];
         f.solve_dirichlet(&mut x, 1);
