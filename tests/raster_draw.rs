@@ -246,6 +246,100 @@ fn anti_aliased_coverage_integrates_to_the_area() {
 }
 
 #[test]
+fn a_large_silhouette_has_no_seam_between_its_strips() {
+    // Large enough (≥ 64K px of work) for the two-strip silhouette; every pixel farther
+    // than 1.5 px from the outline must be exactly in or out, the strips' border row
+    // included, and the coverage must integrate to the area.
+    let source = white_source(420, 420);
+    let centre = DVec2::new(200.3, 201.7);
+    let (positions, triangles, loops) = polygon(centre, 170.4, 96);
+    let zero = vec![[0.0; 3]; positions.len()];
+    for threads in [1, 2] {
+        let mut canvas = opaque_canvas(400, 400, 0.0);
+        let options = RasterOptions {
+            threads,
+            ..RasterOptions::default()
+        };
+        draw(
+            &mut canvas,
+            &positions,
+            &positions,
+            &triangles,
+            &zero,
+            None,
+            &loops,
+            &source,
+            options,
+        );
+        let area: f64 = triangles
+            .iter()
+            .map(|t| 0.5 * raster_meshes::signed_area2(t.map(|v| positions[v as usize])))
+            .sum();
+        let sum = coverage_sum(&canvas);
+        assert!((sum - area).abs() < 1e-3 * area, "{sum} vs {area}");
+        // The polygon's inscribed radius bounds "inside"; its circumradius bounds "outside".
+        let inscribed = 170.4 * (std::f64::consts::PI / 96.0).cos();
+        for j in 0..400 {
+            for i in 0..400 {
+                let distance =
+                    (DVec2::new(f64::from(i) + 0.5, f64::from(j) + 0.5) - centre).length();
+                let value = canvas.pixel_f32(i, j).unwrap()[0];
+                if distance < inscribed - 1.5 {
+                    assert_eq!(value, 1.0, "pixel ({i}, {j}) inside");
+                } else if distance > 170.4 + 1.5 {
+                    assert_eq!(value, 0.0, "pixel ({i}, {j}) outside");
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn a_draw_does_not_depend_on_earlier_draws() {
+    // The silhouette masks grow and are kept; a patch hanging over the canvas edge must come
+    // out the same from a fresh scratch as from one that drew something larger first.
+    let source = raster_meshes::pattern_image(300, 300);
+    let (positions, triangles, loops) = polygon(DVec2::new(150.2, 149.6), 140.3, 57);
+    let zero = vec![[0.02, -0.03, 0.01]; positions.len()];
+    let shifted: Vec<DVec2> = positions
+        .iter()
+        .map(|p| *p + DVec2::new(-61.7, 83.2))
+        .collect();
+    let big: Vec<DVec2> = positions.iter().map(|p| *p * 2.1).collect();
+    let patch = |placed| Patch {
+        rest: &positions,
+        placed,
+        triangles: &triangles,
+        membrane: &zero,
+        depth: None,
+        loops: &loops,
+        source: &source,
+    };
+    let draw_shifted = |scratch: &mut RasterScratch| {
+        let mut canvas = opaque_canvas(260, 270, 0.4);
+        draw_patch(
+            &mut canvas,
+            &patch(&shifted),
+            &RasterOptions::default(),
+            scratch,
+        )
+        .unwrap();
+        canvas.to_float_image(PixelFormat::RGBA8)
+    };
+    let fresh = draw_shifted(&mut RasterScratch::new());
+    let mut used = RasterScratch::new();
+    let mut large = opaque_canvas(700, 700, 0.1);
+    draw_patch(
+        &mut large,
+        &patch(&big),
+        &RasterOptions::default(),
+        &mut used,
+    )
+    .unwrap();
+    assert!(draw_shifted(&mut used).pixels() == fresh.pixels());
+}
+
+#[test]
 fn fold_over_keeps_union_coverage() {
     // A strip of 2 cells; the right cell's far edge is folded back over the left cell, so the
     // right cell's triangles invert and the loop's winding cancels over the overlap.

@@ -1,4 +1,4 @@
-//! Anti-aliased silhouette coverage: takes the placed patch and gives a tiny-skia mask over
+//! Anti-aliased silhouette coverage: takes the placed patch and gives tiny-skia masks over
 //! the work rectangle holding the coverage of the *union* of all placed triangles, exact
 //! inside and anti-aliased only at the union's outline.
 //!
@@ -9,73 +9,191 @@
 //! the plain count of covering triangles: the non-zero fill of that path is exactly the union.
 //! Folds are rare, so the path stays about the size of the boundary. Without loops, every
 //! triangle goes into the path (same union, slower).
+//!
+//! Large work rectangles are covered by two strips, filled at once by two threads. Each
+//! strip's path is clipped ([`clip`](super::clip)) to one pixel beyond the strip, so it lies
+//! inside the strip's mask and tiny-skia's own clipping (whose rounding would depend on the
+//! grow-only mask's size, so on earlier frames) never runs.
 
+use glam::DVec2;
 use tiny_skia::{FillRule, Mask, PathBuilder, Transform};
 
-use super::setup::TriangleSetup;
+use super::clip::{clip_polygon, ClipRect};
 use super::{Patch, PixelRect};
 
-/// Fills `mask` (grown to at least the work size, cleared over it) with the silhouette
-/// coverage. Returns the mask row stride in pixels.
-pub(crate) fn fill_silhouette(
-    patch: &Patch,
-    setups: &[TriangleSetup],
-    work: PixelRect,
-    builder_slot: &mut Option<PathBuilder>,
-    mask_slot: &mut Option<Mask>,
-) -> usize {
-    let mask = ensure_mask(mask_slot, work);
-    let stride = mask.width() as usize;
-    for row in mask.data_mut().chunks_mut(stride).take(work.height()) {
-        row[..work.width()].fill(0);
+/// Work rectangles from this area up are covered by two strips (the top and bottom halves),
+/// which two threads fill at once. The rule depends on the rectangle alone, never on the
+/// thread count, so every thread count gives the same coverage.
+pub(crate) const SPLIT_AREA: usize = 64 * 1024;
+
+/// Pixels of mask around a strip: its path is clipped one pixel outside the strip, and
+/// tiny-skia's conservative path bounds add about half a pixel more.
+const BORDER: i32 = 2;
+
+/// The silhouette coverage of one draw, as one or two horizontal strips of the work
+/// rectangle, each with its own mask. Grow-only storage, kept in the raster scratch.
+#[derive(Default)]
+pub(crate) struct Silhouette {
+    strips: Vec<Strip>,
+    count: usize,
+}
+
+/// One strip: canvas pixels `rect`, the mask holding them `BORDER` px in from its corner.
+#[derive(Default)]
+pub(crate) struct Strip {
+    rect: PixelRect,
+    mask: Option<Mask>,
+    builder: Option<PathBuilder>,
+    clipped: Vec<DVec2>,
+    spare: Vec<DVec2>,
+}
+
+/// What every strip's fill reads.
+#[derive(Clone, Copy)]
+pub(crate) struct SilhouetteInput<'a> {
+    pub patch: &'a Patch<'a>,
+    /// Sign of the loops' rest area (see [`rest_loop_orientation`]).
+    pub loop_orientation: f64,
+}
+
+impl Silhouette {
+    /// Lays out the strips of `work` (one, or two from [`SPLIT_AREA`] up). The strips are
+    /// filled by [`Strip::fill`].
+    pub fn layout(&mut self, work: PixelRect) -> &mut [Strip] {
+        let rects = if work.area() >= SPLIT_AREA && work.height() >= 2 {
+            let middle = work.y0 + (work.height() / 2) as i32;
+            (
+                PixelRect { y1: middle, ..work },
+                Some(PixelRect { y0: middle, ..work }),
+            )
+        } else {
+            (work, None)
+        };
+        self.count = 1 + usize::from(rects.1.is_some());
+        if self.strips.len() < self.count {
+            self.strips.resize_with(self.count, Strip::default);
+        }
+        self.strips[0].rect = rects.0;
+        if let Some(second) = rects.1 {
+            self.strips[1].rect = second;
+        }
+        &mut self.strips[..self.count]
     }
-    let mut builder = builder_slot.take().unwrap_or_default();
-    builder.clear();
-    let local = |p: glam::DVec2| {
-        (
-            (p.x - f64::from(work.x0)) as f32,
-            (p.y - f64::from(work.y0)) as f32,
-        )
-    };
-    let loop_orientation = rest_loop_orientation(patch);
-    if loop_orientation == 0.0 {
-        for (setup, tri) in setups.iter().zip(patch.triangles) {
-            if setup.signed_area2 != 0.0 {
-                let order = oriented(tri, setup.signed_area2 > 0.0);
-                push_polygon(
-                    &mut builder,
-                    order.iter().map(|&v| local(patch.placed[v as usize])),
-                );
+
+    /// The strips of the last layout, top first.
+    pub fn strips(&self) -> &[Strip] {
+        &self.strips[..self.count]
+    }
+
+    /// The coverage row of canvas row `y` over columns `[x0, x1)` (inside the work
+    /// rectangle of the last layout).
+    pub fn row(&self, y: i32, x0: i32, x1: i32) -> &[u8] {
+        let strip = self
+            .strips()
+            .iter()
+            .find(|s| y < s.rect.y1)
+            .unwrap_or(&self.strips[self.count - 1]);
+        let (data, stride, origin) = strip.coverage();
+        let start = (y - origin.1) as usize * stride + (x0 - origin.0) as usize;
+        &data[start..start + (x1 - x0) as usize]
+    }
+}
+
+impl Strip {
+    /// The canvas pixels this strip covers.
+    pub fn rect(&self) -> PixelRect {
+        self.rect
+    }
+
+    /// The mask's bytes, row stride and the canvas pixel of byte 0.
+    pub fn coverage(&self) -> (&[u8], usize, (i32, i32)) {
+        // invariant: a strip is filled (which creates its mask) before anyone reads it.
+        let mask = self.mask.as_ref().expect("strip filled before use");
+        let origin = (self.rect.x0 - BORDER, self.rect.y0 - BORDER);
+        (mask.data(), mask.width() as usize, origin)
+    }
+
+    /// Fills the strip's mask with the coverage of the patch's silhouette over its rows.
+    pub fn fill(&mut self, input: SilhouetteInput) {
+        let (patch, loop_orientation) = (input.patch, input.loop_orientation);
+        let rect = self.rect;
+        let mask = ensure_mask(
+            &mut self.mask,
+            rect.width() as u32 + 2 * BORDER as u32,
+            rect.height() as u32 + 2 * BORDER as u32,
+        );
+        let stride = mask.width() as usize;
+        let rows = rect.height() + 2 * BORDER as usize;
+        for row in mask.data_mut().chunks_mut(stride).take(rows) {
+            row[..rect.width() + 2 * BORDER as usize].fill(0);
+        }
+        let mut path = PolygonSink {
+            builder: self.builder.take().unwrap_or_default(),
+            clip: ClipRect {
+                x0: f64::from(rect.x0) - 1.0,
+                y0: f64::from(rect.y0) - 1.0,
+                x1: f64::from(rect.x1) + 1.0,
+                y1: f64::from(rect.y1) + 1.0,
+            },
+            origin: DVec2::new(f64::from(rect.x0 - BORDER), f64::from(rect.y0 - BORDER)),
+            clipped: &mut self.clipped,
+            spare: &mut self.spare,
+        };
+        path.builder.clear();
+        let placed = |v: &u32| patch.placed[*v as usize];
+        if loop_orientation == 0.0 {
+            for tri in patch.triangles {
+                let area2 = signed_area2(patch, tri);
+                if area2 != 0.0 {
+                    path.push(oriented(tri, area2 > 0.0).iter().map(placed));
+                }
             }
-        }
-    } else {
-        for l in patch.loops {
-            push_polygon(
-                &mut builder,
-                l.vertices.iter().map(|&v| local(patch.placed[v as usize])),
-            );
-        }
-        for (setup, tri) in setups.iter().zip(patch.triangles) {
-            if setup.signed_area2 < 0.0 {
-                // Wind it like a non-inverted triangle relative to the loops' direction.
-                let order = oriented(tri, loop_orientation < 0.0);
-                for _ in 0..2 {
-                    push_polygon(
-                        &mut builder,
-                        order.iter().map(|&v| local(patch.placed[v as usize])),
-                    );
+        } else {
+            for l in patch.loops {
+                path.push(l.vertices.iter().map(placed));
+            }
+            for tri in patch.triangles {
+                if signed_area2(patch, tri) < 0.0 {
+                    // Wind it like a non-inverted triangle relative to the loops' direction.
+                    let order = oriented(tri, loop_orientation < 0.0);
+                    for _ in 0..2 {
+                        path.push(order.iter().map(placed));
+                    }
                 }
             }
         }
+        self.builder = Some(match path.builder.finish() {
+            Some(path) => {
+                mask.fill_path(&path, FillRule::Winding, true, Transform::identity());
+                path.clear()
+            }
+            None => PathBuilder::new(),
+        });
     }
-    match builder.finish() {
-        Some(path) => {
-            mask.fill_path(&path, FillRule::Winding, true, Transform::identity());
-            *builder_slot = Some(path.clear());
-        }
-        None => *builder_slot = Some(PathBuilder::new()),
+}
+
+/// Placed polygons into a path, clipped to the strip and moved to mask coordinates.
+struct PolygonSink<'a> {
+    builder: PathBuilder,
+    clip: ClipRect,
+    origin: DVec2,
+    clipped: &'a mut Vec<DVec2>,
+    spare: &'a mut Vec<DVec2>,
+}
+
+impl PolygonSink<'_> {
+    fn push(&mut self, points: impl Iterator<Item = DVec2>) {
+        clip_polygon(points, &self.clip, self.clipped, self.spare);
+        let origin = self.origin;
+        let local = |p: &DVec2| ((p.x - origin.x) as f32, (p.y - origin.y) as f32);
+        push_polygon(&mut self.builder, self.clipped.iter().map(local));
     }
-    stride
+}
+
+/// The placed triangle's signed area ×2 (negative: inverted), as the triangle setup has it.
+fn signed_area2(patch: &Patch, tri: &[u32; 3]) -> f64 {
+    let [a, b, c] = tri.map(|v| patch.placed[v as usize]);
+    (b - a).perp_dot(c - a)
 }
 
 /// `tri` as given (`keep`) or with its winding reversed.
@@ -99,7 +217,7 @@ fn push_polygon(builder: &mut PathBuilder, mut points: impl Iterator<Item = (f32
 
 /// Sign of the loops' total signed area at rest (+1: same direction as the triangles),
 /// or 0 when there are no usable loops.
-fn rest_loop_orientation(patch: &Patch) -> f64 {
+pub(crate) fn rest_loop_orientation(patch: &Patch) -> f64 {
     let mut area2 = 0.0;
     for l in patch.loops {
         let n = l.vertices.len();
@@ -118,15 +236,14 @@ fn rest_loop_orientation(patch: &Patch) -> f64 {
     }
 }
 
-fn ensure_mask(slot: &mut Option<Mask>, work: PixelRect) -> &mut Mask {
-    let (w, h) = (work.width() as u32, work.height() as u32);
+fn ensure_mask(slot: &mut Option<Mask>, width: u32, height: u32) -> &mut Mask {
     let fits = slot
         .as_ref()
-        .is_some_and(|m| m.width() >= w && m.height() >= h);
+        .is_some_and(|m| m.width() >= width && m.height() >= height);
     if !fits {
         let (old_w, old_h) = slot.as_ref().map_or((0, 0), |m| (m.width(), m.height()));
-        let mask = Mask::new(w.max(old_w), h.max(old_h));
-        *slot = Some(mask.expect("non-empty")); // invariant: the work rectangle is non-empty
+        let mask = Mask::new(width.max(old_w), height.max(old_h));
+        *slot = Some(mask.expect("non-empty")); // invariant: both sizes include the border
     }
     slot.as_mut().expect("mask present") // invariant: set just above when missing.
 }

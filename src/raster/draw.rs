@@ -6,7 +6,7 @@
 use std::sync::{Mutex, OnceLock};
 
 use super::bands::{Bands, APRON};
-use super::coverage::fill_silhouette;
+use super::coverage::{rest_loop_orientation, Silhouette, SilhouetteInput, Strip};
 use super::feather::apply_feather;
 use super::scratch::BandScratch;
 use super::setup::{MembraneSpan, TriangleSetup, MAX_COORDINATE};
@@ -80,22 +80,25 @@ pub fn draw_patch(
     if let Some(stats) = try_replay(canvas, patch, options, work, scratch) {
         return Ok(stats);
     }
-    build_setups(patch, &mut scratch.setups);
-    let mask_stride = options.anti_alias.then(|| {
-        fill_silhouette(
-            patch,
-            &scratch.setups,
-            work,
-            &mut scratch.path_builder,
-            &mut scratch.mask,
-        )
-    });
     let canvas_bounds = canvas_rect(canvas);
+    let target = work.intersect(&canvas_bounds);
+    let replayable = options.replay && patch.depth.is_none() && options.feather == 0.0;
+    let record = replayable
+        && target == work
+        && scratch.replay.wants_record(patch, options.anti_alias, work);
+    // A recording takes everything in order, on this thread.
+    let threads = if record {
+        1
+    } else {
+        worker_threads(options.threads, work.area(), usize::MAX)
+    };
+    prepare(patch, work, options.anti_alias, threads, scratch);
     let frame = Frame {
         patch,
         work,
-        target: work.intersect(&canvas_bounds),
-        mask_stride,
+        target,
+        anti_alias: options.anti_alias,
+        threads,
         use_depth: patch.depth.is_some(),
         kernel: if options.simd {
             Kernel::detect()
@@ -103,10 +106,6 @@ pub fn draw_patch(
             Kernel::Scalar
         },
     };
-    let replayable = options.replay && patch.depth.is_none() && options.feather == 0.0;
-    let record = replayable
-        && frame.target == work
-        && scratch.replay.wants_record(patch, options.anti_alias, work);
     let mut replay = std::mem::take(&mut scratch.replay);
     let canvas_width = canvas.width() as usize;
     let (centre_hits, written) = if record {
@@ -188,8 +187,10 @@ struct Frame<'a> {
     work: PixelRect,
     /// The work rectangle clipped to the canvas: the pixels that can be written.
     target: PixelRect,
-    /// Row stride of the silhouette mask when anti-aliasing.
-    mask_stride: Option<usize>,
+    /// Whether the silhouette strips hold the coverage (else pixel centres decide).
+    anti_alias: bool,
+    /// Threads drawing the frame (1 for a recording).
+    threads: usize,
     use_depth: bool,
     kernel: Kernel,
 }
@@ -213,9 +214,7 @@ fn draw_frame<T: StoreTexel + Send, R: Recorder<u8>>(
         target.width(),
         scratch.band_pixels,
     );
-    // A recording takes the bands in order, on this thread.
-    let requested = if R::ACTIVE { 1 } else { options.threads };
-    let threads = worker_threads(requested, target.area(), scratch.bands.count());
+    let threads = frame.threads.min(scratch.bands.count()).max(1);
     if scratch.workers.len() < threads {
         scratch.workers.resize_with(threads, BandScratch::default);
     }
@@ -223,7 +222,7 @@ fn draw_frame<T: StoreTexel + Send, R: Recorder<u8>>(
         frame,
         setups: &scratch.setups,
         bands: &scratch.bands,
-        mask: scratch.mask.as_ref().map(|m| m.data()),
+        silhouette: frame.anti_alias.then_some(&scratch.silhouette),
     };
     let band_rows = scratch.bands.height() as usize * canvas_width;
     let rows = &mut canvas[target.y0 as usize * canvas_width..target.y1 as usize * canvas_width];
@@ -238,16 +237,21 @@ fn draw_frame<T: StoreTexel + Send, R: Recorder<u8>>(
     }
     let queue = Mutex::new(&mut jobs);
     let mut totals = [(0usize, 0usize); MAX_THREADS];
+    let take_bands = |worker: &mut BandScratch, total: &mut (usize, usize)| loop {
+        let job = queue.lock().unwrap_or_else(|e| e.into_inner()).next();
+        let Some((band, rows)) = job else { break };
+        let (h, w) = draw_band(&shared, band, rows, canvas_width, worker, &mut NoRecorder);
+        *total = (total.0 + h, total.1 + w);
+    };
+    // This thread is one of the workers: one spawn fewer per frame.
+    let ((own, others), (own_total, other_totals)) =
+        (workers.split_at_mut(1), totals.split_at_mut(1));
     std::thread::scope(|scope| {
-        for (worker, total) in workers.iter_mut().zip(&mut totals) {
-            let (queue, shared) = (&queue, &shared);
-            scope.spawn(move || loop {
-                let job = queue.lock().unwrap_or_else(|e| e.into_inner()).next();
-                let Some((band, rows)) = job else { break };
-                let (h, w) = draw_band(shared, band, rows, canvas_width, worker, &mut NoRecorder);
-                *total = (total.0 + h, total.1 + w);
-            });
+        for (worker, total) in others.iter_mut().zip(other_totals) {
+            let take_bands = &take_bands;
+            scope.spawn(move || take_bands(worker, total));
         }
+        take_bands(&mut own[0], &mut own_total[0]);
     });
     totals.iter().fold((0, 0), |(h, w), t| (h + t.0, w + t.1))
 }
@@ -274,7 +278,7 @@ struct BandInput<'a> {
     frame: &'a Frame<'a>,
     setups: &'a [TriangleSetup],
     bands: &'a Bands,
-    mask: Option<&'a [u8]>,
+    silhouette: Option<&'a Silhouette>,
 }
 
 /// Rasterises one band's triangles over the band and its apron, then shades the band's
@@ -306,30 +310,41 @@ fn draw_band<T: StoreTexel, R: Recorder<u8>>(
         &mut scratch.depths,
     );
     let rows = PixelRect { y0, y1, ..target };
-    let (coverage, coverage_stride, coverage_origin) = match (input.mask, frame.mask_stride) {
-        (Some(mask), Some(stride)) => (mask, stride, (work.x0, work.y0)),
-        _ => {
-            let hit = |&id: &u32| if id == NO_TRIANGLE { 0 } else { u8::MAX };
-            scratch.coverage.clear();
-            scratch.coverage.extend(scratch.ids.iter().map(hit));
-            (
-                scratch.coverage.as_slice(),
-                ids_rect.width(),
-                (ids_rect.x0, ids_rect.y0),
-            )
-        }
-    };
-    let shade = ShadeInput {
+    let shade = |coverage, stride, origin| ShadeInput {
         setups: input.setups,
         ids: &scratch.ids,
         ids_rect,
         coverage,
-        coverage_stride,
-        coverage_origin,
+        coverage_stride: stride,
+        coverage_origin: origin,
         source: frame.patch.source,
         kernel: frame.kernel,
     };
-    shade_and_composite(&shade, rows, canvas_rows, canvas_width, recorder)
+    let Some(silhouette) = input.silhouette else {
+        let hit = |&id: &u32| if id == NO_TRIANGLE { 0 } else { u8::MAX };
+        let mut coverage = std::mem::take(&mut scratch.coverage);
+        coverage.clear();
+        coverage.extend(scratch.ids.iter().map(hit));
+        let origin = (ids_rect.x0, ids_rect.y0);
+        let input = shade(&coverage, ids_rect.width(), origin);
+        let totals = shade_and_composite(&input, rows, canvas_rows, canvas_width, recorder);
+        scratch.coverage = coverage;
+        return totals;
+    };
+    // A band may straddle the two strips' border: each part reads its own strip's mask.
+    let mut totals = (0, 0);
+    for strip in silhouette.strips() {
+        let part = rows.intersect(&strip.rect());
+        if part.is_empty() {
+            continue;
+        }
+        let (coverage, stride, origin) = strip.coverage();
+        let canvas_part = &mut canvas_rows[(part.y0 - y0) as usize * canvas_width..];
+        let input = shade(coverage, stride, origin);
+        let (h, w) = shade_and_composite(&input, part, canvas_part, canvas_width, recorder);
+        totals = (totals.0 + h, totals.1 + w);
+    }
+    totals
 }
 
 /// The feathered draw, in one piece: the feather's distance transform needs the ids of the
@@ -359,13 +374,14 @@ fn draw_feathered<T: StoreTexel>(
     let width = work.width();
     let coverage = &mut scratch.coverage;
     coverage.clear();
-    match (&scratch.mask, frame.mask_stride) {
-        (Some(mask), Some(stride)) => {
-            for row in mask.data().chunks(stride).take(work.height()) {
-                coverage.extend(row[..width].iter().map(|&m| m.unit()));
+    match frame.anti_alias {
+        true => {
+            for y in work.y0..work.y1 {
+                let row = scratch.silhouette.row(y, work.x0, work.x1);
+                coverage.extend(row.iter().map(|&m| m.unit()));
             }
         }
-        _ => coverage.extend(
+        false => coverage.extend(
             worker
                 .ids
                 .iter()
@@ -432,18 +448,61 @@ fn work_rect(patch: &Patch, canvas: &Canvas, feather: f32) -> Option<PixelRect> 
     (!work.is_empty() && !placed.intersect(&canvas_rect(canvas)).is_empty()).then_some(work)
 }
 
-fn build_setups(patch: &Patch, setups: &mut Vec<TriangleSetup>) {
-    setups.clear();
-    setups.extend(patch.triangles.iter().map(|tri| {
+/// Large draws split their triangles between two threads from this many up.
+const PARALLEL_SETUPS: usize = 1024;
+
+/// Per-triangle setups and the silhouette's strips: the work before the bands, on two
+/// threads (one half of the setups and one strip each) when `threads` ≥ 2. The split
+/// changes no value: each setup depends on its triangle alone, and the strips are laid out
+/// by [`Silhouette::layout`] whatever the thread count.
+fn prepare(
+    patch: &Patch,
+    work: PixelRect,
+    anti_alias: bool,
+    threads: usize,
+    scratch: &mut RasterScratch,
+) {
+    let setups = &mut scratch.setups;
+    setups.resize(patch.triangles.len(), TriangleSetup::default());
+    let strips: &mut [Strip] = if anti_alias {
+        scratch.silhouette.layout(work)
+    } else {
+        &mut []
+    };
+    let input = SilhouetteInput {
+        patch,
+        loop_orientation: rest_loop_orientation(patch),
+    };
+    if threads < 2 || setups.len() < PARALLEL_SETUPS || strips.len() < 2 {
+        build_setups(patch, 0, setups);
+        strips.iter_mut().for_each(|strip| strip.fill(input));
+        return;
+    }
+    let half = setups.len() / 2;
+    let (first, second) = setups.split_at_mut(half);
+    let (top, rest) = strips.split_at_mut(1);
+    std::thread::scope(|scope| {
+        scope.spawn(|| {
+            build_setups(patch, half, second);
+            rest.iter_mut().for_each(|strip| strip.fill(input));
+        });
+        build_setups(patch, 0, first);
+        top[0].fill(input);
+    });
+}
+
+/// The setups of triangles `first..first + setups.len()`.
+fn build_setups(patch: &Patch, first: usize, setups: &mut [TriangleSetup]) {
+    for (setup, tri) in setups.iter_mut().zip(&patch.triangles[first..]) {
         let [a, b, c] = tri.map(|v| v as usize);
         let depth = patch.depth.map_or([0.0; 3], |d| [d[a], d[b], d[c]]);
-        TriangleSetup::new(
+        *setup = TriangleSetup::new(
             [patch.placed[a], patch.placed[b], patch.placed[c]],
             [patch.rest[a], patch.rest[b], patch.rest[c]],
             [patch.membrane[a], patch.membrane[b], patch.membrane[c]],
             depth,
-        )
-    }));
+        );
+    }
 }
 
 #[cfg(test)]

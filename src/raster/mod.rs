@@ -29,6 +29,7 @@
 //! allocates nothing once the buffers have grown to the patch's size.
 
 mod bands;
+mod clip;
 mod coverage;
 mod covered;
 mod draw;

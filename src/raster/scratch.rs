@@ -4,6 +4,7 @@
 //! nothing.
 
 use super::bands::{Bands, BAND_PIXELS};
+use super::coverage::Silhouette;
 use super::replay::Replay;
 use super::setup::{MembraneSpan, TriangleSetup};
 
@@ -17,8 +18,8 @@ pub struct RasterScratch {
     pub(crate) coverage: Vec<f32>,
     pub(crate) distance: Vec<f32>,
     pub(crate) distance_row: Vec<f32>,
-    pub(crate) path_builder: Option<tiny_skia::PathBuilder>,
-    pub(crate) mask: Option<tiny_skia::Mask>,
+    /// The anti-aliased silhouette's strips.
+    pub(crate) silhouette: Silhouette,
     /// Pixels per row band (tests vary it to prove it changes nothing).
     pub(crate) band_pixels: usize,
     pub(crate) replay: Replay,
@@ -35,8 +36,7 @@ impl Default for RasterScratch {
             coverage: Vec::new(),
             distance: Vec::new(),
             distance_row: Vec::new(),
-            path_builder: None,
-            mask: None,
+            silhouette: Silhouette::default(),
             band_pixels: BAND_PIXELS,
             replay: Replay::default(),
             membrane_spans: Vec::new(),

@@ -25,8 +25,6 @@ pub(crate) struct TriangleSetup {
     pub drawable: bool,
     /// Depth as an affine function of the canvas position: `[constant, d/dx, d/dy]`.
     pub depth_affine: [f64; 3],
-    /// Signed placed area ×2 (negative: inverted).
-    pub signed_area2: f64,
     /// Rest position (source texel space) and membrane as single-precision affine maps
     /// relative to a pixel centre near the triangle, for shading.
     pub span: SpanSetup,
@@ -179,7 +177,6 @@ impl TriangleSetup {
                 f64::from(depth[1]) - f64::from(depth[0]),
                 f64::from(depth[2]) - f64::from(depth[0]),
             ),
-            signed_area2: det,
         }
     }
 
