@@ -662,8 +662,15 @@ fn simd_and_scalar_shading_give_the_same_bytes() {
         ]
     })
     .unwrap();
-    for (cell, columns, rows) in [(2.0, 40, 35), (7.5, 12, 10), (23.0, 4, 3)] {
-        let mesh = raster_meshes::grid(DVec2::new(-4.0, -3.0), cell, columns, rows);
+    // The last grid reaches past the source's right and bottom edges, where the clamped
+    // taps are not adjacent texels.
+    for (origin, cell, columns, rows) in [
+        (DVec2::new(-4.0, -3.0), 2.0, 40, 35),
+        (DVec2::new(-4.0, -3.0), 7.5, 12, 10),
+        (DVec2::new(-4.0, -3.0), 23.0, 4, 3),
+        (DVec2::new(40.0, 30.0), 5.0, 14, 13),
+    ] {
+        let mesh = raster_meshes::grid(origin, cell, columns, rows);
         let membrane: Vec<[f32; 3]> = mesh
             .positions
             .iter()
@@ -676,7 +683,8 @@ fn simd_and_scalar_shading_give_the_same_bytes() {
                 .positions
                 .iter()
                 .map(|p| {
-                    let q = *p * scale;
+                    // The first grids keep their old placement; the last is moved onto them.
+                    let q = (*p - (origin - DVec2::new(-4.0, -3.0))) * scale;
                     DVec2::new(cos * q.x - sin * q.y + 70.3, sin * q.x + cos * q.y + 40.6)
                 })
                 .collect();

@@ -156,11 +156,7 @@ pub(crate) fn shade_and_composite<T: StoreTexel, C: CoverageTexel, R: Recorder<C
         let mut start = 0;
         while start < ids.len() {
             let id = ids[start];
-            let end = start
-                + ids[start..]
-                    .iter()
-                    .take_while(|&&other| other == id)
-                    .count();
+            let end = start + run_length(&ids[start..], id);
             let x0 = rows.x0 + start as i32;
             let span = Span {
                 x0,
@@ -183,6 +179,25 @@ pub(crate) fn shade_and_composite<T: StoreTexel, C: CoverageTexel, R: Recorder<C
         }
     }
     (hits, written)
+}
+
+/// How many ids from the start equal `id`. Eight at a time with a branch-free test (it
+/// vectorises), since the interior runs of a coarse mesh are hundreds of pixels long.
+#[inline]
+fn run_length(ids: &[u32], id: u32) -> usize {
+    let mut chunks = ids.chunks_exact(8);
+    let mut length = 0;
+    for chunk in &mut chunks {
+        if chunk.iter().fold(0, |differ, &other| differ | (other ^ id)) != 0 {
+            break;
+        }
+        length += 8;
+    }
+    length
+        + ids[length..]
+            .iter()
+            .take_while(|&&other| other == id)
+            .count()
 }
 
 /// A run of pixels of one row starting at canvas column `x0`, with their coverage.
@@ -414,4 +429,25 @@ fn owning_triangle<C>(input: &ShadeInput<C>, x: i32, y: i32) -> Option<u32> {
         let id = input.ids[(ny - rect.y0) as usize * width + (nx - rect.x0) as usize];
         (id != NO_TRIANGLE).then_some(id)
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn run_length_counts_the_leading_equal_ids() {
+        // Runs of every length from 0 to 40 at every offset of a 48-id row, against the
+        // one-at-a-time count.
+        for run in 0..=40usize {
+            for tail in [0u32, 1, 7, 8, 9] {
+                let mut ids = vec![5u32; run];
+                ids.extend((0..tail).map(|k| 6 + k % 2));
+                let expected = ids.iter().take_while(|&&id| id == 5).count();
+                assert_eq!(run_length(&ids, 5), expected, "run {run}, tail {tail}");
+                assert_eq!(run_length(&ids, 9), 0);
+            }
+        }
+        assert_eq!(run_length(&[], 3), 0);
+    }
 }

@@ -90,18 +90,21 @@ mod avx2 {
     }
 
     /// Clamped taps of eight texel-space coordinates: first tap, second tap, fraction
-    /// (the scalar `taps_shifted`, lane by lane).
+    /// (the scalar `taps_shifted`, lane by lane), and the lanes (bits) whose second tap is
+    /// the first plus one.
     #[inline]
     #[target_feature(enable = "avx2")]
-    fn taps(shifted: __m256, last: i32, last_f32: f32) -> (__m256i, __m256i, __m256) {
+    fn taps(shifted: __m256, last: i32, last_f32: f32) -> (__m256i, __m256i, __m256, i32) {
         // max(x, 0) gives 0 for NaN and −0 (second operand), like `x > 0 ? x : 0`.
         let low = _mm256_max_ps(shifted, _mm256_setzero_ps());
         let u = _mm256_min_ps(low, _mm256_set1_ps(last_f32));
         let whole = _mm256_cvttps_epi32(u);
         let fraction = _mm256_sub_ps(u, _mm256_cvtepi32_ps(whole));
         // whole < last: the compare gives −1, so subtracting it adds one.
-        let next = _mm256_sub_epi32(whole, _mm256_cmpgt_epi32(_mm256_set1_epi32(last), whole));
-        (whole, next, fraction)
+        let below_last = _mm256_cmpgt_epi32(_mm256_set1_epi32(last), whole);
+        let next = _mm256_sub_epi32(whole, below_last);
+        let stepped = _mm256_movemask_ps(_mm256_castsi256_ps(below_last));
+        (whole, next, fraction, stepped)
     }
 
     /// Texel indices of the four taps of eight pixels, and their fractions.
@@ -109,6 +112,9 @@ mod avx2 {
         index: [[i32; 8]; 4],
         fraction_x: __m256,
         fraction_y: __m256,
+        /// Every lane's right taps follow its left ones in memory (no lane is clamped at
+        /// the source's last column), so one 32-byte load reads both.
+        adjacent: bool,
     }
 
     #[inline]
@@ -118,8 +124,8 @@ mod avx2 {
         let v = affine(maps.texel_y, dx, maps.texel_y_terms[1]);
         // The caller keeps sources with more than i32::MAX texels on the scalar path, so
         // every index fits i32.
-        let (x0, x1, fraction_x) = taps(u, sampler.last_x as i32, sampler.last_x_f32);
-        let (y0, y1, fraction_y) = taps(v, sampler.last_y as i32, sampler.last_y_f32);
+        let (x0, x1, fraction_x, stepped) = taps(u, sampler.last_x as i32, sampler.last_x_f32);
+        let (y0, y1, fraction_y, _) = taps(v, sampler.last_y as i32, sampler.last_y_f32);
         let width = _mm256_set1_epi32(sampler.width as i32);
         let (row0, row1) = (_mm256_mullo_epi32(y0, width), _mm256_mullo_epi32(y1, width));
         let mut index = [[0i32; 8]; 4];
@@ -136,6 +142,7 @@ mod avx2 {
             index,
             fraction_x,
             fraction_y,
+            adjacent: stepped == 0xFF,
         }
     }
 
@@ -167,6 +174,18 @@ mod avx2 {
         unsafe { _mm256_set_m128(_mm_loadu_ps(base.add(b * 4)), _mm_loadu_ps(base.add(a * 4))) }
     }
 
+    /// Texels of taps `tap` and `tap + 1` (left and right) of pixel k, in one load.
+    ///
+    /// # Safety
+    /// As [`texel_pair`], and the right tap is the texel after the left one.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    unsafe fn adjacent_texels(sampler: &Sampler, taps: &Taps, tap: usize, k: usize) -> __m256 {
+        let base = sampler.pixels.as_ptr() as *const f32;
+        // SAFETY: the caller's contract; two texels are eight f32.
+        unsafe { _mm256_loadu_ps(base.add(taps.index[tap][k] as usize * 4)) }
+    }
+
     #[inline]
     #[target_feature(enable = "avx2")]
     fn lerp(a: __m256, b: __m256, t: __m256) -> __m256 {
@@ -182,14 +201,33 @@ mod avx2 {
     unsafe fn sample_pair<const K: i32>(sampler: &Sampler, taps: &Taps) -> __m256 {
         let k = K as usize;
         let (tx, ty) = (pair_of::<K>(taps.fraction_x), pair_of::<K>(taps.fraction_y));
-        // SAFETY: the caller's contract.
-        let (t00, t01, t10, t11) = unsafe {
+        // SAFETY (all loads): the caller's contract; `adjacent` vouches for the right taps.
+        let (t00, t01, t10, t11) = if taps.adjacent {
+            // Rows 0 and 1 of pixels k and k + 1, left and right taps in each half: the
+            // same texels as below, regrouped by tap.
+            let (top_k, bottom_k, top_next, bottom_next) = unsafe {
+                (
+                    adjacent_texels(sampler, taps, 0, k),
+                    adjacent_texels(sampler, taps, 2, k),
+                    adjacent_texels(sampler, taps, 0, k + 1),
+                    adjacent_texels(sampler, taps, 2, k + 1),
+                )
+            };
             (
-                texel_pair(sampler, taps, 0, k),
-                texel_pair(sampler, taps, 1, k),
-                texel_pair(sampler, taps, 2, k),
-                texel_pair(sampler, taps, 3, k),
+                _mm256_permute2f128_ps::<0x20>(top_k, top_next),
+                _mm256_permute2f128_ps::<0x31>(top_k, top_next),
+                _mm256_permute2f128_ps::<0x20>(bottom_k, bottom_next),
+                _mm256_permute2f128_ps::<0x31>(bottom_k, bottom_next),
             )
+        } else {
+            unsafe {
+                (
+                    texel_pair(sampler, taps, 0, k),
+                    texel_pair(sampler, taps, 1, k),
+                    texel_pair(sampler, taps, 2, k),
+                    texel_pair(sampler, taps, 3, k),
+                )
+            }
         };
         lerp(lerp(t00, t01, tx), lerp(t10, t11, tx), ty)
     }
