@@ -9,7 +9,7 @@ use super::bands::{Bands, APRON};
 use super::coverage::{rest_loop_orientation, Silhouette, SilhouetteInput, Strip};
 use super::feather::apply_feather;
 use super::scratch::BandScratch;
-use super::setup::{MembraneSpan, TriangleSetup, MAX_COORDINATE};
+use super::setup::{MembraneSpan, SnappedVertex, TriangleSetup, MAX_COORDINATE};
 use super::shade::{
     shade_and_composite, CoverageTexel, NoRecorder, Recorder, ShadeInput, StoreTexel,
 };
@@ -462,6 +462,10 @@ fn prepare(
     threads: usize,
     scratch: &mut RasterScratch,
 ) {
+    let snapped = &mut scratch.snapped;
+    snapped.clear();
+    snapped.extend(patch.placed.iter().map(|&p| SnappedVertex::new(p)));
+    let snapped = &scratch.snapped[..];
     let setups = &mut scratch.setups;
     setups.resize(patch.triangles.len(), TriangleSetup::default());
     let strips: &mut [Strip] = if anti_alias {
@@ -474,7 +478,7 @@ fn prepare(
         loop_orientation: rest_loop_orientation(patch),
     };
     if threads < 2 || setups.len() < PARALLEL_SETUPS || strips.len() < 2 {
-        build_setups(patch, 0, setups);
+        build_setups(patch, snapped, 0, setups);
         strips.iter_mut().for_each(|strip| strip.fill(input));
         return;
     }
@@ -483,21 +487,27 @@ fn prepare(
     let (top, rest) = strips.split_at_mut(1);
     std::thread::scope(|scope| {
         scope.spawn(|| {
-            build_setups(patch, half, second);
+            build_setups(patch, snapped, half, second);
             rest.iter_mut().for_each(|strip| strip.fill(input));
         });
-        build_setups(patch, 0, first);
+        build_setups(patch, snapped, 0, first);
         top[0].fill(input);
     });
 }
 
 /// The setups of triangles `first..first + setups.len()`.
-fn build_setups(patch: &Patch, first: usize, setups: &mut [TriangleSetup]) {
+fn build_setups(
+    patch: &Patch,
+    snapped: &[SnappedVertex],
+    first: usize,
+    setups: &mut [TriangleSetup],
+) {
     for (setup, tri) in setups.iter_mut().zip(&patch.triangles[first..]) {
         let [a, b, c] = tri.map(|v| v as usize);
         let depth = patch.depth.map_or([0.0; 3], |d| [d[a], d[b], d[c]]);
-        *setup = TriangleSetup::new(
+        *setup = TriangleSetup::from_snapped(
             [patch.placed[a], patch.placed[b], patch.placed[c]],
+            [snapped[a], snapped[b], snapped[c]],
             [patch.rest[a], patch.rest[b], patch.rest[c]],
             [patch.membrane[a], patch.membrane[b], patch.membrane[c]],
             depth,

@@ -67,7 +67,7 @@ impl LocalFrame {
         let (e1, e2) = (b - a, c - a);
         let inv = if usable { 1.0 / e1.perp_dot(e2) } else { 0.0 };
         // Barycentric gradients: λ1 = g1·(p − a), λ2 = g2·(p − a).
-        let clamp = |v: f64| v.floor().clamp(-MAX_COORDINATE, MAX_COORDINATE) as i32;
+        let clamp = |v: f64| floor_to_i32(v.clamp(-MAX_COORDINATE, MAX_COORDINATE));
         let origin = [clamp(a.x), clamp(a.y)];
         LocalFrame {
             g1: DVec2::new(e2.y * inv, -e2.x * inv),
@@ -124,9 +124,49 @@ impl MembraneSpan {
     }
 }
 
+/// `⌊v⌋` for `|v| ≤ MAX_COORDINATE` (NaN gives 0), without the libm call `f64::floor`
+/// becomes on baseline x86_64.
+#[inline]
+fn floor_to_i32(v: f64) -> i32 {
+    let truncated = v as i32;
+    truncated - i32::from(f64::from(truncated) > v)
+}
+
+/// A placed vertex snapped to the fixed-point grid, and whether it is in range. Snapped once
+/// per vertex and frame (not once per triangle corner).
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct SnappedVertex {
+    pub fixed: [i64; 2],
+    pub in_range: bool,
+}
+
+impl SnappedVertex {
+    #[inline]
+    pub fn new(p: DVec2) -> SnappedVertex {
+        SnappedVertex {
+            fixed: snap(p),
+            in_range: p.abs().max_element() <= MAX_COORDINATE,
+        }
+    }
+}
+
 impl TriangleSetup {
     pub fn new(
         placed: [DVec2; 3],
+        rest: [DVec2; 3],
+        membrane: [[f32; 3]; 3],
+        depth: [f32; 3],
+    ) -> TriangleSetup {
+        let snapped = placed.map(SnappedVertex::new);
+        TriangleSetup::from_snapped(placed, snapped, rest, membrane, depth)
+    }
+
+    /// [`new`](Self::new) with the corners already snapped (`snapped[k]` is
+    /// `SnappedVertex::new(placed[k])`).
+    #[inline]
+    pub fn from_snapped(
+        placed: [DVec2; 3],
+        snapped: [SnappedVertex; 3],
         rest: [DVec2; 3],
         membrane: [[f32; 3]; 3],
         depth: [f32; 3],
@@ -135,12 +175,10 @@ impl TriangleSetup {
         let e1 = b - a;
         let e2 = c - a;
         let det = e1.perp_dot(e2);
-        let mut fixed = placed.map(snap);
+        let mut fixed = snapped.map(|s| s.fixed);
         // Out-of-range (or NaN) vertices snap to saturated values whose edge function would
         // overflow i64: test the range first and never evaluate it for them.
-        let in_range = placed
-            .iter()
-            .all(|p| p.abs().max_element() <= MAX_COORDINATE);
+        let in_range = snapped.iter().all(|s| s.in_range);
         let fixed_area = if in_range {
             edge_function(fixed[0], fixed[1], fixed[2])
         } else {
@@ -240,6 +278,19 @@ pub(crate) fn edge_function(a: [i64; 2], b: [i64; 2], p: [i64; 2]) -> i64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn floor_to_i32_is_floor_over_the_coordinate_range() {
+        let mut values = vec![
+            0.0, -0.0, 0.5, -0.5, 1.0, -1.0, 2.999, -2.999, 1e-300, -1e-300,
+        ];
+        values.extend([MAX_COORDINATE, -MAX_COORDINATE, MAX_COORDINATE - 0.25]);
+        values.extend((0..2000).map(|k| (f64::from(k) - 1000.0) * 0.37 + 1e-9 * f64::from(k)));
+        for v in values {
+            assert_eq!(floor_to_i32(v), v.floor() as i32, "{v}");
+        }
+        assert_eq!(floor_to_i32(f64::NAN), 0);
+    }
 
     #[test]
     fn far_or_nan_vertices_are_not_drawable_and_never_overflow() {
