@@ -124,6 +124,40 @@ pub(crate) fn shade_and_composite<T: StoreTexel, C: CoverageTexel, R: Recorder<C
     canvas_width: usize,
     recorder: &mut R,
 ) -> (usize, usize) {
+    #[cfg(target_arch = "x86_64")]
+    if input.kernel == Kernel::Avx2 {
+        // SAFETY: `Kernel::Avx2` is only ever detected on CPUs with AVX2.
+        return unsafe { shade_rows_avx2(input, rows, canvas, canvas_width, recorder) };
+    }
+    shade_rows(input, rows, canvas, canvas_width, recorder)
+}
+
+/// [`shade_rows`] compiled for AVX2, so the SIMD run kernel inlines into the row walk (a
+/// call and the kernel's set-up per run cost as much as a short run's pixels). The scalar
+/// parts do the same IEEE operations either way (Rust never fuses a multiply and an add).
+///
+/// # Safety
+/// The CPU must have AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn shade_rows_avx2<T: StoreTexel, C: CoverageTexel, R: Recorder<C>>(
+    input: &ShadeInput<C>,
+    rows: PixelRect,
+    canvas: &mut [[T; 4]],
+    canvas_width: usize,
+    recorder: &mut R,
+) -> (usize, usize) {
+    shade_rows(input, rows, canvas, canvas_width, recorder)
+}
+
+#[inline(always)]
+fn shade_rows<T: StoreTexel, C: CoverageTexel, R: Recorder<C>>(
+    input: &ShadeInput<C>,
+    rows: PixelRect,
+    canvas: &mut [[T; 4]],
+    canvas_width: usize,
+    recorder: &mut R,
+) -> (usize, usize) {
     let ids_rect = input.ids_rect;
     let ids_width = ids_rect.width();
     let (first, last) = (

@@ -48,6 +48,7 @@ impl Kernel {
 /// Gives the number of pixels written. `coverage` and `pixels` have the run's length, and
 /// the source at most `i32::MAX` texels.
 #[cfg(target_arch = "x86_64")]
+#[inline(always)]
 pub(crate) fn shade_run_rgba8(
     kernel: Kernel,
     setup: &SpanSetup,
@@ -378,6 +379,7 @@ mod avx2 {
     ///
     /// # Safety
     /// The CPU must have AVX2; `coverage` and `pixels` have the same length.
+    #[inline]
     #[target_feature(enable = "avx2")]
     pub(super) unsafe fn shade_run(
         setup: &SpanSetup,
