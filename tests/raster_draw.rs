@@ -247,15 +247,15 @@ fn anti_aliased_coverage_integrates_to_the_area() {
 
 #[test]
 fn a_large_silhouette_has_no_seam_between_its_strips() {
-    // Large enough (≥ 64K px of work) for the two-strip silhouette; every pixel farther
+    // Large enough (≥ 256K px of work) for the four-strip silhouette; every pixel farther
     // than 1.5 px from the outline must be exactly in or out, the strips' border row
     // included, and the coverage must integrate to the area.
-    let source = white_source(420, 420);
-    let centre = DVec2::new(200.3, 201.7);
-    let (positions, triangles, loops) = polygon(centre, 170.4, 96);
+    let source = white_source(640, 640);
+    let centre = DVec2::new(320.3, 321.7);
+    let (positions, triangles, loops) = polygon(centre, 300.4, 96);
     let zero = vec![[0.0; 3]; positions.len()];
     for threads in [1, 2] {
-        let mut canvas = opaque_canvas(400, 400, 0.0);
+        let mut canvas = opaque_canvas(640, 640, 0.0);
         let options = RasterOptions {
             threads,
             ..RasterOptions::default()
@@ -278,15 +278,15 @@ fn a_large_silhouette_has_no_seam_between_its_strips() {
         let sum = coverage_sum(&canvas);
         assert!((sum - area).abs() < 1e-3 * area, "{sum} vs {area}");
         // The polygon's inscribed radius bounds "inside"; its circumradius bounds "outside".
-        let inscribed = 170.4 * (std::f64::consts::PI / 96.0).cos();
-        for j in 0..400 {
-            for i in 0..400 {
+        let inscribed = 300.4 * (std::f64::consts::PI / 96.0).cos();
+        for j in 0..640 {
+            for i in 0..640 {
                 let distance =
                     (DVec2::new(f64::from(i) + 0.5, f64::from(j) + 0.5) - centre).length();
                 let value = canvas.pixel_f32(i, j).unwrap()[0];
                 if distance < inscribed - 1.5 {
                     assert_eq!(value, 1.0, "pixel ({i}, {j}) inside");
-                } else if distance > 170.4 + 1.5 {
+                } else if distance > 300.4 + 1.5 {
                     assert_eq!(value, 0.0, "pixel ({i}, {j}) outside");
                 }
             }

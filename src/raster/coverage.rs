@@ -10,7 +10,7 @@
 //! Folds are rare, so the path stays about the size of the boundary. Without loops, every
 //! triangle goes into the path (same union, slower).
 //!
-//! Large work rectangles are covered by two strips, filled at once by two threads. Each
+//! Large work rectangles are covered by up to four strips, filled at once by two threads. Each
 //! strip's path is clipped ([`clip`](super::clip)) to one pixel beyond the strip, so it lies
 //! inside the strip's mask and tiny-skia's own clipping (whose rounding would depend on the
 //! grow-only mask's size, so on earlier frames) never runs.
@@ -21,17 +21,21 @@ use tiny_skia::{FillRule, Mask, PathBuilder, Transform};
 use super::clip::{clip_polygon, ClipRect};
 use super::{Patch, PixelRect};
 
-/// Work rectangles from this area up are covered by two strips (the top and bottom halves),
-/// which two threads fill at once. The rule depends on the rectangle alone, never on the
-/// thread count, so every thread count gives the same coverage.
+/// Work rectangles are covered by one horizontal strip per this many pixels (at most
+/// [`MAX_STRIPS`]), which threads fill at once. The rule depends on the rectangle alone,
+/// never on the thread count, so every thread count gives the same coverage.
 pub(crate) const SPLIT_AREA: usize = 64 * 1024;
+
+/// Strips of the largest work rectangles: enough for two threads to share them evenly when
+/// one starts late.
+const MAX_STRIPS: usize = 4;
 
 /// Pixels of mask around a strip: its path is clipped one pixel outside the strip, and
 /// tiny-skia's conservative path bounds add about half a pixel more.
 const BORDER: i32 = 2;
 
-/// The silhouette coverage of one draw, as one or two horizontal strips of the work
-/// rectangle, each with its own mask. Grow-only storage, kept in the raster scratch.
+/// The silhouette coverage of one draw, as one to [`MAX_STRIPS`] horizontal strips of the
+/// work rectangle, each with its own mask. Grow-only storage, kept in the raster scratch.
 #[derive(Default)]
 pub(crate) struct Silhouette {
     strips: Vec<Strip>,
@@ -57,25 +61,23 @@ pub(crate) struct SilhouetteInput<'a> {
 }
 
 impl Silhouette {
-    /// Lays out the strips of `work` (one, or two from [`SPLIT_AREA`] up). The strips are
-    /// filled by [`Strip::fill`].
+    /// Lays out the strips of `work` (one per [`SPLIT_AREA`] pixels, 1 to [`MAX_STRIPS`]).
+    /// The strips are filled by [`Strip::fill`].
     pub fn layout(&mut self, work: PixelRect) -> &mut [Strip] {
-        let rects = if work.area() >= SPLIT_AREA && work.height() >= 2 {
-            let middle = work.y0 + (work.height() / 2) as i32;
-            (
-                PixelRect { y1: middle, ..work },
-                Some(PixelRect { y0: middle, ..work }),
-            )
-        } else {
-            (work, None)
-        };
-        self.count = 1 + usize::from(rects.1.is_some());
+        let height = work.height();
+        self.count = (work.area() / SPLIT_AREA)
+            .clamp(1, MAX_STRIPS)
+            .min(height.max(1));
         if self.strips.len() < self.count {
             self.strips.resize_with(self.count, Strip::default);
         }
-        self.strips[0].rect = rects.0;
-        if let Some(second) = rects.1 {
-            self.strips[1].rect = second;
+        for (k, strip) in self.strips[..self.count].iter_mut().enumerate() {
+            let row = |k: usize| work.y0 + (height * k / self.count) as i32;
+            strip.rect = PixelRect {
+                y0: row(k),
+                y1: row(k + 1),
+                ..work
+            };
         }
         &mut self.strips[..self.count]
     }

@@ -331,7 +331,7 @@ fn draw_band<T: StoreTexel, R: Recorder<u8>>(
         scratch.coverage = coverage;
         return totals;
     };
-    // A band may straddle the two strips' border: each part reads its own strip's mask.
+    // A band may straddle a border between strips: each part reads its own strip's mask.
     let mut totals = (0, 0);
     for strip in silhouette.strips() {
         let part = rows.intersect(&strip.rect());
@@ -448,13 +448,22 @@ fn work_rect(patch: &Patch, canvas: &Canvas, feather: f32) -> Option<PixelRect> 
     (!work.is_empty() && !placed.intersect(&canvas_rect(canvas)).is_empty()).then_some(work)
 }
 
-/// Large draws split their triangles between two threads from this many up.
-const PARALLEL_SETUPS: usize = 1024;
+/// Large draws hand out their triangle setups in chunks of this many.
+const SETUP_CHUNK: usize = 1024;
 
-/// Per-triangle setups and the silhouette's strips: the work before the bands, on two
-/// threads (one half of the setups and one strip each) when `threads` ≥ 2. The split
-/// changes no value: each setup depends on its triangle alone, and the strips are laid out
-/// by [`Silhouette::layout`] whatever the thread count.
+/// One piece of the work before the bands.
+enum PrepareJob<'a> {
+    /// A strip of the silhouette.
+    Strip(&'a mut Strip),
+    /// The setups of triangles `first..first + setups.len()`.
+    Setups(usize, &'a mut [TriangleSetup]),
+}
+
+/// Per-triangle setups and the silhouette's strips: the work before the bands. With
+/// `threads` ≥ 2 the pieces (strips first, then chunks of setups) go to whichever thread
+/// asks next, so a helper thread that the scheduler starts late only takes what is left.
+/// The split changes no value: each setup depends on its triangle alone, and the strips
+/// are laid out by [`Silhouette::layout`] whatever the thread count.
 fn prepare(
     patch: &Patch,
     work: PixelRect,
@@ -477,21 +486,30 @@ fn prepare(
         patch,
         loop_orientation: rest_loop_orientation(patch),
     };
-    if threads < 2 || setups.len() < PARALLEL_SETUPS || strips.len() < 2 {
-        build_setups(patch, snapped, 0, setups);
-        strips.iter_mut().for_each(|strip| strip.fill(input));
+    let run = |job: PrepareJob| match job {
+        PrepareJob::Strip(strip) => strip.fill(input),
+        PrepareJob::Setups(first, setups) => build_setups(patch, snapped, first, setups),
+    };
+    let parallel = threads >= 2 && strips.len() + setups.len() / SETUP_CHUNK >= 2;
+    let jobs = strips.iter_mut().map(PrepareJob::Strip).chain(
+        setups
+            .chunks_mut(SETUP_CHUNK)
+            .enumerate()
+            .map(|(k, chunk)| PrepareJob::Setups(k * SETUP_CHUNK, chunk)),
+    );
+    if !parallel {
+        jobs.for_each(run);
         return;
     }
-    let half = setups.len() / 2;
-    let (first, second) = setups.split_at_mut(half);
-    let (top, rest) = strips.split_at_mut(1);
+    let queue = Mutex::new(jobs);
+    let take_jobs = || loop {
+        let job = queue.lock().unwrap_or_else(|e| e.into_inner()).next();
+        let Some(job) = job else { break };
+        run(job);
+    };
     std::thread::scope(|scope| {
-        scope.spawn(|| {
-            build_setups(patch, snapped, half, second);
-            rest.iter_mut().for_each(|strip| strip.fill(input));
-        });
-        build_setups(patch, snapped, 0, first);
-        top[0].fill(input);
+        scope.spawn(take_jobs);
+        take_jobs();
     });
 }
 
