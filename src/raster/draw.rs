@@ -1,7 +1,8 @@
 //! Drawing one patch: takes a [`Patch`], options and a [`RasterScratch`] and composites the
-//! patch over a [`Canvas`]. Per frame: per-triangle setup and silhouette coverage once, then
-//! per row band (threaded for large patches) exact coverage with depth test and shading —
-//! all inside the patch's bounding box. Feathered patches draw in one piece.
+//! patch over a [`Canvas`]. Per frame: per-triangle setup and silhouette coverage once (in
+//! pieces that two threads share, for large patches), then per row band (threaded likewise)
+//! exact coverage with depth test and shading — all inside the patch's bounding box.
+//! Feathered patches draw in one piece.
 
 use std::sync::{Mutex, OnceLock};
 
