@@ -124,5 +124,10 @@ proptest! {
         let mut again = Vec::new();
         covered_boundary_vertices(&placed, &mesh.triangles, &depth, &boundary, &mut grid, &mut again).unwrap();
         prop_assert_eq!(out, again);
+        // Every vertex a candidate (interior ones too), in a scrambled order.
+        let everyone: Vec<u32> = (0..placed.len() as u32).map(|k| (k * 17) % placed.len() as u32).collect();
+        let mut all = Vec::new();
+        covered_boundary_vertices(&placed, &mesh.triangles, &depth, &everyone, &mut grid, &mut all).unwrap();
+        prop_assert_eq!(all, brute_force(&placed, &mesh.triangles, &depth, &everyone));
     }
 }
