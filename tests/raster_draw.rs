@@ -8,7 +8,9 @@ mod raster_meshes;
 use glam::DVec2;
 use lapclone::mesh::BoundaryLoop;
 use lapclone::pixels::{Canvas, Depth, FloatImage, PixelFormat, Texel};
-use lapclone::raster::{draw_patch, Patch, RasterOptions, RasterScratch};
+use lapclone::raster::{
+    draw_patch, draw_patch_solving, Patch, RasterError, RasterOptions, RasterScratch,
+};
 
 fn opaque_canvas(width: u32, height: u32, grey: f32) -> Canvas {
     let image = FloatImage::from_fn(width, height, PixelFormat::RGBA8, |_, _| {
@@ -508,53 +510,186 @@ fn patch_outside_the_canvas_draws_nothing_and_bad_input_is_an_error() {
 
 #[test]
 fn every_thread_count_draws_the_same_pixels() {
-    // Large enough for the threaded path (≥ 64K px) and for many row bands; a wavy,
-    // rotated placement with a depth ramp so bands cut through folds and spans.
-    let source = raster_meshes::pattern_image(200, 200);
-    let mesh = raster_meshes::grid(DVec2::new(2.0, 3.0), 6.0, 32, 32);
-    let placed: Vec<DVec2> = mesh
-        .positions
-        .iter()
-        .map(|p| {
-            let wave = DVec2::new((p.y * 0.05).sin() * 40.0, (p.x * 0.04).cos() * 25.0);
-            DVec2::new(1.6 * p.x - 0.5 * p.y + 60.0, 0.5 * p.x + 1.6 * p.y + 10.0) + wave
-        })
-        .collect();
-    let membrane: Vec<[f32; 3]> = mesh
-        .positions
-        .iter()
-        .map(|p| [(p.x * 0.002) as f32, -0.1, (p.y * 0.001) as f32])
-        .collect();
-    let depth: Vec<f32> = mesh.positions.iter().map(|p| (p.x * 0.01) as f32).collect();
-    let render = |threads: usize, depth: Option<&[f32]>| {
+    let grid = WavyGrid::new();
+    let render = |threads: usize, with_depth: bool| {
         let mut canvas = opaque_canvas(520, 470, 0.3);
         let options = RasterOptions {
             threads,
             ..RasterOptions::default()
         };
-        let patch = Patch {
-            rest: &mesh.positions,
-            placed: &placed,
-            triangles: &mesh.triangles,
-            membrane: &membrane,
-            depth,
-            loops: &mesh.loops,
-            source: &source,
-        };
+        let patch = grid.patch(with_depth);
         let stats = draw_patch(&mut canvas, &patch, &options, &mut RasterScratch::new()).unwrap();
         (canvas.to_float_image(PixelFormat::RGBA8), stats)
     };
-    for depth in [None, Some(&depth[..])] {
-        let (single, single_stats) = render(1, depth);
+    for with_depth in [false, true] {
+        let (single, single_stats) = render(1, with_depth);
         assert!(single_stats.centre_hits > 64 * 1024, "{single_stats:?}");
         for threads in [2, 3, 5, 0] {
-            let (image, stats) = render(threads, depth);
+            let (image, stats) = render(threads, with_depth);
             assert_eq!(stats, single_stats, "{threads} threads");
             assert!(
                 image.pixels() == single.pixels(),
                 "{threads} threads differ from one"
             );
         }
+    }
+}
+
+/// A 32×32-cell grid placed with a wave, a rotation and a depth ramp: large enough for the
+/// threaded path (≥ 64K px), many row bands, two setup chunks and several silhouette
+/// strips; bands cut through folds and spans.
+struct WavyGrid {
+    mesh: raster_meshes::GridMesh,
+    placed: Vec<DVec2>,
+    membrane: Vec<[f32; 3]>,
+    depth: Vec<f32>,
+    source: FloatImage,
+}
+
+impl WavyGrid {
+    fn new() -> WavyGrid {
+        let mesh = raster_meshes::grid(DVec2::new(2.0, 3.0), 6.0, 32, 32);
+        let placed = mesh
+            .positions
+            .iter()
+            .map(|p| {
+                let wave = DVec2::new((p.y * 0.05).sin() * 40.0, (p.x * 0.04).cos() * 25.0);
+                DVec2::new(1.6 * p.x - 0.5 * p.y + 60.0, 0.5 * p.x + 1.6 * p.y + 10.0) + wave
+            })
+            .collect();
+        let membrane = mesh
+            .positions
+            .iter()
+            .map(|p| [(p.x * 0.002) as f32, -0.1, (p.y * 0.001) as f32])
+            .collect();
+        let depth = mesh.positions.iter().map(|p| (p.x * 0.01) as f32).collect();
+        let source = raster_meshes::pattern_image(200, 200);
+        WavyGrid {
+            mesh,
+            placed,
+            membrane,
+            depth,
+            source,
+        }
+    }
+
+    /// The patch, with or without its depth ramp.
+    fn patch(&self, with_depth: bool) -> Patch<'_> {
+        Patch {
+            rest: &self.mesh.positions,
+            placed: &self.placed,
+            triangles: &self.mesh.triangles,
+            membrane: &self.membrane,
+            depth: with_depth.then_some(&self.depth[..]),
+            loops: &self.mesh.loops,
+            source: &self.source,
+        }
+    }
+}
+
+#[test]
+fn a_draw_that_solves_its_membrane_meanwhile_gives_the_same_bytes() {
+    let grid = WavyGrid::new();
+    for with_depth in [false, true] {
+        for threads in [1, 2, 0] {
+            for anti_alias in [true, false] {
+                let options = RasterOptions {
+                    threads,
+                    anti_alias,
+                    ..RasterOptions::default()
+                };
+                let mut solved = opaque_canvas(520, 470, 0.3);
+                let first = draw_patch(
+                    &mut solved,
+                    &grid.patch(with_depth),
+                    &options,
+                    &mut RasterScratch::new(),
+                );
+                let mut solving = opaque_canvas(520, 470, 0.3);
+                // The "solve" computes the membrane afresh (slowly, so the helper thread
+                // gets ahead of it), reading the canvas it was given.
+                let mut computed = Vec::new();
+                let no_membrane = Patch {
+                    membrane: &[],
+                    ..grid.patch(with_depth)
+                };
+                let second = draw_patch_solving(
+                    &mut solving,
+                    &no_membrane,
+                    &options,
+                    &mut RasterScratch::new(),
+                    |canvas: &Canvas| {
+                        assert_eq!(canvas.width(), 520);
+                        for p in &grid.mesh.positions {
+                            let mut x = p.x;
+                            for _ in 0..200 {
+                                x = std::hint::black_box(x);
+                            }
+                            computed.push([(x * 0.002) as f32, -0.1, (p.y * 0.001) as f32]);
+                        }
+                        Ok::<_, RasterError>(&computed[..])
+                    },
+                );
+                let context = format!("depth {with_depth}, {threads} threads, aa {anti_alias}");
+                assert_eq!(first.unwrap(), second.unwrap(), "{context}");
+                assert!(solving == solved, "{context}: the bytes differ");
+            }
+        }
+    }
+}
+
+#[test]
+fn a_failed_or_wrong_solve_leaves_the_canvas_as_it_was() {
+    let grid = WavyGrid::new();
+    let patch = Patch {
+        membrane: &[],
+        ..grid.patch(true)
+    };
+    let vertices = grid.mesh.positions.len();
+    let before = opaque_canvas(520, 470, 0.3);
+    let short = vec![[0.0f32; 3]; vertices - 1];
+    let mut nan = vec![[0.0f32; 3]; vertices];
+    nan[7][1] = f32::NAN;
+    for threads in [1, 2] {
+        let options = RasterOptions {
+            threads,
+            ..RasterOptions::default()
+        };
+        let mut canvas = before.clone();
+        let failed = draw_patch_solving(
+            &mut canvas,
+            &patch,
+            &options,
+            &mut RasterScratch::new(),
+            |_| Err(RasterError::Feather(-1.0)),
+        );
+        assert!(matches!(failed, Err(RasterError::Feather(_))), "{failed:?}");
+        for wrong in [&short, &nan] {
+            let result = draw_patch_solving(
+                &mut canvas,
+                &patch,
+                &options,
+                &mut RasterScratch::new(),
+                |_| Ok::<_, RasterError>(&wrong[..]),
+            );
+            assert!(result.is_err(), "{threads} threads: {result:?}");
+        }
+        // A panicking solve reaches the caller (the helper thread does not wait for it).
+        let panicked = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            let _ = draw_patch_solving(
+                &mut canvas,
+                &patch,
+                &options,
+                &mut RasterScratch::new(),
+                |_| {
+                    panic!("solver bug");
+                    #[allow(unreachable_code)]
+                    Ok::<_, RasterError>(&short[..])
+                },
+            );
+        }));
+        assert!(panicked.is_err());
+        assert!(canvas == before, "{threads} threads: the canvas changed");
     }
 }
 

@@ -4,7 +4,9 @@
 //!
 //! Built once: the mesh, the factored Laplacian, the source (grey in monochrome mode), raster
 //! and coverage scratch. Per call: place the vertices, find boundary vertices hidden under
-//! the patch's own front layer, switch constraints, one 3-RHS solve, the raster.
+//! the patch's own front layer, switch constraints, one 3-RHS solve, the raster. The
+//! hidden-vertex query and the solve run while the raster prepares its membrane-free part on
+//! a second thread ([`draw_patch_solving`]).
 
 use std::time::Instant;
 
@@ -15,8 +17,8 @@ use super::{CloneError, Placement};
 use crate::mesh::Mesh;
 use crate::pixels::{Canvas, FloatImage};
 use crate::raster::{
-    covered_boundary_vertices, draw_patch, CoverageGrid, Patch, RasterOptions, RasterScratch,
-    RasterStats,
+    covered_boundary_vertices, draw_patch_solving, CoverageGrid, Patch, RasterOptions,
+    RasterScratch, RasterStats,
 };
 use crate::solve::LaplacianKind;
 
@@ -71,8 +73,11 @@ impl Default for CloneOptions {
 pub struct CloneStats {
     pub membrane: MembraneStats,
     pub raster: RasterStats,
-    /// Constraint switches + back-substitution.
+    /// Hidden-vertex query ([`clone_deformed`](PatchCloner::clone_deformed) only), constraint
+    /// switches and back-substitution, on the calling thread; the raster's first part runs
+    /// meanwhile on a helper thread.
     pub solve_ms: f64,
+    /// The rest of the call's wall time: the raster beyond what overlapped the solve.
     pub raster_ms: f64,
 }
 
@@ -83,9 +88,7 @@ pub struct PatchCloner {
     membrane: MembraneSolver,
     raster_options: RasterOptions,
     placed: Vec<DVec2>,
-    hidden: Vec<bool>,
-    covered: Vec<u32>,
-    coverage_grid: CoverageGrid,
+    hidden: HiddenVertices,
     raster_scratch: RasterScratch,
 }
 
@@ -115,9 +118,11 @@ impl PatchCloner {
                 ..RasterOptions::default()
             },
             placed: Vec::with_capacity(n),
-            hidden: vec![false; n],
-            covered: Vec::new(),
-            coverage_grid: CoverageGrid::new(),
+            hidden: HiddenVertices {
+                marks: vec![false; n],
+                covered: Vec::new(),
+                grid: CoverageGrid::new(),
+            },
             raster_scratch: RasterScratch::new(),
         })
     }
@@ -160,8 +165,8 @@ impl PatchCloner {
         deformed: &[DVec2],
         depth: Option<&[f32]>,
     ) -> Result<CloneStats, CloneError> {
-        self.prepare_deformed(placement, deformed, depth)?;
-        self.clone_prepared(canvas, depth)
+        self.place_deformed(placement, deformed, depth)?;
+        self.clone_placed(canvas, depth, HiddenBy::Query)
     }
 
     /// The canvas-independent half of [`clone_onto`](Self::clone_onto): places the vertices.
@@ -169,7 +174,7 @@ impl PatchCloner {
     pub fn prepare_rigid(&mut self, placement: &Placement) -> Result<(), CloneError> {
         check_placement(placement)?;
         placement.apply(&self.mesh.positions, &mut self.placed);
-        self.hidden.fill(false);
+        self.hidden.marks.fill(false);
         Ok(())
     }
 
@@ -181,31 +186,25 @@ impl PatchCloner {
         deformed: &[DVec2],
         depth: Option<&[f32]>,
     ) -> Result<(), CloneError> {
+        self.place_deformed(placement, deformed, depth)?;
+        let boundary = self.membrane.boundary_vertices();
+        let frame = (&self.placed[..], &self.mesh.triangles[..]);
+        self.hidden.find(frame, boundary, depth)?;
+        Ok(())
+    }
+
+    fn place_deformed(
+        &mut self,
+        placement: &Placement,
+        deformed: &[DVec2],
+        depth: Option<&[f32]>,
+    ) -> Result<(), CloneError> {
         check_placement(placement)?;
         let n = self.mesh.vertex_count();
         if deformed.len() != n || depth.is_some_and(|d| d.len() != n) {
             return Err(CloneError::VertexCountMismatch(deformed.len(), n));
         }
         placement.apply(deformed, &mut self.placed);
-        self.mark_hidden(depth)
-    }
-
-    fn mark_hidden(&mut self, depth: Option<&[f32]>) -> Result<(), CloneError> {
-        self.hidden.fill(false);
-        let Some(depth) = depth else {
-            return Ok(());
-        };
-        covered_boundary_vertices(
-            &self.placed,
-            &self.mesh.triangles,
-            depth,
-            self.membrane.boundary_vertices(),
-            &mut self.coverage_grid,
-            &mut self.covered,
-        )?;
-        for &v in &self.covered {
-            self.hidden[v as usize] = true;
-        }
         Ok(())
     }
 
@@ -216,37 +215,101 @@ impl PatchCloner {
         canvas: &mut Canvas,
         depth: Option<&[f32]>,
     ) -> Result<CloneStats, CloneError> {
+        self.clone_placed(canvas, depth, HiddenBy::Preparation)
+    }
+
+    /// The membrane solve (after the hidden-vertex query, if it is still to do) on this
+    /// thread while the raster starts its membrane-free work on another
+    /// ([`draw_patch_solving`]).
+    fn clone_placed(
+        &mut self,
+        canvas: &mut Canvas,
+        depth: Option<&[f32]>,
+        hidden_by: HiddenBy,
+    ) -> Result<CloneStats, CloneError> {
         let n = self.mesh.vertex_count();
         if self.placed.len() != n || depth.is_some_and(|d| d.len() != n) {
             return Err(CloneError::VertexCountMismatch(self.placed.len(), n));
         }
         let started = Instant::now();
-        let membrane = self
-            .membrane
-            .solve(&self.placed, canvas, Some(&self.hidden))?;
-        let solved = Instant::now();
+        let mut solved = None;
         let patch = Patch {
             rest: &self.mesh.positions,
             placed: &self.placed,
             triangles: &self.mesh.triangles,
-            membrane: self.membrane.membrane(),
+            membrane: &[],
             depth,
             loops: &self.mesh.loops,
             source: &self.source,
         };
-        let raster = draw_patch(
+        let frame = (&self.placed[..], &self.mesh.triangles[..]);
+        let (solver, hidden, solved_out) = (&mut self.membrane, &mut self.hidden, &mut solved);
+        let solve = move |canvas: &Canvas| {
+            // Moved (not reborrowed), so the membrane can be lent out for the whole draw.
+            let membrane = solver;
+            let solve_started = Instant::now();
+            let hidden = if hidden_by == HiddenBy::Query {
+                hidden.find(frame, membrane.boundary_vertices(), depth)?
+            } else {
+                &hidden.marks
+            };
+            let stats = membrane.solve(frame.0, canvas, Some(hidden))?;
+            *solved_out = Some((stats, millis(solve_started.elapsed())));
+            Ok::<_, CloneError>(membrane.membrane())
+        };
+        let raster = draw_patch_solving(
             canvas,
             &patch,
             &self.raster_options,
             &mut self.raster_scratch,
+            solve,
         )?;
-        let drawn = Instant::now();
+        // invariant: draw_patch_solving runs the solve exactly once, and it succeeded.
+        let (membrane, solve_ms) = solved.expect("the draw ran the solve");
         Ok(CloneStats {
             membrane,
             raster,
-            solve_ms: millis(solved - started),
-            raster_ms: millis(drawn - solved),
+            solve_ms,
+            raster_ms: millis(started.elapsed()) - solve_ms,
         })
+    }
+}
+
+/// Where a clone's hidden boundary vertices come from.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum HiddenBy {
+    /// Found by the preparation (or none: a rigid clone).
+    Preparation,
+    /// Found with the solve, while the raster starts.
+    Query,
+}
+
+/// The boundary vertices under the patch's own front layer, and the query's buffers.
+struct HiddenVertices {
+    /// Per vertex: hidden.
+    marks: Vec<bool>,
+    covered: Vec<u32>,
+    grid: CoverageGrid,
+}
+
+impl HiddenVertices {
+    /// Marks the `boundary` vertices of the placed `(positions, triangles)` under the
+    /// patch's own front layer (none without `depth`); gives the marks.
+    fn find(
+        &mut self,
+        (placed, triangles): (&[DVec2], &[[u32; 3]]),
+        boundary: &[u32],
+        depth: Option<&[f32]>,
+    ) -> Result<&[bool], CloneError> {
+        self.marks.fill(false);
+        if let Some(depth) = depth {
+            let (grid, covered) = (&mut self.grid, &mut self.covered);
+            covered_boundary_vertices(placed, triangles, depth, boundary, grid, covered)?;
+            for &v in covered.iter() {
+                self.marks[v as usize] = true;
+            }
+        }
+        Ok(&self.marks)
     }
 }
 

@@ -7,10 +7,11 @@
 use std::sync::{Mutex, OnceLock};
 
 use super::bands::{Bands, APRON};
-use super::coverage::{rest_loop_orientation, Silhouette, SilhouetteInput, Strip};
+use super::coverage::Silhouette;
 use super::feather::apply_feather;
+use super::prepare::prepare;
 use super::scratch::BandScratch;
-use super::setup::{MembraneSpan, SnappedVertex, TriangleSetup, MAX_COORDINATE};
+use super::setup::{MembraneSpan, TriangleSetup, MAX_COORDINATE};
 use super::shade::{
     shade_and_composite, CoverageTexel, NoRecorder, Recorder, ShadeInput, StoreTexel,
 };
@@ -71,15 +72,38 @@ pub fn draw_patch(
     options: &RasterOptions,
     scratch: &mut RasterScratch,
 ) -> Result<RasterStats, RasterError> {
-    patch.validate()?;
-    if !options.feather.is_finite() || options.feather < 0.0 {
-        return Err(RasterError::Feather(options.feather));
-    }
-    let Some(work) = work_rect(patch, canvas, options.feather) else {
+    draw_patch_solving(canvas, patch, options, scratch, |_| Ok(patch.membrane))
+}
+
+/// [`draw_patch`] for a patch whose membrane is not known yet: `solve` gives it, reading the
+/// canvas before anything is drawn (`patch.membrane` is not read). On a large patch `solve`
+/// runs on this thread while a helper thread starts the raster's membrane-free work (see
+/// [`prepare`](super::prepare)), so the draw finishes sooner than a solve followed by
+/// [`draw_patch`] — with the same bytes. `solve` runs exactly once, also when nothing is
+/// drawn; its error ends the draw with the canvas untouched.
+pub fn draw_patch_solving<'m, E: From<RasterError>>(
+    canvas: &mut Canvas,
+    patch: &Patch,
+    options: &RasterOptions,
+    scratch: &mut RasterScratch,
+    solve: impl FnOnce(&Canvas) -> Result<&'m [[f32; 3]], E>,
+) -> Result<RasterStats, E> {
+    let checked = patch.validate_geometry().and_then(|()| {
+        match options.feather.is_finite() && options.feather >= 0.0 {
+            true => Ok(work_rect(patch, canvas, options.feather)),
+            false => Err(RasterError::Feather(options.feather)),
+        }
+    });
+    let Some(work) = checked? else {
+        let membrane = solve(canvas)?;
+        patch.validate_membrane(membrane)?;
         return Ok(RasterStats::default());
     };
-    if let Some(stats) = try_replay(canvas, patch, options, work, scratch) {
-        return Ok(stats);
+    if let Some(shift) = replay_shift(canvas, patch, options, work, scratch) {
+        let membrane = solve(canvas)?;
+        patch.validate_membrane(membrane)?;
+        let patch = Patch { membrane, ..*patch };
+        return Ok(replay(canvas, &patch, options, work, shift, scratch));
     }
     let canvas_bounds = canvas_rect(canvas);
     let target = work.intersect(&canvas_bounds);
@@ -93,7 +117,10 @@ pub fn draw_patch(
     } else {
         worker_threads(options.threads, work.area(), usize::MAX)
     };
-    prepare(patch, work, options.anti_alias, threads, scratch);
+    let membrane = prepare(patch, work, options.anti_alias, threads, scratch, || {
+        solve(canvas)
+    })?;
+    let patch = &Patch { membrane, ..*patch };
     let frame = Frame {
         patch,
         work,
@@ -142,21 +169,32 @@ pub fn draw_patch(
     })
 }
 
-/// Replays the scratch's record when `patch` is it moved by whole pixels (see
-/// [`replay`](super::replay)); `None` when a fresh draw is needed.
-fn try_replay(
+/// The whole-pixel shift by which the scratch's record replays as `patch` (see
+/// [`replay`](super::replay)); `None` when a fresh draw is needed. Reads no membrane.
+fn replay_shift(
+    canvas: &Canvas,
+    patch: &Patch,
+    options: &RasterOptions,
+    work: PixelRect,
+    scratch: &RasterScratch,
+) -> Option<(i32, i32)> {
+    if !options.replay || patch.depth.is_some() || options.feather != 0.0 {
+        return None;
+    }
+    scratch
+        .replay
+        .shift_for(patch, options.anti_alias, canvas_rect(canvas), work)
+}
+
+/// Replays the scratch's record shifted by `shift` with `patch`'s membrane.
+fn replay(
     canvas: &mut Canvas,
     patch: &Patch,
     options: &RasterOptions,
     work: PixelRect,
+    shift: (i32, i32),
     scratch: &mut RasterScratch,
-) -> Option<RasterStats> {
-    if !options.replay || patch.depth.is_some() || options.feather != 0.0 {
-        return None;
-    }
-    let shift = scratch
-        .replay
-        .shift_for(patch, options.anti_alias, canvas_rect(canvas), work)?;
+) -> RasterStats {
     let spans = &mut scratch.membrane_spans;
     spans.clear();
     spans.extend(patch.triangles.iter().map(|tri| {
@@ -174,12 +212,12 @@ fn try_replay(
         CanvasPixels::Sixteen(p) => replay.draw(shift, spans, p, canvas_width, threads),
     };
     scratch.replay.remember(patch, options.anti_alias);
-    Some(RasterStats {
+    RasterStats {
         work,
         centre_hits,
         written,
         replayed: true,
-    })
+    }
 }
 
 /// What every band of one draw shares.
@@ -447,91 +485,6 @@ fn work_rect(patch: &Patch, canvas: &Canvas, feather: f32) -> Option<PixelRect> 
     };
     let work = placed.intersect(&canvas_rect(canvas).grow(margin));
     (!work.is_empty() && !placed.intersect(&canvas_rect(canvas)).is_empty()).then_some(work)
-}
-
-/// Large draws hand out their triangle setups in chunks of this many.
-const SETUP_CHUNK: usize = 1024;
-
-/// One piece of the work before the bands.
-enum PrepareJob<'a> {
-    /// A strip of the silhouette.
-    Strip(&'a mut Strip),
-    /// The setups of triangles `first..first + setups.len()`.
-    Setups(usize, &'a mut [TriangleSetup]),
-}
-
-/// Per-triangle setups and the silhouette's strips: the work before the bands. With
-/// `threads` ≥ 2 the pieces (strips first, then chunks of setups) go to whichever thread
-/// asks next, so a helper thread that the scheduler starts late only takes what is left.
-/// The split changes no value: each setup depends on its triangle alone, and the strips
-/// are laid out by [`Silhouette::layout`] whatever the thread count.
-fn prepare(
-    patch: &Patch,
-    work: PixelRect,
-    anti_alias: bool,
-    threads: usize,
-    scratch: &mut RasterScratch,
-) {
-    let snapped = &mut scratch.snapped;
-    snapped.clear();
-    snapped.extend(patch.placed.iter().map(|&p| SnappedVertex::new(p)));
-    let snapped = &scratch.snapped[..];
-    let setups = &mut scratch.setups;
-    setups.resize(patch.triangles.len(), TriangleSetup::default());
-    let strips: &mut [Strip] = if anti_alias {
-        scratch.silhouette.layout(work)
-    } else {
-        &mut []
-    };
-    let input = SilhouetteInput {
-        patch,
-        loop_orientation: rest_loop_orientation(patch),
-    };
-    let run = |job: PrepareJob| match job {
-        PrepareJob::Strip(strip) => strip.fill(input),
-        PrepareJob::Setups(first, setups) => build_setups(patch, snapped, first, setups),
-    };
-    let parallel = threads >= 2 && strips.len() + setups.len() / SETUP_CHUNK >= 2;
-    let jobs = strips.iter_mut().map(PrepareJob::Strip).chain(
-        setups
-            .chunks_mut(SETUP_CHUNK)
-            .enumerate()
-            .map(|(k, chunk)| PrepareJob::Setups(k * SETUP_CHUNK, chunk)),
-    );
-    if !parallel {
-        jobs.for_each(run);
-        return;
-    }
-    let queue = Mutex::new(jobs);
-    let take_jobs = || loop {
-        let job = queue.lock().unwrap_or_else(|e| e.into_inner()).next();
-        let Some(job) = job else { break };
-        run(job);
-    };
-    std::thread::scope(|scope| {
-        scope.spawn(take_jobs);
-        take_jobs();
-    });
-}
-
-/// The setups of triangles `first..first + setups.len()`.
-fn build_setups(
-    patch: &Patch,
-    snapped: &[SnappedVertex],
-    first: usize,
-    setups: &mut [TriangleSetup],
-) {
-    for (setup, tri) in setups.iter_mut().zip(&patch.triangles[first..]) {
-        let [a, b, c] = tri.map(|v| v as usize);
-        let depth = patch.depth.map_or([0.0; 3], |d| [d[a], d[b], d[c]]);
-        *setup = TriangleSetup::from_snapped(
-            [patch.placed[a], patch.placed[b], patch.placed[c]],
-            [snapped[a], snapped[b], snapped[c]],
-            [patch.rest[a], patch.rest[b], patch.rest[c]],
-            [patch.membrane[a], patch.membrane[b], patch.membrane[c]],
-            depth,
-        );
-    }
 }
 
 #[cfg(test)]

@@ -37,6 +37,7 @@ mod error;
 mod feather;
 pub mod overlay;
 mod patch;
+mod prepare;
 mod rect;
 mod replay;
 mod sampler;
@@ -47,7 +48,7 @@ mod shade_simd;
 mod triangles;
 
 pub use covered::{covered_boundary_vertices, CoverageGrid};
-pub use draw::{draw_patch, RasterOptions, RasterStats};
+pub use draw::{draw_patch, draw_patch_solving, RasterOptions, RasterStats};
 pub use error::RasterError;
 pub use patch::Patch;
 pub use rect::PixelRect;

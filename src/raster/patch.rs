@@ -33,9 +33,14 @@ impl Patch<'_> {
 
     /// Checks lengths, indices and finiteness; O(vertices + triangles + loop vertices).
     pub fn validate(&self) -> Result<(), RasterError> {
+        self.validate_geometry()?;
+        self.validate_membrane(self.membrane)
+    }
+
+    /// [`validate`](Self::validate) without the membrane.
+    pub(crate) fn validate_geometry(&self) -> Result<(), RasterError> {
         let n = self.rest.len();
         check_len("placed", n, self.placed.len())?;
-        check_len("membrane", n, self.membrane.len())?;
         if let Some(depth) = self.depth {
             check_len("depth", n, depth.len())?;
             if let Some(index) = depth.iter().position(|d| !d.is_finite()) {
@@ -47,16 +52,6 @@ impl Patch<'_> {
         }
         check_finite_points("rest", self.rest)?;
         check_finite_points("placed", self.placed)?;
-        if let Some(index) = self
-            .membrane
-            .iter()
-            .position(|m| m.iter().any(|v| !v.is_finite()))
-        {
-            return Err(RasterError::NonFinite {
-                what: "membrane",
-                index,
-            });
-        }
         for (triangle, tri) in self.triangles.iter().enumerate() {
             if let Some(&vertex) = tri.iter().find(|&&v| v as usize >= n) {
                 return Err(RasterError::TriangleIndex {
@@ -76,6 +71,21 @@ impl Patch<'_> {
             }
         }
         Ok(())
+    }
+
+    /// Checks that `membrane` fits this patch: one finite RGB offset per vertex.
+    pub(crate) fn validate_membrane(&self, membrane: &[[f32; 3]]) -> Result<(), RasterError> {
+        check_len("membrane", self.rest.len(), membrane.len())?;
+        match membrane
+            .iter()
+            .position(|m| m.iter().any(|v| !v.is_finite()))
+        {
+            Some(index) => Err(RasterError::NonFinite {
+                what: "membrane",
+                index,
+            }),
+            None => Ok(()),
+        }
     }
 }
 

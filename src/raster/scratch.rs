@@ -6,12 +6,14 @@
 use super::bands::{Bands, BAND_PIXELS};
 use super::coverage::Silhouette;
 use super::replay::Replay;
-use super::setup::{MembraneSpan, SnappedVertex, TriangleSetup};
+use super::setup::{LocalFrame, MembraneSpan, SnappedVertex, TriangleSetup};
 
 /// Scratch buffers for [`draw_patch`](super::draw_patch); keep one per patch (or per thread)
 /// and pass it every frame.
 pub struct RasterScratch {
     pub(crate) setups: Vec<TriangleSetup>,
+    /// Per-triangle frames of setups whose membrane maps are added after the solve.
+    pub(crate) frames: Vec<LocalFrame>,
     /// Placed vertices snapped to the fixed-point grid.
     pub(crate) snapped: Vec<SnappedVertex>,
     pub(crate) bands: Bands,
@@ -33,6 +35,7 @@ impl Default for RasterScratch {
     fn default() -> Self {
         RasterScratch {
             setups: Vec::new(),
+            frames: Vec::new(),
             snapped: Vec::new(),
             bands: Bands::default(),
             workers: Vec::new(),

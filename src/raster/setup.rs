@@ -53,7 +53,8 @@ pub(crate) struct MembraneSpan {
 /// A triangle's barycentric gradients and the pixel centre near vertex `a` that the span
 /// maps are based at. Only differences from `a` enter, so a patch moved by whole pixels
 /// gets bit-identical span maps (the replay of [`replay`](super::replay) relies on it).
-struct LocalFrame {
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct LocalFrame {
     g1: DVec2,
     g2: DVec2,
     origin: [i32; 2],
@@ -171,6 +172,21 @@ impl TriangleSetup {
         membrane: [[f32; 3]; 3],
         depth: [f32; 3],
     ) -> TriangleSetup {
+        let (mut setup, frame) = TriangleSetup::geometry(placed, snapped, rest, depth);
+        setup.set_membrane(&frame, membrane);
+        setup
+    }
+
+    /// Everything of [`from_snapped`](Self::from_snapped) but the membrane maps (left zero),
+    /// and the frame that [`set_membrane`](Self::set_membrane) needs to add them later: a
+    /// draw computes the geometry while the membrane is still being solved.
+    #[inline]
+    pub fn geometry(
+        placed: [DVec2; 3],
+        snapped: [SnappedVertex; 3],
+        rest: [DVec2; 3],
+        depth: [f32; 3],
+    ) -> (TriangleSetup, LocalFrame) {
         let [a, b, c] = placed;
         let e1 = b - a;
         let e2 = c - a;
@@ -202,11 +218,15 @@ impl TriangleSetup {
             let gradient = frame.gradient(edge1, edge2);
             [at_a - gradient.dot(a), gradient.x, gradient.y]
         };
-        TriangleSetup {
+        let setup = TriangleSetup {
             span: SpanSetup {
                 texel_x: texel(rest[0].x, r1.x, r2.x),
                 texel_y: texel(rest[0].y, r1.y, r2.y),
-                membrane: MembraneSpan::new(&frame, membrane),
+                // The texel maps share the membrane's origin.
+                membrane: MembraneSpan {
+                    origin: frame.origin,
+                    maps: [Vec4::ZERO; 3],
+                },
             },
             fixed,
             drawable,
@@ -215,7 +235,15 @@ impl TriangleSetup {
                 f64::from(depth[1]) - f64::from(depth[0]),
                 f64::from(depth[2]) - f64::from(depth[0]),
             ),
-        }
+        };
+        (setup, frame)
+    }
+
+    /// Adds the membrane maps to a setup from [`geometry`](Self::geometry), with the frame
+    /// it gave.
+    #[inline]
+    pub fn set_membrane(&mut self, frame: &LocalFrame, membrane: [[f32; 3]; 3]) {
+        self.span.membrane = MembraneSpan::new(frame, membrane);
     }
 
     /// Depth at the centre of pixel (x, y) and its step per pixel along the row: a span
