@@ -787,16 +787,25 @@ fn whole_pixel_moves_replay_the_same_bytes_as_fresh_draws() {
 /// anti-aliasing. On a CPU without SIMD both draws take the scalar path and agree trivially.
 #[test]
 fn simd_and_scalar_shading_give_the_same_bytes() {
-    let source = FloatImage::from_fn(97, 83, PixelFormat::RGBA8, |i, j| {
-        let alpha = if (30..45).contains(&i) { 0.6 } else { 1.0 };
-        [
-            ((i * 37 + j * 11) % 256) as f32 / 255.0,
-            ((i * 5 + j * 73) % 256) as f32 / 255.0,
-            ((i * j + 19) % 256) as f32 / 255.0,
-            alpha,
-        ]
-    })
-    .unwrap();
+    // 8-bit levels (the raster reads its 8-bit texels), and the same levels nudged off the
+    // 8-bit grid (it reads the f32 pixels): both texel kinds of both kernels.
+    for nudge in [0.0, 0.3 / 255.0] {
+        let source = FloatImage::from_fn(97, 83, PixelFormat::RGBA8, |i, j| {
+            let alpha = if (30..45).contains(&i) { 0.6 } else { 1.0 };
+            [
+                ((i * 37 + j * 11) % 256) as f32 / 255.0,
+                ((i * 5 + j * 73) % 256) as f32 / 255.0,
+                ((i * j + 19) % 256) as f32 / 255.0 * (1.0 - nudge) + nudge,
+                alpha,
+            ]
+        })
+        .unwrap();
+        assert_eq!(source.eight_bit_texels().is_some(), nudge == 0.0);
+        simd_matches_scalar(&source);
+    }
+}
+
+fn simd_matches_scalar(source: &FloatImage) {
     // The last grid reaches past the source's right and bottom edges, where the clamped
     // taps are not adjacent texels.
     for (origin, cell, columns, rows) in [
@@ -831,7 +840,7 @@ fn simd_and_scalar_shading_give_the_same_bytes() {
                     membrane: &membrane,
                     depth: with_depth.then_some(&depth[..]),
                     loops: &mesh.loops,
-                    source: &source,
+                    source,
                 };
                 let draw = |simd: bool| {
                     let mut canvas = opaque_canvas(170, 150, 0.3);

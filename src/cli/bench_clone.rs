@@ -156,13 +156,16 @@ const RGB8: PixelFormat = PixelFormat {
     depth: Depth::Eight,
 };
 
+/// A smooth 8-bit test picture: its values are levels k / 255, as if loaded from an 8-bit
+/// file (so the raster samples its 8-bit texels, like a photo's).
 fn synthetic(width: u32, height: u32, phase: f32) -> anyhow::Result<FloatImage> {
+    let level = |v: f32| (v * 255.0).round() / 255.0;
     Ok(FloatImage::from_fn(width, height, RGB8, |i, j| {
         let (x, y) = (i as f32 * 0.05 + phase, j as f32 * 0.07);
         [
-            0.5 + 0.4 * x.sin() * y.cos(),
-            0.5 + 0.3 * (x + y).sin(),
-            0.4 + 0.3 * (x * 0.5 - y).cos(),
+            level(0.5 + 0.4 * x.sin() * y.cos()),
+            level(0.5 + 0.3 * (x + y).sin()),
+            level(0.4 + 0.3 * (x * 0.5 - y).cos()),
             1.0,
         ]
     })?)

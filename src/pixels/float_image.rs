@@ -3,6 +3,7 @@
 //! [`PixelFormat`] it was stored in. Grey images are expanded to R = G = B.
 
 use std::path::Path;
+use std::sync::OnceLock;
 
 use super::{sample_bilinear_rgba, ColorKind, Depth, PixelError, PixelFormat};
 
@@ -10,12 +11,24 @@ use super::{sample_bilinear_rgba, ColorKind, Depth, PixelError, PixelFormat};
 pub(crate) const LUMA_709: [f32; 3] = [0.2126, 0.7152, 0.0722];
 
 /// A straight-alpha RGBA float image.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug)]
 pub struct FloatImage {
     width: u32,
     height: u32,
     pixels: Vec<[f32; 4]>,
     format: PixelFormat,
+    /// The pixels as 8-bit texels, when they are exactly that (see
+    /// [`eight_bit_texels`](Self::eight_bit_texels)); built with the image, dropped by
+    /// [`pixels_mut`](Self::pixels_mut) and rebuilt on the next use.
+    eight_bit: OnceLock<Option<Box<[[u8; 4]]>>>,
+}
+
+impl PartialEq for FloatImage {
+    fn eq(&self, other: &Self) -> bool {
+        // The 8-bit view is a function of the rest.
+        (self.width, self.height, self.format) == (other.width, other.height, other.format)
+            && self.pixels == other.pixels
+    }
 }
 
 impl FloatImage {
@@ -36,12 +49,26 @@ impl FloatImage {
                 actual: pixels.len(),
             });
         }
-        Ok(FloatImage {
+        Ok(FloatImage::with_eight_bit_view(width, height, pixels, format))
+    }
+
+    /// The image with its 8-bit view built now, while it is being made (loading), rather
+    /// than in the first draw that samples it.
+    fn with_eight_bit_view(
+        width: u32,
+        height: u32,
+        pixels: Vec<[f32; 4]>,
+        format: PixelFormat,
+    ) -> FloatImage {
+        let image = FloatImage {
             width,
             height,
             pixels,
             format,
-        })
+            eight_bit: OnceLock::new(),
+        };
+        image.eight_bit_texels();
+        image
     }
 
     /// An image whose pixel (i, j) is `colour(i, j)`.
@@ -132,8 +159,39 @@ impl FloatImage {
         &self.pixels
     }
 
+    /// The pixels, for writing (the 8-bit view is rebuilt on its next use).
     pub fn pixels_mut(&mut self) -> &mut [[f32; 4]] {
+        self.eight_bit = OnceLock::new();
         &mut self.pixels
+    }
+
+    /// The pixels as 8-bit texels `k` (channel value = k / 255), when the image is 8-bit and
+    /// every channel value is exactly some `k as f32 / 255.0` — as loaded from an 8-bit file.
+    /// The raster samples these (a quarter of the memory traffic of `f32` texels). Built when
+    /// the image is made, and again on the first call after [`pixels_mut`](Self::pixels_mut)
+    /// (O(pixels) each time).
+    pub fn eight_bit_texels(&self) -> Option<&[[u8; 4]]> {
+        self.eight_bit
+            .get_or_init(|| self.quantised_exactly())
+            .as_deref()
+    }
+
+    fn quantised_exactly(&self) -> Option<Box<[[u8; 4]]>> {
+        if self.format.depth != Depth::Eight {
+            return None;
+        }
+        let exact = |v: f32| {
+            // Out of [0, 1] and NaN give a k whose quotient differs from v.
+            let k = (v * 255.0).round().clamp(0.0, 255.0) as u8;
+            (f32::from(k) / 255.0 == v).then_some(k)
+        };
+        self.pixels
+            .iter()
+            .map(|p| {
+                let [r, g, b, a] = p.map(exact);
+                Some([r?, g?, b?, a?])
+            })
+            .collect()
     }
 
     /// Pixel (i, j); `None` outside the image.
@@ -159,15 +217,11 @@ impl FloatImage {
                 [luma, luma, luma, a]
             })
             .collect();
-        FloatImage {
-            width: self.width,
-            height: self.height,
-            pixels,
-            format: PixelFormat {
-                color: ColorKind::Grey,
-                ..self.format
-            },
-        }
+        let format = PixelFormat {
+            color: ColorKind::Grey,
+            ..self.format
+        };
+        FloatImage::with_eight_bit_view(self.width, self.height, pixels, format)
     }
 }
 
@@ -190,6 +244,46 @@ mod tests {
         assert_eq!(grey.pixels()[0][3], 0.5);
         assert!((grey.pixels()[1][1] - 0.2126).abs() < 1e-6);
         assert_eq!(grey.format().color, ColorKind::Grey);
+    }
+
+    #[test]
+    fn eight_bit_texels_exist_exactly_when_every_value_is_k_over_255() {
+        let image = |format, value: f32| {
+            FloatImage::from_fn(3, 2, format, |i, j| {
+                let k = (i * 97 + j * 51) as f32;
+                [
+                    k / 255.0,
+                    1.0,
+                    0.0,
+                    if (i, j) == (2, 1) { value } else { 1.0 },
+                ]
+            })
+            .unwrap()
+        };
+        let exact = image(PixelFormat::RGBA8, 77.0 / 255.0);
+        let texels = exact.eight_bit_texels().expect("8-bit values");
+        assert_eq!(texels[4], [(97 + 51) as u8, 255, 0, 255]);
+        assert_eq!(texels[5][3], 77);
+        for value in [0.3, 77.5 / 255.0, -0.0 + 1e-9, 1.5, f32::NAN] {
+            assert!(
+                image(PixelFormat::RGBA8, value)
+                    .eight_bit_texels()
+                    .is_none(),
+                "{value}"
+            );
+        }
+        let sixteen = PixelFormat {
+            depth: Depth::Sixteen,
+            ..PixelFormat::RGBA8
+        };
+        assert!(image(sixteen, 77.0 / 255.0).eight_bit_texels().is_none());
+        // Writing drops the view; the next call sees the new values.
+        let mut written = exact.clone();
+        assert!(written.eight_bit_texels().is_some());
+        written.pixels_mut()[0][0] = 0.5;
+        assert!(written.eight_bit_texels().is_none());
+        written.pixels_mut()[0][0] = 128.0 / 255.0;
+        assert_eq!(written.eight_bit_texels().unwrap()[0][0], 128);
     }
 
     #[test]

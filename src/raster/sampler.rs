@@ -4,14 +4,59 @@
 //! (proven in-range) taps; it differs from [`FloatImage::sample_bilinear`] only by the f32
 //! rounding of the position (tested to 1e-5 per channel). The f64 path, kept for tests, is
 //! bit-identical to it.
+//!
+//! Texels come in two kinds ([`SourceTexel`]): the image's `f32` pixels, or — for an 8-bit
+//! source, the usual case — its [`eight_bit_texels`](FloatImage::eight_bit_texels), a quarter
+//! of the bytes, which is what the shading loop waits on. An 8-bit sample blends the integer
+//! levels `k` and divides by 255 once at the end: at texel centres that is exactly the image's
+//! `k / 255`, elsewhere it differs from the `f32` blend by an ulp or so (tested). The SIMD
+//! kernel does the same operations, so both paths still give the same bytes.
 
 use glam::Vec4;
 
 use crate::pixels::FloatImage;
 
+/// A texel type the sampler reads.
+pub(crate) trait SourceTexel: Copy {
+    /// Whether the texels are 8-bit levels (else `f32` values).
+    const EIGHT_BIT: bool;
+    /// The texel's channels in the blend's units.
+    fn blend_units(self) -> Vec4;
+    /// A blend of texels in channel values.
+    fn finish(blend: Vec4) -> Vec4;
+}
+
+impl SourceTexel for [f32; 4] {
+    const EIGHT_BIT: bool = false;
+
+    #[inline(always)]
+    fn blend_units(self) -> Vec4 {
+        Vec4::from_array(self)
+    }
+
+    #[inline(always)]
+    fn finish(blend: Vec4) -> Vec4 {
+        blend
+    }
+}
+
+impl SourceTexel for [u8; 4] {
+    const EIGHT_BIT: bool = true;
+
+    #[inline(always)]
+    fn blend_units(self) -> Vec4 {
+        Vec4::from_array(self.map(f32::from))
+    }
+
+    #[inline(always)]
+    fn finish(blend: Vec4) -> Vec4 {
+        blend / 255.0
+    }
+}
+
 /// A borrowed view of the source, set up once per draw.
-pub(crate) struct Sampler<'a> {
-    pub(super) pixels: &'a [[f32; 4]],
+pub(crate) struct Sampler<'a, S = [f32; 4]> {
+    pub(super) pixels: &'a [S],
     pub(super) width: usize,
     pub(super) last_x: usize,
     pub(super) last_y: usize,
@@ -21,14 +66,7 @@ pub(crate) struct Sampler<'a> {
 
 impl<'a> Sampler<'a> {
     pub fn new(source: &'a FloatImage) -> Sampler<'a> {
-        Sampler {
-            pixels: source.pixels(),
-            width: source.width() as usize,
-            last_x: source.width().saturating_sub(1) as usize,
-            last_y: source.height().saturating_sub(1) as usize,
-            last_x_f32: last_as_f32(source.width()),
-            last_y_f32: last_as_f32(source.height()),
-        }
+        Sampler::with_texels(source, source.pixels())
     }
 
     /// The f64 reference path (tests: bit-identical to the image sampler).
@@ -43,6 +81,21 @@ impl<'a> Sampler<'a> {
         let top = texel(row0 + x0).lerp(texel(row0 + x1), tx);
         let bottom = texel(row1 + x0).lerp(texel(row1 + x1), tx);
         top.lerp(bottom, ty)
+    }
+}
+
+impl<'a, S: SourceTexel> Sampler<'a, S> {
+    /// A sampler of `source` reading `texels` (its pixels in one of the texel kinds).
+    pub fn with_texels(source: &FloatImage, texels: &'a [S]) -> Sampler<'a, S> {
+        assert_eq!(texels.len(), source.pixels().len(), "one texel per pixel");
+        Sampler {
+            pixels: texels,
+            width: source.width() as usize,
+            last_x: source.width().saturating_sub(1) as usize,
+            last_y: source.height().saturating_sub(1) as usize,
+            last_x_f32: last_as_f32(source.width()),
+            last_y_f32: last_as_f32(source.height()),
+        }
     }
 
     /// [`sample`](Self::sample) with `f32` coordinates and tap arithmetic (the shading hot
@@ -62,13 +115,13 @@ impl<'a> Sampler<'a> {
         let (row0, row1) = (y0 * self.width, y1 * self.width);
         // SAFETY: the taps are ≤ last_x < width and ≤ last_y < height (see `taps_f32`), and
         // `pixels` holds width · height ≥ 1 texels (a FloatImage is never empty).
-        let texel = |i: usize| Vec4::from_array(unsafe { *self.pixels.get_unchecked(i) });
+        let texel = |i: usize| unsafe { *self.pixels.get_unchecked(i) }.blend_units();
         // a + (b − a)·t: one multiply fewer than glam's `lerp` (a·(1 − t) + b·t); differs
         // from the f64 reference only in the last bits.
         let lerp = |a: Vec4, b: Vec4, t: f32| a + (b - a) * t;
         let top = lerp(texel(row0 + x0), texel(row0 + x1), tx);
         let bottom = lerp(texel(row1 + x0), texel(row1 + x1), tx);
-        lerp(top, bottom, ty)
+        S::finish(lerp(top, bottom, ty))
     }
 }
 
@@ -177,6 +230,32 @@ mod tests {
                         (s - r).abs() <= 1e-5,
                         "{x} {y}: {single:?} vs {reference:?}"
                     );
+                }
+            }
+        }
+    }
+
+    /// 8-bit texels give the f32 texels' samples: exactly at texel centres, to a few ulps
+    /// elsewhere (the blend runs on levels and divides once).
+    #[test]
+    fn eight_bit_texels_sample_like_the_f32_pixels() {
+        let image = FloatImage::from_fn(9, 6, PixelFormat::RGBA8, |i, j| {
+            let k = |m: u32| ((i * m + j * 59 + m) % 256) as f32 / 255.0;
+            [k(37), k(101), k(7), k(211)]
+        })
+        .unwrap();
+        let texels = image.eight_bit_texels().expect("levels k / 255");
+        let (levels, floats) = (Sampler::with_texels(&image, texels), Sampler::new(&image));
+        for j in -2..9 {
+            for i in -2..12 {
+                let (x, y) = (i as f32, j as f32);
+                let (a, b) = (levels.sample_texel_space(x, y), floats.sample_texel_space(x, y));
+                assert_eq!(a.to_array().map(f32::to_bits), b.to_array().map(f32::to_bits));
+                for (dx, dy) in [(0.25, 0.5), (0.5, 0.125), (0.9, 0.37), (0.013, 0.77)] {
+                    let a = levels.sample_texel_space(x + dx, y + dy);
+                    let b = floats.sample_texel_space(x + dx, y + dy);
+                    let error = (a - b).abs().max_element();
+                    assert!(error <= 4.0 * f32::EPSILON, "{x}+{dx} {y}+{dy}: {a} vs {b}");
                 }
             }
         }

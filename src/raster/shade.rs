@@ -9,7 +9,7 @@
 
 use glam::Vec4;
 
-use super::sampler::Sampler;
+use super::sampler::{Sampler, SourceTexel};
 use super::setup::TriangleSetup;
 #[cfg(target_arch = "x86_64")]
 use super::shade_simd::shade_run_rgba8;
@@ -150,9 +150,32 @@ unsafe fn shade_rows_avx2<T: StoreTexel, C: CoverageTexel, R: Recorder<C>>(
     shade_rows(input, rows, canvas, canvas_width, recorder)
 }
 
+/// The row walk with the source's cheapest texels: its 8-bit view when it has one.
 #[inline(always)]
 fn shade_rows<T: StoreTexel, C: CoverageTexel, R: Recorder<C>>(
     input: &ShadeInput<C>,
+    rows: PixelRect,
+    canvas: &mut [[T; 4]],
+    canvas_width: usize,
+    recorder: &mut R,
+) -> (usize, usize) {
+    let source = input.source;
+    match source.eight_bit_texels() {
+        Some(texels) => {
+            let sampler = Sampler::with_texels(source, texels);
+            walk_rows(input, &sampler, rows, canvas, canvas_width, recorder)
+        }
+        None => {
+            let sampler = Sampler::new(source);
+            walk_rows(input, &sampler, rows, canvas, canvas_width, recorder)
+        }
+    }
+}
+
+#[inline(always)]
+fn walk_rows<S: SourceTexel, T: StoreTexel, C: CoverageTexel, R: Recorder<C>>(
+    input: &ShadeInput<C>,
+    sampler: &Sampler<S>,
     rows: PixelRect,
     canvas: &mut [[T; 4]],
     canvas_width: usize,
@@ -168,7 +191,6 @@ fn shade_rows<T: StoreTexel, C: CoverageTexel, R: Recorder<C>>(
         (rows.x0 - input.coverage_origin.0) as usize,
         (rows.x1 - input.coverage_origin.0) as usize,
     );
-    let sampler = Sampler::new(input.source);
     // A recording draw stays scalar: replays must agree with it byte for byte, and the
     // scalar path is the one that reports every sample.
     // The SIMD kernel indexes texels with i32 lanes: sources beyond 2³¹ texels (far above
@@ -200,13 +222,13 @@ fn shade_rows<T: StoreTexel, C: CoverageTexel, R: Recorder<C>>(
             recorder.run(x0, y, end - start, id);
             let pixels = &mut row[start..end];
             written += if id == NO_TRIANGLE {
-                shade_fringe(input, &sampler, &span, pixels, recorder)
+                shade_fringe(input, sampler, &span, pixels, recorder)
             } else {
                 hits += end - start;
                 let setup = &input.setups[id as usize];
-                match simd_run(kernel, setup, &sampler, &span, pixels) {
+                match simd_run(kernel, setup, sampler, &span, pixels) {
                     Some(written) => written,
-                    None => shade_span(setup, &sampler, &span, pixels, recorder),
+                    None => shade_span(setup, sampler, &span, pixels, recorder),
                 }
             };
             start = end;
@@ -247,9 +269,9 @@ struct Span<'a, C> {
 /// ([`shade_simd`](super::shade_simd)) use, so every path gives the same bytes.
 /// Interior pixels (full coverage, opaque source) skip the blend.
 #[inline(always)]
-fn shade_span<T: StoreTexel, C: CoverageTexel, R: Recorder<C>>(
+fn shade_span<S: SourceTexel, T: StoreTexel, C: CoverageTexel, R: Recorder<C>>(
     setup: &TriangleSetup,
-    sampler: &Sampler,
+    sampler: &Sampler<S>,
     span: &Span<C>,
     pixels: &mut [[T; 4]],
     recorder: &mut R,
@@ -278,10 +300,10 @@ const SIMD_MIN_RUN: usize = 3;
 /// The run shaded by the SIMD kernel when there is one for this CPU and these texel types
 /// (8-bit canvas and coverage); `None`: the caller shades it the scalar way.
 #[inline(always)]
-fn simd_run<T: StoreTexel, C: CoverageTexel>(
+fn simd_run<S: SourceTexel, T: StoreTexel, C: CoverageTexel>(
     kernel: Kernel,
     setup: &TriangleSetup,
-    sampler: &Sampler,
+    sampler: &Sampler<S>,
     span: &Span<C>,
     pixels: &mut [[T; 4]],
 ) -> Option<usize> {
@@ -324,9 +346,9 @@ pub(crate) fn shade_pixel<T: StoreTexel, C: CoverageTexel>(
 
 /// Shades a run of pixels whose centres miss every triangle (the anti-aliased fringe): each
 /// extrapolates the maps of its owning triangle (see [`owning_triangle`]).
-fn shade_fringe<T: StoreTexel, C: CoverageTexel, R: Recorder<C>>(
+fn shade_fringe<S: SourceTexel, T: StoreTexel, C: CoverageTexel, R: Recorder<C>>(
     input: &ShadeInput<C>,
-    sampler: &Sampler,
+    sampler: &Sampler<S>,
     span: &Span<C>,
     pixels: &mut [[T; 4]],
     recorder: &mut R,

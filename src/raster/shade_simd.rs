@@ -21,7 +21,7 @@
 //! are 2–3 px, where the SIMD kernel measured slower than the scalar loop).
 
 #[cfg(target_arch = "x86_64")]
-use super::sampler::Sampler;
+use super::sampler::{Sampler, SourceTexel};
 #[cfg(target_arch = "x86_64")]
 use super::setup::SpanSetup;
 
@@ -49,10 +49,10 @@ impl Kernel {
 /// the source at most `i32::MAX` texels.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
-pub(crate) fn shade_run_rgba8(
+pub(crate) fn shade_run_rgba8<S: SourceTexel>(
     kernel: Kernel,
     setup: &SpanSetup,
-    sampler: &Sampler,
+    sampler: &Sampler<S>,
     (x0, y): (i32, i32),
     coverage: &[u8],
     pixels: &mut [[u8; 4]],
@@ -76,7 +76,7 @@ mod avx2 {
 
     use glam::Vec4;
 
-    use super::super::sampler::Sampler;
+    use super::super::sampler::{Sampler, SourceTexel};
     use super::super::setup::SpanSetup;
     use super::super::shade::shade_pixel;
 
@@ -120,7 +120,7 @@ mod avx2 {
 
     #[inline]
     #[target_feature(enable = "avx2")]
-    fn taps_of_eight(sampler: &Sampler, maps: &RunMaps, dx: __m256) -> Taps {
+    fn taps_of_eight<S: SourceTexel>(sampler: &Sampler<S>, maps: &RunMaps, dx: __m256) -> Taps {
         let u = affine(maps.texel_x, dx, maps.texel_y_terms[0]);
         let v = affine(maps.texel_y, dx, maps.texel_y_terms[1]);
         // The caller keeps sources with more than i32::MAX texels on the scalar path, so
@@ -162,29 +162,62 @@ mod avx2 {
         _mm256_permutevar8x32_ps(v, spread)
     }
 
-    /// Texels of tap `tap` of pixels k and k + 1.
+    /// Texels of tap `tap` of pixels k and k + 1, in blend units (the scalar
+    /// `blend_units`).
     ///
     /// # Safety
     /// The indices are taps of `sampler` (clamped into the image).
     #[inline]
     #[target_feature(enable = "avx2")]
-    unsafe fn texel_pair(sampler: &Sampler, taps: &Taps, tap: usize, k: usize) -> __m256 {
-        let base = sampler.pixels.as_ptr() as *const f32;
+    unsafe fn texel_pair<S: SourceTexel>(
+        sampler: &Sampler<S>,
+        taps: &Taps,
+        tap: usize,
+        k: usize,
+    ) -> __m256 {
         let (a, b) = (taps.index[tap][k] as usize, taps.index[tap][k + 1] as usize);
-        // SAFETY: the caller's contract; a texel is four f32.
-        unsafe { _mm256_set_m128(_mm_loadu_ps(base.add(b * 4)), _mm_loadu_ps(base.add(a * 4))) }
+        if S::EIGHT_BIT {
+            let base = sampler.pixels.as_ptr() as *const u8;
+            // SAFETY: the caller's contract; a texel is four bytes.
+            let (left, right) = unsafe {
+                (
+                    (base.add(a * 4) as *const i32).read_unaligned(),
+                    (base.add(b * 4) as *const i32).read_unaligned(),
+                )
+            };
+            let bytes = _mm_unpacklo_epi32(_mm_cvtsi32_si128(left), _mm_cvtsi32_si128(right));
+            _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(bytes))
+        } else {
+            let base = sampler.pixels.as_ptr() as *const f32;
+            // SAFETY: the caller's contract; a texel is four f32.
+            unsafe { _mm256_set_m128(_mm_loadu_ps(base.add(b * 4)), _mm_loadu_ps(base.add(a * 4))) }
+        }
     }
 
-    /// Texels of taps `tap` and `tap + 1` (left and right) of pixel k, in one load.
+    /// Texels of taps `tap` and `tap + 1` (left and right) of pixel k, in one load, in
+    /// blend units.
     ///
     /// # Safety
     /// As [`texel_pair`], and the right tap is the texel after the left one.
     #[inline]
     #[target_feature(enable = "avx2")]
-    unsafe fn adjacent_texels(sampler: &Sampler, taps: &Taps, tap: usize, k: usize) -> __m256 {
-        let base = sampler.pixels.as_ptr() as *const f32;
-        // SAFETY: the caller's contract; two texels are eight f32.
-        unsafe { _mm256_loadu_ps(base.add(taps.index[tap][k] as usize * 4)) }
+    unsafe fn adjacent_texels<S: SourceTexel>(
+        sampler: &Sampler<S>,
+        taps: &Taps,
+        tap: usize,
+        k: usize,
+    ) -> __m256 {
+        let at = taps.index[tap][k] as usize;
+        if S::EIGHT_BIT {
+            let base = sampler.pixels.as_ptr() as *const u8;
+            // SAFETY: the caller's contract; two texels are eight bytes.
+            let bytes = unsafe { _mm_loadl_epi64(base.add(at * 4) as *const __m128i) };
+            _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(bytes))
+        } else {
+            let base = sampler.pixels.as_ptr() as *const f32;
+            // SAFETY: the caller's contract; two texels are eight f32.
+            unsafe { _mm256_loadu_ps(base.add(at * 4)) }
+        }
     }
 
     #[inline]
@@ -199,7 +232,10 @@ mod avx2 {
     /// As [`texel_pair`].
     #[inline]
     #[target_feature(enable = "avx2")]
-    unsafe fn sample_pair<const K: i32>(sampler: &Sampler, taps: &Taps) -> __m256 {
+    unsafe fn sample_pair<S: SourceTexel, const K: i32>(
+        sampler: &Sampler<S>,
+        taps: &Taps,
+    ) -> __m256 {
         let k = K as usize;
         let (tx, ty) = (pair_of::<K>(taps.fraction_x), pair_of::<K>(taps.fraction_y));
         // SAFETY (all loads): the caller's contract; `adjacent` vouches for the right taps.
@@ -230,7 +266,13 @@ mod avx2 {
                 )
             }
         };
-        lerp(lerp(t00, t01, tx), lerp(t10, t11, tx), ty)
+        let blend = lerp(lerp(t00, t01, tx), lerp(t10, t11, tx), ty);
+        // The scalar `finish`.
+        if S::EIGHT_BIT {
+            _mm256_div_ps(blend, _mm256_set1_ps(255.0))
+        } else {
+            blend
+        }
     }
 
     /// Stores two clamped colours as 8-bit texels (the scalar `store_unit`, twice).
@@ -318,8 +360,8 @@ mod avx2 {
     /// `block.taps` are taps of `sampler`; `K < block.len` = `coverage.len()` = `pixels.len()`.
     #[inline]
     #[target_feature(enable = "avx2")]
-    unsafe fn shade_pair<const K: i32>(
-        sampler: &Sampler,
+    unsafe fn shade_pair<S: SourceTexel, const K: i32>(
+        sampler: &Sampler<S>,
         maps: &RunMaps,
         block: &Block,
         coverage: &[u8],
@@ -327,7 +369,7 @@ mod avx2 {
     ) -> usize {
         let at = K as usize;
         // SAFETY: the caller's contract.
-        let sample = unsafe { sample_pair::<K>(sampler, &block.taps) };
+        let sample = unsafe { sample_pair::<S, K>(sampler, &block.taps) };
         let [m_origin, m_x, m_y_term] = maps.membrane;
         let scaled_dx = _mm256_mul_ps(m_x, pair_of::<K>(block.dx));
         let membrane = _mm256_add_ps(_mm256_add_ps(m_origin, scaled_dx), m_y_term);
@@ -381,9 +423,9 @@ mod avx2 {
     /// The CPU must have AVX2; `coverage` and `pixels` have the same length.
     #[inline]
     #[target_feature(enable = "avx2")]
-    pub(super) unsafe fn shade_run(
+    pub(super) unsafe fn shade_run<S: SourceTexel>(
         setup: &SpanSetup,
-        sampler: &Sampler,
+        sampler: &Sampler<S>,
         (x0, y): (i32, i32),
         coverage: &[u8],
         pixels: &mut [[u8; 4]],
@@ -411,15 +453,15 @@ mod avx2 {
             );
             // SAFETY (each pair): taps are clamped into the image, lanes past the run included.
             unsafe {
-                written += shade_pair::<0>(sampler, &maps, &block, coverage, pixels);
+                written += shade_pair::<S, 0>(sampler, &maps, &block, coverage, pixels);
                 if block.len > 2 {
-                    written += shade_pair::<2>(sampler, &maps, &block, coverage, pixels);
+                    written += shade_pair::<S, 2>(sampler, &maps, &block, coverage, pixels);
                 }
                 if block.len > 4 {
-                    written += shade_pair::<4>(sampler, &maps, &block, coverage, pixels);
+                    written += shade_pair::<S, 4>(sampler, &maps, &block, coverage, pixels);
                 }
                 if block.len > 6 {
-                    written += shade_pair::<6>(sampler, &maps, &block, coverage, pixels);
+                    written += shade_pair::<S, 6>(sampler, &maps, &block, coverage, pixels);
                 }
             }
             k0 += 8;
