@@ -1,8 +1,39 @@
 //! Small helpers shared by every stage: atomic file output (write to a temporary file in the
-//! destination folder, then rename, so a failure never leaves a partial file).
+//! destination folder, then rename, so a failure never leaves a partial file), and the two
+//! pieces of thread hand-off the raster and the caches use.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::{Mutex, MutexGuard};
+
+/// Locks `mutex`, also when a panicking thread poisoned it: every user here keeps its data
+/// whole under the lock (a queue position, a finished entry, a hand-off state).
+pub(crate) fn lock<T>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {
+    mutex
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner())
+}
+
+/// Waiting for another thread's result that comes within about a solve (tens to hundreds of
+/// µs): spin first (a futex wake-up costs that much again on these machines), then yield the
+/// core between looks.
+#[derive(Default)]
+pub(crate) struct SpinWait {
+    spins: u32,
+}
+
+impl SpinWait {
+    const SPINS_BEFORE_YIELD: u32 = 256;
+
+    pub fn pause(&mut self) {
+        if self.spins < Self::SPINS_BEFORE_YIELD {
+            self.spins += 1;
+            std::hint::spin_loop();
+        } else {
+            std::thread::yield_now();
+        }
+    }
+}
 
 /// Writes `bytes` to `path` through a temporary sibling file and a rename.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {

@@ -694,6 +694,66 @@ fn a_failed_or_wrong_solve_leaves_the_canvas_as_it_was() {
 }
 
 #[test]
+fn a_replay_whose_solve_fails_leaves_the_canvas_and_the_record_usable() {
+    let grid = WavyGrid::new();
+    // Inside the canvas (a clipped draw is not recorded), then moved by whole pixels.
+    let shifted =
+        |from: &[DVec2], by: DVec2| -> Vec<DVec2> { from.iter().map(|p| *p + by).collect() };
+    let first = shifted(&grid.placed, DVec2::new(120.0, 40.0));
+    let moved = shifted(&first, DVec2::new(3.0, 2.0));
+    let first_patch = Patch {
+        placed: &first,
+        ..grid.patch(false)
+    };
+    let moved_patch = Patch {
+        placed: &moved,
+        ..grid.patch(false)
+    };
+    for threads in [1, 2] {
+        let options = RasterOptions {
+            threads,
+            replay: true,
+            ..RasterOptions::default()
+        };
+        let mut scratch = RasterScratch::new();
+        let mut canvas = opaque_canvas(640, 600, 0.3);
+        let recorded = draw_patch(&mut canvas, &first_patch, &options, &mut scratch).unwrap();
+        assert!(recorded.written > 8 * 1024, "{recorded:?}");
+        let before = canvas.clone();
+        let failed = draw_patch_solving(&mut canvas, &moved_patch, &options, &mut scratch, |_| {
+            Err(RasterError::Feather(-1.0))
+        });
+        assert!(failed.is_err());
+        let panicked = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            let _ = draw_patch_solving(&mut canvas, &moved_patch, &options, &mut scratch, |_| {
+                panic!("solver bug");
+                #[allow(unreachable_code)]
+                Ok::<_, RasterError>(&grid.membrane[..])
+            });
+        }));
+        assert!(panicked.is_err());
+        assert!(canvas == before, "{threads} threads: the canvas changed");
+        // The record survived: the move still replays, byte for byte a fresh draw.
+        let mut replayed = opaque_canvas(640, 600, 0.3);
+        let stats = draw_patch(&mut replayed, &moved_patch, &options, &mut scratch).unwrap();
+        assert!(stats.replayed, "{threads} threads");
+        let mut fresh = opaque_canvas(640, 600, 0.3);
+        let fresh_options = RasterOptions {
+            replay: false,
+            ..options
+        };
+        draw_patch(
+            &mut fresh,
+            &moved_patch,
+            &fresh_options,
+            &mut RasterScratch::new(),
+        )
+        .unwrap();
+        assert!(replayed == fresh, "{threads} threads: the replay differs");
+    }
+}
+
+#[test]
 fn whole_pixel_moves_replay_the_same_bytes_as_fresh_draws() {
     let source = raster_meshes::pattern_image(120, 100);
     let mesh = raster_meshes::grid(DVec2::new(3.0, 4.0), 5.5, 18, 15);

@@ -49,7 +49,9 @@ impl FloatImage {
                 actual: pixels.len(),
             });
         }
-        Ok(FloatImage::with_eight_bit_view(width, height, pixels, format))
+        Ok(FloatImage::with_eight_bit_view(
+            width, height, pixels, format,
+        ))
     }
 
     /// The image with its 8-bit view built now, while it is being made (loading), rather
@@ -181,8 +183,9 @@ impl FloatImage {
             return None;
         }
         let exact = |v: f32| {
-            // Out of [0, 1] and NaN give a k whose quotient differs from v.
-            let k = (v * 255.0).round().clamp(0.0, 255.0) as u8;
+            // The cast saturates (NaN → 0), and out of [0, 1] the quotient differs from v;
+            // no libm `round` call per channel.
+            let k = (v * 255.0 + 0.5) as u8;
             (f32::from(k) / 255.0 == v).then_some(k)
         };
         self.pixels

@@ -10,15 +10,17 @@ use super::bands::{Bands, APRON};
 use super::coverage::Silhouette;
 use super::feather::apply_feather;
 use super::prepare::prepare;
+use super::replay::SpanGeometry;
 use super::scratch::BandScratch;
-use super::setup::{MembraneSpan, TriangleSetup, MAX_COORDINATE};
+use super::setup::{TriangleSetup, MAX_COORDINATE};
 use super::shade::{
     shade_and_composite, CoverageTexel, NoRecorder, Recorder, ShadeInput, StoreTexel,
 };
 use super::shade_simd::Kernel;
 use super::triangles::{rasterise_triangles, NO_TRIANGLE};
 use super::{Patch, PixelRect, RasterError, RasterScratch};
-use crate::pixels::{Canvas, CanvasPixels};
+use crate::pixels::{Canvas, CanvasPixels, Depth};
+use crate::util::lock;
 
 /// How to draw a patch.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -100,10 +102,7 @@ pub fn draw_patch_solving<'m, E: From<RasterError>>(
         return Ok(RasterStats::default());
     };
     if let Some(shift) = replay_shift(canvas, patch, options, work, scratch) {
-        let membrane = solve(canvas)?;
-        patch.validate_membrane(membrane)?;
-        let patch = Patch { membrane, ..*patch };
-        return Ok(replay(canvas, &patch, options, work, shift, scratch));
+        return replay(canvas, patch, options, work, shift, scratch, solve);
     }
     let canvas_bounds = canvas_rect(canvas);
     let target = work.intersect(&canvas_bounds);
@@ -186,37 +185,64 @@ fn replay_shift(
         .shift_for(patch, options.anti_alias, canvas_rect(canvas), work)
 }
 
-/// Replays the scratch's record shifted by `shift` with `patch`'s membrane.
-fn replay(
+/// Replays the scratch's record shifted by `shift` with the membrane `solve` gives (see
+/// [`Replay::draw_solving`](super::replay::Replay::draw_solving)).
+fn replay<'m, E: From<RasterError>>(
     canvas: &mut Canvas,
     patch: &Patch,
     options: &RasterOptions,
     work: PixelRect,
     shift: (i32, i32),
     scratch: &mut RasterScratch,
-) -> RasterStats {
-    let spans = &mut scratch.membrane_spans;
-    spans.clear();
-    spans.extend(patch.triangles.iter().map(|tri| {
-        let [a, b, c] = tri.map(|v| v as usize);
-        MembraneSpan::of_triangle(
-            [patch.placed[a], patch.placed[b], patch.placed[c]],
-            [patch.membrane[a], patch.membrane[b], patch.membrane[c]],
-        )
-    }));
-    let canvas_width = canvas.width() as usize;
-    let replay = &scratch.replay;
-    let threads = worker_threads(options.threads, work.area(), 2);
-    let (centre_hits, written) = match canvas.pixels_mut() {
-        CanvasPixels::Eight(p) => replay.draw(shift, spans, p, canvas_width, threads),
-        CanvasPixels::Sixteen(p) => replay.draw(shift, spans, p, canvas_width, threads),
+    solve: impl FnOnce(&Canvas) -> Result<&'m [[f32; 3]], E>,
+) -> Result<RasterStats, E> {
+    let solve = |canvas: &Canvas| -> Result<&'m [[f32; 3]], E> {
+        let membrane = solve(canvas)?;
+        patch.validate_membrane(membrane)?;
+        Ok(membrane)
     };
+    let geometry = SpanGeometry {
+        placed: patch.placed,
+        triangles: patch.triangles,
+    };
+    let threads = worker_threads(options.threads, work.area(), 2);
+    let (replay, workers) = (&scratch.replay, &mut scratch.replay_spans);
+    let (centre_hits, written) = match canvas.depth() {
+        Depth::Eight => {
+            replay.draw_solving(shift, geometry, threads, workers, canvas, eight_bit, solve)
+        }
+        Depth::Sixteen => replay.draw_solving(
+            shift,
+            geometry,
+            threads,
+            workers,
+            canvas,
+            sixteen_bit,
+            solve,
+        ),
+    }?;
     scratch.replay.remember(patch, options.anti_alias);
-    RasterStats {
+    Ok(RasterStats {
         work,
         centre_hits,
         written,
         replayed: true,
+    })
+}
+
+fn eight_bit(canvas: &mut Canvas) -> &mut [[u8; 4]] {
+    match canvas.pixels_mut() {
+        CanvasPixels::Eight(pixels) => pixels,
+        // invariant: called only for a canvas whose depth is eight bits.
+        CanvasPixels::Sixteen(_) => unreachable!("an 8-bit canvas"),
+    }
+}
+
+fn sixteen_bit(canvas: &mut Canvas) -> &mut [[u16; 4]] {
+    match canvas.pixels_mut() {
+        CanvasPixels::Sixteen(pixels) => pixels,
+        // invariant: called only for a canvas whose depth is sixteen bits.
+        CanvasPixels::Eight(_) => unreachable!("a 16-bit canvas"),
     }
 }
 
@@ -277,7 +303,7 @@ fn draw_frame<T: StoreTexel + Send, R: Recorder<u8>>(
     let queue = Mutex::new(&mut jobs);
     let mut totals = [(0usize, 0usize); MAX_THREADS];
     let take_bands = |worker: &mut BandScratch, total: &mut (usize, usize)| loop {
-        let job = queue.lock().unwrap_or_else(|e| e.into_inner()).next();
+        let job = lock(&queue).next();
         let Some((band, rows)) = job else { break };
         let (h, w) = draw_band(&shared, band, rows, canvas_width, worker, &mut NoRecorder);
         *total = (total.0 + h, total.1 + w);

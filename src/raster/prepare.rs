@@ -14,11 +14,12 @@
 //! setup depends on its triangle alone (geometry then membrane gives the bits of one pass),
 //! and the strips are laid out by [`Silhouette::layout`] whatever the thread count.
 
-use std::sync::{Mutex, MutexGuard};
+use std::sync::Mutex;
 
 use super::coverage::{rest_loop_orientation, SilhouetteInput, Strip};
 use super::setup::{LocalFrame, SnappedVertex, TriangleSetup};
 use super::{Patch, PixelRect, RasterError, RasterScratch};
+use crate::util::{lock, SpinWait};
 
 /// Large draws hand out their triangle setups in chunks of at least this many triangles...
 const SETUP_CHUNK: usize = 1024;
@@ -26,9 +27,6 @@ const SETUP_CHUNK: usize = 1024;
 /// ... and in at most this many chunks, so that the chunks waiting for the membrane fit a
 /// fixed array (no allocation per frame).
 const MAX_SETUP_CHUNKS: usize = 16;
-
-/// Spins of a thread waiting for the membrane before it yields its core between looks.
-const SPINS_BEFORE_YIELD: u32 = 256;
 
 /// Fills `scratch`'s setups and (with `anti_alias`) silhouette strips for `patch` over
 /// `work`, with the membrane that `solve` gives; gives that membrane. `patch.membrane` is
@@ -173,11 +171,6 @@ impl<'s, 'm, I: Iterator<Item = Job<'s>>> Queue<'s, 'm, I> {
     }
 }
 
-fn lock<T>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {
-    // A panic while the lock is held leaves nothing half-updated that a reader could trip on.
-    mutex.lock().unwrap_or_else(|e| e.into_inner())
-}
-
 /// Publishes the solve's outcome to the queue; on drop (a panicking solve) declares it
 /// failed, so the helper stops waiting.
 struct Abandon<'q, 's, 'm, I>(&'q Mutex<Queue<'s, 'm, I>>);
@@ -207,7 +200,7 @@ struct Context<'a> {
 impl Context<'_> {
     /// Takes and runs jobs until none is left (or the solve failed).
     fn work<'s, 'm, I: Iterator<Item = Job<'s>>>(&self, queue: &Mutex<Queue<'s, 'm, I>>) {
-        let mut spins = 0u32;
+        let mut wait = SpinWait::default();
         loop {
             let next = lock(queue).next();
             match next {
@@ -219,11 +212,7 @@ impl Context<'_> {
                     }
                 }
                 Next::Membrane(chunk, membrane) => self.add_membrane(chunk, membrane),
-                Next::Wait if spins < SPINS_BEFORE_YIELD => {
-                    spins += 1;
-                    std::hint::spin_loop();
-                }
-                Next::Wait => std::thread::yield_now(),
+                Next::Wait => wait.pause(),
                 Next::Stop => return,
             }
         }

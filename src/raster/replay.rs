@@ -15,12 +15,16 @@
 //! patch moved by whole pixels since the previous draw (so a continuously, fractionally
 //! moving patch never pays for recording).
 
+use std::sync::Mutex;
+
 use glam::{DVec2, Vec4};
 
 use super::setup::MembraneSpan;
 use super::shade::{shade_pixel, Recorder, StoreTexel};
 use super::triangles::NO_TRIANGLE;
 use super::{Patch, PixelRect};
+use crate::pixels::Canvas;
+use crate::util::{lock, SpinWait};
 
 /// Largest shift replayed (px): far below the fixed-point range, so shifted coordinates stay
 /// exact.
@@ -29,12 +33,10 @@ const MAX_SHIFT: f64 = (1u64 << 20) as f64;
 /// Largest recorded area (px): the record holds 17 bytes per covered pixel.
 const MAX_RECORDED_AREA: usize = 4 << 20;
 
-/// Recorded pixels from which a second thread replays half the rows. Measured on the
-/// 2-core machines (`bench clone`): at 16K pixels the 400² spiral's replay (≈ 34K pixels in
-/// 2–3-pixel runs) got slower, 0.39 → 0.46–0.49 ms, and the 800² one moved within the noise
-/// (1.21–1.25 → 1.05–1.37 ms): the thread hand-off costs about what half of such a replay
-/// saves. Only larger patches split.
-const THREADED_PIXELS: usize = 128 * 1024;
+/// Recorded pixels from which a second thread replays half the rows. The thread starts
+/// before the membrane solve, so its start-up (≈ 50 µs on the 2-core machines) hides behind
+/// it; when it was started after the solve, 16K pixels measured slower than one thread.
+const THREADED_PIXELS: usize = 8 * 1024;
 
 /// What identifies the patch a record belongs to (addresses and sizes of the mesh and
 /// source slices the draw read; the scratch belongs to one patch).
@@ -147,36 +149,58 @@ impl Replay {
         Recording { replay: self }
     }
 
-    /// Composites the record shifted by `(dx, dy)` with the membrane maps `spans` (one per
-    /// triangle of the shifted patch), on up to `threads` threads (at most two: the rows
-    /// are cut in two halves). Gives (centre hits, pixels written), as a fresh draw would;
-    /// any thread count gives the same bytes (each pixel is written by one run).
-    pub fn draw<T: StoreTexel + Send>(
+    /// Composites the record shifted by `shift` with the membrane that `solve` gives for the
+    /// shifted `geometry` (on this thread, reading the canvas first), on up to `threads`
+    /// threads. Gives (centre hits, pixels written), as a fresh draw would.
+    ///
+    /// A large record is cut into two halves of whole rows. The second thread starts before
+    /// the solve, so its start-up hides behind it, and takes the lower half once the
+    /// membrane is known; each thread computes the membrane maps of the triangles its runs
+    /// meet ([`LazySpans`]). Any thread count gives the same bytes: each pixel is written by
+    /// one run with the maps of a fresh draw.
+    #[allow(clippy::too_many_arguments)]
+    pub fn draw_solving<'m, T: StoreTexel + Send, E>(
         &self,
         shift: (i32, i32),
-        spans: &[MembraneSpan],
-        canvas: &mut [[T; 4]],
-        canvas_width: usize,
+        geometry: SpanGeometry,
         threads: usize,
-    ) -> (usize, usize) {
+        workers: &mut [LazySpans; 2],
+        canvas: &mut Canvas,
+        pixels: impl FnOnce(&mut Canvas) -> &mut [[T; 4]],
+        solve: impl FnOnce(&Canvas) -> Result<&'m [[f32; 3]], E>,
+    ) -> Result<(usize, usize), E> {
+        let canvas_width = canvas.width() as usize;
         let split = (threads >= 2 && self.samples.len() >= THREADED_PIXELS)
             .then(|| self.row_split())
             .flatten();
+        let [upper_spans, lower_spans] = workers;
         let Some(k) = split else {
-            return self.draw_runs(&self.runs, shift, 0, spans, canvas, canvas_width);
+            let membrane = solve(canvas)?;
+            let maps = SpanSource::new(geometry, membrane, upper_spans);
+            return Ok(self.draw_runs(&self.runs, shift, 0, maps, pixels(canvas), canvas_width));
         };
         let (top_runs, bottom_runs) = self.runs.split_at(k);
         let first_row = (bottom_runs[0].y + shift.1) as usize;
-        let (top, bottom) = canvas.split_at_mut(first_row * canvas_width);
+        let handoff = Mutex::new(Handoff::Waiting);
         std::thread::scope(|scope| {
-            let lower = scope.spawn(move || {
-                self.draw_runs(bottom_runs, shift, first_row, spans, bottom, canvas_width)
+            let lower = scope.spawn(|| {
+                let (bottom, membrane) = wait_for(&handoff)?;
+                let maps = SpanSource::new(geometry, membrane, lower_spans);
+                Some(self.draw_runs(bottom_runs, shift, first_row, maps, bottom, canvas_width))
             });
-            let upper = self.draw_runs(top_runs, shift, 0, spans, top, canvas_width);
+            // Whatever happens to the solve, the lower half must stop waiting for it.
+            let cancel = CancelOnDrop(&handoff);
+            let membrane = solve(canvas)?;
+            let (top, bottom) = pixels(canvas).split_at_mut(first_row * canvas_width);
+            *lock(&handoff) = Handoff::Go((bottom, membrane));
+            drop(cancel);
+            let maps = SpanSource::new(geometry, membrane, upper_spans);
+            let upper = self.draw_runs(top_runs, shift, 0, maps, top, canvas_width);
             let lower = lower
                 .join()
-                .unwrap_or_else(|e| std::panic::resume_unwind(e));
-            (upper.0 + lower.0, upper.1 + lower.1)
+                .unwrap_or_else(|e| std::panic::resume_unwind(e))
+                .unwrap_or_default();
+            Ok((upper.0 + lower.0, upper.1 + lower.1))
         })
     }
 
@@ -194,7 +218,7 @@ impl Replay {
         runs: &[RecordedRun],
         (dx, dy): (i32, i32),
         first_row: usize,
-        spans: &[MembraneSpan],
+        mut maps: SpanSource,
         canvas: &mut [[T; 4]],
         canvas_width: usize,
     ) -> (usize, usize) {
@@ -219,23 +243,123 @@ impl Replay {
                     else {
                         break;
                     };
-                    let membrane = spans[owner as usize].at_pixel(x + dx, y);
+                    let membrane = maps.of(owner).at_pixel(x + dx, y);
                     let pixel = &mut pixels[(x - run.x0) as usize];
                     written += usize::from(shade_pixel(pixel, sample, membrane, cover));
                 }
                 continue;
             }
             hits += run.len as usize;
-            let maps = &spans[run.id as usize];
+            let span = maps.of(run.id);
             for (x, (pixel, &cover)) in (x0..).zip(pixels.iter_mut().zip(coverage.by_ref())) {
                 if cover > 0 {
                     let Some(&sample) = samples.next() else { break };
-                    let membrane = maps.at_pixel(x, y);
+                    let membrane = span.at_pixel(x, y);
                     written += usize::from(shade_pixel(pixel, sample, membrane, cover));
                 }
             }
         }
         (hits, written)
+    }
+}
+
+/// The shifted patch's placed positions and triangles, which the membrane maps are made of.
+#[derive(Clone, Copy)]
+pub(crate) struct SpanGeometry<'a> {
+    pub placed: &'a [DVec2],
+    pub triangles: &'a [[u32; 3]],
+}
+
+/// One thread's membrane maps of a replay, each computed the first time a run needs it
+/// (a half of the rows meets about half of the triangles). Grow-only; kept in the scratch.
+#[derive(Default)]
+pub(crate) struct LazySpans {
+    spans: Vec<MembraneSpan>,
+    /// Per triangle: the replay whose map `spans` holds.
+    computed_in: Vec<u32>,
+    replay: u32,
+}
+
+/// The maps of one replay: the geometry and membrane, and a thread's [`LazySpans`].
+struct SpanSource<'a> {
+    geometry: SpanGeometry<'a>,
+    membrane: &'a [[f32; 3]],
+    lazy: &'a mut LazySpans,
+}
+
+impl<'a> SpanSource<'a> {
+    fn new(
+        geometry: SpanGeometry<'a>,
+        membrane: &'a [[f32; 3]],
+        lazy: &'a mut LazySpans,
+    ) -> SpanSource<'a> {
+        let triangles = geometry.triangles.len();
+        lazy.spans.resize(triangles, MembraneSpan::default());
+        lazy.computed_in.resize(triangles, 0);
+        lazy.replay = lazy.replay.wrapping_add(1);
+        if lazy.replay == 0 {
+            // Every 2³² replays: no stale mark may equal the new number.
+            lazy.computed_in.fill(0);
+            lazy.replay = 1;
+        }
+        SpanSource {
+            geometry,
+            membrane,
+            lazy,
+        }
+    }
+
+    /// The membrane maps of triangle `t` (exactly `MembraneSpan::of_triangle`).
+    #[inline]
+    fn of(&mut self, t: u32) -> MembraneSpan {
+        let t = t as usize;
+        let lazy = &mut *self.lazy;
+        if lazy.computed_in[t] != lazy.replay {
+            let [a, b, c] = self.geometry.triangles[t].map(|v| v as usize);
+            let (placed, membrane) = (self.geometry.placed, self.membrane);
+            lazy.spans[t] = MembraneSpan::of_triangle(
+                [placed[a], placed[b], placed[c]],
+                [membrane[a], membrane[b], membrane[c]],
+            );
+            lazy.computed_in[t] = lazy.replay;
+        }
+        lazy.spans[t]
+    }
+}
+
+/// The lower half's canvas rows and the membrane.
+type LowerHalf<'c, 'm, T> = (&'c mut [[T; 4]], &'m [[f32; 3]]);
+
+/// What the lower half of a two-thread replay is waiting for.
+enum Handoff<'c, 'm, T> {
+    Waiting,
+    Go(LowerHalf<'c, 'm, T>),
+    /// The solve failed or panicked.
+    Cancelled,
+}
+
+/// Waits for the hand-off; `None` when it is cancelled. Spins (the wait is about one solve),
+/// yielding the core after a while.
+fn wait_for<'c, 'm, T>(handoff: &Mutex<Handoff<'c, 'm, T>>) -> Option<LowerHalf<'c, 'm, T>> {
+    let mut wait = SpinWait::default();
+    loop {
+        match std::mem::replace(&mut *lock(handoff), Handoff::Waiting) {
+            Handoff::Go(lower) => return Some(lower),
+            Handoff::Cancelled => return None,
+            Handoff::Waiting => wait.pause(),
+        }
+    }
+}
+
+/// Cancels a hand-off still waiting when dropped (an error or panic in the solve).
+struct CancelOnDrop<'h, 'c, 'm, T>(&'h Mutex<Handoff<'c, 'm, T>>);
+
+impl<T> Drop for CancelOnDrop<'_, '_, '_, T> {
+    fn drop(&mut self) {
+        let mut handoff = lock(self.0);
+        if matches!(*handoff, Handoff::Waiting) {
+            *handoff = Handoff::Cancelled;
+        }
     }
 }
 

@@ -249,8 +249,14 @@ mod tests {
         for j in -2..9 {
             for i in -2..12 {
                 let (x, y) = (i as f32, j as f32);
-                let (a, b) = (levels.sample_texel_space(x, y), floats.sample_texel_space(x, y));
-                assert_eq!(a.to_array().map(f32::to_bits), b.to_array().map(f32::to_bits));
+                let (a, b) = (
+                    levels.sample_texel_space(x, y),
+                    floats.sample_texel_space(x, y),
+                );
+                assert_eq!(
+                    a.to_array().map(f32::to_bits),
+                    b.to_array().map(f32::to_bits)
+                );
                 for (dx, dy) in [(0.25, 0.5), (0.5, 0.125), (0.9, 0.37), (0.013, 0.77)] {
                     let a = levels.sample_texel_space(x + dx, y + dy);
                     let b = floats.sample_texel_space(x + dx, y + dy);

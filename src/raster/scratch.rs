@@ -5,8 +5,8 @@
 
 use super::bands::{Bands, BAND_PIXELS};
 use super::coverage::Silhouette;
-use super::replay::Replay;
-use super::setup::{LocalFrame, MembraneSpan, SnappedVertex, TriangleSetup};
+use super::replay::{LazySpans, Replay};
+use super::setup::{LocalFrame, SnappedVertex, TriangleSetup};
 
 /// Scratch buffers for [`draw_patch`](super::draw_patch); keep one per patch (or per thread)
 /// and pass it every frame.
@@ -27,8 +27,8 @@ pub struct RasterScratch {
     /// Pixels per row band (tests vary it to prove it changes nothing).
     pub(crate) band_pixels: usize,
     pub(crate) replay: Replay,
-    /// Per-triangle membrane maps of a replayed draw.
-    pub(crate) membrane_spans: Vec<MembraneSpan>,
+    /// Per-thread membrane maps of a replayed draw.
+    pub(crate) replay_spans: [LazySpans; 2],
 }
 
 impl Default for RasterScratch {
@@ -45,7 +45,7 @@ impl Default for RasterScratch {
             silhouette: Silhouette::default(),
             band_pixels: BAND_PIXELS,
             replay: Replay::default(),
-            membrane_spans: Vec::new(),
+            replay_spans: Default::default(),
         }
     }
 }

@@ -13,6 +13,7 @@ use crate::mesh::Mesh;
 use crate::pixels::{Canvas, Depth, FloatImage, PixelFormat};
 use crate::raster::PixelRect;
 use crate::scene::{frame_time, Background, FrameState, Patch, Scene};
+use crate::util::lock;
 
 /// What [`Renderer::set_scene`] kept and built.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -264,7 +265,7 @@ impl Renderer {
         std::thread::scope(|scope| {
             for _ in 0..available_cores().min(deforming) {
                 scope.spawn(|| loop {
-                    let job = queue.lock().unwrap_or_else(|e| e.into_inner()).next();
+                    let job = lock(&queue).next();
                     let Some((index, layer, result)) = job else {
                         break;
                     };

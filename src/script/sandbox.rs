@@ -12,6 +12,8 @@ use std::sync::{Arc, Mutex};
 use rhai::module_resolvers::ModuleResolver;
 use rhai::{Dynamic, Engine, EvalAltResult, Module, Position, Scope, Shared};
 
+use crate::util::lock;
+
 type SharedModule = Shared<Module>;
 
 /// Bounds on what a script may use.
@@ -162,11 +164,6 @@ impl ModuleFiles {
         lock(&self.files).clear();
         lock(&self.modules).clear();
     }
-}
-
-/// Locks a cache; the caches hold only whole entries, so a poisoned lock is still usable.
-fn lock<T>(mutex: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
-    mutex.lock().unwrap_or_else(|p| p.into_inner())
 }
 
 impl ModuleResolver for SandboxResolver {
