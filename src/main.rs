@@ -14,7 +14,7 @@ fn main() {
                 eprintln!("lapclone: {usage}");
                 std::process::exit(2);
             }
-            eprintln!("lapclone: error: {err:#}");
+            eprintln!("lapclone: error: {}", cli::describe(&err));
             std::process::exit(1);
         }
     }

@@ -156,6 +156,17 @@ fn run_catalogue(fixture: &Fixture, cases: &[Case]) {
         if !messages.iter().any(|l| l.contains(&case.message)) {
             wrong.push(format!("no `{}` in the message", case.message));
         }
+        // A cause is named once (typed errors end with their cause's text already).
+        for line in &messages {
+            let parts: Vec<&str> = line.split(": ").filter(|p| p.len() >= 8).collect();
+            if parts
+                .iter()
+                .enumerate()
+                .any(|(k, p)| parts[..k].contains(p))
+            {
+                wrong.push(format!("a repeated cause in `{line}`"));
+            }
+        }
         if (stderr.clone() + stdout.clone()).contains("panicked")
             || stderr.contains("RUST_BACKTRACE")
         {

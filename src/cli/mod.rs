@@ -22,6 +22,23 @@ pub mod repl;
 #[error("{0}")]
 pub struct UsageError(pub String);
 
+/// The error and its causes as one line, `outer: cause: …`. The library's errors already
+/// end their message with their cause's, so a cause whose text the line holds is not
+/// repeated (anyhow's `{:#}` would print it twice).
+pub fn describe(error: &anyhow::Error) -> String {
+    let mut line = String::new();
+    for cause in error.chain() {
+        let text = cause.to_string();
+        if !line.contains(&text) {
+            if !line.is_empty() {
+                line.push_str(": ");
+            }
+            line.push_str(&text);
+        }
+    }
+    line
+}
+
 #[derive(Parser, Debug)]
 #[command(
     name = "lapclone",
@@ -82,4 +99,25 @@ pub fn point(text: &str) -> Result<[f64; 2], String> {
         .split_once(',')
         .ok_or_else(|| format!("`{text}` is not a point X,Y"))?;
     Ok([finite_f64(x)?, finite_f64(y)?])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn describe_names_every_cause_once() {
+        let io = std::io::Error::new(std::io::ErrorKind::NotFound, "no such file");
+        let typed = lapclone::pixels::PixelError::Read {
+            path: "in/a.png".into(),
+            source: io,
+        };
+        let error = anyhow::Error::new(typed).context("loading the source");
+        assert_eq!(
+            describe(&error),
+            "loading the source: cannot read image in/a.png: no such file"
+        );
+        let plain = anyhow::anyhow!("first").context("second");
+        assert_eq!(describe(&plain), "second: first");
+    }
 }

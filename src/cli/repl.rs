@@ -59,7 +59,7 @@ pub fn run(args: ReplArgs) -> anyhow::Result<()> {
     let mut failures = 0;
     if let Some(scene) = &args.scene {
         if let Err(error) = session.load(scene) {
-            eprintln!("{error:#}");
+            eprintln!("{}", super::describe(&error));
             failures += 1;
         }
     }

@@ -116,7 +116,7 @@ impl Session {
         match result {
             Ok(()) => Step::Ok,
             Err(error) => {
-                eprintln!("{error:#}");
+                eprintln!("{}", crate::cli::describe(&error));
                 Step::Failed
             }
         }
