@@ -5,7 +5,7 @@
 //!
 //! The modules follow the pipeline: [`mesh`] → [`solve`] → [`clone`] / [`deform`] →
 //! [`raster`], driven per frame by [`scene`]. [`pixels`] holds the float image type shared by
-//! all stages; [`reference`] holds the pixel-grid and MVC baselines used by tests and benches;
+//! all stages; [`reference`](mod@reference) holds the pixel-grid and MVC baselines used by tests and benches;
 //! [`limits`] the documented resource limits every input is checked against.
 
 pub mod clone;

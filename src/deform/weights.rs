@@ -5,7 +5,7 @@
 //!
 //! Edge k of triangle `[a, b, c]` runs from corner k to corner k+1 (ab, bc, ca); for cotangent
 //! weights its share is ½ cot of the angle at the third corner, computed with the same formula
-//! and degeneracy rule as [`solve::laplacian`](crate::solve::laplacian), and an edge whose total
+//! and degeneracy rule as [`solve::laplacian`](fn@crate::solve::laplacian), and an edge whose total
 //! is negative gets share 0 in every triangle (the solver's clamp to 0).
 
 use crate::mesh::Mesh;

@@ -22,7 +22,7 @@ use super::BitMask;
 #[derive(Clone, Debug, PartialEq)]
 pub struct CrackLoop {
     pub points: Vec<DVec2>,
-    /// `anchor[i]`: points[i] is a saddle corner and must survive simplification.
+    /// `anchor[i]`: `points[i]` is a saddle corner and must survive simplification.
     pub anchor: Vec<bool>,
     /// Twice the signed area (integer for crack loops): > 0 outer, < 0 hole.
     pub doubled_area: i64,

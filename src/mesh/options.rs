@@ -30,7 +30,7 @@ pub struct MeshOptions {
     pub relax_sweeps: usize,
 }
 
-/// Where [`super::mesh_mask`] puts the boundary of a mask mesh.
+/// Where [`mesh_mask`](fn@super::mesh_mask) puts the boundary of a mask mesh.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum BoundaryPlacement {

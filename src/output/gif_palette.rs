@@ -25,7 +25,7 @@ pub const MAX_COLOURS: usize = 255;
 /// Half the range of the ordered-dither offset added to each channel.
 const DITHER_AMPLITUDE: f32 = 8.0;
 
-/// An ordered list of at most [`MAX_COLOURS`] opaque RGB colours.
+/// An ordered list of at most `MAX_COLOURS` (255) opaque RGB colours.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Palette {
     colours: Vec<[u8; 3]>,

@@ -32,7 +32,7 @@ pub struct RasterOptions {
     /// Threads drawing one large patch (0: one per core). Any count gives the same pixels.
     pub threads: usize,
     /// Replay the previous draw when the patch only moved by whole pixels (see
-    /// [`replay`](super::replay)). Only for a scratch that stays with one patch whose
+    /// `raster/replay.rs`). Only for a scratch that stays with one patch whose
     /// source and mesh are not modified in place between draws.
     pub replay: bool,
     /// Shade with the CPU's SIMD kernel when it has one (AVX2 on x86_64, 8-bit canvases).
@@ -80,7 +80,7 @@ pub fn draw_patch(
 /// [`draw_patch`] for a patch whose membrane is not known yet: `solve` gives it, reading the
 /// canvas before anything is drawn (`patch.membrane` is not read). On a large patch `solve`
 /// runs on this thread while a helper thread starts the raster's membrane-free work (see
-/// [`prepare`](super::prepare)), so the draw finishes sooner than a solve followed by
+/// `raster/prepare.rs`), so the draw finishes sooner than a solve followed by
 /// [`draw_patch`] — with the same bytes. `solve` runs exactly once, also when nothing is
 /// drawn; its error ends the draw with the canvas untouched.
 pub fn draw_patch_solving<'m, E: From<RasterError>>(

@@ -6,20 +6,20 @@
 //! Rules (see each file for the why):
 //! - A pixel belongs to a triangle when its centre is inside the placed triangle, decided
 //!   exactly in 1/256-px fixed point with a top-left fill rule, so triangles sharing an edge
-//!   leave no cracks and no double hits ([`triangles`]). Inverted (folded) triangles are drawn.
+//!   leave no cracks and no double hits (`triangles.rs`). Inverted (folded) triangles are drawn.
 //! - Overlaps: the larger interpolated depth wins; on equal depth the later triangle wins.
 //! - Coverage: the union of all placed triangles, anti-aliased only at its silhouette, filled
-//!   by tiny-skia as the boundary loops plus every inverted triangle twice (see [`coverage`]).
+//!   by tiny-skia as the boundary loops plus every inverted triangle twice (see `coverage.rs`).
 //!   Edge pixels whose centre misses every triangle take their colour by extrapolating the
 //!   affine maps of the nearest hit pixel's triangle.
-//! - `feather` px ramps the coverage down by distance to the silhouette ([`feather`]).
+//! - `feather` px ramps the coverage down by distance to the silhouette (`feather.rs`).
 //! - Composite: straight-alpha source-over; over an opaque canvas that is
 //!   `out = cov·α·patch + (1 − cov·α)·canvas`.
 //!
 //! [`covered_boundary_vertices`] answers, independently of pixels, which boundary vertices
 //! lie under the patch's own front layer (issue 5 switches their constraints off).
 //!
-//! Work is split into row bands of a few dozen rows ([`bands`]): a band's ids, depths and
+//! Work is split into row bands of a few dozen rows (`bands.rs`): a band's ids, depths and
 //! coverage stay in cache, and bands are shaded by up to one thread per core in any order —
 //! every band's pixels depend only on the frame's inputs, so any thread count gives the
 //! same bytes. Feathering draws in one piece (its distance transform spans the patch).

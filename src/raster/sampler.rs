@@ -1,6 +1,6 @@
 //! The shading sampler: takes the source [`FloatImage`] and gives bilinear samples as SIMD
 //! [`Vec4`]s for the raster's inner loop — branch-free clamped taps, one slice, no per-call
-//! setup. The hot path ([`Sampler::sample_f32`]) takes f32 positions and unchecked
+//! setup. The hot path ([`Sampler::sample_texel_space`]) takes f32 positions and unchecked
 //! (proven in-range) taps; it differs from [`FloatImage::sample_bilinear`] only by the f32
 //! rounding of the position (tested to 1e-5 per channel). The f64 path, kept for tests, is
 //! bit-identical to it.
@@ -106,7 +106,7 @@ impl<'a, S: SourceTexel> Sampler<'a, S> {
         self.sample_texel_space(x - 0.5, y - 0.5)
     }
 
-    /// [`sample_f32`](Self::sample_f32) at `(x + ½, y + ½)`: positions in texel space,
+    /// `sample_f32` at `(x + ½, y + ½)`: positions in texel space,
     /// where texel (i, j)'s centre is at (i, j) (the shading loop folds the ½ into its maps).
     #[inline(always)]
     pub fn sample_texel_space(&self, x: f32, y: f32) -> Vec4 {

@@ -10,7 +10,7 @@
 //! `trunc(255·c + ½)` with saturating packs. Only the grouping differs: tap positions for
 //! eight pixels at once, then two pixels per 256-bit register for the texel blend and the
 //! store. Pixels that need a blend (partial coverage or a translucent source) take the
-//! scalar [`shade_pixel`] with the vector's own sample and membrane.
+//! scalar `shade_pixel` with the vector's own sample and membrane.
 //!
 //! Dispatch: [`Kernel::detect`] once per draw (unless `RasterOptions::simd` is off); without
 //! AVX2 (or off x86_64) the scalar path runs. The recording draw of a replay always runs the

@@ -14,7 +14,7 @@
 //!
 //! Boundary values are the product's: `target − source`, both bilinear at the boundary
 //! vertices (pixel-crack corners). The grid reference pins `target − source` at the outside
-//! pixel centres (see [`super::poisson_membrane`]): that half-pixel offset is part of what
+//! pixel centres (see [`poisson_membrane`](fn@super::poisson_membrane)): that half-pixel offset is part of what
 //! the PSNR measures.
 //!
 //! [`reclone_ms`] times the interactive path, a re-clone at a moved placement through

@@ -3,7 +3,7 @@
 //! gives reference membranes and quality figures out:
 //!
 //! - [`grid_mask`]: the pixel mask shared by the reference solver and the metrics;
-//! - [`poisson_membrane`]: the exact pixel-grid Laplace membrane (Pérez et al. 2003), the
+//! - [`poisson_membrane`](fn@poisson_membrane): the exact pixel-grid Laplace membrane (Pérez et al. 2003), the
 //!   quality reference;
 //! - [`mvc`]: Mean-Value-Coordinates cloning (Farbman et al. 2009) on a triangle mesh, the
 //!   speed and quality baseline of the paper's Table I and Fig. 5;
