@@ -10,6 +10,54 @@ use super::{sample_bilinear_rgba, ColorKind, Depth, PixelError, PixelFormat};
 /// Rec. 709 luma weights (sum exactly 1 in real numbers).
 pub(crate) const LUMA_709: [f32; 3] = [0.2126, 0.7152, 0.0722];
 
+/// `k / 255` for every 8-bit level `k`: the values the 8-bit loader gives (const evaluation
+/// rounds like the run-time division).
+const LEVEL_VALUES: [f32; 256] = {
+    let mut values = [0.0; 256];
+    let mut k = 0;
+    while k < 256 {
+        values[k] = k as f32 / 255.0;
+        k += 1;
+    }
+    values
+};
+
+/// The 8-bit levels `k` of a pixel whose channels are exactly `k / 255` (bit for bit: −0,
+/// NaN and values off the levels or out of [0, 1] give `None`). Called once per pixel when
+/// an image is made, so it avoids libm's `round` and float-to-u8 casts (SSE2 on x86_64).
+#[inline]
+fn level_of(pixel: &[f32; 4]) -> Option<[u8; 4]> {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::*;
+        // SAFETY: SSE2 is part of the x86_64 baseline; the load and store are unaligned.
+        unsafe {
+            let v = _mm_loadu_ps(pixel.as_ptr());
+            // Truncation of v·255 + ½; NaN and out-of-range lanes become i32::MIN, which
+            // the saturating packs map to 0, whose value then differs from the lane.
+            let rounded = _mm_cvttps_epi32(_mm_add_ps(
+                _mm_mul_ps(v, _mm_set1_ps(255.0)),
+                _mm_set1_ps(0.5),
+            ));
+            let bytes = _mm_packus_epi16(_mm_packs_epi32(rounded, rounded), _mm_setzero_si128());
+            let level = _mm_unpacklo_epi16(
+                _mm_unpacklo_epi8(bytes, _mm_setzero_si128()),
+                _mm_setzero_si128(),
+            );
+            // k / 255 by the same correctly rounded division as LEVEL_VALUES.
+            let value = _mm_div_ps(_mm_cvtepi32_ps(level), _mm_set1_ps(255.0));
+            let same = _mm_cmpeq_epi32(_mm_castps_si128(value), _mm_castps_si128(v));
+            (_mm_movemask_epi8(same) == 0xFFFF).then(|| _mm_cvtsi128_si32(bytes).to_le_bytes())
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        let levels = pixel.map(|v| (v * 255.0 + 0.5) as u8);
+        let values = levels.map(|k| LEVEL_VALUES[usize::from(k)].to_bits());
+        (values == pixel.map(f32::to_bits)).then_some(levels)
+    }
+}
+
 /// A straight-alpha RGBA float image.
 #[derive(Clone, Debug)]
 pub struct FloatImage {
@@ -133,7 +181,7 @@ impl FloatImage {
             _ if format.depth == Depth::Eight => image
                 .to_rgba8()
                 .pixels()
-                .map(|p| p.0.map(|v| f32::from(v) / 255.0))
+                .map(|p| p.0.map(|v| LEVEL_VALUES[usize::from(v)]))
                 .collect(),
             _ => image
                 .to_rgba16()
@@ -182,19 +230,11 @@ impl FloatImage {
         if self.format.depth != Depth::Eight {
             return None;
         }
-        let exact = |v: f32| {
-            // The cast saturates (NaN → 0), and out of [0, 1] the quotient differs from v;
-            // no libm `round` call per channel.
-            let k = (v * 255.0 + 0.5) as u8;
-            (f32::from(k) / 255.0 == v).then_some(k)
-        };
-        self.pixels
-            .iter()
-            .map(|p| {
-                let [r, g, b, a] = p.map(exact);
-                Some([r?, g?, b?, a?])
-            })
-            .collect()
+        let mut view = vec![[0u8; 4]; self.pixels.len()];
+        for (levels, pixel) in view.iter_mut().zip(&self.pixels) {
+            *levels = level_of(pixel)?;
+        }
+        Some(view.into_boxed_slice())
     }
 
     /// Pixel (i, j); `None` outside the image.
@@ -287,6 +327,38 @@ mod tests {
         assert!(written.eight_bit_texels().is_none());
         written.pixels_mut()[0][0] = 128.0 / 255.0;
         assert_eq!(written.eight_bit_texels().unwrap()[0][0], 128);
+    }
+
+    #[test]
+    fn level_values_are_the_divisions() {
+        for k in 0..=255u8 {
+            assert_eq!(
+                LEVEL_VALUES[usize::from(k)].to_bits(),
+                (f32::from(k) / 255.0).to_bits()
+            );
+        }
+    }
+
+    #[test]
+    fn levels_are_found_exactly_and_nothing_else_is() {
+        for k in 0..=255u8 {
+            let v = LEVEL_VALUES[usize::from(k)];
+            assert_eq!(level_of(&[v, 1.0, 0.0, v]), Some([k, 255, 0, k]));
+            for off in [f32::from_bits(v.to_bits() + 1), v + 0.4 / 255.0, -v - 1e-3] {
+                assert_eq!(level_of(&[1.0, off, 0.0, 1.0]), None, "{k}: {off}");
+            }
+        }
+        for odd in [
+            -0.0,
+            f32::NAN,
+            1.0 + f32::EPSILON,
+            2.0,
+            -1.0,
+            f32::INFINITY,
+            1e12,
+        ] {
+            assert_eq!(level_of(&[odd, 0.0, 0.0, 1.0]), None, "{odd}");
+        }
     }
 
     #[test]
