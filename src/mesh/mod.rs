@@ -6,8 +6,8 @@
 //! (i, j) covers the square [i, i+1] × [j, j+1], so its centre is (i + 0.5, j + 0.5) and the
 //! crack boundary runs along integer coordinates.
 //!
-//! Pipeline ([`mesh_mask`](fn@mesh_mask)): [`BitMask`] → small pieces dropped → crack loops (`contour`) →
-//! Douglas–Peucker + subdivision to `density` (`simplify`) → spade CDT + refinement
+//! Pipeline ([`mesh_mask`](fn@mesh_mask)): [`BitMask`] → small pieces dropped → crack loops
+//! (`contour`) → Douglas–Peucker + subdivision to `density` (`simplify`) → spade CDT + refinement
 //! (`triangulate`) → [`Mesh`], verified by [`Mesh::sanity_check`]. With
 //! [`BoundaryPlacement::OutsideCentres`] the loops run through the outside pixel centres
 //! instead (`centre_loops`); [`relax_interior`] evens out the interior for the combinatorial

@@ -12,7 +12,8 @@
 //! geometry is done before the membrane is known waits for it in a fixed array, and gets its
 //! membrane maps from the first thread that asks once it is. The split changes no value: each
 //! setup depends on its triangle alone (geometry then membrane gives the bits of one pass),
-//! and the strips are laid out by [`Silhouette::layout`](super::coverage::Silhouette::layout) whatever the thread count.
+//! and the strips are laid out by
+//! [`Silhouette::layout`](super::coverage::Silhouette::layout) whatever the thread count.
 
 use std::sync::Mutex;
 
