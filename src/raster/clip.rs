@@ -70,37 +70,61 @@ pub(crate) fn clip_polygon(
 ) {
     out.clear();
     out.extend(points);
+    // Every point a pass makes lies on a segment between the input's points, so inside their
+    // box: a side that the box lies on the kept side of keeps every point, in order, and its
+    // pass is skipped (the same output, without the copy). Strips cut the silhouette's loops
+    // only at their top and bottom, and most triangles not at all.
+    let (min, max, nan) = out.iter().fold(
+        (
+            DVec2::splat(f64::INFINITY),
+            DVec2::splat(f64::NEG_INFINITY),
+            false,
+        ),
+        |(min, max, nan), &p| (min.min(p), max.max(p), nan || p.is_nan()),
+    );
+    // A NaN point is outside every side, and the box (which skips NaN) would not show it.
+    let kept = |inside: bool| inside && !nan;
     let sides = [
-        (true, rect.x0, true),
-        (true, rect.x1, false),
-        (false, rect.y0, true),
-        (false, rect.y1, false),
+        (true, rect.x0, true, kept(min.x >= rect.x0)),
+        (true, rect.x1, false, kept(max.x <= rect.x1)),
+        (false, rect.y0, true, kept(min.y >= rect.y0)),
+        (false, rect.y1, false, kept(max.y <= rect.y1)),
     ];
-    for (vertical, bound, keep_above) in sides {
+    for (vertical, bound, keep_above, all_kept) in sides {
         if out.is_empty() {
             return;
         }
-        let side = Side {
-            vertical,
-            bound,
-            keep_above,
-        };
-        spare.clear();
-        let mut previous = out[out.len() - 1];
-        for &point in out.iter() {
-            match (side.inside(previous), side.inside(point)) {
-                (true, true) => spare.push(point),
-                (true, false) => spare.push(side.crossing(previous, point)),
-                (false, true) => {
-                    spare.push(side.crossing(previous, point));
-                    spare.push(point);
-                }
-                (false, false) => {}
-            }
-            previous = point;
+        if !all_kept {
+            let side = Side {
+                vertical,
+                bound,
+                keep_above,
+            };
+            clip_to_side(out, spare, side);
         }
-        std::mem::swap(out, spare);
     }
+}
+
+/// One Sutherland–Hodgman pass: `out` clipped to `side`'s kept half-plane.
+fn clip_to_side(out: &mut Vec<DVec2>, spare: &mut Vec<DVec2>, side: Side) {
+    spare.clear();
+    let Some(&last) = out.last() else {
+        return;
+    };
+    let mut previous = last;
+    for &point in out.iter() {
+        match (side.inside(previous), side.inside(point)) {
+            (true, true) => spare.push(point),
+            (true, false) => spare.push(side.crossing(previous, point)),
+            (false, true) => {
+                spare.push(side.crossing(previous, point));
+                spare.push(point);
+            }
+            (false, false) => {}
+        }
+        previous = point;
+    }
+    std::mem::swap(out, spare);
 }
 
 #[cfg(test)]
@@ -155,8 +179,45 @@ mod tests {
         assert!(clipped.iter().all(|&p| rect.contains(p)), "{clipped:?}");
     }
 
+    /// Every side's pass, none skipped.
+    fn clip_every_side(polygon: &[DVec2], rect: &ClipRect) -> Vec<DVec2> {
+        let (mut out, mut spare) = (polygon.to_vec(), Vec::new());
+        for (vertical, bound, keep_above) in [
+            (true, rect.x0, true),
+            (true, rect.x1, false),
+            (false, rect.y0, true),
+            (false, rect.y1, false),
+        ] {
+            let side = Side {
+                vertical,
+                bound,
+                keep_above,
+            };
+            clip_to_side(&mut out, &mut spare, side);
+        }
+        out
+    }
+
     proptest! {
         #![proptest_config(ProptestConfig { cases: 300, rng_seed: proptest::test_runner::RngSeed::Fixed(0xC11F), ..ProptestConfig::default() })]
+
+        /// Skipping the passes whose side the polygon's box lies inside gives the points of
+        /// all four passes, bit for bit (the polygons reach inside, across and past the
+        /// rectangle).
+        #[test]
+        fn skipped_passes_change_no_point(
+            points in prop::collection::vec((-20.0f64..60.0, -20.0f64..60.0), 3..12),
+            x0 in -10.0f64..30.0, y0 in -10.0f64..30.0, w in 0.5f64..40.0, h in 0.5f64..40.0,
+        ) {
+            let polygon: Vec<DVec2> = points.iter().map(|&(x, y)| DVec2::new(x, y)).collect();
+            let rect = ClipRect { x0, y0, x1: x0 + w, y1: y0 + h };
+            let clipped = clip(&polygon, &rect);
+            let reference = clip_every_side(&polygon, &rect);
+            prop_assert_eq!(
+                clipped.iter().map(|p| p.to_array().map(f64::to_bits)).collect::<Vec<_>>(),
+                reference.iter().map(|p| p.to_array().map(f64::to_bits)).collect::<Vec<_>>()
+            );
+        }
 
         /// Self-intersecting random loops: every point strictly inside the rectangle keeps
         /// its winding number, and every clipped vertex lies in the rectangle.
