@@ -73,6 +73,9 @@ struct RecordedRun {
     id: u32,
     /// Fringe runs: how many of their pixels were drawn (and recorded).
     fringe_pixels: u32,
+    /// Record numbers given before this run: the triangles of all earlier runs have smaller
+    /// numbers, and every triangle first met from here on a number at least this.
+    numbered_before: u32,
     /// Where the run's data starts in the record's `coverage`, `samples` and `fringe`, so
     /// a replay can start at any run (two threads each take half the rows).
     data: [u32; 3],
@@ -185,18 +188,23 @@ impl Replay {
             .then(|| self.row_split())
             .flatten();
         let [upper_spans, lower_spans] = workers;
+        let every = 0..self.triangles.len() as u32;
         let Some(k) = split else {
             let membrane = solve(canvas)?;
-            let maps = SpanSource::new(geometry, &self.triangles, membrane, upper_spans);
+            let maps = SpanSource::new(geometry, &self.triangles, every, membrane, upper_spans);
             return Ok(self.draw_runs(&self.runs, shift, 0, maps, pixels(canvas), canvas_width));
         };
         let (top_runs, bottom_runs) = self.runs.split_at(k);
         let first_row = (bottom_runs[0].y + shift.1) as usize;
+        // The top half meets exactly the numbers below `first_new`; the bottom half all
+        // from it on, and a few below (triangles crossing the split row).
+        let first_new = bottom_runs[0].numbered_before;
+        let (upper, lower) = (0..first_new, first_new..every.end);
         let handoff = Mutex::new(Handoff::Waiting);
         std::thread::scope(|scope| {
             let lower = scope.spawn(|| {
                 let (bottom, membrane) = wait_for(&handoff)?;
-                let maps = SpanSource::new(geometry, &self.triangles, membrane, lower_spans);
+                let maps = SpanSource::new(geometry, &self.triangles, lower, membrane, lower_spans);
                 Some(self.draw_runs(bottom_runs, shift, first_row, maps, bottom, canvas_width))
             });
             // Whatever happens to the solve, the lower half must stop waiting for it.
@@ -205,7 +213,7 @@ impl Replay {
             let (top, bottom) = pixels(canvas).split_at_mut(first_row * canvas_width);
             *lock(&handoff) = Handoff::Go((bottom, membrane));
             drop(cancel);
-            let maps = SpanSource::new(geometry, &self.triangles, membrane, upper_spans);
+            let maps = SpanSource::new(geometry, &self.triangles, upper, membrane, upper_spans);
             let upper = self.draw_runs(top_runs, shift, 0, maps, top, canvas_width);
             let lower = lower
                 .join()
@@ -281,7 +289,8 @@ pub(crate) struct SpanGeometry<'a> {
     pub triangles: &'a [[u32; 3]],
 }
 
-/// One thread's membrane maps of a replay, by record number, each computed the first time a
+/// One thread's membrane maps of a replay, by record number: those of the numbers its rows
+/// are known to meet computed up front in one sequential pass, any other the first time a
 /// run needs it (a half of the rows meets about half of the triangles). Grow-only; kept in
 /// the scratch.
 #[derive(Default)]
@@ -303,9 +312,12 @@ struct SpanSource<'a> {
 }
 
 impl<'a> SpanSource<'a> {
+    /// The maps of `triangles` (mesh triangle per record number), those numbered in `eager`
+    /// computed now.
     fn new(
         geometry: SpanGeometry<'a>,
         triangles: &'a [u32],
+        eager: std::ops::Range<u32>,
         membrane: &'a [[f32; 3]],
         lazy: &'a mut LazySpans,
     ) -> SpanSource<'a> {
@@ -318,31 +330,39 @@ impl<'a> SpanSource<'a> {
             lazy.computed_in.fill(0);
             lazy.replay = 1;
         }
-        SpanSource {
+        let mut source = SpanSource {
             geometry,
             triangles,
             membrane,
             lazy,
+        };
+        for n in eager.start as usize..(eager.end as usize).min(count) {
+            source.compute(n);
         }
+        source
     }
 
     /// The membrane maps of the triangle with record number `n` (exactly
     /// `MembraneSpan::of_triangle`).
-    #[inline]
+    #[inline(always)]
     fn of(&mut self, n: u32) -> MembraneSpan {
         let n = n as usize;
-        let lazy = &mut *self.lazy;
-        if lazy.computed_in[n] != lazy.replay {
-            let t = self.triangles[n] as usize;
-            let [a, b, c] = self.geometry.triangles[t].map(|v| v as usize);
-            let (placed, membrane) = (self.geometry.placed, self.membrane);
-            lazy.spans[n] = MembraneSpan::of_triangle(
-                [placed[a], placed[b], placed[c]],
-                [membrane[a], membrane[b], membrane[c]],
-            );
-            lazy.computed_in[n] = lazy.replay;
+        if self.lazy.computed_in[n] != self.lazy.replay {
+            self.compute(n);
         }
-        lazy.spans[n]
+        self.lazy.spans[n]
+    }
+
+    #[inline(never)]
+    fn compute(&mut self, n: usize) {
+        let t = self.triangles[n] as usize;
+        let [a, b, c] = self.geometry.triangles[t].map(|v| v as usize);
+        let (placed, membrane) = (self.geometry.placed, self.membrane);
+        self.lazy.spans[n] = MembraneSpan::of_triangle(
+            [placed[a], placed[b], placed[c]],
+            [membrane[a], membrane[b], membrane[c]],
+        );
+        self.lazy.computed_in[n] = self.lazy.replay;
     }
 }
 
@@ -406,6 +426,7 @@ impl Recording<'_> {
 impl Recorder<u8> for Recording<'_> {
     fn run(&mut self, x0: i32, y: i32, len: usize, id: u32) {
         let len = u32::try_from(len).unwrap_or(u32::MAX);
+        let numbered_before = self.replay.triangles.len() as u32;
         let id = if id == NO_TRIANGLE {
             id
         } else {
@@ -425,6 +446,7 @@ impl Recorder<u8> for Recording<'_> {
             len,
             id,
             fringe_pixels: 0,
+            numbered_before,
             data,
         });
     }
