@@ -306,13 +306,18 @@ fn bench_deform(vertices: usize, frames: usize) -> anyhow::Result<DeformRow> {
 
     let (mut frame, mut deform, mut solve, mut raster) = (vec![], vec![], vec![], vec![]);
     let (mut switches, mut hidden_max, mut restore) = (0usize, 0usize, 0.0f64);
+    // Like the scene renderer, each frame restores only what the previous one drew.
+    let mut dirty = None;
     for k in 0..frames + 5 {
         // The handle circles around its grab point, reaching over the patch's centre.
         let angle = k as f64 * 0.15;
         let to = grab + 0.5 * radius * DVec2::new(angle.cos() - 1.0, angle.sin());
         let handle = Handle::drag(grab, to, 0.5 * radius);
         let restore_started = Instant::now();
-        canvas.copy_from(&background);
+        match dirty {
+            Some(rect) => canvas.copy_rect_from(&background, rect)?,
+            None => canvas.copy_from(&background),
+        }
         let restored = Instant::now();
         rig.deform(&[handle], &[], &mut deformed)?;
         let deformed_at = Instant::now();
@@ -323,6 +328,7 @@ fn bench_deform(vertices: usize, frames: usize) -> anyhow::Result<DeformRow> {
             Some(&deformed.depth),
         )?;
         let done = Instant::now();
+        dirty = Some(stats.raster.work);
         if k < 5 {
             continue; // warm-up: first factor touches, buffer growth
         }
