@@ -9,6 +9,7 @@ use std::sync::{Mutex, OnceLock};
 use super::bands::{Bands, APRON};
 use super::coverage::Silhouette;
 use super::feather::apply_feather;
+use super::helper;
 use super::prepare::prepare;
 use super::replay::SpanGeometry;
 use super::scratch::BandScratch;
@@ -308,16 +309,24 @@ fn draw_frame<T: StoreTexel + Send, R: Recorder<u8>>(
         let (h, w) = draw_band(&shared, band, rows, canvas_width, worker, &mut NoRecorder);
         *total = (total.0 + h, total.1 + w);
     };
-    // This thread is one of the workers: one spawn fewer per frame.
+    // This thread is one of the workers and its helper thread another; more (on machines
+    // with more cores) are spawned.
     let ((own, others), (own_total, other_totals)) =
         (workers.split_at_mut(1), totals.split_at_mut(1));
-    std::thread::scope(|scope| {
-        for (worker, total) in others.iter_mut().zip(other_totals) {
-            let take_bands = &take_bands;
-            scope.spawn(move || take_bands(worker, total));
-        }
-        take_bands(&mut own[0], &mut own_total[0]);
-    });
+    let ((helped, spawned), (helped_total, spawned_totals)) =
+        (others.split_at_mut(1), other_totals.split_at_mut(1));
+    let take_bands = &take_bands;
+    helper::join(
+        || take_bands(&mut helped[0], &mut helped_total[0]),
+        || {
+            std::thread::scope(|scope| {
+                for (worker, total) in spawned.iter_mut().zip(spawned_totals) {
+                    scope.spawn(move || take_bands(worker, total));
+                }
+                take_bands(&mut own[0], &mut own_total[0]);
+            })
+        },
+    );
     totals.iter().fold((0, 0), |(h, w), t| (h + t.0, w + t.1))
 }
 

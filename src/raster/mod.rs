@@ -35,6 +35,7 @@ mod covered;
 mod draw;
 mod error;
 mod feather;
+mod helper;
 pub mod overlay;
 mod patch;
 mod prepare;

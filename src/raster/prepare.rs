@@ -18,6 +18,7 @@
 use std::sync::Mutex;
 
 use super::coverage::{rest_loop_orientation, SilhouetteInput, Strip};
+use super::helper;
 use super::setup::{LocalFrame, SnappedVertex, TriangleSetup};
 use super::{Patch, PixelRect, RasterError, RasterScratch};
 use crate::util::{lock, SpinWait};
@@ -88,15 +89,18 @@ pub(crate) fn prepare<'m, E: From<RasterError>>(
         waiting: Default::default(),
         membrane: MembraneState::Solving,
     });
-    std::thread::scope(|scope| {
-        scope.spawn(|| context.work(&queue));
-        // Whatever happens to the solve, the helper must stop waiting for it.
-        let mut abandon = Abandon(&queue);
-        let membrane = solved(patch, solve);
-        abandon.publish(membrane.as_ref().ok().copied());
-        context.work(&queue);
-        membrane
-    })
+    let ((), membrane) = helper::join(
+        || context.work(&queue),
+        || {
+            // Whatever happens to the solve, the helper must stop waiting for it.
+            let mut abandon = Abandon(&queue);
+            let membrane = solved(patch, solve);
+            abandon.publish(membrane.as_ref().ok().copied());
+            context.work(&queue);
+            membrane
+        },
+    );
+    membrane
 }
 
 /// The solve's membrane, checked against the patch.

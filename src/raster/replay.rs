@@ -19,6 +19,7 @@ use std::sync::Mutex;
 
 use glam::{DVec2, Vec4};
 
+use super::helper;
 use super::setup::MembraneSpan;
 use super::shade::{shade_pixel, Recorder, StoreTexel};
 use super::triangles::NO_TRIANGLE;
@@ -33,9 +34,9 @@ const MAX_SHIFT: f64 = (1u64 << 20) as f64;
 /// Largest recorded area (px): the record holds 17 bytes per covered pixel.
 const MAX_RECORDED_AREA: usize = 4 << 20;
 
-/// Recorded pixels from which a second thread replays half the rows. The thread starts
-/// before the membrane solve, so its start-up (≈ 50 µs on the 2-core machines) hides behind
-/// it; when it was started after the solve, 16K pixels measured slower than one thread.
+/// Recorded pixels from which a second thread (this thread's [helper](super::helper)) replays half the
+/// rows. It is handed its half before the membrane solve, so any wake-up hides behind it;
+/// when a thread was spawned after the solve, 16K pixels measured slower than one thread.
 const THREADED_PIXELS: usize = 8 * 1024;
 
 /// What identifies the patch a record belongs to (addresses and sizes of the mesh and
@@ -167,8 +168,8 @@ impl Replay {
     /// shifted `geometry` (on this thread, reading the canvas first), on up to `threads`
     /// threads. Gives (centre hits, pixels written), as a fresh draw would.
     ///
-    /// A large record is cut into two halves of whole rows. The second thread starts before
-    /// the solve, so its start-up hides behind it, and takes the lower half once the
+    /// A large record is cut into two halves of whole rows. This thread's helper thread gets
+    /// the lower half before the solve, so its wake-up hides behind it, and starts once the
     /// membrane is known; each thread computes the membrane maps of the triangles its runs
     /// meet ([`LazySpans`]). Any thread count gives the same bytes: each pixel is written by
     /// one run with the maps of a fresh draw.
@@ -201,26 +202,25 @@ impl Replay {
         let first_new = bottom_runs[0].numbered_before;
         let (upper, lower) = (0..first_new, first_new..every.end);
         let handoff = Mutex::new(Handoff::Waiting);
-        std::thread::scope(|scope| {
-            let lower = scope.spawn(|| {
+        let (lower, upper) = helper::join(
+            || {
                 let (bottom, membrane) = wait_for(&handoff)?;
                 let maps = SpanSource::new(geometry, &self.triangles, lower, membrane, lower_spans);
                 Some(self.draw_runs(bottom_runs, shift, first_row, maps, bottom, canvas_width))
-            });
-            // Whatever happens to the solve, the lower half must stop waiting for it.
-            let cancel = CancelOnDrop(&handoff);
-            let membrane = solve(canvas)?;
-            let (top, bottom) = pixels(canvas).split_at_mut(first_row * canvas_width);
-            *lock(&handoff) = Handoff::Go((bottom, membrane));
-            drop(cancel);
-            let maps = SpanSource::new(geometry, &self.triangles, upper, membrane, upper_spans);
-            let upper = self.draw_runs(top_runs, shift, 0, maps, top, canvas_width);
-            let lower = lower
-                .join()
-                .unwrap_or_else(|e| std::panic::resume_unwind(e))
-                .unwrap_or_default();
-            Ok((upper.0 + lower.0, upper.1 + lower.1))
-        })
+            },
+            || {
+                // Whatever happens to the solve, the lower half must stop waiting for it.
+                let cancel = CancelOnDrop(&handoff);
+                let membrane = solve(canvas)?;
+                let (top, bottom) = pixels(canvas).split_at_mut(first_row * canvas_width);
+                *lock(&handoff) = Handoff::Go((bottom, membrane));
+                drop(cancel);
+                let maps = SpanSource::new(geometry, &self.triangles, upper, membrane, upper_spans);
+                Ok(self.draw_runs(top_runs, shift, 0, maps, top, canvas_width))
+            },
+        );
+        let (upper, lower) = (upper?, lower.unwrap_or_default());
+        Ok((upper.0 + lower.0, upper.1 + lower.1))
     }
 
     /// A run index near the middle where a new row starts (runs are in row order), or
