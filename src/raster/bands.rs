@@ -25,6 +25,8 @@ pub(crate) struct Bands {
     height: i32,
     starts: Vec<u32>,
     triangles: Vec<u32>,
+    /// Per triangle: its first and last band (`lo > hi`: none), found once per frame.
+    ranges: Vec<(u32, u32)>,
 }
 
 impl Bands {
@@ -42,13 +44,18 @@ impl Bands {
         self.last_row = last_row.max(first_row);
         self.height = (band_pixels / width.max(1)).clamp(8, 64) as i32;
         let count = self.count();
+        let mut ranges = std::mem::take(&mut self.ranges);
+        ranges.clear();
+        // Bands are at most canvas rows, so their indices fit u32.
+        ranges.extend(setups.iter().map(|setup| {
+            self.band_range(setup)
+                .map_or((1, 0), |(lo, hi)| (lo as u32, hi as u32))
+        }));
         self.starts.clear();
         self.starts.resize(count + 1, 0);
-        for setup in setups {
-            if let Some((lo, hi)) = self.band_range(setup) {
-                for band in lo..=hi {
-                    self.starts[band + 1] += 1;
-                }
+        for &(lo, hi) in &ranges {
+            for band in lo..=hi {
+                self.starts[band as usize + 1] += 1;
             }
         }
         for band in 0..count {
@@ -57,14 +64,13 @@ impl Bands {
         self.triangles.clear();
         self.triangles.resize(self.starts[count] as usize, 0);
         // `starts[band]` serves as the band's fill cursor, then is shifted back.
-        for (index, setup) in setups.iter().enumerate() {
-            if let Some((lo, hi)) = self.band_range(setup) {
-                for band in lo..=hi {
-                    self.triangles[self.starts[band] as usize] = index as u32;
-                    self.starts[band] += 1;
-                }
+        for (index, &(lo, hi)) in ranges.iter().enumerate() {
+            for band in lo as usize..=hi as usize {
+                self.triangles[self.starts[band] as usize] = index as u32;
+                self.starts[band] += 1;
             }
         }
+        self.ranges = ranges;
         for band in (1..=count).rev() {
             self.starts[band] = self.starts[band - 1];
         }
