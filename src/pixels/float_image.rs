@@ -68,7 +68,14 @@ pub struct FloatImage {
     /// The pixels as 8-bit texels, when they are exactly that (see
     /// [`eight_bit_texels`](Self::eight_bit_texels)); built with the image, dropped by
     /// [`pixels_mut`](Self::pixels_mut) and rebuilt on the next use.
-    eight_bit: OnceLock<Option<Box<[[u8; 4]]>>>,
+    eight_bit: OnceLock<Option<EightBitView>>,
+}
+
+/// The 8-bit texels, and whether every alpha level is 255.
+#[derive(Clone, Debug)]
+struct EightBitView {
+    texels: Box<[[u8; 4]]>,
+    opaque: bool,
 }
 
 impl PartialEq for FloatImage {
@@ -221,20 +228,33 @@ impl FloatImage {
     /// the image is made, and again on the first call after [`pixels_mut`](Self::pixels_mut)
     /// (O(pixels) each time).
     pub fn eight_bit_texels(&self) -> Option<&[[u8; 4]]> {
-        self.eight_bit
-            .get_or_init(|| self.quantised_exactly())
-            .as_deref()
+        self.eight_bit_view().map(|(texels, _)| texels)
     }
 
-    fn quantised_exactly(&self) -> Option<Box<[[u8; 4]]>> {
+    /// [`eight_bit_texels`](Self::eight_bit_texels), and whether every texel's alpha level
+    /// is 255 (then every bilinear sample's alpha is exactly 1, which the raster's kernel
+    /// need not test pixel by pixel).
+    pub(crate) fn eight_bit_view(&self) -> Option<(&[[u8; 4]], bool)> {
+        self.eight_bit
+            .get_or_init(|| self.quantised_exactly())
+            .as_ref()
+            .map(|view| (&view.texels[..], view.opaque))
+    }
+
+    fn quantised_exactly(&self) -> Option<EightBitView> {
         if self.format.depth != Depth::Eight {
             return None;
         }
         let mut view = vec![[0u8; 4]; self.pixels.len()];
+        let mut opaque = true;
         for (levels, pixel) in view.iter_mut().zip(&self.pixels) {
             *levels = level_of(pixel)?;
+            opaque &= levels[3] == u8::MAX;
         }
-        Some(view.into_boxed_slice())
+        Some(EightBitView {
+            texels: view.into_boxed_slice(),
+            opaque,
+        })
     }
 
     /// Pixel (i, j); `None` outside the image.
@@ -327,6 +347,27 @@ mod tests {
         assert!(written.eight_bit_texels().is_none());
         written.pixels_mut()[0][0] = 128.0 / 255.0;
         assert_eq!(written.eight_bit_texels().unwrap()[0][0], 128);
+    }
+
+    #[test]
+    fn the_eight_bit_view_is_opaque_exactly_when_every_alpha_level_is_255() {
+        let image = |alpha: f32| {
+            FloatImage::from_fn(3, 2, PixelFormat::RGBA8, |i, j| {
+                [0.0, 1.0, 0.0, if (i, j) == (1, 1) { alpha } else { 1.0 }]
+            })
+            .unwrap()
+        };
+        assert_eq!(
+            image(1.0).eight_bit_view().map(|(_, opaque)| opaque),
+            Some(true)
+        );
+        assert_eq!(
+            image(254.0 / 255.0).eight_bit_view().map(|(_, o)| o),
+            Some(false)
+        );
+        let mut written = image(1.0);
+        written.pixels_mut()[0][3] = 0.0;
+        assert_eq!(written.eight_bit_view().map(|(_, o)| o), Some(false));
     }
 
     #[test]

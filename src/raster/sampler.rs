@@ -62,6 +62,8 @@ pub(crate) struct Sampler<'a, S = [f32; 4]> {
     pub(super) last_y: usize,
     pub(super) last_x_f32: f32,
     pub(super) last_y_f32: f32,
+    /// Every texel's alpha is 1 (so is every sample's, exactly); `false` when unknown.
+    pub(super) opaque: bool,
 }
 
 impl<'a> Sampler<'a> {
@@ -95,7 +97,13 @@ impl<'a, S: SourceTexel> Sampler<'a, S> {
             last_y: source.height().saturating_sub(1) as usize,
             last_x_f32: last_as_f32(source.width()),
             last_y_f32: last_as_f32(source.height()),
+            opaque: false,
         }
+    }
+
+    /// Declares every texel's alpha 1 (the caller checked it).
+    pub fn known_opaque(self, opaque: bool) -> Sampler<'a, S> {
+        Sampler { opaque, ..self }
     }
 
     /// [`sample`](Self::sample) with `f32` coordinates and tap arithmetic (the shading hot

@@ -160,9 +160,9 @@ fn shade_rows<T: StoreTexel, C: CoverageTexel, R: Recorder<C>>(
     recorder: &mut R,
 ) -> (usize, usize) {
     let source = input.source;
-    match source.eight_bit_texels() {
-        Some(texels) => {
-            let sampler = Sampler::with_texels(source, texels);
+    match source.eight_bit_view() {
+        Some((texels, opaque)) => {
+            let sampler = Sampler::with_texels(source, texels).known_opaque(opaque);
             walk_rows(input, &sampler, rows, canvas, canvas_width, recorder)
         }
         None => {

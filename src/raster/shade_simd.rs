@@ -351,16 +351,18 @@ mod avx2 {
         taps: Taps,
         dx: __m256,
         len: usize,
+        /// Eight pixels, all fully covered (no pair needs its coverage looked at).
+        full: bool,
     }
 
     /// Shades pixels K and K + 1 of `block` (K + 1 only when the block has it); gives the
-    /// number written.
+    /// number written. `OPAQUE`: every sample's alpha is known to be 1.
     ///
     /// # Safety
     /// `block.taps` are taps of `sampler`; `K < block.len` = `coverage.len()` = `pixels.len()`.
     #[inline]
     #[target_feature(enable = "avx2")]
-    unsafe fn shade_pair<S: SourceTexel, const K: i32>(
+    unsafe fn shade_pair<S: SourceTexel, const K: i32, const OPAQUE: bool>(
         sampler: &Sampler<S>,
         maps: &RunMaps,
         block: &Block,
@@ -376,8 +378,14 @@ mod avx2 {
         // Interior pairs (full coverage, opaque source) are stored directly, the rest take
         // the scalar path out of line (a call per pair would cost as much as the pair).
         let both = at + 1 < block.len;
-        let opaque = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_GE_OQ>(sample, _mm256_set1_ps(1.0)));
-        if both && coverage[at] & coverage[at + 1] == u8::MAX && opaque & 0x88 == 0x88 {
+        let covered = block.full || (both && coverage[at] & coverage[at + 1] == u8::MAX);
+        let opaque = || {
+            OPAQUE
+                || _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_GE_OQ>(sample, _mm256_set1_ps(1.0)))
+                    & 0x88
+                    == 0x88
+        };
+        if covered && opaque() {
             let colour = _mm256_min_ps(
                 _mm256_max_ps(_mm256_add_ps(sample, membrane), _mm256_setzero_ps()),
                 _mm256_set1_ps(1.0),
@@ -426,6 +434,27 @@ mod avx2 {
     pub(super) unsafe fn shade_run<S: SourceTexel>(
         setup: &SpanSetup,
         sampler: &Sampler<S>,
+        at: (i32, i32),
+        coverage: &[u8],
+        pixels: &mut [[u8; 4]],
+    ) -> usize {
+        // SAFETY (both): the caller's contract.
+        if sampler.opaque {
+            unsafe { shade_run_as::<S, true>(setup, sampler, at, coverage, pixels) }
+        } else {
+            unsafe { shade_run_as::<S, false>(setup, sampler, at, coverage, pixels) }
+        }
+    }
+
+    /// [`shade_run`] knowing whether every sample is opaque.
+    ///
+    /// # Safety
+    /// As [`shade_run`].
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    unsafe fn shade_run_as<S: SourceTexel, const OPAQUE: bool>(
+        setup: &SpanSetup,
+        sampler: &Sampler<S>,
         (x0, y): (i32, i32),
         coverage: &[u8],
         pixels: &mut [[u8; 4]],
@@ -442,26 +471,26 @@ mod avx2 {
                 _mm256_set1_epi32(first_dx + k0 as i32),
                 lanes,
             ));
+            let len = (n - k0).min(8);
+            let (coverage, pixels) = (&coverage[k0..k0 + len], &mut pixels[k0..k0 + len]);
             let block = Block {
                 taps: taps_of_eight(sampler, &maps, dx),
                 dx,
-                len: (n - k0).min(8),
+                len,
+                full: <[u8; 8]>::try_from(coverage)
+                    .is_ok_and(|c| u64::from_ne_bytes(c) == u64::MAX),
             };
-            let (coverage, pixels) = (
-                &coverage[k0..k0 + block.len],
-                &mut pixels[k0..k0 + block.len],
-            );
             // SAFETY (each pair): taps are clamped into the image, lanes past the run included.
             unsafe {
-                written += shade_pair::<S, 0>(sampler, &maps, &block, coverage, pixels);
+                written += shade_pair::<S, 0, OPAQUE>(sampler, &maps, &block, coverage, pixels);
                 if block.len > 2 {
-                    written += shade_pair::<S, 2>(sampler, &maps, &block, coverage, pixels);
+                    written += shade_pair::<S, 2, OPAQUE>(sampler, &maps, &block, coverage, pixels);
                 }
                 if block.len > 4 {
-                    written += shade_pair::<S, 4>(sampler, &maps, &block, coverage, pixels);
+                    written += shade_pair::<S, 4, OPAQUE>(sampler, &maps, &block, coverage, pixels);
                 }
                 if block.len > 6 {
-                    written += shade_pair::<S, 6>(sampler, &maps, &block, coverage, pixels);
+                    written += shade_pair::<S, 6, OPAQUE>(sampler, &maps, &block, coverage, pixels);
                 }
             }
             k0 += 8;
