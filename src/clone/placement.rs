@@ -48,7 +48,7 @@ impl Placement {
     }
 
     /// Maps every rest point into `out` (resized to fit; reused across frames), on the grid
-    /// of [`PLACED_GRID`]: `on_grid(map′(p)) + ⌊at⌋`, where `map′` places the pivot at
+    /// of `PLACED_GRID` (2⁻¹⁶ px): `on_grid(map′(p)) + ⌊at⌋`, where `map′` places the pivot at
     /// `at − ⌊at⌋`.
     ///
     /// Why: moving `at` by whole pixels then moves every placed point by exactly that many

@@ -34,7 +34,7 @@ const MAX_SHIFT: f64 = (1u64 << 20) as f64;
 /// Largest recorded area (px): the record holds 17 bytes per covered pixel.
 const MAX_RECORDED_AREA: usize = 4 << 20;
 
-/// Recorded pixels from which a second thread (this thread's [helper](super::helper)) replays half the
+/// Recorded pixels from which a second thread (this thread's [`helper`]) replays half the
 /// rows. It is handed its half before the membrane solve, so any wake-up hides behind it;
 /// when a thread was spawned after the solve, 16K pixels measured slower than one thread.
 const THREADED_PIXELS: usize = 8 * 1024;
