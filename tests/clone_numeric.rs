@@ -184,6 +184,11 @@ fn outside_boundary_vertices_switch_off_and_come_back() {
         (first.membrane.constrained, first.membrane.outside),
         (boundary.len(), 0)
     );
+    // The factor is built with the whole boundary constrained: a first clone inside the
+    // target switches nothing (and so never refactors).
+    let switches = first.membrane.switches;
+    assert_eq!((switches.updates, switches.downdates), (0, 0));
+    assert!(!switches.refactored);
 
     let out = cloner
         .clone_onto(&mut target.clone(), &centred(DVec2::new(8.0, 40.0)))

@@ -176,6 +176,38 @@ fn drift_guard_fires_once_the_budget_is_spent() {
     assert_eq!(f.refactor_count(), refactors_before + 1);
 }
 
+/// A factor built with constraints on solves like one built without and switched: the
+/// same constrained set, solutions within 1e-12 of a fresh refactor's; it then switches on
+/// from there like any other factor.
+#[test]
+fn factors_built_constrained_match_factors_switched_on() {
+    for kind in [LaplacianKind::Combinatorial, LaplacianKind::Cotangent] {
+        let mesh = fixtures::disc(9);
+        let l = laplacian(&mesh, kind);
+        let opts = PenaltyOptions::default();
+        let mut built = PenaltyFactor::with_constrained(&l, &opts, &mesh.is_boundary).unwrap();
+        let boundary = mesh.is_boundary.iter().filter(|&&b| b).count();
+        assert_eq!(built.constrained(), &mesh.is_boundary[..]);
+        assert_eq!(built.constrained_count(), boundary);
+        assert_eq!(built.refactor_count(), 0);
+        // Nothing to switch: the constrained set is already the wanted one.
+        let stats = built.set_constrained(&mesh.is_boundary).unwrap();
+        assert_eq!((stats.updates, stats.downdates), (0, 0));
+        assert!(compare_with_fresh(&l, &mut built, &opts, 5) <= 1e-12);
+        let mut rng = Rng(77);
+        for _ in 0..200 {
+            let v = rng.below(l.n);
+            built.switch(&[(v, !built.is_constrained(v))]).unwrap();
+        }
+        assert!(compare_with_fresh(&l, &mut built, &opts, 6) <= 1e-9);
+    }
+    let l = laplacian(&fixtures::grid(2, 2), LaplacianKind::Combinatorial);
+    assert!(matches!(
+        PenaltyFactor::with_constrained(&l, &PenaltyOptions::default(), &[true]),
+        Err(SolveError::WrongLength { got: 1, .. })
+    ));
+}
+
 #[test]
 fn bad_switch_input_is_an_error_and_changes_nothing() {
     let l = laplacian(&fixtures::grid(2, 2), LaplacianKind::Combinatorial);

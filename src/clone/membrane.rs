@@ -45,8 +45,14 @@ impl MembraneSolver {
     /// source at the rest boundary.
     pub fn new(mesh: &Mesh, source: &FloatImage, kind: LaplacianKind) -> Result<Self, CloneError> {
         let l = laplacian(mesh, kind);
-        let factor = PenaltyFactor::new(&l, &PenaltyOptions::default())?;
         let boundary: Vec<u32> = mesh.boundary_vertices().collect();
+        // Factored with every boundary constraint on, the usual state: a first clone inside
+        // the target then switches nothing (switching them all on would refactor).
+        let mut wanted = vec![false; mesh.vertex_count()];
+        for &v in &boundary {
+            wanted[v as usize] = true;
+        }
+        let factor = PenaltyFactor::with_constrained(&l, &PenaltyOptions::default(), &wanted)?;
         let source_at_boundary = boundary
             .iter()
             .map(|&v| {
@@ -59,7 +65,7 @@ impl MembraneSolver {
             factor,
             boundary,
             source_at_boundary,
-            wanted: vec![false; n],
+            wanted,
             values: vec![0.0; n * MEMBRANE_CHANNELS],
             membrane: vec![[0.0; 3]; n],
         })

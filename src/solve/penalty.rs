@@ -227,6 +227,31 @@ pub struct PenaltyFactor {
 impl PenaltyFactor {
     /// Analyses and factors `l + εI` with no constraint on.
     pub fn new(l: &SymmetricCsc, opts: &PenaltyOptions) -> Result<Self, SolveError> {
+        Self::build(l, opts, None)
+    }
+
+    /// Analyses and factors `l + εI + P` with the constraints `constrained[v]` on (length
+    /// n): one factorisation where [`new`](Self::new) followed by switching them on would
+    /// cost a second (a batch that large refactors).
+    pub fn with_constrained(
+        l: &SymmetricCsc,
+        opts: &PenaltyOptions,
+        constrained: &[bool],
+    ) -> Result<Self, SolveError> {
+        if constrained.len() != l.n {
+            return Err(SolveError::WrongLength {
+                got: constrained.len(),
+                expected: l.n,
+            });
+        }
+        Self::build(l, opts, Some(constrained))
+    }
+
+    fn build(
+        l: &SymmetricCsc,
+        opts: &PenaltyOptions,
+        constrained: Option<&[bool]>,
+    ) -> Result<Self, SolveError> {
         let symbolic = SymbolicFactor::analyse_scheduled(l, opts.method, opts.schedule)?;
         let scale = l.diagonal_scale();
         let alpha = opts.alpha.unwrap_or(DEFAULT_ALPHA_RELATIVE * scale);
@@ -256,8 +281,8 @@ impl PenaltyFactor {
             epsilon,
             drift_budget: opts.drift_budget,
             workspace,
-            constrained: vec![false; n],
-            constrained_count: 0,
+            constrained: constrained.map_or_else(|| vec![false; n], <[bool]>::to_vec),
+            constrained_count: constrained.map_or(0, |c| c.iter().filter(|&&on| on).count()),
             drift: 0.0,
             refactor_count: 0,
             update_scratch: vec![0.0; n],
