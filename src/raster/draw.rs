@@ -111,15 +111,18 @@ pub fn draw_patch_solving<'m, E: From<RasterError>>(
     let record = replayable
         && target == work
         && scratch.replay.wants_record(patch, options.anti_alias, work);
-    // A recording takes everything in order, on this thread.
-    let threads = if record {
-        1
-    } else {
-        worker_threads(options.threads, work.area(), usize::MAX)
-    };
-    let membrane = prepare(patch, work, options.anti_alias, threads, scratch, || {
-        solve(canvas)
-    })?;
+    // A recording shades everything in order, on this thread; the preparation records
+    // nothing, so it shares the work (and the solve's time) as usual.
+    let prepare_threads = worker_threads(options.threads, work.area(), usize::MAX);
+    let threads = if record { 1 } else { prepare_threads };
+    let membrane = prepare(
+        patch,
+        work,
+        options.anti_alias,
+        prepare_threads,
+        scratch,
+        || solve(canvas),
+    )?;
     let patch = &Patch { membrane, ..*patch };
     let frame = Frame {
         patch,
