@@ -55,15 +55,87 @@ impl Mesh {
     }
 
     /// Unique undirected edges (i < j), sorted.
+    ///
+    /// A counting sort by the first vertex, then a sort of each vertex's few neighbours: a
+    /// comparison sort of all the triangles' edges cost more than the factorisation it feeds.
     pub fn edges(&self) -> Vec<(u32, u32)> {
-        let mut edges: Vec<(u32, u32)> = self
+        let ordered = |a: u32, b: u32| (a.min(b), a.max(b));
+        let corners = |t: &[u32; 3]| {
+            [
+                ordered(t[0], t[1]),
+                ordered(t[1], t[2]),
+                ordered(t[2], t[0]),
+            ]
+        };
+        // Sized by the largest index used, so a mesh whose triangles name vertices it lacks
+        // still gets its edges (its sanity check reports the fault).
+        let buckets = self
             .triangles
             .iter()
-            .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
-            .map(|(a, b)| (a.min(b), a.max(b)))
-            .collect();
-        edges.sort_unstable();
-        edges.dedup();
+            .flatten()
+            .max()
+            .map_or(0, |&v| v as usize + 1);
+        let mut start = vec![0usize; buckets + 1];
+        for (a, _) in self.triangles.iter().flat_map(corners) {
+            start[a as usize + 1] += 1;
+        }
+        for v in 0..buckets {
+            start[v + 1] += start[v];
+        }
+        let mut next = start.clone();
+        let mut seconds = vec![0u32; start[buckets]];
+        for (a, b) in self.triangles.iter().flat_map(corners) {
+            seconds[next[a as usize]] = b;
+            next[a as usize] += 1;
+        }
+        let mut edges = Vec::with_capacity(seconds.len() / 2 + buckets);
+        for a in 0..buckets {
+            let neighbours = &mut seconds[start[a]..start[a + 1]];
+            neighbours.sort_unstable();
+            let mut last = None;
+            for &b in neighbours.iter() {
+                if last != Some(b) {
+                    edges.push((a as u32, b));
+                    last = Some(b);
+                }
+            }
+        }
         edges
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::solve::fixtures;
+
+    /// The counting sort gives what sorting and deduplicating every triangle edge gives.
+    #[test]
+    fn edges_match_the_sorted_deduplicated_triangle_edges() {
+        let mut fan = fixtures::disc(5);
+        // A hub: one vertex in every triangle of a 300-triangle fan.
+        let hub = fan.positions.len() as u32;
+        fan.positions.push(glam::DVec2::ZERO);
+        let rim: Vec<u32> = (0..300).map(|k| hub + 1 + k).collect();
+        fan.positions
+            .extend((0..300).map(|k| glam::DVec2::new(f64::from(k), 1.0)));
+        fan.triangles
+            .extend(rim.windows(2).map(|w| [w[1], hub, w[0]]));
+        for mesh in [
+            fixtures::grid(6, 4),
+            fixtures::disc(7),
+            fan,
+            Mesh::default(),
+        ] {
+            let mut expected: Vec<(u32, u32)> = mesh
+                .triangles
+                .iter()
+                .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
+                .map(|(a, b)| (a.min(b), a.max(b)))
+                .collect();
+            expected.sort_unstable();
+            expected.dedup();
+            assert_eq!(mesh.edges(), expected);
+        }
     }
 }
