@@ -9,7 +9,7 @@
 use glam::DVec2;
 
 use super::centre_loops::outside_centre_loops;
-use super::contour::{label_pieces, trace_crack_loops, CrackLoop};
+use super::contour::{for_each_edge_pixel, label_pieces, trace_crack_loops, CrackLoop};
 use super::options::{min_angle_deg, BoundaryPlacement};
 use super::simplify::{doubled_signed_area, simplify_loop, subdivide_loop, subdivided_len};
 use super::triangulate::{triangulate_loops, Refinement};
@@ -304,18 +304,14 @@ const MIN_CRACK_EDGE_LIMIT: usize = 1 << 20;
 /// Pixel edges between inside and outside (the image border counts as outside), counted
 /// without allocating.
 fn crack_edge_count(mask: &BitMask) -> usize {
-    let (w, h) = (mask.width as i64, mask.height as i64);
     let mut edges = 0;
-    for y in 0..h {
-        for x in 0..w {
-            if mask.get(x, y) {
-                edges += [(-1, 0), (1, 0), (0, -1), (0, 1)]
-                    .iter()
-                    .filter(|(dx, dy)| !mask.get(x + dx, y + dy))
-                    .count();
-            }
-        }
-    }
+    for_each_edge_pixel(mask, |x, y| {
+        let (x, y) = (x as i64, y as i64);
+        edges += [(-1, 0), (1, 0), (0, -1), (0, 1)]
+            .iter()
+            .filter(|(dx, dy)| !mask.get(x + dx, y + dy))
+            .count();
+    });
     edges
 }
 
