@@ -21,14 +21,31 @@ pub fn doubled_signed_area(points: &[DVec2]) -> f64 {
         .sum()
 }
 
-fn distance_to_segment(p: DVec2, a: DVec2, b: DVec2) -> f64 {
-    let ab = b - a;
-    let len2 = ab.length_squared();
-    if len2 == 0.0 {
-        return p.distance(a);
+/// A segment with the parts of the point distance that do not depend on the point.
+struct Segment {
+    a: DVec2,
+    ab: DVec2,
+    len2: f64,
+}
+
+impl Segment {
+    fn new(a: DVec2, b: DVec2) -> Self {
+        let ab = b - a;
+        Segment {
+            a,
+            ab,
+            len2: ab.length_squared(),
+        }
     }
-    let t = ((p - a).dot(ab) / len2).clamp(0.0, 1.0);
-    p.distance(a + ab * t)
+
+    /// Distance from `p` to the segment.
+    fn distance(&self, p: DVec2) -> f64 {
+        if self.len2 == 0.0 {
+            return p.distance(self.a);
+        }
+        let t = ((p - self.a).dot(self.ab) / self.len2).clamp(0.0, 1.0);
+        p.distance(self.a + self.ab * t)
+    }
 }
 
 /// Douglas–Peucker on a closed loop. Points with `anchor[i]` set are always kept; the first
@@ -64,13 +81,15 @@ pub fn simplify_loop(points: &[DVec2], anchor: &[bool], tolerance: f64) -> Simpl
             if b - a < 2 {
                 continue;
             }
-            let (pa, pb) = (points[a % n], points[b % n]);
+            // Indices run up to 2n (the loop unrolled once): wrap without a division.
+            let wrap = |i: usize| if i < n { i } else { i - n };
+            let segment = Segment::new(points[wrap(a)], points[wrap(b)]);
             let (worst, distance) = (a + 1..b)
-                .map(|i| (i, distance_to_segment(points[i % n], pa, pb)))
+                .map(|i| (i, segment.distance(points[wrap(i)])))
                 .max_by(|x, y| x.1.total_cmp(&y.1))
                 .unwrap_or((a, 0.0));
             if distance > tolerance {
-                keep[worst % n] = true;
+                keep[wrap(worst)] = true;
                 stack.push((worst, b));
                 stack.push((a, worst));
             } else {
@@ -146,7 +165,7 @@ mod tests {
         let m = s.points.len();
         for p in &pts {
             let d = (0..m)
-                .map(|i| distance_to_segment(*p, s.points[i], s.points[(i + 1) % m]))
+                .map(|i| Segment::new(s.points[i], s.points[(i + 1) % m]).distance(*p))
                 .fold(f64::INFINITY, f64::min);
             assert!(d <= 0.9 + 1e-12);
         }
