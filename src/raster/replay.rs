@@ -479,3 +479,108 @@ fn whole_pixel_shift(before: &[DVec2], now: &[DVec2]) -> Option<(i32, i32)> {
     let exact = before.iter().zip(now).all(|(b, n)| *b + shift == *n);
     exact.then_some((shift.x as i32, shift.y as i32))
 }
+
+#[cfg(test)]
+mod tests {
+    use glam::DVec2;
+
+    use crate::mesh::{BoundaryLoop, LoopKind};
+    use crate::pixels::{Canvas, FloatImage, PixelFormat};
+    use crate::raster::{draw_patch, Patch, RasterOptions, RasterScratch};
+
+    /// A rotated, scaled `cells`² grid whose triangles give runs long enough for the SIMD
+    /// kernel, over a source of exact 8-bit levels (`translucent`: alpha below 1 in places).
+    fn record(simd: bool, translucent: bool) -> RasterScratch {
+        let cells = 6u32;
+        let side = cells + 1;
+        let rest: Vec<DVec2> = (0..side * side)
+            .map(|k| DVec2::new((k % side) as f64 * 9.0 + 2.0, (k / side) as f64 * 8.0 + 3.0))
+            .collect();
+        let mut triangles = vec![];
+        for j in 0..cells {
+            for i in 0..cells {
+                let v = j * side + i;
+                triangles.push([v, v + 1, v + side + 1]);
+                triangles.push([v, v + side + 1, v + side]);
+            }
+        }
+        let ring = (0..cells)
+            .chain((0..cells).map(|j| j * side + cells))
+            .chain((0..cells).map(|i| cells * side + cells - i))
+            .chain((0..cells).map(|j| (cells - j) * side))
+            .collect();
+        let loops = [BoundaryLoop {
+            kind: LoopKind::Outer,
+            piece: 0,
+            vertices: ring,
+        }];
+        let placed: Vec<DVec2> = rest
+            .iter()
+            .map(|p| DVec2::new(1.3 * p.x - 0.4 * p.y + 30.3, 0.4 * p.x + 1.3 * p.y + 7.6))
+            .collect();
+        let membrane: Vec<[f32; 3]> = rest
+            .iter()
+            .map(|p| [(p.x * 0.004) as f32, -0.03, (p.y * 0.003) as f32])
+            .collect();
+        let source = FloatImage::from_fn(60, 56, PixelFormat::RGBA8, |i, j| {
+            let level = |m: u32| ((i * m + j * 37 + m) % 256) as f32 / 255.0;
+            let alpha = if translucent && (i + j) % 5 == 0 {
+                0.4
+            } else {
+                1.0
+            };
+            [level(13), level(29), level(71), alpha]
+        })
+        .unwrap();
+        assert!(source.eight_bit_texels().is_some(), "exact 8-bit levels");
+        let patch = Patch {
+            rest: &rest,
+            placed: &placed,
+            triangles: &triangles,
+            membrane: &membrane,
+            depth: None,
+            loops: &loops,
+            source: &source,
+        };
+        let mut canvas = Canvas::from_image(
+            &FloatImage::from_fn(140, 150, PixelFormat::RGBA8, |_, _| [0.3, 0.5, 0.7, 1.0])
+                .unwrap(),
+        );
+        let options = RasterOptions {
+            replay: true,
+            simd,
+            ..RasterOptions::default()
+        };
+        let mut scratch = RasterScratch::new();
+        draw_patch(&mut canvas, &patch, &options, &mut scratch).unwrap();
+        scratch
+    }
+
+    #[test]
+    fn a_record_made_by_the_simd_kernel_is_the_scalar_record_bit_for_bit() {
+        for translucent in [false, true] {
+            let (simd, scalar) = (record(true, translucent), record(false, translucent));
+            let (simd, scalar) = (&simd.replay, &scalar.replay);
+            assert!(!scalar.samples.is_empty(), "the draw recorded");
+            assert!(
+                scalar.runs.iter().filter(|r| r.len >= 8).count() > 10,
+                "runs long enough for the kernel"
+            );
+            assert_eq!(format!("{:?}", simd.runs), format!("{:?}", scalar.runs));
+            assert_eq!(simd.coverage, scalar.coverage);
+            assert_eq!(simd.fringe, scalar.fringe);
+            assert_eq!(simd.triangles, scalar.triangles);
+            let bits = |samples: &[glam::Vec4]| -> Vec<[u32; 4]> {
+                samples
+                    .iter()
+                    .map(|s| s.to_array().map(f32::to_bits))
+                    .collect()
+            };
+            assert_eq!(
+                bits(&simd.samples),
+                bits(&scalar.samples),
+                "translucent {translucent}"
+            );
+        }
+    }
+}

@@ -191,12 +191,10 @@ fn walk_rows<S: SourceTexel, T: StoreTexel, C: CoverageTexel, R: Recorder<C>>(
         (rows.x0 - input.coverage_origin.0) as usize,
         (rows.x1 - input.coverage_origin.0) as usize,
     );
-    // A recording draw stays scalar: replays must agree with it byte for byte, and the
-    // scalar path is the one that reports every sample.
     // The SIMD kernel indexes texels with i32 lanes: sources beyond 2³¹ texels (far above
     // `limits`, but a library caller may build one) take the scalar path.
     let small_source = input.source.pixels().len() <= i32::MAX as usize;
-    let kernel = if R::ACTIVE || !small_source {
+    let kernel = if !small_source {
         Kernel::Scalar
     } else {
         input.kernel
@@ -226,7 +224,7 @@ fn walk_rows<S: SourceTexel, T: StoreTexel, C: CoverageTexel, R: Recorder<C>>(
             } else {
                 hits += end - start;
                 let setup = &input.setups[id as usize];
-                match simd_run(kernel, setup, sampler, &span, pixels) {
+                match simd_run(kernel, setup, sampler, &span, pixels, recorder) {
                     Some(written) => written,
                     None => shade_span(setup, sampler, &span, pixels, recorder),
                 }
@@ -300,17 +298,23 @@ const SIMD_MIN_RUN: usize = 3;
 /// The run shaded by the SIMD kernel when there is one for this CPU and these texel types
 /// (8-bit canvas and coverage); `None`: the caller shades it the scalar way.
 #[inline(always)]
-fn simd_run<S: SourceTexel, T: StoreTexel, C: CoverageTexel>(
+fn simd_run<S: SourceTexel, T: StoreTexel, C: CoverageTexel, R: Recorder<C>>(
     kernel: Kernel,
     setup: &TriangleSetup,
     sampler: &Sampler<S>,
     span: &Span<C>,
     pixels: &mut [[T; 4]],
+    recorder: &mut R,
 ) -> Option<usize> {
     #[cfg(target_arch = "x86_64")]
     if kernel != Kernel::Scalar && span.coverage.len() >= SIMD_MIN_RUN {
         if let (Some(coverage), Some(pixels)) = (C::as_bytes(span.coverage), T::as_rgba8(pixels)) {
             let at = (span.x0, span.y);
+            let mut sink = RecorderSink {
+                recorder,
+                coverage: span.coverage,
+                next: 0,
+            };
             return Some(shade_run_rgba8(
                 kernel,
                 &setup.span,
@@ -318,11 +322,35 @@ fn simd_run<S: SourceTexel, T: StoreTexel, C: CoverageTexel>(
                 at,
                 coverage,
                 pixels,
+                &mut sink,
             ));
         }
     }
-    let _ = (kernel, setup, sampler, span, pixels);
+    let _ = (kernel, setup, sampler, span, pixels, recorder);
     None
+}
+
+/// A [`Recorder`] seen by the SIMD kernel: it reports byte coverage, which is the run's own
+/// coverage texels (the kernel runs only when they are bytes), so each report takes the next
+/// texel of the run instead of converting.
+#[cfg(target_arch = "x86_64")]
+struct RecorderSink<'a, C, R> {
+    recorder: &'a mut R,
+    coverage: &'a [C],
+    next: usize,
+}
+
+#[cfg(target_arch = "x86_64")]
+impl<C: CoverageTexel, R: Recorder<C>> super::shade_simd::SampleSink for RecorderSink<'_, C, R> {
+    const ACTIVE: bool = R::ACTIVE;
+
+    #[inline(always)]
+    fn pixel(&mut self, sample: Option<Vec4>, _coverage: u8) {
+        // invariant: the kernel reports each pixel of the run once, in order.
+        let texel = self.coverage[self.next];
+        self.next += 1;
+        self.recorder.pixel(sample, texel);
+    }
 }
 
 /// Source sample plus membrane, composited with the pixel's coverage; whether it changed.
