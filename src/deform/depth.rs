@@ -3,19 +3,19 @@
 //! `depth_h = 1`), 0 at vertices held by an explicit pin (rules in [`deform`](super)).
 
 use super::rig::DeformRig;
-use super::Handle;
 
 impl DeformRig {
-    /// Writes the depth of every vertex into `depth` (length n).
-    pub(crate) fn vertex_depth(&self, handles: &[Handle], depth: &mut [f32]) {
-        for (v, (p, out)) in self.rest.iter().zip(depth.iter_mut()).enumerate() {
+    /// Writes the depth of every vertex into `depth` (length n), for the `handles` count of
+    /// handles whose frames and falloff weights are up to date.
+    pub(crate) fn vertex_depth(&self, handles: usize, depth: &mut [f32]) {
+        let slots = self.frames.iter().zip(&self.falloff).take(handles);
+        for (v, out) in depth.iter_mut().enumerate() {
             *out = if self.pinned[v] {
                 0.0
             } else {
-                handles
-                    .iter()
-                    .zip(&self.frames)
-                    .map(|(h, f)| f64::from(f.depth) * (-f.rate * p.distance_squared(h.from)).exp())
+                slots
+                    .clone()
+                    .map(|(f, falloff)| f64::from(f.depth) * falloff.vertices[v])
                     .sum::<f64>() as f32
             };
         }

@@ -66,6 +66,7 @@
 pub mod constraints;
 pub mod depth;
 pub mod divergence;
+pub(crate) mod falloff;
 pub mod inversion;
 pub mod rig;
 pub mod rotation;

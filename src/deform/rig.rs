@@ -3,6 +3,7 @@
 //! and share-weighted edge vectors, the rest centroid (default pivot), the assembled Laplacian
 //! and its own [`PenaltyFactor`], plus the per-frame scratch that [`step`](super::step) reuses.
 
+use super::falloff::HandleFalloff;
 use super::weights::{assemble_laplacian, edge_shares};
 use super::{DeformError, DeformOptions};
 use crate::mesh::Mesh;
@@ -35,6 +36,8 @@ pub struct DeformRig {
     pub(crate) factor: PenaltyFactor,
     // Per-frame scratch.
     pub(crate) frames: Vec<HandleFrame>,
+    /// Per handle slot: its falloff weights, kept while its grab point and rate hold.
+    pub(crate) falloff: Vec<HandleFalloff>,
     pub(crate) theta: Vec<f64>,
     pub(crate) wanted: Vec<bool>,
     pub(crate) pinned: Vec<bool>,
@@ -88,6 +91,7 @@ impl DeformRig {
             laplacian,
             factor,
             frames: Vec::new(),
+            falloff: Vec::new(),
             theta: vec![0.0; mesh.triangles.len()],
             wanted: vec![false; n],
             pinned: vec![false; n],

@@ -66,15 +66,16 @@ impl DeformRig {
         Ok(())
     }
 
-    /// `self.theta[t] = Σ_h θ_h exp(−rate_h |c_t − p0_h|²)`.
-    pub(crate) fn triangle_angles(&mut self, handles: &[Handle]) {
+    /// `self.theta[t] = Σ_h θ_h exp(−rate_h |c_t − p0_h|²)`, the exponentials from
+    /// [`update_falloff`](DeformRig::update_falloff).
+    pub(crate) fn triangle_angles(&mut self) {
         self.theta.iter_mut().for_each(|a| *a = 0.0);
-        for (h, frame) in handles.iter().zip(&self.frames) {
+        for (frame, falloff) in self.frames.iter().zip(&self.falloff) {
             if frame.theta == 0.0 {
                 continue;
             }
-            for (angle, c) in self.theta.iter_mut().zip(&self.centroids) {
-                *angle += frame.theta * (-frame.rate * c.distance_squared(h.from)).exp();
+            for (angle, weight) in self.theta.iter_mut().zip(&falloff.triangles) {
+                *angle += frame.theta * weight;
             }
         }
     }

@@ -16,6 +16,7 @@ impl DeformRig {
         out: &mut Deformed,
     ) -> Result<DeformStats, DeformError> {
         self.prepare_handles(handles)?;
+        self.update_falloff(handles);
         self.choose_constraints(handles, pins)?;
         let n = self.rest.len();
         out.positions.resize(n, DVec2::ZERO);
@@ -24,7 +25,7 @@ impl DeformRig {
         if handles.is_empty() && !self.options.solve_without_handles {
             out.positions.copy_from_slice(&self.rest);
         } else {
-            self.triangle_angles(handles);
+            self.triangle_angles();
             self.divergence_rhs();
             let switched = self.apply_constraints()?;
             stats.updates = switched.updates;
@@ -38,7 +39,7 @@ impl DeformRig {
             }
         }
         stats.constrained = self.factor.constrained_count();
-        self.vertex_depth(handles, &mut out.depth);
+        self.vertex_depth(handles.len(), &mut out.depth);
         Ok(stats)
     }
 }
