@@ -269,19 +269,13 @@ impl Replay {
                 continue;
             }
             hits += run.len as usize;
-            let span = maps.of(run.id);
-            // `at_pixel`'s terms, hoisted: `(m₀ + m_x·dx) + m_y·dy` in that order, with the
-            // row's `m_y·dy` computed once and dx stepped exactly (small integers in f32).
-            let [m_origin, m_x, m_y] = span.maps;
-            let row_term = m_y * (y - span.origin[1]) as f32;
-            let mut dx = (x0 - span.origin[0]) as f32;
+            let mut membrane = maps.of(run.id).along_row(x0, y);
             for (pixel, &cover) in pixels.iter_mut().zip(coverage.by_ref()) {
                 if cover > 0 {
                     let Some(&sample) = samples.next() else { break };
-                    let membrane = m_origin + m_x * dx + row_term;
-                    written += usize::from(shade_pixel(pixel, sample, membrane, cover));
+                    written += usize::from(shade_pixel(pixel, sample, membrane.value(), cover));
                 }
-                dx += 1.0;
+                membrane.advance();
             }
         }
         (hits, written)

@@ -123,6 +123,52 @@ impl MembraneSpan {
         let [m_origin, m_x, m_y] = self.maps;
         m_origin + m_x * dx + m_y * dy
     }
+
+    /// [`at_pixel`](Self::at_pixel) along row `y` from column `x0` (see [`RowWalk`]).
+    #[inline(always)]
+    pub fn along_row(&self, x0: i32, y: i32) -> RowWalk<Vec4> {
+        RowWalk::new(self.maps, (x0 - self.origin[0], y - self.origin[1]))
+    }
+}
+
+/// An affine map's values along one row: at dx = dx₀, dx₀ + 1, … it gives
+/// `(m₀ + m_x·dx) + m_y·dy`, the per-pixel evaluation's operations in its order, with the
+/// row's `m_y·dy` computed once and dx stepped by 1.0 (exact: the offsets are integers far
+/// below 2²⁴). So a walk gives the per-pixel values bit for bit.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct RowWalk<T> {
+    origin: T,
+    step: T,
+    row_term: T,
+    dx: f32,
+}
+
+impl<T> RowWalk<T>
+where
+    T: Copy + std::ops::Add<Output = T> + std::ops::Mul<f32, Output = T>,
+{
+    /// The walk of `[m₀, m_x, m_y]` from pixel offset `(dx₀, dy)` relative to the maps' origin.
+    #[inline(always)]
+    pub fn new([origin, step, m_y]: [T; 3], (dx, dy): (i32, i32)) -> RowWalk<T> {
+        RowWalk {
+            origin,
+            step,
+            row_term: m_y * dy as f32,
+            dx: dx as f32,
+        }
+    }
+
+    /// The value at the current pixel.
+    #[inline(always)]
+    pub fn value(&self) -> T {
+        self.origin + self.step * self.dx + self.row_term
+    }
+
+    /// Moves to the next pixel of the row.
+    #[inline(always)]
+    pub fn advance(&mut self) {
+        self.dx += 1.0;
+    }
 }
 
 /// `⌊v⌋` for `|v| ≤ MAX_COORDINATE` (NaN gives 0), without the libm call `f64::floor`
@@ -306,6 +352,57 @@ pub(crate) fn edge_function(a: [i64; 2], b: [i64; 2], p: [i64; 2]) -> i64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Row walks give `at_pixel`'s values bit for bit, for placed triangles anywhere in the
+    /// coordinate range and runs starting on either side of the maps' origin.
+    #[test]
+    fn row_walks_are_the_per_pixel_maps_bit_for_bit() {
+        let mut state = 0x5eed_u64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut walked = 0;
+        for _ in 0..300 {
+            let far = 4000.0 * next() * next();
+            let corner = |next: &mut dyn FnMut() -> f64| {
+                DVec2::new(far * (2.0 * next() - 1.0), far * (2.0 * next() - 1.0))
+            };
+            let placed = [corner(&mut next), corner(&mut next), corner(&mut next)];
+            let rest = [corner(&mut next), corner(&mut next), corner(&mut next)];
+            let membrane = [0, 1, 2].map(|_| [next() as f32, -next() as f32, next() as f32]);
+            let setup = TriangleSetup::new(placed, rest, membrane, [0.0; 3]);
+            if !setup.drawable {
+                continue;
+            }
+            let span = &setup.span;
+            let y = span.membrane.origin[1] + (next() * 200.0) as i32 - 100;
+            let x0 = span.membrane.origin[0] + (next() * 200.0) as i32 - 100;
+            let offset = (x0 - span.membrane.origin[0], y - span.membrane.origin[1]);
+            let (mut u, mut v) = (
+                RowWalk::new(span.texel_x, offset),
+                RowWalk::new(span.texel_y, offset),
+            );
+            let mut m = span.membrane.along_row(x0, y);
+            for x in x0..x0 + 40 {
+                let (eu, ev, em) = span.at_pixel(x, y);
+                assert_eq!(u.value().to_bits(), eu.to_bits(), "u at {x}");
+                assert_eq!(v.value().to_bits(), ev.to_bits(), "v at {x}");
+                assert_eq!(
+                    m.value().to_array().map(f32::to_bits),
+                    em.to_array().map(f32::to_bits),
+                    "membrane at {x}"
+                );
+                u.advance();
+                v.advance();
+                m.advance();
+            }
+            walked += 1;
+        }
+        assert!(walked > 250, "{walked} drawable triangles walked");
+    }
 
     #[test]
     fn floor_to_i32_is_floor_over_the_coordinate_range() {
