@@ -5,28 +5,33 @@
 //! strictly greater than the vertex's own. Independent of the pixel grid; candidates are
 //! reported in the order given, so the answer is deterministic.
 //!
-//! A uniform grid over the placed bounding box, rebuilt per call into reusable buffers,
-//! makes each query look at the few triangles near the vertex. Each triangle's bounding
-//! box and cell span are computed once per call (the grid's two passes and the queries
-//! share them), and a query rejects a triangle by its box before any edge function: on
-//! graded meshes a cell near the boundary lists dozens of small triangles, and most of
-//! them are rejected by two comparisons.
+//! A uniform grid over the candidates, rebuilt per call into reusable buffers, lets each
+//! triangle look only at the candidates near it: per grid row that its bounding box spans,
+//! the candidates of its cells are one contiguous slice (cells are numbered row by row), so
+//! a triangle costs a few slice look-ups plus a box test per nearby candidate. The candidates
+//! are about a fifth of the vertices and sit along the boundary, so this visits far fewer
+//! (candidate, triangle) pairs than a grid over the triangles queried per candidate, and a
+//! candidate found covered is not tested again. The predicate of each pair is unchanged, so
+//! the answer is too.
 
 use glam::DVec2;
 
 use super::RasterError;
 
-/// Reusable buffers of the spatial grid.
+/// Reusable buffers of the candidates' grid.
 #[derive(Default, Debug)]
 pub struct CoverageGrid {
+    /// Per cell (and one past the last): the first of its candidates in `cell_candidates`.
     cell_start: Vec<u32>,
-    cell_triangles: Vec<u32>,
-    cursor: Vec<u32>,
-    /// Per triangle: bounding box `[min x, min y, max x, max y]`.
-    boxes: Vec<[f64; 4]>,
-    /// Per triangle: cell span `[first column, first row, last column, last row]`.
-    spans: Vec<[u32; 4]>,
-    origin: DVec2,
+    /// Candidate slots (indices into the candidate list), grouped by cell.
+    cell_candidates: Vec<u32>,
+    /// Per slot: its cell.
+    cell_of_slot: Vec<u32>,
+    /// Per slot: found covered.
+    covered: Vec<bool>,
+    /// The candidates' bounding box.
+    min: DVec2,
+    max: DVec2,
     inverse_cell: f64,
     columns: usize,
     rows: usize,
@@ -37,94 +42,101 @@ impl CoverageGrid {
         CoverageGrid::default()
     }
 
-    fn build(&mut self, placed: &[DVec2], triangles: &[[u32; 3]]) {
-        self.boxes.clear();
-        self.boxes.extend(triangles.iter().map(|tri| {
-            let [a, b, c] = tri.map(|v| placed[v as usize]);
-            let (min, max) = (a.min(b).min(c), a.max(b).max(c));
-            [min.x, min.y, max.x, max.y]
-        }));
-        let (min, max) = bounds(&self.boxes);
-        let extent = (max - min).max(DVec2::splat(1e-9));
-        // About one triangle per cell on average.
-        let cell = ((extent.x * extent.y) / triangles.len().max(1) as f64)
+    /// Buckets the candidates' placed positions (the grid covers their bounding box).
+    fn build(&mut self, placed: &[DVec2], candidates: &[u32]) {
+        self.min = DVec2::splat(f64::INFINITY);
+        self.max = DVec2::splat(f64::NEG_INFINITY);
+        for &v in candidates {
+            let p = placed[v as usize];
+            self.min = self.min.min(p);
+            self.max = self.max.max(p);
+        }
+        let extent = (self.max - self.min).max(DVec2::splat(1e-9));
+        // About four cells per candidate: boundary candidates line up along curves, so an
+        // occupied cell holds a few, and a small boundary triangle's box spans one or two
+        // cells. The second bound keeps a box that is flat (candidates on a line) at about
+        // 4n cells per side, so never more than about 12n cells.
+        let slots = 4.0 * candidates.len() as f64;
+        let cell = ((extent.x * extent.y) / slots)
             .sqrt()
+            .max(extent.max_element() / slots)
             .max(1e-9);
         self.columns = ((extent.x / cell).ceil() as usize).clamp(1, 4096);
         self.rows = ((extent.y / cell).ceil() as usize).clamp(1, 4096);
-        self.origin = min;
         self.inverse_cell = 1.0 / (extent.x / self.columns as f64).max(extent.y / self.rows as f64);
         let cells = self.columns * self.rows;
         self.cell_start.clear();
         self.cell_start.resize(cells + 1, 0);
-        let mut spans = std::mem::take(&mut self.spans);
-        spans.clear();
-        spans.extend(self.boxes.iter().map(|b| {
-            let (c0, r0) = self.cell_of(DVec2::new(b[0], b[1]));
-            let (c1, r1) = self.cell_of(DVec2::new(b[2], b[3]));
-            // Cells are at most 4096 per side, so the indices fit u32.
-            [c0, r0, c1, r1].map(|i| i as u32)
-        }));
-        for &[c0, r0, c1, r1] in &spans {
-            for r in r0..=r1 {
-                let row = r as usize * self.columns;
-                for c in c0..=c1 {
-                    self.cell_start[row + c as usize + 1] += 1;
-                }
-            }
+        self.cell_of_slot.clear();
+        for &v in candidates {
+            let (c, r) = self.cell_of(placed[v as usize]);
+            // Cells are at most 4096² < 2³², so the index fits u32.
+            let cell = (r * self.columns + c) as u32;
+            self.cell_of_slot.push(cell);
+            self.cell_start[cell as usize + 1] += 1;
         }
         for i in 0..cells {
             self.cell_start[i + 1] += self.cell_start[i];
         }
-        self.cursor.clear();
-        self.cursor.extend_from_slice(&self.cell_start[..cells]);
-        self.cell_triangles.clear();
-        self.cell_triangles
-            .resize(self.cell_start[cells] as usize, 0);
-        for (index, &[c0, r0, c1, r1]) in spans.iter().enumerate() {
-            for r in r0..=r1 {
-                let row = r as usize * self.columns;
-                for c in c0..=c1 {
-                    let slot = &mut self.cursor[row + c as usize];
-                    self.cell_triangles[*slot as usize] = index as u32;
-                    *slot += 1;
-                }
-            }
+        // Counting sort: `cell_start[cell]` serves as the cell's cursor, so afterwards each
+        // entry holds the next cell's start, and shifting by one cell restores the starts.
+        self.cell_candidates.clear();
+        self.cell_candidates.resize(candidates.len(), 0);
+        for (slot, &cell) in self.cell_of_slot.iter().enumerate() {
+            let cursor = &mut self.cell_start[cell as usize];
+            self.cell_candidates[*cursor as usize] = slot as u32;
+            *cursor += 1;
         }
-        self.spans = spans;
+        self.cell_start.copy_within(0..cells, 1);
+        self.cell_start[0] = 0;
+        self.covered.clear();
+        self.covered.resize(candidates.len(), false);
     }
 
     fn cell_of(&self, p: DVec2) -> (usize, usize) {
-        let q = (p - self.origin) * self.inverse_cell;
+        let q = (p - self.min) * self.inverse_cell;
         let c = (q.x.max(0.0) as usize).min(self.columns - 1);
         let r = (q.y.max(0.0) as usize).min(self.rows - 1);
         (c, r)
     }
 
-    fn triangles_near(&self, p: DVec2) -> &[u32] {
-        let (c, r) = self.cell_of(p);
-        let cell = r * self.columns + c;
-        &self.cell_triangles[self.cell_start[cell] as usize..self.cell_start[cell + 1] as usize]
-    }
-
-    /// Whether `p` lies strictly inside triangle `t`'s bounding box (a strictly inside
-    /// point always does).
-    #[inline]
-    fn box_holds(&self, t: usize, p: DVec2) -> bool {
-        let b = &self.boxes[t];
-        p.x > b[0] && p.y > b[1] && p.x < b[2] && p.y < b[3]
+    /// Marks the candidates that triangle `tri` covers (see the module doc).
+    fn sweep_triangle(&mut self, query: &Query, tri: [u32; 3]) {
+        let corners = tri.map(|i| query.placed[i as usize]);
+        let [a, b, c] = corners;
+        let (min, max) = (a.min(b).min(c), a.max(b).max(c));
+        if !(max.x > self.min.x && max.y > self.min.y && min.x < self.max.x && min.y < self.max.y) {
+            return; // no candidate strictly inside the box
+        }
+        // A point strictly inside the triangle is strictly inside its box, and the cell map
+        // is monotone, so the box's corner cells bound every cell such a point falls in.
+        let ((c0, r0), (c1, r1)) = (self.cell_of(min), self.cell_of(max));
+        let depth = tri.map(|i| query.depth[i as usize]);
+        for r in r0..=r1 {
+            let row = r * self.columns;
+            let slots = self.cell_start[row + c0] as usize..self.cell_start[row + c1 + 1] as usize;
+            for k in slots {
+                let slot = self.cell_candidates[k] as usize;
+                if self.covered[slot] {
+                    continue;
+                }
+                let v = query.candidates[slot];
+                let p = query.placed[v as usize];
+                let in_box = p.x > min.x && p.y > min.y && p.x < max.x && p.y < max.y;
+                self.covered[slot] = in_box
+                    && !tri.contains(&v)
+                    && depth_if_strictly_inside(corners, depth, p)
+                        .is_some_and(|d| d > f64::from(query.depth[v as usize]));
+            }
+        }
     }
 }
 
-/// Bounding box of the triangles' boxes.
-fn bounds(boxes: &[[f64; 4]]) -> (DVec2, DVec2) {
-    let mut min = DVec2::splat(f64::INFINITY);
-    let mut max = DVec2::splat(f64::NEG_INFINITY);
-    for b in boxes {
-        min = min.min(DVec2::new(b[0], b[1]));
-        max = max.max(DVec2::new(b[2], b[3]));
-    }
-    (min, max)
+/// What the sweep reads.
+struct Query<'a> {
+    placed: &'a [DVec2],
+    depth: &'a [f32],
+    candidates: &'a [u32],
 }
 
 /// Writes into `out` (cleared first) the candidates covered by the patch's front layer.
@@ -138,28 +150,20 @@ pub fn covered_boundary_vertices(
 ) -> Result<(), RasterError> {
     validate(placed, triangles, depth, candidates)?;
     out.clear();
-    if triangles.is_empty() {
+    if triangles.is_empty() || candidates.is_empty() {
         return Ok(());
     }
-    grid.build(placed, triangles);
-    for &v in candidates {
-        let p = placed[v as usize];
-        let own = depth[v as usize];
-        let covered = grid.triangles_near(p).iter().any(|&t| {
-            let tri = triangles[t as usize];
-            grid.box_holds(t as usize, p)
-                && !tri.contains(&v)
-                && depth_if_strictly_inside(
-                    tri.map(|i| placed[i as usize]),
-                    tri.map(|i| depth[i as usize]),
-                    p,
-                )
-                .is_some_and(|d| d > f64::from(own))
-        });
-        if covered {
-            out.push(v);
-        }
+    grid.build(placed, candidates);
+    let query = Query {
+        placed,
+        depth,
+        candidates,
+    };
+    for &tri in triangles {
+        grid.sweep_triangle(&query, tri);
     }
+    let covered = candidates.iter().zip(&grid.covered);
+    out.extend(covered.filter(|(_, &hit)| hit).map(|(&v, _)| v));
     Ok(())
 }
 
