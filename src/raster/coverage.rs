@@ -19,6 +19,7 @@ use glam::DVec2;
 use tiny_skia::{FillRule, Mask, PathBuilder, Transform};
 
 use super::clip::{clip_polygon, ClipRect};
+use super::folds::{wound, FoldOutline};
 use super::{Patch, PixelRect};
 
 /// Work rectangles are covered by one horizontal strip per this many pixels (at most
@@ -58,6 +59,9 @@ pub(crate) struct SilhouetteInput<'a> {
     pub patch: &'a Patch<'a>,
     /// Sign of the loops' rest area (see [`rest_loop_orientation`]).
     pub loop_orientation: f64,
+    /// The outline of the inverted triangles, built for this `loop_orientation` (unread
+    /// when it is 0).
+    pub folds: &'a FoldOutline,
 }
 
 impl Silhouette {
@@ -147,20 +151,16 @@ impl Strip {
             for tri in patch.triangles {
                 let area2 = signed_area2(patch, tri);
                 if area2 != 0.0 {
-                    path.push(oriented(tri, area2 > 0.0).iter().map(placed));
+                    path.push(wound(tri, area2 > 0.0).iter().map(placed));
                 }
             }
         } else {
             for l in patch.loops {
                 path.push(l.vertices.iter().map(placed));
             }
-            for tri in patch.triangles {
-                if signed_area2(patch, tri) < 0.0 {
-                    // Wind it like a non-inverted triangle relative to the loops' direction.
-                    let order = oriented(tri, loop_orientation < 0.0);
-                    for _ in 0..2 {
-                        path.push(order.iter().map(placed));
-                    }
+            for contour in input.folds.contours() {
+                for _ in 0..2 {
+                    path.push(contour.iter().map(placed));
                 }
             }
         }
@@ -196,15 +196,6 @@ impl PolygonSink<'_> {
 fn signed_area2(patch: &Patch, tri: &[u32; 3]) -> f64 {
     let [a, b, c] = tri.map(|v| patch.placed[v as usize]);
     (b - a).perp_dot(c - a)
-}
-
-/// `tri` as given (`keep`) or with its winding reversed.
-fn oriented(tri: &[u32; 3], keep: bool) -> [u32; 3] {
-    if keep {
-        *tri
-    } else {
-        [tri[0], tri[2], tri[1]]
-    }
 }
 
 fn push_polygon(builder: &mut PathBuilder, mut points: impl Iterator<Item = (f32, f32)>) {

@@ -35,6 +35,7 @@ mod covered;
 mod draw;
 mod error;
 mod feather;
+mod folds;
 mod helper;
 pub mod overlay;
 mod patch;

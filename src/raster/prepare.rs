@@ -48,17 +48,23 @@ pub(crate) fn prepare<'m, E: From<RasterError>>(
     let triangles = patch.triangles.len();
     scratch.setups.resize(triangles, TriangleSetup::default());
     scratch.frames.resize(triangles, LocalFrame::default());
+    let loop_orientation = rest_loop_orientation(patch);
     let strips: &mut [Strip] = if anti_alias {
         scratch.silhouette.layout(work)
     } else {
         &mut []
     };
+    match anti_alias && loop_orientation != 0.0 {
+        true => scratch.folds.build(patch, loop_orientation),
+        false => scratch.folds.clear(),
+    }
     let context = Context {
         patch,
         snapped: &scratch.snapped,
         silhouette: SilhouetteInput {
             patch,
-            loop_orientation: rest_loop_orientation(patch),
+            loop_orientation,
+            folds: &scratch.folds,
         },
     };
     let chunk = SETUP_CHUNK.max(triangles.div_ceil(MAX_SETUP_CHUNKS));
@@ -285,6 +291,7 @@ fn depth_of(patch: &Patch, [a, b, c]: [usize; 3]) -> [f32; 3] {
 
 #[cfg(test)]
 mod tests {
+    use super::super::folds::FoldOutline;
     use super::*;
     use crate::pixels::{FloatImage, PixelFormat};
     use glam::DVec2;
@@ -356,6 +363,7 @@ mod tests {
             silhouette: SilhouetteInput {
                 patch: &patch,
                 loop_orientation: 0.0,
+                folds: &FoldOutline::default(),
             },
         };
         let mut setups = vec![TriangleSetup::default(); triangles.len()];

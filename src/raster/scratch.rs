@@ -5,6 +5,7 @@
 
 use super::bands::{Bands, BAND_PIXELS};
 use super::coverage::Silhouette;
+use super::folds::FoldOutline;
 use super::replay::{LazySpans, Replay};
 use super::setup::{LocalFrame, SnappedVertex, TriangleSetup};
 
@@ -24,6 +25,8 @@ pub struct RasterScratch {
     pub(crate) distance_row: Vec<f32>,
     /// The anti-aliased silhouette's strips.
     pub(crate) silhouette: Silhouette,
+    /// The outline of the inverted triangles, for the silhouette.
+    pub(crate) folds: FoldOutline,
     /// Pixels per row band (tests vary it to prove it changes nothing).
     pub(crate) band_pixels: usize,
     pub(crate) replay: Replay,
@@ -43,6 +46,7 @@ impl Default for RasterScratch {
             distance: Vec::new(),
             distance_row: Vec::new(),
             silhouette: Silhouette::default(),
+            folds: FoldOutline::default(),
             band_pixels: BAND_PIXELS,
             replay: Replay::default(),
             replay_spans: Default::default(),
