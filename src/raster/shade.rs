@@ -382,20 +382,46 @@ fn shade_fringe<S: SourceTexel, T: StoreTexel, C: CoverageTexel, R: Recorder<C>>
     recorder: &mut R,
 ) -> usize {
     let mut written = 0;
-    for (k, (&texel, pixel)) in span.coverage.iter().zip(pixels.iter_mut()).enumerate() {
+    let len = span.coverage.len().min(pixels.len());
+    let bytes = C::as_bytes(&span.coverage[..len]);
+    let mut k = 0;
+    while k < len {
+        // Most pixels of a run without a triangle lie outside the silhouette altogether
+        // (the work rectangle's corners): skip their zero coverage bytes in blocks.
+        if let Some(bytes) = bytes {
+            k += zero_prefix(&bytes[k..]);
+            if k == len {
+                break;
+            }
+        }
+        let texel = span.coverage[k];
+        let x = span.x0 + k as i32;
+        k += 1;
         if !texel.is_covered() {
             continue;
         }
-        let x = span.x0 + k as i32;
         let Some(triangle) = owning_triangle(input, x, span.y) else {
             continue;
         };
         let (u, v, membrane) = input.setups[triangle as usize].span.at_pixel(x, span.y);
         let sample = sampler.sample_texel_space(u, v);
         recorder.fringe(x, triangle, sample, texel);
-        written += usize::from(shade_pixel(pixel, sample, membrane, texel));
+        written += usize::from(shade_pixel(&mut pixels[k - 1], sample, membrane, texel));
     }
     written
+}
+
+/// How many bytes from the start are zero; sixteen at a time with a branch-free test.
+#[inline]
+fn zero_prefix(bytes: &[u8]) -> usize {
+    let mut length = 0;
+    for chunk in bytes.chunks_exact(16) {
+        if chunk.iter().fold(0, |any, &b| any | b) != 0 {
+            break;
+        }
+        length += 16;
+    }
+    length + bytes[length..].iter().take_while(|&&b| b == 0).count()
 }
 
 /// Watches shading (for [`replay`](super::replay)): runs, the source sample and coverage
@@ -533,5 +559,25 @@ mod tests {
             }
         }
         assert_eq!(run_length(&[], 3), 0);
+    }
+
+    #[test]
+    fn zero_prefix_counts_the_leading_zero_bytes() {
+        // A non-zero byte at every position of rows up to 50 bytes long, one or two of them.
+        for len in 0..=50usize {
+            for hit in 0..=len {
+                for value in [1u8, 128, 255] {
+                    let mut bytes = vec![0u8; len];
+                    if hit < len {
+                        bytes[hit] = value;
+                    }
+                    assert_eq!(zero_prefix(&bytes), hit, "len {len}, hit {hit}");
+                    if hit + 17 < len {
+                        bytes[hit + 17] = 3;
+                        assert_eq!(zero_prefix(&bytes), hit);
+                    }
+                }
+            }
+        }
     }
 }
