@@ -8,11 +8,11 @@
 //! in any order without changing a single pixel. The apron holds the rows the fringe lookup
 //! of [`shade`](super::shade) reads beyond the band (its neighbour radius).
 
-use super::setup::TriangleSetup;
-use super::triangles::centre_rows;
-
 /// Rows above and below a band whose triangle ids the band's shading reads.
 pub(crate) const APRON: i32 = 2;
+
+/// The centre rows of a triangle that owns no pixel (not drawable).
+pub(crate) const NO_ROWS: (i64, i64) = (0, 0);
 
 /// Pixels per band to aim for (ids + depths + coverage of a band stay well inside L2).
 pub(crate) const BAND_PIXELS: usize = 32 * 1024;
@@ -32,10 +32,11 @@ pub(crate) struct Bands {
 impl Bands {
     /// Splits rows `[first_row, last_row)` of a `width`-pixel-wide region into bands of about
     /// `band_pixels` pixels (8 to 64 rows; any height gives the same pixels) and bins every
-    /// drawable triangle into the bands whose rows or apron it may reach.
+    /// triangle into the bands whose rows or apron its centre rows (`[top, bottom)`, per
+    /// triangle: `centre_rows` of a drawable one, [`NO_ROWS`] otherwise) may reach.
     pub fn build(
         &mut self,
-        setups: &[TriangleSetup],
+        centre_rows: &[(i64, i64)],
         (first_row, last_row): (i32, i32),
         width: usize,
         band_pixels: usize,
@@ -47,8 +48,8 @@ impl Bands {
         let mut ranges = std::mem::take(&mut self.ranges);
         ranges.clear();
         // Bands are at most canvas rows, so their indices fit u32.
-        ranges.extend(setups.iter().map(|setup| {
-            self.band_range(setup)
+        ranges.extend(centre_rows.iter().map(|&rows| {
+            self.band_range(rows, count)
                 .map_or((1, 0), |(lo, hi)| (lo as u32, hi as u32))
         }));
         self.starts.clear();
@@ -100,12 +101,11 @@ impl Bands {
         &self.triangles[self.starts[band] as usize..self.starts[band + 1] as usize]
     }
 
-    /// The bands whose rows ± [`APRON`] meet the triangle's centre rows, if any.
-    fn band_range(&self, setup: &TriangleSetup) -> Option<(usize, usize)> {
-        if !setup.drawable || self.count() == 0 {
+    /// The bands (of `count`) whose rows ± [`APRON`] meet the centre rows `[top, bottom)`.
+    fn band_range(&self, (top, bottom): (i64, i64), count: usize) -> Option<(usize, usize)> {
+        if count == 0 {
             return None;
         }
-        let (top, bottom) = centre_rows(setup);
         let (apron, first, last_row) = (
             i64::from(APRON),
             i64::from(self.first_row),
@@ -116,18 +116,28 @@ impl Bands {
         }
         let reach_top = top - i64::from(APRON) - i64::from(self.first_row);
         let reach_bottom = bottom - 1 + i64::from(APRON) - i64::from(self.first_row);
-        let last = self.count() as i64 - 1;
-        let height = i64::from(self.height);
-        let lo = reach_top.div_euclid(height).max(0);
-        let hi = reach_bottom.div_euclid(height).min(last);
-        (top < bottom && lo <= hi).then_some((lo as usize, hi as usize))
+        // Rows above the first band clamp to band 0, rows far below to the last band, so an
+        // unsigned 32-bit division gives the floor (heights are 8 to 64, never 0).
+        let height = self.height.max(1) as u32;
+        let band_of = |reach: i64| (reach.clamp(0, i64::from(u32::MAX)) as u32 / height) as usize;
+        let (lo, hi) = (band_of(reach_top), band_of(reach_bottom).min(count - 1));
+        (top < bottom && lo <= hi).then_some((lo, hi))
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::raster::setup::TriangleSetup;
+    use crate::raster::triangles::centre_rows;
     use glam::DVec2;
+
+    fn rows_of(setups: &[TriangleSetup]) -> Vec<(i64, i64)> {
+        setups
+            .iter()
+            .map(|s| if s.drawable { centre_rows(s) } else { NO_ROWS })
+            .collect()
+    }
 
     fn triangle(y0: f64, y1: f64) -> TriangleSetup {
         let corners = [
@@ -147,7 +157,7 @@ mod tests {
             })
             .collect();
         let mut bands = Bands::default();
-        bands.build(&setups, (3, 301), 2000, BAND_PIXELS);
+        bands.build(&rows_of(&setups), (3, 301), 2000, BAND_PIXELS);
         assert_eq!(bands.height(), 16);
         assert_eq!(bands.count(), 19);
         assert_eq!(bands.rows(18), (291, 301));
@@ -166,7 +176,7 @@ mod tests {
     #[test]
     fn no_rows_no_bands() {
         let mut bands = Bands::default();
-        bands.build(&[triangle(0.0, 5.0)], (10, 10), 100, BAND_PIXELS);
+        bands.build(&rows_of(&[triangle(0.0, 5.0)]), (10, 10), 100, BAND_PIXELS);
         assert_eq!(bands.count(), 0);
     }
 }

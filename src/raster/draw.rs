@@ -278,7 +278,7 @@ fn draw_frame<T: StoreTexel + Send, R: Recorder<u8>>(
     }
     let target = frame.target;
     scratch.bands.build(
-        &scratch.setups,
+        &scratch.centre_rows,
         (target.y0, target.y1),
         target.width(),
         scratch.band_pixels,

@@ -17,9 +17,11 @@
 
 use std::sync::Mutex;
 
+use super::bands::NO_ROWS;
 use super::coverage::{rest_loop_orientation, SilhouetteInput, Strip};
 use super::helper;
 use super::setup::{LocalFrame, SnappedVertex, TriangleSetup};
+use super::triangles::centre_rows;
 use super::{Patch, PixelRect, RasterError, RasterScratch};
 use crate::util::{lock, SpinWait};
 
@@ -48,6 +50,7 @@ pub(crate) fn prepare<'m, E: From<RasterError>>(
     let triangles = patch.triangles.len();
     scratch.setups.resize(triangles, TriangleSetup::default());
     scratch.frames.resize(triangles, LocalFrame::default());
+    scratch.centre_rows.resize(triangles, NO_ROWS);
     let loop_orientation = rest_loop_orientation(patch);
     let strips: &mut [Strip] = if anti_alias {
         scratch.silhouette.layout(work)
@@ -72,12 +75,14 @@ pub(crate) fn prepare<'m, E: From<RasterError>>(
     let jobs = strips.iter_mut().map(Job::Strip).chain(
         (scratch.setups.chunks_mut(chunk))
             .zip(scratch.frames.chunks_mut(chunk))
+            .zip(scratch.centre_rows.chunks_mut(chunk))
             .enumerate()
-            .map(move |(k, (setups, frames))| {
+            .map(move |(k, ((setups, frames), rows))| {
                 Job::Geometry(SetupChunk {
                     first: k * chunk,
                     setups,
                     frames,
+                    rows,
                 })
             }),
     );
@@ -119,11 +124,13 @@ fn solved<'m, E: From<RasterError>>(
     Ok(membrane)
 }
 
-/// Setups of triangles `first..first + setups.len()`, and their frames.
+/// Setups of triangles `first..first + setups.len()`, their frames and centre rows.
 struct SetupChunk<'s> {
     first: usize,
     setups: &'s mut [TriangleSetup],
     frames: &'s mut [LocalFrame],
+    /// What the bands bin (see [`triangle_rows`]).
+    rows: &'s mut [(i64, i64)],
 }
 
 /// One piece of the work before the bands.
@@ -246,7 +253,8 @@ impl Context<'_> {
     fn build_setups(&self, chunk: SetupChunk, membrane: &[[f32; 3]]) {
         let patch = self.patch;
         let triangles = &patch.triangles[chunk.first..];
-        for (setup, tri) in chunk.setups.iter_mut().zip(triangles) {
+        let setups = chunk.setups.iter_mut().zip(chunk.rows.iter_mut());
+        for ((setup, rows), tri) in setups.zip(triangles) {
             let [a, b, c] = tri.map(|v| v as usize);
             *setup = TriangleSetup::from_snapped(
                 [patch.placed[a], patch.placed[b], patch.placed[c]],
@@ -255,6 +263,7 @@ impl Context<'_> {
                 [membrane[a], membrane[b], membrane[c]],
                 depth_of(patch, [a, b, c]),
             );
+            *rows = triangle_rows(setup);
         }
     }
 
@@ -263,7 +272,7 @@ impl Context<'_> {
         let patch = self.patch;
         let triangles = &patch.triangles[chunk.first..];
         let setups = chunk.setups.iter_mut().zip(chunk.frames.iter_mut());
-        for ((setup, frame), tri) in setups.zip(triangles) {
+        for (((setup, frame), rows), tri) in setups.zip(chunk.rows.iter_mut()).zip(triangles) {
             let [a, b, c] = tri.map(|v| v as usize);
             (*setup, *frame) = TriangleSetup::geometry(
                 [patch.placed[a], patch.placed[b], patch.placed[c]],
@@ -271,6 +280,7 @@ impl Context<'_> {
                 [patch.rest[a], patch.rest[b], patch.rest[c]],
                 depth_of(patch, [a, b, c]),
             );
+            *rows = triangle_rows(setup);
         }
     }
 
@@ -282,6 +292,17 @@ impl Context<'_> {
             let [a, b, c] = tri.map(|v| v as usize);
             setup.set_membrane(frame, [membrane[a], membrane[b], membrane[c]]);
         }
+    }
+}
+
+/// The canvas rows whose pixel centres the triangle may own ([`centre_rows`]), or none
+/// when it is not drawn. Kept beside the setups while they are hot in this thread's cache,
+/// so the bands bin a compact array instead of reading every setup again.
+fn triangle_rows(setup: &TriangleSetup) -> (i64, i64) {
+    if setup.drawable {
+        centre_rows(setup)
+    } else {
+        NO_ROWS
     }
 }
 
@@ -368,16 +389,19 @@ mod tests {
         };
         let mut setups = vec![TriangleSetup::default(); triangles.len()];
         let mut frames = vec![LocalFrame::default(); triangles.len()];
+        let mut rows = vec![NO_ROWS; triangles.len()];
         let chunk = 1024;
         let jobs = setups
             .chunks_mut(chunk)
             .zip(frames.chunks_mut(chunk))
+            .zip(rows.chunks_mut(chunk))
             .enumerate()
-            .map(|(k, (setups, frames))| {
+            .map(|(k, ((setups, frames), rows))| {
                 Job::Geometry(SetupChunk {
                     first: k * chunk,
                     setups,
                     frames,
+                    rows,
                 })
             });
         let mut queue = Queue {

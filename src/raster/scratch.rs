@@ -15,6 +15,8 @@ pub struct RasterScratch {
     pub(crate) setups: Vec<TriangleSetup>,
     /// Per-triangle frames of setups whose membrane maps are added after the solve.
     pub(crate) frames: Vec<LocalFrame>,
+    /// Per triangle: the canvas rows its pixel centres may reach (what the bands bin).
+    pub(crate) centre_rows: Vec<(i64, i64)>,
     /// Placed vertices snapped to the fixed-point grid.
     pub(crate) snapped: Vec<SnappedVertex>,
     pub(crate) bands: Bands,
@@ -39,6 +41,7 @@ impl Default for RasterScratch {
         RasterScratch {
             setups: Vec::new(),
             frames: Vec::new(),
+            centre_rows: Vec::new(),
             snapped: Vec::new(),
             bands: Bands::default(),
             workers: Vec::new(),
