@@ -8,9 +8,11 @@
 mod fixtures;
 
 use glam::DVec2;
-use lapclone::clone::{CloneMode, CloneOptions, PatchCloner, Placement};
+use lapclone::clone::{CloneMode, CloneOptions, MembraneSolver, PatchCloner, Placement};
 use lapclone::mesh::synth;
 use lapclone::pixels::{Canvas, ColorKind, Depth, FloatImage, PixelFormat};
+use lapclone::raster::{draw_patch, Patch, RasterOptions, RasterScratch};
+use lapclone::solve::LaplacianKind;
 
 use fixtures::*;
 
@@ -29,7 +31,8 @@ fn two_holes_cloner(options: &CloneOptions) -> PatchCloner {
 
 /// Largest |membrane − (target − source)| over constrained boundary vertices.
 fn boundary_mismatch(cloner: &PatchCloner, target: &Canvas) -> f64 {
-    let factor = cloner.membrane().factor();
+    // invariant: the cloner has cloned, so its factor exists.
+    let factor = cloner.membrane().factor().expect("a factored cloner");
     let mut worst = 0.0f64;
     for &v in cloner.membrane().boundary_vertices() {
         let v = v as usize;
@@ -123,8 +126,8 @@ fn moving_the_patch_equals_a_fresh_cloner_at_the_new_place() {
         let mut fresh_canvas = target.clone();
         fresh.clone_onto(&mut fresh_canvas, &centred(at)).unwrap();
         assert_eq!(
-            fresh.membrane().factor().constrained(),
-            moved.membrane().factor().constrained()
+            fresh.membrane().factor().unwrap().constrained(),
+            moved.membrane().factor().unwrap().constrained()
         );
         let difference = membrane_difference(&moved, &fresh);
         assert!(
@@ -132,6 +135,72 @@ fn moving_the_patch_equals_a_fresh_cloner_at_the_new_place() {
             "at {at}: membranes differ by {difference} ({stats:?})"
         );
         assert!(boundary_mismatch(&moved, &target) <= 1e-5);
+    }
+}
+
+/// The first clone factors the Laplacian on the solving thread while the raster records its
+/// draw on the other, then composites the record. Its membrane must be an eagerly factored
+/// solver's, bit for bit, and its pixels those of a plain draw (no record, no replay).
+#[test]
+fn a_first_clone_factors_while_recording_and_draws_the_plain_bytes() {
+    let target = Canvas::from_image(&smooth_target(120, 100));
+    for laplacian in [LaplacianKind::Combinatorial, LaplacianKind::Cotangent] {
+        let options = CloneOptions {
+            laplacian,
+            ..CloneOptions::default()
+        };
+        let mut cloner = two_holes_cloner(&options);
+        assert!(
+            cloner.membrane().factor().is_none(),
+            "new() factored already"
+        );
+        let placement = Placement {
+            rotation_deg: -21.0,
+            scale: 1.17,
+            ..centred(DVec2::new(57.4, 49.85))
+        };
+        let mut canvas = target.clone();
+        let first = cloner.clone_onto(&mut canvas, &placement).unwrap();
+        assert!(cloner.membrane().factor().is_some());
+        assert!(!first.raster.replayed);
+        assert!(first.raster.written > 1000, "{first:?}");
+
+        let mut eager = MembraneSolver::new(cloner.mesh(), cloner.source(), laplacian).unwrap();
+        eager.solve(cloner.placed(), &target, None).unwrap();
+        assert!(
+            eager.membrane() == cloner.membrane().membrane(),
+            "{laplacian:?}"
+        );
+
+        let mesh = cloner.mesh();
+        let patch = Patch {
+            rest: &mesh.positions,
+            placed: cloner.placed(),
+            triangles: &mesh.triangles,
+            membrane: cloner.membrane().membrane(),
+            depth: None,
+            loops: &mesh.loops,
+            source: cloner.source(),
+        };
+        for threads in [1, 2] {
+            let plain_options = RasterOptions {
+                threads,
+                ..RasterOptions::default()
+            };
+            let mut plain = target.clone();
+            let stats = draw_patch(
+                &mut plain,
+                &patch,
+                &plain_options,
+                &mut RasterScratch::new(),
+            )
+            .unwrap();
+            assert_eq!(stats, first.raster, "{laplacian:?}, {threads} threads");
+            assert!(
+                canvas.pixels() == plain.pixels(),
+                "{laplacian:?}: the first clone differs from a plain draw"
+            );
+        }
     }
 }
 
@@ -198,7 +267,11 @@ fn outside_boundary_vertices_switch_off_and_come_back() {
         let p = cloner.placed()[v as usize];
         let outside = p.x < 0.0 || p.y < 0.0 || p.x > width || p.y > f64::from(target.height());
         assert_eq!(
-            cloner.membrane().factor().is_constrained(v as usize),
+            cloner
+                .membrane()
+                .factor()
+                .unwrap()
+                .is_constrained(v as usize),
             !outside,
             "vertex {v} at {p}"
         );

@@ -573,6 +573,19 @@ impl WavyGrid {
         }
     }
 
+    /// The placed positions moved wholly inside a canvas (24 px margins), and that canvas's
+    /// size: a clipped draw is not recorded for replays.
+    fn inside_a_canvas(&self) -> (Vec<DVec2>, (u32, u32)) {
+        let (min, max) = self.placed.iter().fold(
+            (DVec2::splat(f64::MAX), DVec2::splat(f64::MIN)),
+            |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+        );
+        let offset = DVec2::splat(24.0) - min.floor();
+        let size = (max + offset + DVec2::splat(24.0)).ceil();
+        let inside = self.placed.iter().map(|p| *p + offset).collect();
+        (inside, (size.x as u32, size.y as u32))
+    }
+
     /// The patch, with or without its depth ramp.
     fn patch(&self, with_depth: bool) -> Patch<'_> {
         Patch {
@@ -638,21 +651,106 @@ fn a_draw_that_solves_its_membrane_meanwhile_gives_the_same_bytes() {
     }
 }
 
+/// A recording draw (the first through a replaying scratch) records on the helper thread while
+/// the solve runs, then composites the record: the bytes and counts of a plain draw, for any
+/// thread count; the next whole-pixel move replays that record.
+#[test]
+fn a_recording_draw_that_solves_meanwhile_gives_the_bytes_of_a_plain_draw() {
+    let grid = WavyGrid::new();
+    let (inside, (width, height)) = grid.inside_a_canvas();
+    let moved: Vec<DVec2> = inside.iter().map(|p| *p + DVec2::new(3.0, -2.0)).collect();
+    let placed = Patch {
+        placed: &inside,
+        ..grid.patch(false)
+    };
+    for threads in [1, 2, 0] {
+        for anti_alias in [true, false] {
+            let plain_options = RasterOptions {
+                threads,
+                anti_alias,
+                ..RasterOptions::default()
+            };
+            let recording = RasterOptions {
+                replay: true,
+                ..plain_options
+            };
+            let context = format!("{threads} threads, aa {anti_alias}");
+            let mut plain = opaque_canvas(width, height, 0.3);
+            let plain_stats = draw_patch(
+                &mut plain,
+                &placed,
+                &plain_options,
+                &mut RasterScratch::new(),
+            )
+            .unwrap();
+            let mut scratch = RasterScratch::new();
+            let mut recorded = opaque_canvas(width, height, 0.3);
+            let no_membrane = Patch {
+                membrane: &[],
+                ..placed
+            };
+            let mut computed = Vec::new();
+            let stats = draw_patch_solving(
+                &mut recorded,
+                &no_membrane,
+                &recording,
+                &mut scratch,
+                |canvas: &Canvas| {
+                    // Slowly, so the recording gets ahead of it; reads the untouched canvas.
+                    assert!(canvas.pixels() == opaque_canvas(width, height, 0.3).pixels());
+                    for p in &grid.mesh.positions {
+                        let mut x = p.x;
+                        for _ in 0..200 {
+                            x = std::hint::black_box(x);
+                        }
+                        computed.push([(x * 0.002) as f32, -0.1, (p.y * 0.001) as f32]);
+                    }
+                    Ok::<_, RasterError>(&computed[..])
+                },
+            )
+            .unwrap();
+            assert_eq!(stats, plain_stats, "{context}");
+            assert!(recorded == plain, "{context}: the bytes differ");
+
+            let moved_patch = Patch {
+                placed: &moved,
+                ..placed
+            };
+            let mut replayed = opaque_canvas(width, height, 0.3);
+            let stats = draw_patch(&mut replayed, &moved_patch, &recording, &mut scratch).unwrap();
+            assert!(stats.replayed, "{context}");
+            let mut fresh = opaque_canvas(width, height, 0.3);
+            draw_patch(
+                &mut fresh,
+                &moved_patch,
+                &plain_options,
+                &mut RasterScratch::new(),
+            )
+            .unwrap();
+            assert!(replayed == fresh, "{context}: the replay differs");
+        }
+    }
+}
+
 #[test]
 fn a_failed_or_wrong_solve_leaves_the_canvas_as_it_was() {
     let grid = WavyGrid::new();
-    let patch = Patch {
-        membrane: &[],
-        ..grid.patch(true)
-    };
     let vertices = grid.mesh.positions.len();
-    let before = opaque_canvas(520, 470, 0.3);
+    let (inside, (width, height)) = grid.inside_a_canvas();
+    let before = opaque_canvas(width, height, 0.3);
     let short = vec![[0.0f32; 3]; vertices - 1];
     let mut nan = vec![[0.0f32; 3]; vertices];
     nan[7][1] = f32::NAN;
-    for threads in [1, 2] {
+    // With depth: a plain draw; without, through a replaying scratch: a recording draw.
+    for (threads, recording) in [(1, false), (2, false), (1, true), (2, true)] {
+        let patch = Patch {
+            membrane: &[],
+            placed: &inside,
+            ..grid.patch(!recording)
+        };
         let options = RasterOptions {
             threads,
+            replay: recording,
             ..RasterOptions::default()
         };
         let mut canvas = before.clone();

@@ -202,7 +202,7 @@ pub fn run(args: CloneArgs) -> anyhow::Result<()> {
             "hidden": stats.membrane.hidden,
             "switched": stats.membrane.switches.updates + stats.membrane.switches.downdates,
             "mesh_ms": mesh_ms,
-            "factor_ms": factor_ms,
+            "factor_ms": factor_ms + stats.factor_ms,
             "solve_ms": stats.solve_ms,
             "raster_ms": stats.raster_ms,
             "total_ms": total_ms,

@@ -6,7 +6,8 @@
 //! and coverage scratch. Per call: place the vertices, find boundary vertices hidden under
 //! the patch's own front layer, switch constraints, one 3-RHS solve, the raster. The
 //! hidden-vertex query and the solve run while the raster prepares its membrane-free part on
-//! a second thread ([`draw_patch_solving`]).
+//! a second thread ([`draw_patch_solving`]). The first call also factors the Laplacian there
+//! ([`MembraneSolver::deferred`]), so the factor overlaps the first draw's preparation.
 
 use std::time::Instant;
 
@@ -77,7 +78,11 @@ pub struct CloneStats {
     /// switches and back-substitution, on the calling thread; the raster's first part runs
     /// meanwhile on a helper thread.
     pub solve_ms: f64,
-    /// The rest of the call's wall time: the raster beyond what overlapped the solve.
+    /// The Laplacian's factorisation, on the calling thread before the solve: the first
+    /// call's (0 afterwards). The raster's first part overlaps it too.
+    pub factor_ms: f64,
+    /// The rest of the call's wall time: the raster beyond what overlapped the factor and
+    /// the solve.
     pub raster_ms: f64,
 }
 
@@ -93,7 +98,9 @@ pub struct PatchCloner {
 }
 
 impl PatchCloner {
-    /// Factors the patch's Laplacian and samples the source along the rest boundary.
+    /// Assembles the patch's Laplacian and samples the source along the rest boundary. The
+    /// factor is built by the first clone (and its errors reported there), on the thread
+    /// that solves while the raster starts on another.
     pub fn new(source: FloatImage, mesh: Mesh, options: &CloneOptions) -> Result<Self, CloneError> {
         if !(options.feather.is_finite() && options.feather >= 0.0) {
             return Err(CloneError::BadOption(format!(
@@ -105,7 +112,7 @@ impl PatchCloner {
             CloneMode::Normal => source,
             CloneMode::Monochrome => source.to_grey(),
         };
-        let membrane = MembraneSolver::new(&mesh, &source, options.laplacian)?;
+        let membrane = MembraneSolver::deferred(&mesh, &source, options.laplacian);
         let n = mesh.vertex_count();
         Ok(Self {
             source,
@@ -247,6 +254,8 @@ impl PatchCloner {
         let solve = move |canvas: &Canvas| {
             // Moved (not reborrowed), so the membrane can be lent out for the whole draw.
             let membrane = solver;
+            let factor_started = Instant::now();
+            membrane.factor_now()?;
             let solve_started = Instant::now();
             let hidden = if hidden_by == HiddenBy::Query {
                 hidden.find(frame, membrane.boundary_vertices(), depth)?
@@ -254,7 +263,8 @@ impl PatchCloner {
                 &hidden.marks
             };
             let stats = membrane.solve(frame.0, canvas, Some(hidden))?;
-            *solved_out = Some((stats, millis(solve_started.elapsed())));
+            let factor_ms = millis(solve_started - factor_started);
+            *solved_out = Some((stats, factor_ms, millis(solve_started.elapsed())));
             Ok::<_, CloneError>(membrane.membrane())
         };
         let raster = draw_patch_solving(
@@ -265,12 +275,13 @@ impl PatchCloner {
             solve,
         )?;
         // invariant: draw_patch_solving runs the solve exactly once, and it succeeded.
-        let (membrane, solve_ms) = solved.expect("the draw ran the solve");
+        let (membrane, factor_ms, solve_ms) = solved.expect("the draw ran the solve");
         Ok(CloneStats {
             membrane,
             raster,
             solve_ms,
-            raster_ms: millis(started.elapsed()) - solve_ms,
+            factor_ms,
+            raster_ms: millis(started.elapsed()) - factor_ms - solve_ms,
         })
     }
 }

@@ -6,26 +6,39 @@
 //! switched off (rank-1 downdates of the kept factor) rather than clamped, and switched back
 //! on when they return. Source colours at the rest boundary never change, so they are sampled
 //! once per mesh; per frame only the canvas is sampled.
+//!
+//! The factor can be built eagerly ([`MembraneSolver::new`]) or by the first solve
+//! ([`MembraneSolver::deferred`]): a first clone then factors on the solving thread while the
+//! raster's membrane-free work runs on its helper.
 
 use glam::DVec2;
 
 use super::CloneError;
 use crate::mesh::Mesh;
 use crate::pixels::{Canvas, FloatImage};
-use crate::solve::{laplacian, LaplacianKind, PenaltyFactor, PenaltyOptions, SwitchStats};
+use crate::solve::{
+    laplacian, LaplacianKind, PenaltyFactor, PenaltyOptions, SwitchStats, SymmetricCsc,
+};
 
 /// Number of colour channels the membrane carries (alpha is never cloned).
 pub const MEMBRANE_CHANNELS: usize = 3;
 
 /// The factored Laplacian of one patch mesh and the scratch buffers of its per-frame solve.
 pub struct MembraneSolver {
-    factor: PenaltyFactor,
+    factor: FactorState,
     boundary: Vec<u32>,
     /// f_S at each boundary vertex's rest position, RGB.
     source_at_boundary: Vec<[f32; 3]>,
     wanted: Vec<bool>,
     values: Vec<f64>,
     membrane: Vec<[f32; 3]>,
+}
+
+/// The kept factor, or the Laplacian it will be built from.
+enum FactorState {
+    /// Waiting for the first solve (or [`MembraneSolver::factor_now`]).
+    Pending(SymmetricCsc),
+    Ready(Box<PenaltyFactor>),
 }
 
 /// What one membrane solve did.
@@ -41,9 +54,18 @@ pub struct MembraneStats {
 }
 
 impl MembraneSolver {
-    /// Builds and factors the Laplacian of `mesh` (no constraint on yet) and samples the
-    /// source at the rest boundary.
+    /// Builds and factors the Laplacian of `mesh` and samples the source at the rest
+    /// boundary.
     pub fn new(mesh: &Mesh, source: &FloatImage, kind: LaplacianKind) -> Result<Self, CloneError> {
+        let mut solver = Self::deferred(mesh, source, kind);
+        solver.factor_now()?;
+        Ok(solver)
+    }
+
+    /// Builds the Laplacian of `mesh` and samples the source at the rest boundary; the
+    /// factor waits for the first [`solve`](Self::solve) or [`factor_now`](Self::factor_now),
+    /// which then report its errors.
+    pub fn deferred(mesh: &Mesh, source: &FloatImage, kind: LaplacianKind) -> Self {
         let l = laplacian(mesh, kind);
         let boundary: Vec<u32> = mesh.boundary_vertices().collect();
         // Factored with every boundary constraint on, the usual state: a first clone inside
@@ -52,7 +74,6 @@ impl MembraneSolver {
         for &v in &boundary {
             wanted[v as usize] = true;
         }
-        let factor = PenaltyFactor::with_constrained(&l, &PenaltyOptions::default(), &wanted)?;
         let source_at_boundary = boundary
             .iter()
             .map(|&v| {
@@ -61,14 +82,26 @@ impl MembraneSolver {
             })
             .collect();
         let n = mesh.vertex_count();
-        Ok(Self {
-            factor,
+        Self {
+            factor: FactorState::Pending(l),
             boundary,
             source_at_boundary,
             wanted,
             values: vec![0.0; n * MEMBRANE_CHANNELS],
             membrane: vec![[0.0; 3]; n],
-        })
+        }
+    }
+
+    /// Factors the Laplacian if that is still to do (with every boundary constraint on);
+    /// gives whether it did.
+    pub fn factor_now(&mut self) -> Result<bool, CloneError> {
+        let FactorState::Pending(l) = &self.factor else {
+            return Ok(false);
+        };
+        // The boundary marks: `wanted` is the all-on state until the first solve changes it.
+        let factor = PenaltyFactor::with_constrained(l, &PenaltyOptions::default(), &self.wanted)?;
+        self.factor = FactorState::Ready(Box::new(factor));
+        Ok(true)
     }
 
     /// Solves the membrane for a patch whose vertices sit at `placed` on `canvas`.
@@ -79,6 +112,11 @@ impl MembraneSolver {
         canvas: &Canvas,
         hidden: Option<&[bool]>,
     ) -> Result<MembraneStats, CloneError> {
+        self.factor_now()?;
+        let FactorState::Ready(factor) = &mut self.factor else {
+            // invariant: factor_now either leaves a factor or returned the error above.
+            unreachable!("factor_now leaves a factor");
+        };
         let n = self.wanted.len();
         let mut stats = MembraneStats::default();
         let (width, height) = (f64::from(canvas.width()), f64::from(canvas.height()));
@@ -99,14 +137,13 @@ impl MembraneSolver {
                 }
             }
         }
-        stats.switches = self.factor.set_constrained(&self.wanted)?;
-        stats.constrained = self.factor.constrained_count();
+        stats.switches = factor.set_constrained(&self.wanted)?;
+        stats.constrained = factor.constrained_count();
         if stats.constrained == 0 {
             self.membrane.fill([0.0; 3]);
             return Ok(stats);
         }
-        self.factor
-            .solve_dirichlet(&mut self.values, MEMBRANE_CHANNELS);
+        factor.solve_dirichlet(&mut self.values, MEMBRANE_CHANNELS);
         for (v, m) in self.membrane.iter_mut().enumerate() {
             *m = [0, 1, 2].map(|c| self.values[c * n + v] as f32);
         }
@@ -118,8 +155,12 @@ impl MembraneSolver {
         &self.membrane
     }
 
-    pub fn factor(&self) -> &PenaltyFactor {
-        &self.factor
+    /// The kept factor; `None` until the first solve of a [`deferred`](Self::deferred) one.
+    pub fn factor(&self) -> Option<&PenaltyFactor> {
+        match &self.factor {
+            FactorState::Ready(factor) => Some(factor),
+            FactorState::Pending(_) => None,
+        }
     }
 
     pub fn boundary_vertices(&self) -> &[u32] {

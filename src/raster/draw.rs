@@ -11,6 +11,7 @@ use super::coverage::Silhouette;
 use super::feather::apply_feather;
 use super::helper;
 use super::prepare::prepare;
+use super::record::record_and_composite;
 use super::replay::SpanGeometry;
 use super::scratch::BandScratch;
 use super::setup::{TriangleSetup, MAX_COORDINATE};
@@ -108,21 +109,14 @@ pub fn draw_patch_solving<'m, E: From<RasterError>>(
     let canvas_bounds = canvas_rect(canvas);
     let target = work.intersect(&canvas_bounds);
     let replayable = options.replay && patch.depth.is_none() && options.feather == 0.0;
-    let record = replayable
-        && target == work
-        && scratch.replay.wants_record(patch, options.anti_alias, work);
-    // A recording shades everything in order, on this thread; the preparation records
-    // nothing, so it shares the work (and the solve's time) as usual.
-    let prepare_threads = worker_threads(options.threads, work.area(), usize::MAX);
-    let threads = if record { 1 } else { prepare_threads };
-    let membrane = prepare(
-        patch,
-        work,
-        options.anti_alias,
-        prepare_threads,
-        scratch,
-        || solve(canvas),
-    )?;
+    if replayable && target == work && scratch.replay.wants_record(patch, options.anti_alias, work)
+    {
+        return record_and_composite(canvas, patch, options, work, scratch, solve);
+    }
+    let threads = worker_threads(options.threads, work.area(), usize::MAX);
+    let membrane = prepare(patch, work, options.anti_alias, threads, scratch, || {
+        solve(canvas)
+    })?;
     let patch = &Patch { membrane, ..*patch };
     let frame = Frame {
         patch,
@@ -137,33 +131,17 @@ pub fn draw_patch_solving<'m, E: From<RasterError>>(
             Kernel::Scalar
         },
     };
-    let mut replay = std::mem::take(&mut scratch.replay);
     let canvas_width = canvas.width() as usize;
-    let (centre_hits, written) = if record {
-        let mut recording = replay.start(patch, options.anti_alias, work);
-        match canvas.pixels_mut() {
-            CanvasPixels::Eight(p) => {
-                draw_frame(&frame, options, scratch, p, canvas_width, &mut recording)
-            }
-            CanvasPixels::Sixteen(p) => {
-                draw_frame(&frame, options, scratch, p, canvas_width, &mut recording)
-            }
-        }
-    } else {
-        let mut none = NoRecorder;
-        match canvas.pixels_mut() {
-            CanvasPixels::Eight(p) => {
-                draw_frame(&frame, options, scratch, p, canvas_width, &mut none)
-            }
-            CanvasPixels::Sixteen(p) => {
-                draw_frame(&frame, options, scratch, p, canvas_width, &mut none)
-            }
+    let mut none = NoRecorder;
+    let (centre_hits, written) = match canvas.pixels_mut() {
+        CanvasPixels::Eight(p) => draw_frame(&frame, options, scratch, p, canvas_width, &mut none),
+        CanvasPixels::Sixteen(p) => {
+            draw_frame(&frame, options, scratch, p, canvas_width, &mut none)
         }
     };
     if replayable {
-        replay.remember(patch, options.anti_alias);
+        scratch.replay.remember(patch, options.anti_alias);
     }
-    scratch.replay = replay;
     Ok(RasterStats {
         work,
         centre_hits,
@@ -191,7 +169,7 @@ fn replay_shift(
 
 /// Replays the scratch's record shifted by `shift` with the membrane `solve` gives (see
 /// [`Replay::draw_solving`](super::replay::Replay::draw_solving)).
-fn replay<'m, E: From<RasterError>>(
+pub(super) fn replay<'m, E: From<RasterError>>(
     canvas: &mut Canvas,
     patch: &Patch,
     options: &RasterOptions,
@@ -251,21 +229,21 @@ fn sixteen_bit(canvas: &mut Canvas) -> &mut [[u16; 4]] {
 }
 
 /// What every band of one draw shares.
-struct Frame<'a> {
-    patch: &'a Patch<'a>,
-    work: PixelRect,
+pub(super) struct Frame<'a> {
+    pub(super) patch: &'a Patch<'a>,
+    pub(super) work: PixelRect,
     /// The work rectangle clipped to the canvas: the pixels that can be written.
-    target: PixelRect,
+    pub(super) target: PixelRect,
     /// Whether the silhouette strips hold the coverage (else pixel centres decide).
-    anti_alias: bool,
+    pub(super) anti_alias: bool,
     /// Threads drawing the frame (1 for a recording).
-    threads: usize,
-    use_depth: bool,
-    kernel: Kernel,
+    pub(super) threads: usize,
+    pub(super) use_depth: bool,
+    pub(super) kernel: Kernel,
 }
 
 /// Draws over the canvas pixels; gives (centre hits, pixels written).
-fn draw_frame<T: StoreTexel + Send, R: Recorder<u8>>(
+pub(super) fn draw_frame<T: StoreTexel + Send, R: Recorder<u8>>(
     frame: &Frame,
     options: &RasterOptions,
     scratch: &mut RasterScratch,
@@ -340,7 +318,7 @@ const MAX_THREADS: usize = 8;
 const THREADED_AREA: usize = 64 * 1024;
 
 /// Threads for one draw: `requested` (0: one per core), at most one per band.
-fn worker_threads(requested: usize, area: usize, bands: usize) -> usize {
+pub(super) fn worker_threads(requested: usize, area: usize, bands: usize) -> usize {
     static CORES: OnceLock<usize> = OnceLock::new();
     let cores = *CORES.get_or_init(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
     let wanted = if requested == 0 { cores } else { requested };

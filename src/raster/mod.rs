@@ -40,6 +40,7 @@ mod helper;
 pub mod overlay;
 mod patch;
 mod prepare;
+mod record;
 mod rect;
 mod replay;
 mod sampler;

@@ -34,6 +34,8 @@ pub struct RasterScratch {
     pub(crate) replay: Replay,
     /// Per-thread membrane maps of a replayed draw.
     pub(crate) replay_spans: [LazySpans; 2],
+    /// The membrane a recording draw prepares with (all zero; see `record.rs`).
+    pub(crate) zero_membrane: Vec<[f32; 3]>,
 }
 
 impl Default for RasterScratch {
@@ -53,6 +55,7 @@ impl Default for RasterScratch {
             band_pixels: BAND_PIXELS,
             replay: Replay::default(),
             replay_spans: Default::default(),
+            zero_membrane: Vec::new(),
         }
     }
 }
