@@ -87,22 +87,11 @@ pub fn mesh_from_polygons(
 /// Corners of the bounding box of the inside pixels; a zero box at the origin when empty
 /// (meshing reports the empty mask before this matters).
 fn inside_bbox(mask: &BitMask) -> (DVec2, DVec2) {
-    let mut min = (usize::MAX, usize::MAX);
-    let mut max = (0, 0);
-    let mut any = false;
-    for (index, &inside) in mask.as_slice().iter().enumerate() {
-        if inside {
-            let (x, y) = (index % mask.width, index / mask.width);
-            min = (min.0.min(x), min.1.min(y));
-            max = (max.0.max(x), max.1.max(y));
-            any = true;
-        }
-    }
-    if !any {
+    let Some(((x0, y0), (x1, y1))) = mask.inside_bounds() else {
         return (DVec2::ZERO, DVec2::ZERO);
-    }
+    };
     (
-        DVec2::new(min.0 as f64, min.1 as f64),
-        DVec2::new(max.0 as f64 + 1.0, max.1 as f64 + 1.0),
+        DVec2::new(x0 as f64, y0 as f64),
+        DVec2::new(x1 as f64, y1 as f64),
     )
 }

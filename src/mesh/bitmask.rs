@@ -6,6 +6,38 @@ use std::path::Path;
 
 use super::MeshError;
 
+/// The first index from `from` on whose byte differs from `value` (`bytes.len()` if none),
+/// eight bytes per test where it can.
+pub fn run_end(bytes: &[u8], from: usize, value: u8) -> usize {
+    let repeated = u64::from_ne_bytes([value; 8]);
+    let mut at = from;
+    while at + 8 <= bytes.len() && word(&bytes[at..at + 8]) == repeated {
+        at += 8;
+    }
+    at + bytes[at..].iter().take_while(|&&b| b == value).count()
+}
+
+/// Where the trailing zero bytes of `bytes` start (0 when all are zero), eight bytes per
+/// test where it can.
+pub fn zero_suffix_start(bytes: &[u8]) -> usize {
+    let mut end = bytes.len();
+    while end >= 8 && word(&bytes[end - 8..end]) == 0 {
+        end -= 8;
+    }
+    bytes[..end]
+        .iter()
+        .rposition(|&b| b != 0)
+        .map_or(0, |last| last + 1)
+}
+
+/// Eight bytes as one word.
+#[inline]
+pub(crate) fn word(bytes: &[u8]) -> u64 {
+    let mut eight = [0; 8];
+    eight.copy_from_slice(bytes);
+    u64::from_ne_bytes(eight)
+}
+
 /// A width × height grid of inside/outside pixels. Pixel (x, y) covers [x, x+1] × [y, y+1].
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct BitMask {
@@ -97,12 +129,47 @@ impl BitMask {
     }
 
     pub fn count_inside(&self) -> usize {
-        self.inside.iter().filter(|&&b| b).count()
+        let bytes = self.as_bytes();
+        let mut words = bytes.chunks_exact(8);
+        // Each byte is 0 or 1, so a word's byte sum is its popcount.
+        let whole: u32 = (&mut words).map(|w| word(w).count_ones()).sum();
+        whole as usize + words.remainder().iter().filter(|&&b| b != 0).count()
     }
 
     /// Row-major inside flags.
     pub fn as_slice(&self) -> &[bool] {
         &self.inside
+    }
+
+    /// Row-major inside flags as bytes (1 inside, 0 outside), for word-at-a-time scans.
+    pub fn as_bytes(&self) -> &[u8] {
+        // SAFETY: `bool` is one byte holding 0 or 1, so its slice reads as bytes.
+        unsafe { std::slice::from_raw_parts(self.inside.as_ptr().cast(), self.inside.len()) }
+    }
+
+    /// Row `y`'s flags as bytes.
+    pub fn row_bytes(&self, y: usize) -> &[u8] {
+        &self.as_bytes()[y * self.width..(y + 1) * self.width]
+    }
+
+    /// Corners of the bounding box of the inside pixels (pixel (x, y) spans [x, x+1] ×
+    /// [y, y+1]); `None` for an empty mask. Reads each row only until the box so far
+    /// decides it.
+    pub fn inside_bounds(&self) -> Option<((usize, usize), (usize, usize))> {
+        let has_inside = |y: usize| run_end(self.row_bytes(y), 0, 0) < self.width;
+        let y0 = (0..self.height).find(|&y| has_inside(y))?;
+        // invariant: row y0 has an inside pixel, so a last such row exists.
+        let y1 = (y0..self.height)
+            .rev()
+            .find(|&y| has_inside(y))
+            .expect("row y0");
+        let (mut x0, mut x1) = (self.width, 0);
+        for y in y0..=y1 {
+            let row = self.row_bytes(y);
+            x0 = run_end(&row[..x0], 0, 0).min(x0);
+            x1 += zero_suffix_start(&row[x1..]);
+        }
+        Some(((x0, y0), (x1, y1 + 1)))
     }
 
     /// White inside, black outside.
@@ -154,6 +221,59 @@ mod tests {
         let mask = BitMask::from_fn(2, 2, |_, _| true);
         assert!(mask.get(1, 1));
         assert!(!mask.get(-1, 0) && !mask.get(2, 0) && !mask.get(0, 2));
+    }
+
+    /// Random masks with long inside and outside runs (so the word paths run) and isolated
+    /// pixels (so the byte tails do).
+    fn random_mask(width: usize, height: usize, seed: u64) -> BitMask {
+        let mut state = seed | 1;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        let mut inside = false;
+        BitMask::from_fn(width, height, |_, _| {
+            if next() % 13 == 0 {
+                inside = !inside;
+            }
+            inside && next() % 29 != 0
+        })
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig {
+            cases: 200,
+            rng_algorithm: proptest::test_runner::RngAlgorithm::ChaCha,
+            ..Default::default()
+        })]
+
+        /// The word-at-a-time scans agree with pixel-by-pixel definitions.
+        #[test]
+        fn word_scans_match_pixel_scans(width in 0usize..40, height in 0usize..12, seed: u64) {
+            let mask = random_mask(width, height, seed);
+            let flags = mask.as_slice();
+            proptest::prop_assert_eq!(mask.count_inside(), flags.iter().filter(|&&b| b).count());
+            let mut naive: Option<((usize, usize), (usize, usize))> = None;
+            for (i, _) in flags.iter().enumerate().filter(|(_, &b)| b) {
+                let (x, y) = (i % width, i / width);
+                let ((x0, y0), (x1, y1)) = naive.unwrap_or(((x, y), (x + 1, y + 1)));
+                naive = Some(((x0.min(x), y0.min(y)), (x1.max(x + 1), y1.max(y + 1))));
+            }
+            proptest::prop_assert_eq!(mask.inside_bounds(), naive);
+            for y in 0..height {
+                let row = mask.row_bytes(y);
+                for from in 0..=width {
+                    for value in [0, 1] {
+                        let end = (from..width).find(|&x| row[x] != value).unwrap_or(width);
+                        proptest::prop_assert_eq!(run_end(row, from, value), end);
+                    }
+                    let suffix = row[..from].iter().rposition(|&b| b != 0).map_or(0, |l| l + 1);
+                    proptest::prop_assert_eq!(zero_suffix_start(&row[..from]), suffix);
+                }
+            }
+        }
     }
 
     #[test]

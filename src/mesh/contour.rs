@@ -15,6 +15,7 @@
 
 use glam::DVec2;
 
+use super::bitmask::run_end;
 use super::BitMask;
 
 /// One traced crack loop: only the corners where the direction changes (plus saddle
@@ -236,37 +237,59 @@ fn trace_one(
 /// above that touch it (diagonals included); the root of a piece is its first run in
 /// raster order, which gives the label order.
 pub fn label_pieces(mask: &BitMask) -> (Vec<u32>, Vec<usize>) {
-    let (runs, row_start) = inside_runs(mask);
-    let mut parent: Vec<u32> = (0..runs.len() as u32).collect();
-    for y in 1..mask.height {
-        let above = row_start[y - 1]..row_start[y];
-        let mut first_candidate = above.start;
-        for current in row_start[y]..row_start[y + 1] {
-            let (x0, x1) = (runs[current].x0, runs[current].x1);
-            while first_candidate < above.end && runs[first_candidate].x1 < x0 {
-                first_candidate += 1;
-            }
-            let mut other = first_candidate;
-            while other < above.end && runs[other].x0 <= x1 {
-                union(&mut parent, current as u32, other as u32);
-                other += 1;
-            }
-        }
-    }
+    let pieces = RunPieces::of(mask);
     let mut labels = vec![u32::MAX; mask.width * mask.height];
-    let mut label_of_root = vec![u32::MAX; runs.len()];
-    let mut sizes = Vec::new();
-    for (index, run) in runs.iter().enumerate() {
-        let root = find(&mut parent, index as u32) as usize;
-        if label_of_root[root] == u32::MAX {
-            label_of_root[root] = sizes.len() as u32;
-            sizes.push(0);
-        }
-        let label = label_of_root[root];
-        sizes[label as usize] += run.x1 - run.x0;
+    for (run, &label) in pieces.runs.iter().zip(&pieces.label) {
         labels[run.y * mask.width + run.x0..run.y * mask.width + run.x1].fill(label);
     }
-    (labels, sizes)
+    (labels, pieces.sizes)
+}
+
+/// The pixel counts of [`label_pieces`], without the per-pixel labels.
+pub(crate) fn piece_sizes(mask: &BitMask) -> Vec<usize> {
+    RunPieces::of(mask).sizes
+}
+
+/// A mask's runs of inside pixels with the piece label of each, and each piece's size.
+struct RunPieces {
+    runs: Vec<Run>,
+    label: Vec<u32>,
+    sizes: Vec<usize>,
+}
+
+impl RunPieces {
+    fn of(mask: &BitMask) -> RunPieces {
+        let (runs, row_start) = inside_runs(mask);
+        let mut parent: Vec<u32> = (0..runs.len() as u32).collect();
+        for y in 1..mask.height {
+            let above = row_start[y - 1]..row_start[y];
+            let mut first_candidate = above.start;
+            for current in row_start[y]..row_start[y + 1] {
+                let (x0, x1) = (runs[current].x0, runs[current].x1);
+                while first_candidate < above.end && runs[first_candidate].x1 < x0 {
+                    first_candidate += 1;
+                }
+                let mut other = first_candidate;
+                while other < above.end && runs[other].x0 <= x1 {
+                    union(&mut parent, current as u32, other as u32);
+                    other += 1;
+                }
+            }
+        }
+        let mut label_of_root = vec![u32::MAX; runs.len()];
+        let mut label = Vec::with_capacity(runs.len());
+        let mut sizes = Vec::new();
+        for (index, run) in runs.iter().enumerate() {
+            let root = find(&mut parent, index as u32) as usize;
+            if label_of_root[root] == u32::MAX {
+                label_of_root[root] = sizes.len() as u32;
+                sizes.push(0);
+            }
+            label.push(label_of_root[root]);
+            sizes[label_of_root[root] as usize] += run.x1 - run.x0;
+        }
+        RunPieces { runs, label, sizes }
+    }
 }
 
 /// A maximal horizontal run of inside pixels: row `y`, columns `x0..x1`.
@@ -280,22 +303,17 @@ struct Run {
 fn inside_runs(mask: &BitMask) -> (Vec<Run>, Vec<usize>) {
     let mut runs = Vec::new();
     let mut row_start = Vec::with_capacity(mask.height + 1);
-    for (y, row) in mask.as_slice().chunks_exact(mask.width.max(1)).enumerate() {
+    for y in 0..mask.height {
         row_start.push(runs.len());
-        let mut x = 0;
+        let row = mask.row_bytes(y);
+        let mut x = run_end(row, 0, 0);
         while x < row.len() {
-            if row[x] {
-                let x0 = x;
-                while x < row.len() && row[x] {
-                    x += 1;
-                }
-                runs.push(Run { y, x0, x1: x });
-            } else {
-                x += 1;
-            }
+            let x1 = run_end(row, x, 1);
+            runs.push(Run { y, x0: x, x1 });
+            x = run_end(row, x1, 0);
         }
     }
-    row_start.resize(mask.height + 1, runs.len());
+    row_start.push(runs.len());
     (runs, row_start)
 }
 

@@ -8,8 +8,9 @@
 
 use glam::DVec2;
 
+use super::bitmask::word;
 use super::centre_loops::outside_centre_loops;
-use super::contour::{for_each_edge_pixel, label_pieces, trace_crack_loops, CrackLoop};
+use super::contour::{label_pieces, piece_sizes, trace_crack_loops, CrackLoop};
 use super::options::{min_angle_deg, BoundaryPlacement};
 use super::simplify::{doubled_signed_area, simplify_loop, subdivide_loop, subdivided_len};
 use super::triangulate::{triangulate_loops, Refinement};
@@ -238,7 +239,7 @@ fn drop_small_pieces(
     min_area: f64,
     warnings: &mut Vec<String>,
 ) -> (Option<BitMask>, usize, usize, usize) {
-    let (labels, sizes) = label_pieces(mask);
+    let sizes = piece_sizes(mask);
     let small: Vec<bool> = sizes.iter().map(|&s| (s as f64) < min_area).collect();
     let dropped_pieces = small.iter().filter(|&&s| s).count();
     let kept_pieces = sizes.len() - dropped_pieces;
@@ -254,6 +255,7 @@ fn drop_small_pieces(
     warnings.push(format!(
         "dropped {dropped_pieces} piece(s) smaller than {min_area} px² ({dropped_pixels} pixels)"
     ));
+    let (labels, _) = label_pieces(mask);
     let kept = BitMask::from_fn(mask.width, mask.height, |x, y| {
         let label = labels[y * mask.width + x];
         label != u32::MAX && !small[label as usize]
@@ -304,15 +306,39 @@ const MIN_CRACK_EDGE_LIMIT: usize = 1 << 20;
 /// Pixel edges between inside and outside (the image border counts as outside), counted
 /// without allocating.
 fn crack_edge_count(mask: &BitMask) -> usize {
+    let (width, height) = (mask.width, mask.height);
+    if width == 0 {
+        return 0;
+    }
+    let outside_row = vec![0u8; width];
+    let row = |y: usize| match y {
+        0 => &outside_row[..],
+        _ if y > height => &outside_row[..],
+        _ => mask.row_bytes(y - 1),
+    };
+    // A crack separates an inside pixel from an outside one (or from beyond the image):
+    // between rows y − 1 and y, and between columns x − 1 and x of a row.
     let mut edges = 0;
-    for_each_edge_pixel(mask, |x, y| {
-        let (x, y) = (x as i64, y as i64);
-        edges += [(-1, 0), (1, 0), (0, -1), (0, 1)]
-            .iter()
-            .filter(|(dx, dy)| !mask.get(x + dx, y + dy))
-            .count();
-    });
+    for y in 0..=height {
+        edges += differing_bytes(row(y), row(y + 1));
+    }
+    for y in 0..height {
+        let bytes = mask.row_bytes(y);
+        edges += usize::from(bytes[0]) + usize::from(bytes[width - 1]);
+        edges += differing_bytes(&bytes[..width - 1], &bytes[1..]);
+    }
     edges
+}
+
+/// Positions where two equally long 0/1 byte slices differ, eight per word.
+fn differing_bytes(a: &[u8], b: &[u8]) -> usize {
+    let (mut words_a, mut words_b) = (a.chunks_exact(8), b.chunks_exact(8));
+    let whole: u32 = (&mut words_a)
+        .zip(&mut words_b)
+        .map(|(x, y)| (word(x) ^ word(y)).count_ones())
+        .sum();
+    let rest = words_a.remainder().iter().zip(words_b.remainder());
+    whole as usize + rest.filter(|(x, y)| x != y).count()
 }
 
 fn stats_of(
@@ -343,6 +369,40 @@ fn stats_of(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The word-wise crack count against its definition: outside 4-neighbours of inside
+    /// pixels, beyond the image counting as outside.
+    #[test]
+    fn crack_edges_are_counted_like_outside_neighbours() {
+        type Shape = (usize, usize, fn(usize, usize) -> bool);
+        let shapes: [Shape; 5] = [
+            (1, 1, |_, _| true),
+            (9, 1, |x, _| x % 3 != 1),
+            (17, 11, |x, y| (x * 7 + y * 3) % 5 < 2),
+            (33, 20, |x, y| (x / 4 + y / 3) % 2 == 0 || x == 32),
+            (24, 16, |x, y| {
+                x > 2 && y > 1 && x < 21 && y < 14 && (x, y) != (9, 7)
+            }),
+        ];
+        for (width, height, inside) in shapes {
+            let mask = BitMask::from_fn(width, height, inside);
+            let mut expected = 0;
+            for y in 0..height as i64 {
+                for x in 0..width as i64 {
+                    if mask.get(x, y) {
+                        let around = [(-1, 0), (1, 0), (0, -1), (0, 1)];
+                        expected += around
+                            .iter()
+                            .filter(|(dx, dy)| !mask.get(x + dx, y + dy))
+                            .count();
+                    }
+                }
+            }
+            assert_eq!(crack_edge_count(&mask), expected, "{width}×{height}");
+        }
+        assert_eq!(crack_edge_count(&BitMask::new(0, 0)), 0);
+        assert_eq!(crack_edge_count(&BitMask::new(5, 0)), 0);
+    }
 
     fn triangle(far: f64) -> Vec<Polygon> {
         vec![Polygon {
