@@ -156,6 +156,11 @@ impl Replay {
         self.runs.clear();
         self.coverage.clear();
         self.samples.clear();
+        // A draw records at most one coverage byte and one sample per work pixel. Reserving
+        // that bound up front saves a fresh scratch's first draw the copies of growing (its
+        // untouched pages cost nothing).
+        self.coverage.reserve(work.area());
+        self.samples.reserve(work.area());
         self.fringe.clear();
         self.triangles.clear();
         self.record_number.clear();
