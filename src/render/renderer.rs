@@ -72,7 +72,8 @@ pub struct Renderer {
 }
 
 impl Renderer {
-    /// Loads images, meshes and factors every patch.
+    /// Loads images and meshes every patch; the cloning factors are built by the first frame
+    /// (see `PatchCloner::new`).
     pub fn new(scene: Scene) -> Result<Self, RenderError> {
         scene.sanity_check()?;
         let background = background_canvas(&scene)?;
