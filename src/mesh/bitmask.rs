@@ -38,6 +38,53 @@ pub(crate) fn word(bytes: &[u8]) -> u64 {
     u64::from_ne_bytes(eight)
 }
 
+/// Positions where two equally long 0/1 byte slices differ, eight per word.
+pub(crate) fn differing_bytes(a: &[u8], b: &[u8]) -> usize {
+    let (mut words_a, mut words_b) = (a.chunks_exact(8), b.chunks_exact(8));
+    let whole: u32 = (&mut words_a)
+        .zip(&mut words_b)
+        .map(|(x, y)| (word(x) ^ word(y)).count_ones())
+        .sum();
+    let rest = words_a.remainder().iter().zip(words_b.remainder());
+    whole as usize + rest.filter(|(x, y)| x != y).count()
+}
+
+/// Calls `count(y, edges)` for every y in `0..=height`: the crack edges (pixel edges between
+/// inside and outside, the image border counting as outside) on the line between rows y − 1
+/// and y, plus those between the columns of row y (none for y = height).
+pub(crate) fn crack_edges_by_row(mask: &BitMask, mut count: impl FnMut(usize, usize)) {
+    let (width, height) = (mask.width, mask.height);
+    if width == 0 {
+        return;
+    }
+    let outside_row = vec![0u8; width];
+    let row = |y: usize| match y {
+        0 => &outside_row[..],
+        _ if y > height => &outside_row[..],
+        _ => mask.row_bytes(y - 1),
+    };
+    for y in 0..=height {
+        let mut edges = differing_bytes(row(y), row(y + 1));
+        if y < height {
+            let bytes = mask.row_bytes(y);
+            edges += usize::from(bytes[0]) + usize::from(bytes[width - 1]);
+            edges += differing_bytes(&bytes[..width - 1], &bytes[1..]);
+        }
+        count(y, edges);
+    }
+}
+
+/// Positions where two equally long 0/1 byte slices are both 1, eight per word.
+pub(crate) fn shared_ones(a: &[u8], b: &[u8]) -> usize {
+    let (mut words_a, mut words_b) = (a.chunks_exact(8), b.chunks_exact(8));
+    let whole: u32 = (&mut words_a)
+        .zip(&mut words_b)
+        .map(|(x, y)| (word(x) & word(y)).count_ones())
+        .sum();
+    let rest = words_a.remainder().iter().zip(words_b.remainder());
+    whole as usize + rest.filter(|(&x, &y)| x & y != 0).count()
+}
+
 /// A width × height grid of inside/outside pixels. Pixel (x, y) covers [x, x+1] × [y, y+1].
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct BitMask {
@@ -145,6 +192,17 @@ impl BitMask {
     pub fn as_bytes(&self) -> &[u8] {
         // SAFETY: `bool` is one byte holding 0 or 1, so its slice reads as bytes.
         unsafe { std::slice::from_raw_parts(self.inside.as_ptr().cast(), self.inside.len()) }
+    }
+
+    /// Rows `rows` of the mask as a mask of their own (row `rows.start` becomes row 0).
+    pub fn rows(&self, rows: std::ops::Range<usize>) -> BitMask {
+        let start = rows.start.min(self.height);
+        let rows = start..rows.end.clamp(start, self.height);
+        BitMask {
+            width: self.width,
+            height: rows.len(),
+            inside: self.inside[rows.start * self.width..rows.end * self.width].to_vec(),
+        }
     }
 
     /// Row `y`'s flags as bytes.

@@ -1,6 +1,8 @@
 //! The meshing pipeline: [`mesh_mask`] takes a [`BitMask`], [`mesh_polygons`] takes
 //! [`Polygon`]s; both give a [`MeshResult`]. Mask path: drop small pieces → crack loops →
-//! Douglas–Peucker (anchored at saddle corners) → subdivide to `density` → CDT + refinement.
+//! Douglas–Peucker (anchored at saddle corners) → subdivide to `density` → CDT + refinement;
+//! masks with a long boundary go through it as two halves at once, joined afterwards
+//! (`split`).
 //! If simplification makes two loops touch or cross (a thin gap closed by the tolerance), the
 //! mask is meshed again from the raw crack loops, which never cross. With
 //! [`BoundaryPlacement::OutsideCentres`] the loops run through the outside pixel centres
@@ -8,11 +10,14 @@
 
 use glam::DVec2;
 
-use super::bitmask::word;
+use super::bitmask::crack_edges_by_row;
 use super::centre_loops::outside_centre_loops;
 use super::contour::{label_pieces, piece_sizes, trace_crack_loops, CrackLoop};
 use super::options::{min_angle_deg, BoundaryPlacement};
-use super::simplify::{doubled_signed_area, simplify_loop, subdivide_loop, subdivided_len};
+use super::simplify::{
+    doubled_signed_area, simplify_loop, subdivide_loop, subdivide_loop_sharing_row, subdivided_len,
+};
+use super::split::Cut;
 use super::triangulate::{triangulate_loops, Refinement};
 use super::{BitMask, Mesh, MeshError, MeshOptions, MeshResult, MeshStats};
 
@@ -45,77 +50,24 @@ pub fn mesh_mask(mask: &BitMask, options: &MeshOptions) -> Result<MeshResult, Me
     if edges > max_edges {
         return Err(MeshError::BoundaryTooLong { edges, max_edges });
     }
-    let crack = trace_crack_loops(kept_mask);
-    let expected_holes = crack.iter().filter(|l| l.is_hole()).count();
-    let attempt = |loops: &[Vec<DVec2>], keep_boundary: bool| -> Result<(Mesh, bool), MeshError> {
-        let refinement = Refinement {
-            max_area: options.max_area,
-            keep_boundary,
-            ..Refinement::new(options.min_angle_deg, options.max_vertices)
-        };
-        let t = triangulate_loops(loops, &refinement)?;
-        // The full check costs about as much as the refinement; the tests run it on every
-        // shape family, so release builds rely on the topology counts below.
-        if cfg!(debug_assertions) {
-            t.mesh.sanity_check()?;
-        }
-        if t.mesh.hole_count() != expected_holes || t.mesh.piece_count as usize != pieces {
-            return Err(MeshError::IntersectingBoundary { conflicts: 0 });
-        }
-        Ok((t.mesh, t.refinement_complete))
+    let split = match options.boundary {
+        BoundaryPlacement::Cracks => Cut::choose(kept_mask, edges, options.max_vertices)
+            .map(|cut| mesh_in_halves(kept_mask, &cut, pieces, options))
+            .transpose()?
+            .flatten(),
+        BoundaryPlacement::OutsideCentres => None,
     };
-    let mut placement = options.boundary;
-    let mut off_centre = 0;
-    let mut centred = None;
-    if placement == BoundaryPlacement::OutsideCentres {
-        let (loops, fallbacks) = outside_centre_loops(&crack, options.density);
-        check_budget(loops.iter().map(Vec::len).sum::<usize>() as f64, options)?;
-        // Splitting a boundary edge would put a vertex between two centres, sampling mixed
-        // pixels: keep the edges as given.
-        match attempt(&loops, true) {
-            Ok(done) => {
-                off_centre = fallbacks;
-                centred = Some(done);
-            }
-            Err(MeshError::IntersectingBoundary { .. } | MeshError::Sanity(_)) => {
-                warnings.push(
-                    "the loops through the outside pixel centres touch or cross; meshed the \
-                     crack boundary instead"
-                        .into(),
-                );
-                placement = BoundaryPlacement::Cracks;
-            }
-            Err(e) => return Err(e),
-        }
+    let meshed = match split {
+        Some(meshed) => meshed,
+        None => mesh_whole(kept_mask, pieces, options, &mut warnings)?,
+    };
+    if meshed.fell_back {
+        warnings.push(
+            "simplification made boundary loops touch; meshed the unsimplified crack boundary"
+                .into(),
+        );
     }
-    let mut simplified = placement == BoundaryPlacement::Cracks && options.simplify_tolerance > 0.0;
-    let mut deviation = 0.0;
-    let (mesh, complete) = match centred {
-        Some(done) => done,
-        None => {
-            let mut on_cracks = |tolerance: f64| -> Result<(Mesh, bool), MeshError> {
-                let (loops, d) = sample_crack_loops(&crack, tolerance, options)?;
-                deviation = d;
-                attempt(&loops, false)
-            };
-            match on_cracks(options.simplify_tolerance) {
-                Ok(done) => done,
-                Err(MeshError::IntersectingBoundary { .. } | MeshError::Sanity(_))
-                    if simplified =>
-                {
-                    warnings.push(
-                        "simplification made boundary loops touch; meshed the unsimplified \
-                         crack boundary"
-                            .into(),
-                    );
-                    simplified = false;
-                    on_cracks(0.0)?
-                }
-                Err(e) => return Err(e),
-            }
-        }
-    };
-    if !complete {
+    if !meshed.complete {
         warnings.push(format!(
             "refinement stopped at its vertex budget (max_vertices {}, or the size-based bound) \
              before every angle reached {}°",
@@ -123,20 +75,183 @@ pub fn mesh_mask(mask: &BitMask, options: &MeshOptions) -> Result<MeshResult, Me
         ));
     }
     let mut stats = stats_of(
-        &mesh,
-        deviation,
-        simplified,
-        complete,
+        &meshed.mesh,
+        meshed.deviation,
+        meshed.simplified,
+        meshed.complete,
         dropped_pieces,
         dropped_pixels,
     );
-    stats.boundary = placement;
-    stats.off_centre_boundary_vertices = off_centre;
+    stats.boundary = meshed.placement;
+    stats.off_centre_boundary_vertices = meshed.off_centre;
     Ok(MeshResult {
-        mesh,
+        mesh: meshed.mesh,
         warnings,
         stats,
     })
+}
+
+/// A mask's mesh and how it was made.
+struct Meshed {
+    mesh: Mesh,
+    /// spade's `refinement_complete` (false: the vertex budget ran out).
+    complete: bool,
+    /// Largest distance of a dropped crack corner from the simplified boundary, px.
+    deviation: f64,
+    simplified: bool,
+    /// Simplification made loops touch, so the raw crack loops were meshed.
+    fell_back: bool,
+    placement: BoundaryPlacement,
+    off_centre: usize,
+}
+
+/// The inside-pixel topology a mesh of some crack loops must have.
+#[derive(Clone, Copy)]
+struct Topology {
+    holes: usize,
+    pieces: usize,
+}
+
+/// Meshes `mask` in one piece, through the outside pixel centres if asked and possible,
+/// else on the (simplified) crack loops.
+fn mesh_whole(
+    mask: &BitMask,
+    pieces: usize,
+    options: &MeshOptions,
+    warnings: &mut Vec<String>,
+) -> Result<Meshed, MeshError> {
+    let crack = trace_crack_loops(mask);
+    let expected = Topology {
+        holes: crack.iter().filter(|l| l.is_hole()).count(),
+        pieces,
+    };
+    if options.boundary == BoundaryPlacement::OutsideCentres {
+        let (loops, fallbacks) = outside_centre_loops(&crack, options.density);
+        check_budget(loops.iter().map(Vec::len).sum::<usize>() as f64, options)?;
+        // Splitting a boundary edge would put a vertex between two centres, sampling mixed
+        // pixels: keep the edges as given.
+        match triangulate_checked(&loops, true, expected, options) {
+            Ok((mesh, complete)) => {
+                return Ok(Meshed {
+                    mesh,
+                    complete,
+                    deviation: 0.0,
+                    simplified: false,
+                    fell_back: false,
+                    placement: BoundaryPlacement::OutsideCentres,
+                    off_centre: fallbacks,
+                })
+            }
+            Err(MeshError::IntersectingBoundary { .. } | MeshError::Sanity(_)) => {
+                warnings.push(
+                    "the loops through the outside pixel centres touch or cross; meshed the \
+                     crack boundary instead"
+                        .into(),
+                );
+            }
+            Err(e) => return Err(e),
+        }
+    }
+    mesh_crack_loops(&crack, expected, options, None)
+}
+
+/// Meshes the two halves of `mask` on either side of `cut` at once and joins them; `None`
+/// when the joined mesh exceeds the vertex budget (the caller then meshes the mask whole,
+/// which refines within the budget).
+fn mesh_in_halves(
+    mask: &BitMask,
+    cut: &Cut,
+    pieces: usize,
+    options: &MeshOptions,
+) -> Result<Option<Meshed>, MeshError> {
+    let [top, bottom] = cut.halves(mask);
+    let mesh_half = |half: &BitMask, first_row: usize| {
+        let mut crack = trace_crack_loops(half);
+        cut.pin(&mut crack, first_row as f64);
+        let expected = Topology {
+            holes: crack.iter().filter(|l| l.is_hole()).count(),
+            pieces: piece_sizes(half).len(),
+        };
+        mesh_crack_loops(&crack, expected, options, Some(cut.y()))
+    };
+    let (upper, lower) = rayon::join(|| mesh_half(&top, 0), || mesh_half(&bottom, cut.row));
+    let (upper, lower) = (upper?, lower?);
+    let mesh = cut.merge(&upper.mesh, &lower.mesh);
+    if cfg!(debug_assertions) {
+        mesh.sanity_check()?;
+    }
+    // Joined halves that miss the mask's pieces would be a fault of the join (the tests
+    // check it on every shape family); the whole-mask path is the safe answer.
+    debug_assert_eq!(mesh.piece_count as usize, pieces, "cut at row {}", cut.row);
+    if mesh.piece_count as usize != pieces || mesh.vertex_count() > options.max_vertices {
+        return Ok(None);
+    }
+    Ok(Some(Meshed {
+        mesh,
+        complete: upper.complete && lower.complete,
+        deviation: upper.deviation.max(lower.deviation),
+        simplified: upper.simplified && lower.simplified,
+        fell_back: upper.fell_back || lower.fell_back,
+        placement: BoundaryPlacement::Cracks,
+        off_centre: 0,
+    }))
+}
+
+/// Meshes crack loops simplified with the options' tolerance or, if simplification makes two
+/// loops touch or cross (a thin gap closed by the tolerance), unsimplified. Edges on
+/// `shared_row` are subdivided the same way in either direction.
+fn mesh_crack_loops(
+    crack: &[CrackLoop],
+    expected: Topology,
+    options: &MeshOptions,
+    shared_row: Option<f64>,
+) -> Result<Meshed, MeshError> {
+    let attempt = |tolerance: f64| -> Result<(Mesh, bool, f64), MeshError> {
+        let (loops, deviation) = sample_crack_loops(crack, tolerance, options, shared_row)?;
+        let (mesh, complete) = triangulate_checked(&loops, false, expected, options)?;
+        Ok((mesh, complete, deviation))
+    };
+    let simplify = options.simplify_tolerance > 0.0;
+    let (result, fell_back) = match attempt(options.simplify_tolerance) {
+        Err(MeshError::IntersectingBoundary { .. } | MeshError::Sanity(_)) if simplify => {
+            (attempt(0.0)?, true)
+        }
+        result => (result?, false),
+    };
+    let (mesh, complete, deviation) = result;
+    Ok(Meshed {
+        mesh,
+        complete,
+        deviation,
+        simplified: simplify && !fell_back,
+        fell_back,
+        placement: BoundaryPlacement::Cracks,
+        off_centre: 0,
+    })
+}
+
+/// Triangulates and refines `loops`, and checks the result's holes and pieces.
+fn triangulate_checked(
+    loops: &[Vec<DVec2>],
+    keep_boundary: bool,
+    expected: Topology,
+    options: &MeshOptions,
+) -> Result<(Mesh, bool), MeshError> {
+    let refinement = Refinement {
+        max_area: options.max_area,
+        keep_boundary,
+        ..Refinement::new(options.min_angle_deg, options.max_vertices)
+    };
+    let t = triangulate_loops(loops, &refinement)?;
+    // The full check costs about as much as the refinement; the tests run it on every
+    // shape family, so release builds rely on the topology counts below.
+    if cfg!(debug_assertions) {
+        t.mesh.sanity_check()?;
+    }
+    if t.mesh.hole_count() != expected.holes || t.mesh.piece_count as usize != expected.pieces {
+        return Err(MeshError::IntersectingBoundary { conflicts: 0 });
+    }
+    Ok((t.mesh, t.refinement_complete))
 }
 
 /// Polygon coordinates are bounded so that spade's predicates and the raster's fixed point
@@ -269,6 +384,7 @@ fn sample_crack_loops(
     crack: &[CrackLoop],
     tolerance: f64,
     options: &MeshOptions,
+    shared_row: Option<f64>,
 ) -> Result<(Vec<Vec<DVec2>>, f64), MeshError> {
     let mut deviation = 0.0f64;
     let mut points = 0.0;
@@ -279,7 +395,7 @@ fn sample_crack_loops(
         points += subdivided_len(&s.points, options.density);
         check_budget(points, options)?;
         let mut out = Vec::new();
-        subdivide_loop(&s.points, options.density, &mut out);
+        subdivide_loop_sharing_row(&s.points, options.density, shared_row, &mut out);
         loops.push(out);
     }
     Ok((loops, deviation))
@@ -306,39 +422,9 @@ const MIN_CRACK_EDGE_LIMIT: usize = 1 << 20;
 /// Pixel edges between inside and outside (the image border counts as outside), counted
 /// without allocating.
 fn crack_edge_count(mask: &BitMask) -> usize {
-    let (width, height) = (mask.width, mask.height);
-    if width == 0 {
-        return 0;
-    }
-    let outside_row = vec![0u8; width];
-    let row = |y: usize| match y {
-        0 => &outside_row[..],
-        _ if y > height => &outside_row[..],
-        _ => mask.row_bytes(y - 1),
-    };
-    // A crack separates an inside pixel from an outside one (or from beyond the image):
-    // between rows y − 1 and y, and between columns x − 1 and x of a row.
     let mut edges = 0;
-    for y in 0..=height {
-        edges += differing_bytes(row(y), row(y + 1));
-    }
-    for y in 0..height {
-        let bytes = mask.row_bytes(y);
-        edges += usize::from(bytes[0]) + usize::from(bytes[width - 1]);
-        edges += differing_bytes(&bytes[..width - 1], &bytes[1..]);
-    }
+    crack_edges_by_row(mask, |_, row_edges| edges += row_edges);
     edges
-}
-
-/// Positions where two equally long 0/1 byte slices differ, eight per word.
-fn differing_bytes(a: &[u8], b: &[u8]) -> usize {
-    let (mut words_a, mut words_b) = (a.chunks_exact(8), b.chunks_exact(8));
-    let whole: u32 = (&mut words_a)
-        .zip(&mut words_b)
-        .map(|(x, y)| (word(x) ^ word(y)).count_ones())
-        .sum();
-    let rest = words_a.remainder().iter().zip(words_b.remainder());
-    whole as usize + rest.filter(|(x, y)| x != y).count()
 }
 
 fn stats_of(
@@ -402,6 +488,102 @@ mod tests {
         }
         assert_eq!(crack_edge_count(&BitMask::new(0, 0)), 0);
         assert_eq!(crack_edge_count(&BitMask::new(5, 0)), 0);
+    }
+
+    /// A mask of a few discs, some of them cut out again (holes, separate pieces).
+    fn discs(width: usize, height: usize, discs: &[(f64, f64, f64, bool)]) -> BitMask {
+        BitMask::from_fn(width, height, |x, y| {
+            let (px, py) = (x as f64 + 0.5, y as f64 + 0.5);
+            let mut inside = false;
+            for &(cx, cy, r, add) in discs {
+                if (px - cx).powi(2) + (py - cy).powi(2) < r * r {
+                    inside = add;
+                }
+            }
+            inside
+        })
+    }
+
+    use proptest::prelude::*;
+
+    proptest! {
+        #![proptest_config(ProptestConfig {
+            cases: 64,
+            rng_seed: proptest::test_runner::RngSeed::Fixed(0x5b11_7000),
+            ..ProptestConfig::default()
+        })]
+        /// A mask meshed as two halves at any row is a sane mesh with the whole mask's pieces
+        /// and holes, covering every mask pixel: the halves share every interface vertex (a
+        /// vertex one half lacks would leave boundary along the cut, which the sanity check
+        /// and the hole count catch).
+        #[test]
+        fn halves_join_into_the_masks_topology(
+            (width, height) in (16usize..64, 16usize..64),
+            shapes in proptest::collection::vec(
+                (0.0f64..1.0, 0.0f64..1.0, 0.1f64..0.45, proptest::bool::weighted(0.7)),
+                1..6,
+            ),
+            row_share in 0.0f64..1.0,
+        ) {
+            let size = width.min(height) as f64;
+            let discs_px: Vec<_> = shapes
+                .iter()
+                .map(|&(x, y, r, add)| (x * width as f64, y * height as f64, r * size, add))
+                .collect();
+            let mask = discs(width, height, &discs_px);
+            let options = MeshOptions::default();
+            let mut warnings = Vec::new();
+            let (kept, _, _, pieces) = drop_small_pieces(&mask, options.min_piece_area, &mut warnings);
+            prop_assume!(pieces > 0);
+            let kept = kept.unwrap_or(mask);
+            let whole = mesh_whole(&kept, pieces, &options, &mut warnings).unwrap();
+            let row = 1 + ((height - 1) as f64 * row_share) as usize;
+            let row = row.min(height - 1);
+            let cut = Cut::at(&kept, row);
+            let halves = mesh_in_halves(&kept, &cut, pieces, &options).unwrap().unwrap();
+            prop_assert_eq!(halves.mesh.sanity_check(), Ok(()));
+            prop_assert_eq!(halves.mesh.piece_count, whole.mesh.piece_count);
+            prop_assert_eq!(halves.mesh.hole_count(), whole.mesh.hole_count());
+            prop_assert_eq!(crate::mesh::uncovered_mask_pixels(&halves.mesh, &kept), 0);
+        }
+    }
+
+    /// The paper's spiral is large enough to be cut; its mesh is the join of the halves and
+    /// the same on one thread as on two.
+    #[test]
+    fn a_large_mask_is_meshed_in_halves_the_same_on_any_thread_count() {
+        let mask = crate::mesh::synth::spiral(400, 400);
+        let options = MeshOptions::default();
+        let cut = Cut::choose(&mask, crack_edge_count(&mask), options.max_vertices).unwrap();
+        let joined = mesh_in_halves(&mask, &cut, 1, &options).unwrap().unwrap();
+        let meshed = mesh_mask(&mask, &options).unwrap();
+        assert_eq!(meshed.mesh, joined.mesh);
+        let one_thread = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap();
+        let alone = one_thread.install(|| mesh_mask(&mask, &options)).unwrap();
+        assert_eq!(alone.mesh, meshed.mesh);
+        // Some vertex on the cut is interior: the halves were joined, not just put side by side.
+        let y = cut.y();
+        let interior_on_cut = (0..meshed.mesh.vertex_count())
+            .filter(|&v| meshed.mesh.positions[v].y == y && !meshed.mesh.is_boundary[v])
+            .count();
+        assert!(interior_on_cut > 10, "{interior_on_cut}");
+    }
+
+    /// Small masks (the golden cases, most scene patches) and tight vertex budgets are meshed
+    /// whole.
+    #[test]
+    fn small_masks_and_tight_budgets_are_not_cut() {
+        let disc = crate::mesh::synth::disc(200, 200, 90.0);
+        let edges = crack_edge_count(&disc);
+        assert!(edges < crate::mesh::split::SPLIT_MIN_CRACK_EDGES);
+        assert_eq!(Cut::choose(&disc, edges, 2_000_000), None);
+        let spiral = crate::mesh::synth::spiral(400, 400);
+        let edges = crack_edge_count(&spiral);
+        assert!(Cut::choose(&spiral, edges, 2_000_000).is_some());
+        assert_eq!(Cut::choose(&spiral, edges, 4 * edges), None);
     }
 
     fn triangle(far: f64) -> Vec<Polygon> {

@@ -8,7 +8,8 @@
 //!
 //! Pipeline ([`mesh_mask`](fn@mesh_mask)): [`BitMask`] → small pieces dropped → crack loops
 //! (`contour`) → Douglas–Peucker + subdivision to `density` (`simplify`) → spade CDT + refinement
-//! (`triangulate`) → [`Mesh`], verified by [`Mesh::sanity_check`]. With
+//! (`triangulate`) → [`Mesh`], verified by [`Mesh::sanity_check`]. Large masks are cut along a
+//! pixel row and the two halves meshed at once, then joined (`split`). With
 //! [`BoundaryPlacement::OutsideCentres`] the loops run through the outside pixel centres
 //! instead (`centre_loops`); [`relax_interior`] evens out the interior for the combinatorial
 //! Laplacian (the clone stage applies it). Mask-aware checks are in
@@ -25,6 +26,7 @@ mod options;
 mod relax;
 mod sanity;
 mod simplify;
+mod split;
 pub mod synth;
 mod triangulate;
 mod types;

@@ -218,7 +218,7 @@ pub fn assemble_mesh(positions: Vec<DVec2>, triangles: Vec<[u32; 3]>) -> Mesh {
 
 /// [`assemble_mesh`] with the boundary edges already known (sorted, as [`boundary_edges`]
 /// gives them).
-fn assemble_mesh_with_boundary(
+pub(crate) fn assemble_mesh_with_boundary(
     positions: Vec<DVec2>,
     triangles: Vec<[u32; 3]>,
     boundary: Vec<(u32, u32)>,
