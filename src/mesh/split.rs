@@ -183,9 +183,13 @@ impl Cut {
         let mut boundary = Vec::new();
         for (half, index) in halves {
             let split = interface.splits(self, &positions, half, index);
-            for t in &half.triangles {
-                let t = t.map(|v| index[v as usize]);
-                push_split(t, &split, &mut triangles);
+            let on_cut = |v: &u32| positions[*v as usize].y == y;
+            for t in half.triangles.iter().map(|t| t.map(|v| index[v as usize])) {
+                // Only a triangle with an edge on the cut can have a split edge.
+                match !split.is_empty() && t.iter().filter(|v| on_cut(v)).count() >= 2 {
+                    true => push_split(t, &split, &mut triangles),
+                    false => triangles.push(t),
+                }
             }
             for (a, b) in loop_edges(half) {
                 let (a, b) = (index[a as usize], index[b as usize]);
