@@ -49,13 +49,13 @@ pub(crate) fn differing_bytes(a: &[u8], b: &[u8]) -> usize {
     whole as usize + rest.filter(|(x, y)| x != y).count()
 }
 
-/// Calls `count(y, edges)` for every y in `0..=height`: the crack edges (pixel edges between
-/// inside and outside, the image border counting as outside) on the line between rows y − 1
-/// and y, plus those between the columns of row y (none for y = height).
-pub(crate) fn crack_edges_by_row(mask: &BitMask, mut count: impl FnMut(usize, usize)) {
+/// For every y in `0..=height`: the crack edges (pixel edges between inside and outside, the
+/// image border counting as outside) on the line between rows y − 1 and y, plus those between
+/// the columns of row y (none for y = height). Empty for a zero-width mask.
+pub(crate) fn crack_edges_by_row(mask: &BitMask) -> Vec<usize> {
     let (width, height) = (mask.width, mask.height);
     if width == 0 {
-        return;
+        return Vec::new();
     }
     let outside_row = vec![0u8; width];
     let row = |y: usize| match y {
@@ -63,15 +63,17 @@ pub(crate) fn crack_edges_by_row(mask: &BitMask, mut count: impl FnMut(usize, us
         _ if y > height => &outside_row[..],
         _ => mask.row_bytes(y - 1),
     };
-    for y in 0..=height {
-        let mut edges = differing_bytes(row(y), row(y + 1));
-        if y < height {
-            let bytes = mask.row_bytes(y);
-            edges += usize::from(bytes[0]) + usize::from(bytes[width - 1]);
-            edges += differing_bytes(&bytes[..width - 1], &bytes[1..]);
-        }
-        count(y, edges);
-    }
+    (0..=height)
+        .map(|y| {
+            let mut edges = differing_bytes(row(y), row(y + 1));
+            if y < height {
+                let bytes = mask.row_bytes(y);
+                edges += usize::from(bytes[0]) + usize::from(bytes[width - 1]);
+                edges += differing_bytes(&bytes[..width - 1], &bytes[1..]);
+            }
+            edges
+        })
+        .collect()
 }
 
 /// Positions where two equally long 0/1 byte slices are both 1, eight per word.

@@ -43,7 +43,8 @@ pub fn mesh_mask(mask: &BitMask, options: &MeshOptions) -> Result<MeshResult, Me
         });
     }
     let kept_mask = kept.as_ref().unwrap_or(mask);
-    let edges = crack_edge_count(kept_mask);
+    let edges_by_row = crack_edges_by_row(kept_mask);
+    let edges: usize = edges_by_row.iter().sum();
     let max_edges = MAX_CRACK_EDGES_PER_VERTEX
         .saturating_mul(options.max_vertices)
         .max(MIN_CRACK_EDGE_LIMIT);
@@ -51,7 +52,7 @@ pub fn mesh_mask(mask: &BitMask, options: &MeshOptions) -> Result<MeshResult, Me
         return Err(MeshError::BoundaryTooLong { edges, max_edges });
     }
     let split = match options.boundary {
-        BoundaryPlacement::Cracks => Cut::choose(kept_mask, edges, options.max_vertices)
+        BoundaryPlacement::Cracks => Cut::choose(kept_mask, &edges_by_row, options.max_vertices)
             .map(|cut| mesh_in_halves(kept_mask, &cut, pieces, options))
             .transpose()?
             .flatten(),
@@ -419,12 +420,10 @@ const MAX_CRACK_EDGES_PER_VERTEX: usize = 16;
 /// the more useful `VertexBudget` error instead.
 const MIN_CRACK_EDGE_LIMIT: usize = 1 << 20;
 
-/// Pixel edges between inside and outside (the image border counts as outside), counted
-/// without allocating.
+/// Pixel edges between inside and outside (the image border counts as outside).
+#[cfg(test)]
 fn crack_edge_count(mask: &BitMask) -> usize {
-    let mut edges = 0;
-    crack_edges_by_row(mask, |_, row_edges| edges += row_edges);
-    edges
+    crack_edges_by_row(mask).iter().sum()
 }
 
 fn stats_of(
@@ -554,7 +553,8 @@ mod tests {
     fn a_large_mask_is_meshed_in_halves_the_same_on_any_thread_count() {
         let mask = crate::mesh::synth::spiral(400, 400);
         let options = MeshOptions::default();
-        let cut = Cut::choose(&mask, crack_edge_count(&mask), options.max_vertices).unwrap();
+        let by_row = crack_edges_by_row(&mask);
+        let cut = Cut::choose(&mask, &by_row, options.max_vertices).unwrap();
         let joined = mesh_in_halves(&mask, &cut, 1, &options).unwrap().unwrap();
         let meshed = mesh_mask(&mask, &options).unwrap();
         assert_eq!(meshed.mesh, joined.mesh);
@@ -577,13 +577,16 @@ mod tests {
     #[test]
     fn small_masks_and_tight_budgets_are_not_cut() {
         let disc = crate::mesh::synth::disc(200, 200, 90.0);
-        let edges = crack_edge_count(&disc);
-        assert!(edges < crate::mesh::split::SPLIT_MIN_CRACK_EDGES);
-        assert_eq!(Cut::choose(&disc, edges, 2_000_000), None);
+        assert!(crack_edge_count(&disc) < crate::mesh::split::SPLIT_MIN_CRACK_EDGES);
+        assert_eq!(
+            Cut::choose(&disc, &crack_edges_by_row(&disc), 2_000_000),
+            None
+        );
         let spiral = crate::mesh::synth::spiral(400, 400);
+        let by_row = crack_edges_by_row(&spiral);
         let edges = crack_edge_count(&spiral);
-        assert!(Cut::choose(&spiral, edges, 2_000_000).is_some());
-        assert_eq!(Cut::choose(&spiral, edges, 4 * edges), None);
+        assert!(Cut::choose(&spiral, &by_row, 2_000_000).is_some());
+        assert_eq!(Cut::choose(&spiral, &by_row, 4 * edges), None);
     }
 
     fn triangle(far: f64) -> Vec<Polygon> {

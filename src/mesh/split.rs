@@ -19,7 +19,7 @@ use std::collections::HashMap;
 
 use glam::DVec2;
 
-use super::bitmask::{crack_edges_by_row, shared_ones};
+use super::bitmask::shared_ones;
 use super::contour::CrackLoop;
 use super::triangulate::assemble_mesh_with_boundary;
 use super::{BitMask, Mesh};
@@ -48,18 +48,21 @@ pub(crate) struct Cut {
 }
 
 impl Cut {
-    /// The cut for `mask` (with `edges` crack edges), or `None` when it is meshed whole.
-    pub fn choose(mask: &BitMask, edges: usize, max_vertices: usize) -> Option<Cut> {
+    /// The cut for `mask`, whose crack edges by row are `edges_by_row`
+    /// (`crack_edges_by_row`), or `None` when it is meshed whole.
+    pub fn choose(mask: &BitMask, edges_by_row: &[usize], max_vertices: usize) -> Option<Cut> {
+        let edges: usize = edges_by_row.iter().sum();
         let budget_allows = max_vertices / BUDGET_PER_CRACK_EDGE >= edges;
         if edges < SPLIT_MIN_CRACK_EDGES || !budget_allows || mask.height < 2 {
             return None;
         }
         // above[y]: crack edges on the lines and rows above the line y.
-        let mut above = Vec::with_capacity(mask.height + 2);
-        above.push(0usize);
-        crack_edges_by_row(mask, |_, row_edges| {
-            above.push(above[above.len() - 1] + row_edges)
-        });
+        let above: Vec<usize> = std::iter::once(0)
+            .chain(edges_by_row.iter().scan(0, |sum, &row| {
+                *sum += row;
+                Some(*sum)
+            }))
+            .collect();
         let half = edges as f64 / 2.0;
         let imbalance = |row: usize| (above[row] as f64 - half).abs();
         let interface_len = |row: usize| shared_ones(mask.row_bytes(row - 1), mask.row_bytes(row));
@@ -198,7 +201,7 @@ impl Cut {
                 }
             }
         }
-        boundary.sort_unstable();
+        let boundary = sorted_edges(&boundary, positions.len());
         assemble_mesh_with_boundary(positions, triangles, boundary)
     }
 }
@@ -268,6 +271,29 @@ fn push_split(t: [u32; 3], split: &HashMap<(u32, u32), Vec<u32>>, out: &mut Vec<
         }
     }
     out.push(t);
+}
+
+/// `edges` sorted by (from, to): a counting sort by the first vertex, then each vertex's few
+/// edges by the second (a comparison sort of the joined boundary cost as much as the rest
+/// of the join).
+fn sorted_edges(edges: &[(u32, u32)], vertex_count: usize) -> Vec<(u32, u32)> {
+    let mut start = vec![0usize; vertex_count + 1];
+    for &(from, _) in edges {
+        start[from as usize + 1] += 1;
+    }
+    for v in 0..vertex_count {
+        start[v + 1] += start[v];
+    }
+    let mut next = start.clone();
+    let mut sorted = vec![(0, 0); edges.len()];
+    for &edge in edges {
+        sorted[next[edge.0 as usize]] = edge;
+        next[edge.0 as usize] += 1;
+    }
+    for v in 0..vertex_count {
+        sorted[start[v]..start[v + 1]].sort_unstable();
+    }
+    sorted
 }
 
 /// The directed boundary edges of `mesh`, loop by loop.
