@@ -19,7 +19,7 @@ use std::collections::HashMap;
 
 use glam::DVec2;
 
-use super::bitmask::shared_ones;
+use super::bitmask::{differing_bytes, shared_ones};
 use super::contour::CrackLoop;
 use super::triangulate::assemble_mesh_with_boundary;
 use super::{BitMask, Mesh};
@@ -35,7 +35,8 @@ pub(crate) const SPLIT_MIN_CRACK_EDGES: usize = 6000;
 const BUDGET_PER_CRACK_EDGE: usize = 8;
 
 /// The cut's row keeps each half's crack edges within this share of the total from an even
-/// split; among those rows, the one with the shortest interface is taken.
+/// split; among those rows, the one with the fewest boundary steps on its line, then the
+/// shortest interface, is taken.
 const BALANCE_SLACK: f64 = 0.05;
 
 /// Where a mask is cut: along the line y = `row`, between pixel rows `row − 1` and `row`.
@@ -65,7 +66,14 @@ impl Cut {
             .collect();
         let half = edges as f64 / 2.0;
         let imbalance = |row: usize| (above[row] as f64 - half).abs();
-        let interface_len = |row: usize| shared_ones(mask.row_bytes(row - 1), mask.row_bytes(row));
+        let (above_row, below_row) = (
+            |row: usize| mask.row_bytes(row - 1),
+            |row| mask.row_bytes(row),
+        );
+        let interface_len = |row: usize| shared_ones(above_row(row), below_row(row));
+        // Boundary running along the cut ends at it in a step whose corner the cut pins, an
+        // input angle refinement cannot open: rows the boundary only crosses are better.
+        let steps_on_line = |row: usize| differing_bytes(above_row(row), below_row(row));
         let rows = 1..mask.height;
         let balanced = rows
             .clone()
@@ -73,7 +81,10 @@ impl Cut {
         let slack = (BALANCE_SLACK * edges as f64).max(imbalance(balanced));
         let row = rows
             .filter(|&row| imbalance(row) <= slack)
-            .min_by_key(|&row| (interface_len(row), row.abs_diff(balanced), row))?;
+            .min_by_key(|&row| {
+                let closeness = row.abs_diff(balanced);
+                (steps_on_line(row), interface_len(row), closeness, row)
+            })?;
         Some(Cut::at(mask, row))
     }
 
