@@ -73,10 +73,10 @@ pub const MIN_MAX_AREA: f64 = 0.25;
 impl Default for MeshOptions {
     /// - `density` 3 px: on the spiral, PSNR against the pixel-grid clone saturates with
     ///   boundary density (`lapclone bench paper --sweep`, docs/quality.md: combinatorial /
-    ///   cotangent 36.1 / 39.4 dB at 3 px, 37.1 / 41.2 at 2, 39.1 / 42.7 at 1), while
+    ///   cotangent 36.0 / 39.2 dB at 3 px, 37.1 / 41.2 at 2, 38.6 / 42.5 at 1), while
     ///   vertices, meshing, factor and re-clone time grow as 1/density. Since large masks
-    ///   are meshed as two halves at once, the 770×743 spiral meshes in 7 ms at 3 px and
-    ///   10 ms at 2 px (its 20 ms budget no longer decides); 3 px keeps the first clone and
+    ///   are meshed as two halves at once, the 770×743 spiral meshes in 6–7 ms at 3 px and
+    ///   9 ms at 2 px (its 20 ms budget no longer decides); 3 px keeps the first clone and
     ///   the re-clone of issue #4 within reach. Seam-critical work can ask for `density` 1–2.
     /// - `simplify_tolerance` 0.9 px: keeps every mask pixel centre within 0.5 px of the
     ///   mesh (a centre is 0.5 px inside the crack boundary) and every mesh point within
