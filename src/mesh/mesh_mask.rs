@@ -547,6 +547,39 @@ mod tests {
         }
     }
 
+    proptest! {
+        #![proptest_config(ProptestConfig {
+            cases: 200,
+            rng_seed: proptest::test_runner::RngSeed::Fixed(0x5b11_7001),
+            ..ProptestConfig::default()
+        })]
+        /// Pixel noise cut at any row: pieces touching at a corner across the cut, one-pixel
+        /// interface runs, steps on the cut line, holes cut in two.
+        #[test]
+        fn noisy_masks_cut_at_any_row_join_into_the_masks_topology(
+            (width, height, bits) in (8usize..40, 4usize..40).prop_flat_map(|(w, h)| {
+                (Just(w), Just(h), proptest::collection::vec(any::<u8>(), w * h))
+            }),
+            density in 64u8..230,
+            row_share in 0.0f64..1.0,
+        ) {
+            let mask = BitMask::from_fn(width, height, |x, y| bits[y * width + x] < density);
+            let options = MeshOptions::default();
+            let mut warnings = Vec::new();
+            let (kept, _, _, pieces) = drop_small_pieces(&mask, options.min_piece_area, &mut warnings);
+            prop_assume!(pieces > 0);
+            let kept = kept.unwrap_or(mask);
+            let whole = mesh_whole(&kept, pieces, &options, &mut warnings).unwrap();
+            let row = (1 + ((height - 1) as f64 * row_share) as usize).min(height - 1);
+            let halves = mesh_in_halves(&kept, &Cut::at(&kept, row), pieces, &options).unwrap();
+            let halves = halves.expect("the joined mesh has the mask's pieces");
+            prop_assert_eq!(halves.mesh.sanity_check(), Ok(()));
+            prop_assert_eq!(halves.mesh.piece_count, whole.mesh.piece_count);
+            prop_assert_eq!(halves.mesh.hole_count(), whole.mesh.hole_count());
+            prop_assert_eq!(crate::mesh::uncovered_mask_pixels(&halves.mesh, &kept), 0);
+        }
+    }
+
     /// The paper's spiral is large enough to be cut; its mesh is the join of the halves and
     /// the same on one thread as on two.
     #[test]

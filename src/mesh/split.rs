@@ -46,6 +46,9 @@ pub(crate) struct Cut {
     pub row: usize,
     /// Per column x: pixels (x, row − 1) and (x, row) are both inside.
     interface: Vec<bool>,
+    /// Per corner x on the cut (0..=width): a saddle of the whole mask (inside pixels touching
+    /// diagonally across the cut), which each half sees as a plain corner.
+    saddle: Vec<bool>,
 }
 
 impl Cut {
@@ -93,7 +96,19 @@ impl Cut {
         let interface = (mask.row_bytes(row - 1).iter().zip(mask.row_bytes(row)))
             .map(|(&up, &down)| up & down != 0)
             .collect();
-        Cut { row, interface }
+        let (x_max, y) = (mask.width as i64, row as i64);
+        let saddle = (0..=x_max)
+            .map(|x| {
+                let (nw, ne) = (mask.get(x - 1, y - 1), mask.get(x, y - 1));
+                let (sw, se) = (mask.get(x - 1, y), mask.get(x, y));
+                nw == se && ne == sw && nw != ne
+            })
+            .collect();
+        Cut {
+            row,
+            interface,
+            saddle,
+        }
     }
 
     /// The cut's y coordinate.
@@ -108,8 +123,9 @@ impl Cut {
 
     /// Moves a half's crack loops down by `first_row` (into the whole mask's coordinates)
     /// and pins the interface: a loop edge on the cut gets a vertex wherever it passes from
-    /// interface to real boundary, and every vertex at an end of the interface becomes an
-    /// anchor, so simplification keeps interface runs as they are.
+    /// interface to real boundary, and every vertex at an end of the interface or at a saddle
+    /// of the whole mask becomes an anchor, so simplification keeps interface runs as they
+    /// are and the pieces that touch across the cut still touch.
     pub fn pin(&self, loops: &mut [CrackLoop], first_row: f64) {
         let y = self.y();
         for lp in loops {
@@ -120,7 +136,7 @@ impl Cut {
                 let p = lp.points[i] + DVec2::new(0.0, first_row);
                 let q = lp.points[(i + 1) % n] + DVec2::new(0.0, first_row);
                 points.push(p);
-                anchor.push(lp.anchor[i] || self.touches_interface(p));
+                anchor.push(lp.anchor[i] || self.is_pinned(p));
                 if p.y == y && q.y == y {
                     for x in self.changes_between(p.x as i64, q.x as i64) {
                         points.push(DVec2::new(x as f64, y));
@@ -141,12 +157,14 @@ impl Cut {
             .unwrap_or(false)
     }
 
-    /// A point on the cut next to an interface column.
-    fn touches_interface(&self, p: DVec2) -> bool {
+    /// A point on the cut that both halves must keep: next to an interface column, or a
+    /// saddle of the whole mask (its pieces touch there once joined).
+    fn is_pinned(&self, p: DVec2) -> bool {
         let x = p.x as i64;
+        let saddle = || usize::try_from(x).is_ok_and(|x| self.saddle.get(x) == Some(&true));
         p.y == self.y()
             && p.x == x as f64
-            && (self.is_interface_column(x - 1) || self.is_interface_column(x))
+            && (self.is_interface_column(x - 1) || self.is_interface_column(x) || saddle())
     }
 
     /// Corners strictly between x = `from` and `to` (in that order) where the columns on
