@@ -605,10 +605,10 @@ mod tests {
         assert!(interior_on_cut > 10, "{interior_on_cut}");
     }
 
-    /// Small masks (the golden cases, most scene patches) and tight vertex budgets are meshed
-    /// whole.
+    /// Small masks (the golden cases, most scene patches), tight vertex budgets and masks
+    /// whose every balanced cut would be long (a large disc) are meshed whole.
     #[test]
-    fn small_masks_and_tight_budgets_are_not_cut() {
+    fn small_masks_tight_budgets_and_wide_insides_are_not_cut() {
         let disc = crate::mesh::synth::disc(200, 200, 90.0);
         assert!(crack_edge_count(&disc) < crate::mesh::split::SPLIT_MIN_CRACK_EDGES);
         assert_eq!(
@@ -620,6 +620,10 @@ mod tests {
         let edges = crack_edge_count(&spiral);
         assert!(Cut::choose(&spiral, &by_row, 2_000_000).is_some());
         assert_eq!(Cut::choose(&spiral, &by_row, 4 * edges), None);
+        let wide = crate::mesh::synth::disc(2000, 2000, 990.0);
+        let by_row = crack_edges_by_row(&wide);
+        assert!(crack_edge_count(&wide) >= crate::mesh::split::SPLIT_MIN_CRACK_EDGES);
+        assert_eq!(Cut::choose(&wide, &by_row, 2_000_000), None);
     }
 
     fn triangle(far: f64) -> Vec<Polygon> {
