@@ -580,6 +580,26 @@ mod tests {
         }
     }
 
+    /// A long one-pixel line has its crack edges on two lines; a cut between them would leave
+    /// one half empty. Cuts lie strictly between the first and the last inside row.
+    #[test]
+    fn a_cut_leaves_inside_pixels_on_both_sides() {
+        let line = BitMask::from_fn(4000, 4, |x, y| y == 1 && x > 10);
+        let by_row = crack_edges_by_row(&line);
+        assert!(by_row.iter().sum::<usize>() >= crate::mesh::split::SPLIT_MIN_CRACK_EDGES);
+        assert_eq!(
+            Cut::choose(&line, &by_row, 2_000_000).map(|cut| cut.row),
+            None
+        );
+        let result = mesh_mask(&line, &MeshOptions::default()).unwrap();
+        assert_eq!(result.mesh.sanity_check(), Ok(()));
+        let band = BitMask::from_fn(4000, 6, |x, y| (1..5).contains(&y) && x > 10);
+        let cut = Cut::choose(&band, &crack_edges_by_row(&band), 2_000_000).map(|cut| cut.row);
+        assert!(cut.is_none_or(|row| (2..5).contains(&row)), "{cut:?}");
+        let result = mesh_mask(&band, &MeshOptions::default()).unwrap();
+        assert_eq!(result.mesh.sanity_check(), Ok(()));
+    }
+
     /// The paper's spiral is large enough to be cut; its mesh is the join of the halves and
     /// the same on one thread as on two.
     #[test]

@@ -60,7 +60,7 @@ impl Cut {
     pub fn choose(mask: &BitMask, edges_by_row: &[usize], max_vertices: usize) -> Option<Cut> {
         let edges: usize = edges_by_row.iter().sum();
         let budget_allows = max_vertices / BUDGET_PER_CRACK_EDGE >= edges;
-        if edges < SPLIT_MIN_CRACK_EDGES || !budget_allows || mask.height < 2 {
+        if edges < SPLIT_MIN_CRACK_EDGES || !budget_allows {
             return None;
         }
         // above[y]: crack edges on the lines and rows above the line y.
@@ -80,7 +80,9 @@ impl Cut {
         // Boundary running along the cut ends at it in a step whose corner the cut pins, an
         // input angle refinement cannot open: rows the boundary only crosses are better.
         let steps_on_line = |row: usize| differing_bytes(above_row(row), below_row(row));
-        let rows = 1..mask.height;
+        // Rows strictly between the first and the last inside row: a half needs inside pixels.
+        let ((_, first), (_, end)) = mask.inside_bounds()?;
+        let rows = first + 1..end;
         let balanced = rows
             .clone()
             .min_by(|&a, &b| imbalance(a).total_cmp(&imbalance(b)))?;
