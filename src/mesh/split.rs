@@ -7,13 +7,15 @@
 //! own thread. The *interface* — the crack edges on the cut whose pixels above and below are
 //! both inside — is an edge of both halves' loops, with its ends anchored so simplification
 //! keeps it straight, and subdivided at the same points whichever way a loop runs along it
-//! (`subdivide_loop_sharing_row`), so both halves have its vertices bit for bit. Refinement
+//! (`subdivide_loop_sharing_row`), so both halves have its vertices bit for bit; the whole
+//! mask's saddles on the cut are anchored too, so pieces touching there still touch. Refinement
 //! may still split an interface edge in one half only; the join then splits the other
 //! half's triangle on that edge at the same points (a fan from its third vertex), so the
 //! mesh conforms.
 //!
-//! The cut depends on the mask alone and such a mask is always cut, so the mesh is the same
-//! whether the halves run on one thread or two.
+//! Which masks are cut, and where: [`Cut::choose`] (a long boundary, a short interface, rows
+//! the boundary only crosses). The cut depends on the mask alone and such a mask is always
+//! cut, so the mesh is the same whether the halves run on one thread or two.
 
 use std::collections::HashMap;
 
@@ -194,19 +196,16 @@ impl Cut {
         a.y == y && b.y == y && self.is_interface_column(((a.x + b.x) / 2.0).floor() as i64)
     }
 
-    /// Joins the meshes of the halves above and below the cut: vertices on the cut at the
-    /// same position become one, interface edges that one half split are split in the other
-    /// half too, and the interface edges leave the boundary.
-    pub fn merge(&self, upper: &Mesh, lower: &Mesh) -> Mesh {
-        let mut positions = upper.positions.clone();
-        let mut on_cut: HashMap<u64, u32> = HashMap::new();
+    /// The joined vertex positions (the upper half's, then the lower half's not on the cut
+    /// at an upper position) and each lower vertex's joined index.
+    fn join_vertices(&self, upper: &Mesh, lower: &Mesh) -> (Vec<DVec2>, Vec<u32>) {
         let y = self.y();
-        for (v, p) in upper.positions.iter().enumerate() {
-            if p.y == y {
-                on_cut.insert(p.x.to_bits(), v as u32);
-            }
-        }
-        let lower_index: Vec<u32> = (lower.positions.iter())
+        let mut positions = upper.positions.clone();
+        let mut on_cut: HashMap<u64, u32> = (upper.positions.iter().enumerate())
+            .filter(|(_, p)| p.y == y)
+            .map(|(v, p)| (p.x.to_bits(), v as u32))
+            .collect();
+        let lower_index = (lower.positions.iter())
             .map(|&p| {
                 let mut add = || {
                     positions.push(p);
@@ -218,6 +217,15 @@ impl Cut {
                 }
             })
             .collect();
+        (positions, lower_index)
+    }
+
+    /// Joins the meshes of the halves above and below the cut: vertices on the cut at the
+    /// same position become one, interface edges that one half split are split in the other
+    /// half too, and the interface edges leave the boundary.
+    pub fn merge(&self, upper: &Mesh, lower: &Mesh) -> Mesh {
+        let y = self.y();
+        let (positions, lower_index) = self.join_vertices(upper, lower);
         let upper_index: Vec<u32> = (0..upper.positions.len() as u32).collect();
         let halves = [(upper, &upper_index), (lower, &lower_index)];
         let interface = InterfaceVertices::of(self, &positions, &halves);
