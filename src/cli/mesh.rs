@@ -78,8 +78,12 @@ pub fn run(args: MeshArgs) -> anyhow::Result<()> {
         });
         println!("{json}");
     } else {
+        let halves = match stats.cut_row {
+            Some(row) => format!(" (two halves cut at row {row})"),
+            None => String::new(),
+        };
         println!(
-            "{} vertices, {} triangles, {} boundary vertices, {} piece(s), {} hole(s), min angle {:.1}°, {:.2} ms",
+            "{} vertices, {} triangles, {} boundary vertices, {} piece(s), {} hole(s), min angle {:.1}°, {:.2} ms{halves}",
             stats.vertices, stats.triangles, stats.boundary_vertices, stats.pieces, stats.holes, stats.min_angle_deg, mesh_ms
         );
     }

@@ -85,6 +85,7 @@ pub fn mesh_mask(mask: &BitMask, options: &MeshOptions) -> Result<MeshResult, Me
     );
     stats.boundary = meshed.placement;
     stats.off_centre_boundary_vertices = meshed.off_centre;
+    stats.cut_row = meshed.cut_row;
     Ok(MeshResult {
         mesh: meshed.mesh,
         warnings,
@@ -104,6 +105,8 @@ struct Meshed {
     fell_back: bool,
     placement: BoundaryPlacement,
     off_centre: usize,
+    /// The row the mask was cut at, when meshed as two halves.
+    cut_row: Option<usize>,
 }
 
 /// The inside-pixel topology a mesh of some crack loops must have.
@@ -141,6 +144,7 @@ fn mesh_whole(
                     fell_back: false,
                     placement: BoundaryPlacement::OutsideCentres,
                     off_centre: fallbacks,
+                    cut_row: None,
                 })
             }
             Err(MeshError::IntersectingBoundary { .. } | MeshError::Sanity(_)) => {
@@ -195,6 +199,7 @@ fn mesh_in_halves(
         fell_back: upper.fell_back || lower.fell_back,
         placement: BoundaryPlacement::Cracks,
         off_centre: 0,
+        cut_row: Some(cut.row),
     }))
 }
 
@@ -228,6 +233,7 @@ fn mesh_crack_loops(
         fell_back,
         placement: BoundaryPlacement::Cracks,
         off_centre: 0,
+        cut_row: None,
     })
 }
 
@@ -448,6 +454,7 @@ fn stats_of(
         dropped_pixels,
         boundary: BoundaryPlacement::Cracks,
         off_centre_boundary_vertices: 0,
+        cut_row: None,
     }
 }
 
@@ -611,6 +618,7 @@ mod tests {
         let joined = mesh_in_halves(&mask, &cut, 1, &options).unwrap().unwrap();
         let meshed = mesh_mask(&mask, &options).unwrap();
         assert_eq!(meshed.mesh, joined.mesh);
+        assert_eq!(meshed.stats.cut_row, Some(cut.row));
         let one_thread = rayon::ThreadPoolBuilder::new()
             .num_threads(1)
             .build()
@@ -635,6 +643,8 @@ mod tests {
             Cut::choose(&disc, &crack_edges_by_row(&disc), 2_000_000),
             None
         );
+        let whole = mesh_mask(&disc, &MeshOptions::default()).unwrap();
+        assert_eq!(whole.stats.cut_row, None);
         let spiral = crate::mesh::synth::spiral(400, 400);
         let by_row = crack_edges_by_row(&spiral);
         let edges = crack_edge_count(&spiral);
