@@ -217,3 +217,35 @@ fn output_in_a_missing_folder_fails_without_a_file() {
     );
     assert!(!dir.path().join("missing").exists());
 }
+
+#[test]
+fn boundary_data_is_chosen_by_name_and_changes_the_result() {
+    let dir = tempfile::tempdir().unwrap();
+    inputs(dir.path());
+    assert_fails(
+        dir.path(),
+        &args_with(&[("--boundary-data", "pointy")]),
+        2,
+        "unknown boundary data",
+    );
+    let mut written = Vec::new();
+    for (data, name) in [("vertex", "vertex.png"), ("hat-average", "hat.png")] {
+        let output = clone(
+            dir.path(),
+            &args_with(&[("--boundary-data", data), ("-o", name)]),
+        );
+        assert!(output.status.success(), "{data}: {}", stderr(&output));
+        written.push(std::fs::read(dir.path().join(name)).unwrap());
+    }
+    // The default is the hat average.
+    let output = clone(dir.path(), &args_with(&[]));
+    assert!(output.status.success(), "{}", stderr(&output));
+    assert_eq!(
+        std::fs::read(dir.path().join("out.png")).unwrap(),
+        written[1]
+    );
+    assert_ne!(
+        written[0], written[1],
+        "the textured source's boundary data differ"
+    );
+}

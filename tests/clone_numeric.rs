@@ -8,7 +8,9 @@
 mod fixtures;
 
 use glam::DVec2;
-use lapclone::clone::{CloneMode, CloneOptions, MembraneSolver, PatchCloner, Placement};
+use lapclone::clone::{
+    BoundaryData, BoundarySampler, CloneMode, CloneOptions, MembraneSolver, PatchCloner, Placement,
+};
 use lapclone::mesh::synth;
 use lapclone::pixels::{Canvas, ColorKind, Depth, FloatImage, PixelFormat};
 use lapclone::raster::{draw_patch, Patch, RasterOptions, RasterScratch};
@@ -29,23 +31,55 @@ fn two_holes_cloner(options: &CloneOptions) -> PatchCloner {
     cloner_for(&textured_source(64, 64), &synth::two_holes(64, 64), options).0
 }
 
-/// Largest |membrane − (target − source)| over constrained boundary vertices.
+/// Largest |membrane − (target − source)| over constrained boundary vertices: for
+/// `BoundaryData::Vertex` sampled at the vertex (written out here), for a hat average as
+/// `BoundarySampler` gives it (its own tests check it against the integral it stands for).
 fn boundary_mismatch(cloner: &PatchCloner, target: &Canvas) -> f64 {
     // invariant: the cloner has cloned, so its factor exists.
     let factor = cloner.membrane().factor().expect("a factored cloner");
+    let boundary = cloner.membrane().boundary_vertices();
+    let rgb = |c: [f32; 4]| [c[0], c[1], c[2]];
+    let (mut at_target, mut at_source) = (
+        vec![[0.0; 3]; boundary.len()],
+        vec![[0.0; 3]; boundary.len()],
+    );
+    match cloner.membrane().boundary_data() {
+        BoundaryData::Vertex => {
+            for (slot, &v) in boundary.iter().enumerate() {
+                let (p, rest) = (
+                    cloner.placed()[v as usize],
+                    cloner.mesh().positions[v as usize],
+                );
+                at_target[slot] = rgb(target.sample_bilinear(p.x, p.y));
+                at_source[slot] = rgb(cloner.source().sample_bilinear(rest.x, rest.y));
+            }
+        }
+        data => {
+            let sampler = BoundarySampler::new(cloner.mesh(), data);
+            let placed = cloner.placed();
+            sampler.sample(
+                placed,
+                |p| rgb(target.sample_bilinear(p.x, p.y)),
+                &mut at_target,
+            );
+            let rest = &cloner.mesh().positions;
+            let source = cloner.source();
+            sampler.sample(
+                rest,
+                |p| rgb(source.sample_bilinear(p.x, p.y)),
+                &mut at_source,
+            );
+        }
+    }
     let mut worst = 0.0f64;
-    for &v in cloner.membrane().boundary_vertices() {
-        let v = v as usize;
-        if !factor.is_constrained(v) {
+    for (slot, &v) in boundary.iter().enumerate() {
+        if !factor.is_constrained(v as usize) {
             continue;
         }
-        let p = cloner.placed()[v];
-        let rest = cloner.mesh().positions[v];
-        let t = target.sample_bilinear(p.x, p.y);
-        let s = cloner.source().sample_bilinear(rest.x, rest.y);
         for c in 0..3 {
-            let want = f64::from(t[c]) - f64::from(s[c]);
-            worst = worst.max((f64::from(cloner.membrane().membrane()[v][c]) - want).abs());
+            let want = f64::from(at_target[slot][c]) - f64::from(at_source[slot][c]);
+            let got = f64::from(cloner.membrane().membrane()[v as usize][c]);
+            worst = worst.max((got - want).abs());
         }
     }
     worst
@@ -53,21 +87,29 @@ fn boundary_mismatch(cloner: &PatchCloner, target: &Canvas) -> f64 {
 
 #[test]
 fn membrane_matches_target_minus_source_on_the_boundary() {
-    let mut cloner = two_holes_cloner(&CloneOptions::default());
-    let target = Canvas::from_image(&smooth_target(96, 80));
-    let mut canvas = target.clone();
-    let placement = Placement {
-        rotation_deg: 17.0,
-        scale: 1.1,
-        ..centred(DVec2::new(47.3, 40.6))
-    };
-    let stats = cloner.clone_onto(&mut canvas, &placement).unwrap();
-    assert_eq!(
-        stats.membrane.constrained,
-        cloner.membrane().boundary_vertices().len()
-    );
-    let worst = boundary_mismatch(&cloner, &target);
-    assert!(worst <= 1e-5, "membrane off target − source by {worst}");
+    for boundary_data in [BoundaryData::Vertex, BoundaryData::HatAverage] {
+        let mut cloner = two_holes_cloner(&CloneOptions {
+            boundary_data,
+            ..CloneOptions::default()
+        });
+        let target = Canvas::from_image(&smooth_target(96, 80));
+        let mut canvas = target.clone();
+        let placement = Placement {
+            rotation_deg: 17.0,
+            scale: 1.1,
+            ..centred(DVec2::new(47.3, 40.6))
+        };
+        let stats = cloner.clone_onto(&mut canvas, &placement).unwrap();
+        assert_eq!(
+            stats.membrane.constrained,
+            cloner.membrane().boundary_vertices().len()
+        );
+        let worst = boundary_mismatch(&cloner, &target);
+        assert!(
+            worst <= 1e-5,
+            "{boundary_data:?}: membrane off target − source by {worst}"
+        );
+    }
 }
 
 #[test]
@@ -165,7 +207,9 @@ fn a_first_clone_factors_while_recording_and_draws_the_plain_bytes() {
         assert!(!first.raster.replayed);
         assert!(first.raster.written > 1000, "{first:?}");
 
-        let mut eager = MembraneSolver::new(cloner.mesh(), cloner.source(), laplacian).unwrap();
+        let data = cloner.membrane().boundary_data();
+        let mut eager =
+            MembraneSolver::new(cloner.mesh(), cloner.source(), laplacian, data).unwrap();
         eager.solve(cloner.placed(), &target, None).unwrap();
         assert!(
             eager.membrane() == cloner.membrane().membrane(),

@@ -9,7 +9,7 @@
 //!   membrane or deformation, and never a NaN pixel in a rendered frame.
 
 use glam::DVec2;
-use lapclone::clone::{CloneOptions, MembraneSolver, PatchCloner, Placement};
+use lapclone::clone::{BoundaryData, CloneOptions, MembraneSolver, PatchCloner, Placement};
 use lapclone::deform::{DeformOptions, DeformRig, Deformed, Handle, Pin};
 use lapclone::mesh::{assemble_mesh, mesh_mask, BitMask, Mesh, MeshOptions};
 use lapclone::pixels::{Canvas, CanvasPixels, FloatImage, PixelFormat};
@@ -74,7 +74,7 @@ fn membrane_over_a_random_walk_matches_fresh_solvers() {
     let source = textured(60, 40, 3);
     let canvas = Canvas::from_image(&textured(50, 36, 11));
     for kind in [LaplacianKind::Combinatorial, LaplacianKind::Cotangent] {
-        let mut kept = MembraneSolver::new(&mesh, &source, kind).unwrap();
+        let mut kept = MembraneSolver::new(&mesh, &source, kind, BoundaryData::default()).unwrap();
         let mut rng = Rng(0xc0ffee);
         let (mut switches, mut refactors) = (0, 0);
         let mut placed = Vec::new();
@@ -90,7 +90,8 @@ fn membrane_over_a_random_walk_matches_fresh_solvers() {
             let stats = kept.solve(&placed, &canvas, None).unwrap();
             switches += stats.switches.updates + stats.switches.downdates;
             refactors += usize::from(stats.switches.refactored);
-            let mut fresh = MembraneSolver::new(&mesh, &source, kind).unwrap();
+            let mut fresh =
+                MembraneSolver::new(&mesh, &source, kind, BoundaryData::default()).unwrap();
             fresh.solve(&placed, &canvas, None).unwrap();
             let difference = max_abs_difference(kept.membrane(), fresh.membrane());
             assert!(
@@ -219,8 +220,13 @@ fn a_piece_losing_its_last_constraint_gets_an_exactly_zero_membrane() {
         "releasing a piece's last constraint must go through the refactor guard"
     );
     // The constrained pieces still match a fresh solve.
-    let mut fresh =
-        MembraneSolver::new(&mesh, cloner.source(), LaplacianKind::Combinatorial).unwrap();
+    let mut fresh = MembraneSolver::new(
+        &mesh,
+        cloner.source(),
+        LaplacianKind::Combinatorial,
+        BoundaryData::default(),
+    )
+    .unwrap();
     fresh
         .solve(
             cloner.placed(),

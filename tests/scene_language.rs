@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use std::sync::atomic::Ordering;
 
 use glam::DVec2;
-use lapclone::scene::{Background, CloneMode, Easing, LaplacianKind, Scene, Shape};
+use lapclone::scene::{Background, BoundaryData, CloneMode, Easing, LaplacianKind, Scene, Shape};
 use lapclone::script::{parse_scene, ErrorKind, Limits, SceneError, ScriptOptions};
 
 fn root() -> PathBuf {
@@ -255,6 +255,26 @@ fn bad_inputs_are_positioned() {
         4,
         34,
         "out of order",
+    );
+    assert_error_at(
+        "canvas(64, 48);\nlet p = patch(\"p\", #{ source: \"assets/astronaut.png\", mask: \"assets/horse_mask.png\", boundary_data: \"pointy\" });",
+        2, 9, "unknown boundary data \"pointy\"",
+    );
+}
+
+#[test]
+fn boundary_data_defaults_to_the_hat_average_and_can_be_the_vertex_sample() {
+    assert_eq!(
+        parse(HEAD).unwrap().patches[0].boundary_data,
+        BoundaryData::HatAverage
+    );
+    let text = HEAD.replace(
+        "horse_mask.png\"",
+        "horse_mask.png\", boundary_data: \"vertex\"",
+    );
+    assert_eq!(
+        parse(&text).unwrap().patches[0].boundary_data,
+        BoundaryData::Vertex
     );
 }
 

@@ -5,8 +5,8 @@ use std::path::PathBuf;
 
 use glam::DVec2;
 use lapclone::scene::{
-    Background, Canvas, CloneMode, Easing, Handle, LaplacianKind, Patch, Pin, Placement, Polygon,
-    Scene, Shape, Track,
+    Background, BoundaryData, Canvas, CloneMode, Easing, Handle, LaplacianKind, Patch, Pin,
+    Placement, Polygon, Scene, Shape, Track,
 };
 use lapclone::script::{parse_scene, Limits, ScriptOptions};
 use proptest::prelude::*;
@@ -114,6 +114,7 @@ fn patch(index: usize) -> impl Strategy<Value = Patch> {
         any::<bool>(),
         any::<bool>(),
         prop_oneof![Just(0.0), positive()],
+        any::<bool>(),
         (
             track(point()),
             track(positive()),
@@ -124,7 +125,18 @@ fn patch(index: usize) -> impl Strategy<Value = Patch> {
         prop::collection::vec(pin(), 0..3),
     )
         .prop_map(
-            move |(name, shape, density, cot, mono, feather, tracks, handles, pins)| Patch {
+            move |(
+                name,
+                shape,
+                density,
+                cot,
+                mono,
+                feather,
+                vertex_data,
+                tracks,
+                handles,
+                pins,
+            )| Patch {
                 name: format!("{name}{index}"),
                 source: asset("astronaut.png"),
                 shape,
@@ -140,6 +152,11 @@ fn patch(index: usize) -> impl Strategy<Value = Patch> {
                     CloneMode::Normal
                 },
                 feather,
+                boundary_data: if vertex_data {
+                    BoundaryData::Vertex
+                } else {
+                    BoundaryData::HatAverage
+                },
                 placement: Placement {
                     position: tracks.0,
                     scale: tracks.1,

@@ -46,6 +46,10 @@ pub struct CloneBenchArgs {
     /// Maximum boundary edge length of the spiral meshes in px (default: the library's).
     #[arg(long, value_parser = super::finite_f64)]
     pub density: Option<f64>,
+    /// The membrane's boundary values: `hat-average` (the default) or `vertex` (the paper's
+    /// sample at the vertex).
+    #[arg(long, default_value = "hat-average")]
+    pub boundary_data: lapclone::clone::BoundaryData,
     #[command(flatten)]
     pub mesh: super::mesh_args::MeshQualityArgs,
 }
@@ -116,6 +120,10 @@ pub fn run(args: CloneBenchArgs) -> anyhow::Result<()> {
     mesh_options
         .validate()
         .map_err(|e| super::UsageError(e.to_string()))?;
+    let clone_options = CloneOptions {
+        boundary_data: args.boundary_data,
+        ..CloneOptions::default()
+    };
     let mut spiral = Vec::new();
     for &size in &args.sizes {
         spiral.push(bench_spiral(
@@ -123,10 +131,11 @@ pub fn run(args: CloneBenchArgs) -> anyhow::Result<()> {
             &photo,
             &target,
             &mesh_options,
+            &clone_options,
             args.repeats,
         )?);
     }
-    let deform = bench_deform(args.vertices, args.frames)?;
+    let deform = bench_deform(args.vertices, args.frames, &clone_options)?;
     let report = Report { spiral, deform };
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
@@ -197,6 +206,7 @@ fn bench_spiral(
     photo: &FloatImage,
     target: &FloatImage,
     mesh_options: &MeshOptions,
+    clone_options: &CloneOptions,
     repeats: usize,
 ) -> anyhow::Result<SpiralRow> {
     let mask = synth::spiral(size, size);
@@ -216,8 +226,7 @@ fn bench_spiral(
         let started = Instant::now();
         let patch = mesh_from_mask(&mask, None, (source.width(), source.height()), mesh_options)?;
         let meshed = Instant::now();
-        let mut fresh =
-            PatchCloner::new(owned_source, patch.result.mesh, &CloneOptions::default())?;
+        let mut fresh = PatchCloner::new(owned_source, patch.result.mesh, clone_options)?;
         let factored = Instant::now();
         let stats = fresh.clone_onto(&mut canvas, &placement)?;
         let total = millis(started.elapsed());
@@ -306,14 +315,18 @@ fn disc_patch(vertices: usize) -> anyhow::Result<lapclone::mesh::Mesh> {
     }
 }
 
-fn bench_deform(vertices: usize, frames: usize) -> anyhow::Result<DeformRow> {
+fn bench_deform(
+    vertices: usize,
+    frames: usize,
+    clone_options: &CloneOptions,
+) -> anyhow::Result<DeformRow> {
     let mesh = disc_patch(vertices)?;
     let (min, max) = bounds(&mesh.positions);
     let side = (max - min).max_element().ceil() as u32 + 2;
     let source = synthetic(side, side, 0.9)?;
     let background = Canvas::from_image(&synthetic(1920, 1080, 2.1)?);
     let mut canvas = background.clone();
-    let mut cloner = PatchCloner::new(source, mesh, &CloneOptions::default())?;
+    let mut cloner = PatchCloner::new(source, mesh, clone_options)?;
     let mut rig = DeformRig::new(cloner.mesh(), LaplacianKind::Combinatorial)?;
     let mut deformed = Deformed::default();
     let centre = (min + max) * 0.5;

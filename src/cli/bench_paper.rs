@@ -98,6 +98,10 @@ pub struct PaperBenchArgs {
     /// Also give PSNR by distance from the boundary (rings of 4-steps from the outside).
     #[arg(long)]
     pub rings: bool,
+    /// The membrane's boundary values: `hat-average` (the default) or `vertex` (the paper's
+    /// sample at the vertex).
+    #[arg(long, default_value = "hat-average")]
+    pub boundary_data: lapclone::clone::BoundaryData,
     #[command(flatten)]
     pub mesh: super::mesh_args::MeshQualityArgs,
 }
@@ -181,6 +185,7 @@ pub fn run(args: PaperBenchArgs) -> anyhow::Result<()> {
         repeats: if args.quick { 1 } else { args.repeat },
         mvc_max_weights: args.mvc_max_weights,
         keep_membranes: false,
+        boundary_data: args.boundary_data,
     };
     let names: Vec<&str> = MODEL_NAMES
         .into_iter()
@@ -547,6 +552,7 @@ fn run_sweep(args: &PaperBenchArgs, run_options: &RunOptions) -> anyhow::Result<
             experiment.target(),
             run.mesh.clone(),
             LaplacianKind::Combinatorial,
+            run_options.boundary_data,
             DVec2::new(0.6, 0.3),
             run_options.repeats.max(5),
         )?;

@@ -7,7 +7,8 @@ use std::time::Instant;
 use anyhow::Context;
 use glam::DVec2;
 use lapclone::clone::{
-    mesh_from_mask, Anchor, CloneMode, CloneOptions, CloneStats, PatchCloner, Placement,
+    mesh_from_mask, Anchor, BoundaryData, CloneMode, CloneOptions, CloneStats, PatchCloner,
+    Placement,
 };
 use lapclone::deform::{DeformRig, Deformed, Handle, Pin};
 use lapclone::mesh::{BitMask, MeshOptions};
@@ -55,6 +56,10 @@ pub struct CloneArgs {
     pub laplacian: LaplacianArg,
     #[arg(long, value_enum, default_value_t = ModeArg::Normal)]
     pub mode: ModeArg,
+    /// The membrane's boundary values: `hat-average` (target − source averaged along each
+    /// boundary vertex's edges) or `vertex` (sampled at the vertex, as in the paper).
+    #[arg(long, default_value = "hat-average")]
+    pub boundary_data: BoundaryData,
     /// Soften the patch's outer edge over this many pixels.
     #[arg(long, default_value_t = 0.0, value_parser = finite_f64, allow_hyphen_values = true)]
     pub feather: f64,
@@ -173,6 +178,7 @@ pub fn run(args: CloneArgs) -> anyhow::Result<()> {
             ModeArg::Monochrome => CloneMode::Monochrome,
         },
         feather: args.feather as f32,
+        boundary_data: args.boundary_data,
     };
     let mut cloner = PatchCloner::new(source, mesh, &options)?;
     let mut deformation = if handles.is_empty() && pins.is_empty() {

@@ -14,7 +14,7 @@ use std::time::Instant;
 use glam::DVec2;
 
 use super::membrane::{MembraneSolver, MembraneStats};
-use super::{CloneError, Placement};
+use super::{BoundaryData, CloneError, Placement};
 use crate::mesh::Mesh;
 use crate::pixels::{Canvas, FloatImage};
 use crate::raster::{
@@ -57,6 +57,8 @@ pub struct CloneOptions {
     pub mode: CloneMode,
     /// Width in px of the soft outer edge (0: a crisp anti-aliased edge).
     pub feather: f32,
+    /// How the membrane's boundary values are taken from `target − source`.
+    pub boundary_data: BoundaryData,
 }
 
 impl Default for CloneOptions {
@@ -65,6 +67,7 @@ impl Default for CloneOptions {
             laplacian: LaplacianKind::Combinatorial,
             mode: CloneMode::Normal,
             feather: 0.0,
+            boundary_data: BoundaryData::default(),
         }
     }
 }
@@ -112,7 +115,8 @@ impl PatchCloner {
             CloneMode::Normal => source,
             CloneMode::Monochrome => source.to_grey(),
         };
-        let membrane = MembraneSolver::deferred(&mesh, &source, options.laplacian);
+        let membrane =
+            MembraneSolver::deferred(&mesh, &source, options.laplacian, options.boundary_data);
         let n = mesh.vertex_count();
         Ok(Self {
             source,

@@ -13,7 +13,7 @@
 
 use glam::DVec2;
 
-use super::CloneError;
+use super::{BoundaryData, BoundarySampler, CloneError};
 use crate::mesh::Mesh;
 use crate::pixels::{Canvas, FloatImage};
 use crate::solve::{
@@ -26,9 +26,11 @@ pub const MEMBRANE_CHANNELS: usize = 3;
 /// The factored Laplacian of one patch mesh and the scratch buffers of its per-frame solve.
 pub struct MembraneSolver {
     factor: FactorState,
-    boundary: Vec<u32>,
-    /// f_S at each boundary vertex's rest position, RGB.
+    sampler: BoundarySampler,
+    /// f_S's boundary data at the rest boundary, RGB, one per boundary vertex.
     source_at_boundary: Vec<[f32; 3]>,
+    /// Scratch: f_T's boundary data where the boundary is placed.
+    target_at_boundary: Vec<[f32; 3]>,
     wanted: Vec<bool>,
     values: Vec<f64>,
     membrane: Vec<[f32; 3]>,
@@ -55,9 +57,14 @@ pub struct MembraneStats {
 
 impl MembraneSolver {
     /// Builds and factors the Laplacian of `mesh` and samples the source at the rest
-    /// boundary.
-    pub fn new(mesh: &Mesh, source: &FloatImage, kind: LaplacianKind) -> Result<Self, CloneError> {
-        let mut solver = Self::deferred(mesh, source, kind);
+    /// boundary, `data` deciding how.
+    pub fn new(
+        mesh: &Mesh,
+        source: &FloatImage,
+        kind: LaplacianKind,
+        data: BoundaryData,
+    ) -> Result<Self, CloneError> {
+        let mut solver = Self::deferred(mesh, source, kind, data);
         solver.factor_now()?;
         Ok(solver)
     }
@@ -65,26 +72,32 @@ impl MembraneSolver {
     /// Builds the Laplacian of `mesh` and samples the source at the rest boundary; the
     /// factor waits for the first [`solve`](Self::solve) or [`factor_now`](Self::factor_now),
     /// which then report its errors.
-    pub fn deferred(mesh: &Mesh, source: &FloatImage, kind: LaplacianKind) -> Self {
+    pub fn deferred(
+        mesh: &Mesh,
+        source: &FloatImage,
+        kind: LaplacianKind,
+        data: BoundaryData,
+    ) -> Self {
         let l = laplacian(mesh, kind);
-        let boundary: Vec<u32> = mesh.boundary_vertices().collect();
+        let sampler = BoundarySampler::new(mesh, data);
+        let boundary = sampler.boundary_vertices();
         // Factored with every boundary constraint on, the usual state: a first clone inside
         // the target then switches nothing (switching them all on would refactor).
         let mut wanted = vec![false; mesh.vertex_count()];
-        for &v in &boundary {
+        for &v in boundary {
             wanted[v as usize] = true;
         }
-        let source_at_boundary = boundary
-            .iter()
-            .map(|&v| {
-                let p = mesh.positions[v as usize];
-                rgb(source.sample_bilinear(p.x, p.y))
-            })
-            .collect();
+        let mut source_at_boundary = vec![[0.0; 3]; boundary.len()];
+        sampler.sample(
+            &mesh.positions,
+            |p| rgb(source.sample_bilinear(p.x, p.y)),
+            &mut source_at_boundary,
+        );
         let n = mesh.vertex_count();
         Self {
             factor: FactorState::Pending(l),
-            boundary,
+            target_at_boundary: vec![[0.0; 3]; boundary.len()],
+            sampler,
             source_at_boundary,
             wanted,
             values: vec![0.0; n * MEMBRANE_CHANNELS],
@@ -120,7 +133,13 @@ impl MembraneSolver {
         let n = self.wanted.len();
         let mut stats = MembraneStats::default();
         let (width, height) = (f64::from(canvas.width()), f64::from(canvas.height()));
-        for (slot, &v) in self.boundary.iter().enumerate() {
+        self.sampler.sample(
+            placed,
+            |p| rgb(canvas.sample_bilinear(p.x, p.y)),
+            &mut self.target_at_boundary,
+        );
+        let boundary = self.sampler.boundary_vertices();
+        for (slot, &v) in boundary.iter().enumerate() {
             let v = v as usize;
             let p = placed[v];
             let inside = p.x >= 0.0 && p.y >= 0.0 && p.x <= width && p.y <= height;
@@ -130,7 +149,7 @@ impl MembraneSolver {
             let on = inside && !covered;
             self.wanted[v] = on;
             if on {
-                let target = canvas.sample_bilinear(p.x, p.y);
+                let target = self.target_at_boundary[slot];
                 let source = self.source_at_boundary[slot];
                 for c in 0..MEMBRANE_CHANNELS {
                     self.values[c * n + v] = f64::from(target[c] - source[c]);
@@ -164,7 +183,12 @@ impl MembraneSolver {
     }
 
     pub fn boundary_vertices(&self) -> &[u32] {
-        &self.boundary
+        self.sampler.boundary_vertices()
+    }
+
+    /// How the boundary data is sampled.
+    pub fn boundary_data(&self) -> BoundaryData {
+        self.sampler.kind()
     }
 }
 

@@ -6,6 +6,7 @@
 //! move or a deformation costs only constraint switches, one multi-RHS back-substitution
 //! and the raster.
 
+mod boundary_data;
 mod cloner;
 mod error;
 mod expand;
@@ -13,6 +14,7 @@ mod membrane;
 mod patch_mesh;
 mod placement;
 
+pub use boundary_data::{BoundaryData, BoundarySampler, HAT_SAMPLE_SPACING};
 pub use cloner::{CloneMode, CloneOptions, CloneStats, PatchCloner};
 pub use error::CloneError;
 pub use expand::{expand_boundary, HALF_PIXEL};

@@ -31,7 +31,9 @@ use super::{
     GridMask, GridPoisson, MaskError, MembraneComparison, MetricError, MvcError, MvcWeights,
     PoissonError,
 };
-use crate::clone::{CloneError, CloneOptions, MembraneSolver, PatchCloner, Placement};
+use crate::clone::{
+    BoundaryData, BoundarySampler, CloneError, CloneOptions, MembraneSolver, PatchCloner, Placement,
+};
 use crate::mesh::{mesh_mask, BitMask, Mesh, MeshError, MeshOptions};
 use crate::pixels::{Canvas, FloatImage};
 use crate::solve::LaplacianKind;
@@ -73,6 +75,8 @@ pub struct RunOptions {
     pub mvc_max_weights: usize,
     /// Keep the rasterised membranes in the result (for pictures).
     pub keep_membranes: bool,
+    /// How every method takes its boundary values from `target − source`.
+    pub boundary_data: BoundaryData,
 }
 
 impl Default for RunOptions {
@@ -81,6 +85,7 @@ impl Default for RunOptions {
             repeats: 3,
             mvc_max_weights: 40_000_000,
             keep_membranes: false,
+            boundary_data: BoundaryData::default(),
         }
     }
 }
@@ -310,7 +315,7 @@ impl Experiment {
         let mut solver = None;
         for _ in 0..run.repeats {
             let started = Instant::now();
-            let mut fresh = MembraneSolver::new(mesh, &self.source, kind)?;
+            let mut fresh = MembraneSolver::new(mesh, &self.source, kind, run.boundary_data)?;
             fresh.solve(placed, canvas, None)?;
             preprocess_ms = preprocess_ms.min(millis(started.elapsed()));
             solver = Some(fresh);
@@ -353,18 +358,30 @@ impl Experiment {
             mvc = Some(fresh);
         }
         let mvc = mvc.expect("repeats ≥ 1"); // invariant: repeats ≥ 1 was checked, so the loop ran at least once.
-        let source_at_boundary = boundary_samples(mesh, |p| self.source.sample_bilinear(p.x, p.y));
+        let boundary = BoundarySampler::new(mesh, run.boundary_data);
+        let rgb = |c: [f32; 4]| [c[0], c[1], c[2]];
+        let mut source_at_boundary = vec![[0.0; 3]; boundary.boundary_vertices().len()];
+        boundary.sample(
+            &mesh.positions,
+            |p| rgb(self.source.sample_bilinear(p.x, p.y)),
+            &mut source_at_boundary,
+        );
+        let mut target_at_boundary = source_at_boundary.clone();
         let n = mesh.vertex_count();
         let mut values = vec![0.0f64; n * CHANNELS];
         let mut out = vec![0.0f64; n * CHANNELS];
         let mut membrane_ms = f64::INFINITY;
         for _ in 0..run.repeats {
             let started = Instant::now();
-            for (v, source) in &source_at_boundary {
-                let p = mesh.positions[*v as usize];
-                let target = canvas.sample_bilinear(p.x, p.y);
+            boundary.sample(
+                &mesh.positions,
+                |p| rgb(canvas.sample_bilinear(p.x, p.y)),
+                &mut target_at_boundary,
+            );
+            let pairs = source_at_boundary.iter().zip(&target_at_boundary);
+            for (&v, (source, target)) in boundary.boundary_vertices().iter().zip(pairs) {
                 for c in 0..CHANNELS {
-                    values[*v as usize * CHANNELS + c] = f64::from(target[c] - source[c]);
+                    values[v as usize * CHANNELS + c] = f64::from(target[c] - source[c]);
                 }
             }
             mvc.apply(&values, CHANNELS, &mut out)?;
@@ -423,6 +440,7 @@ pub fn reclone_ms(
     target: &FloatImage,
     mesh: Mesh,
     kind: LaplacianKind,
+    boundary_data: BoundaryData,
     nudge: DVec2,
     repeats: usize,
 ) -> Result<f64, ExperimentError> {
@@ -431,6 +449,7 @@ pub fn reclone_ms(
     }
     let options = CloneOptions {
         laplacian: kind,
+        boundary_data,
         ..CloneOptions::default()
     };
     let mut cloner = PatchCloner::new(source.clone(), mesh, &options)?;
@@ -448,12 +467,6 @@ pub fn reclone_ms(
         best = best.min(stats.solve_ms + stats.raster_ms);
     }
     Ok(best)
-}
-
-fn boundary_samples(mesh: &Mesh, sample: impl Fn(DVec2) -> [f32; 4]) -> Vec<(u32, [f32; 4])> {
-    mesh.boundary_vertices()
-        .map(|v| (v, sample(mesh.positions[v as usize])))
-        .collect()
 }
 
 /// Interleaved RGB samples of an image.

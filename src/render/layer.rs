@@ -78,6 +78,7 @@ impl Layer {
             laplacian: patch.laplacian,
             mode: patch.mode,
             feather: patch.feather as f32,
+            boundary_data: patch.boundary_data,
         };
         let cloner =
             PatchCloner::new(source, patch_mesh.result.mesh, &options).map_err(clone_error)?;

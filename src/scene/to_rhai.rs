@@ -61,6 +61,7 @@ fn write_patch(out: &mut String, patch: &Patch, var: &str) {
     options.push(format!("laplacian: \"{}\"", patch.laplacian.name()));
     options.push(format!("mode: \"{}\"", patch.mode.name()));
     options.push(format!("feather: {}", num(patch.feather)));
+    options.push(format!("boundary_data: \"{}\"", patch.boundary_data.name()));
     let _ = writeln!(
         out,
         "let {var} = patch({}, #{{ {} }});",

@@ -51,7 +51,7 @@ pub enum Shape {
     Polygons(Vec<Polygon>),
 }
 
-pub use crate::clone::CloneMode;
+pub use crate::clone::{BoundaryData, CloneMode};
 pub use crate::solve::LaplacianKind;
 
 /// Where a patch sits in the canvas over time. Empty tracks take their defaults:
@@ -111,6 +111,8 @@ pub struct Patch {
     pub mode: CloneMode,
     /// Width in pixels of the softened outer edge (0: hard edge, anti-aliased).
     pub feather: f64,
+    /// How the membrane's boundary values are sampled.
+    pub boundary_data: BoundaryData,
     pub placement: Placement,
     pub handles: Vec<Handle>,
     pub pins: Vec<Pin>,
@@ -127,6 +129,7 @@ impl Patch {
             laplacian: LaplacianKind::default(),
             mode: CloneMode::default(),
             feather: 0.0,
+            boundary_data: BoundaryData::default(),
             placement: Placement::default(),
             handles: Vec::new(),
             pins: Vec::new(),

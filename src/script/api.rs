@@ -153,7 +153,7 @@ fn parse_canvas(
     Ok(canvas)
 }
 
-const PATCH_OPTIONS: [&str; 7] = [
+const PATCH_OPTIONS: [&str; 8] = [
     "source",
     "mask",
     "polygons",
@@ -161,6 +161,7 @@ const PATCH_OPTIONS: [&str; 7] = [
     "laplacian",
     "mode",
     "feather",
+    "boundary_data",
 ];
 
 fn new_patch(
@@ -224,6 +225,9 @@ fn parse_patch(base_dir: &Path, name: &Dynamic, options: &Dynamic) -> Result<Pat
     }
     if let Some(v) = options.get("feather") {
         patch.feather = values::non_negative(v, "feather")?;
+    }
+    if let Some(v) = options.get("boundary_data") {
+        patch.boundary_data = values::string(v, "boundary_data")?.parse()?;
     }
     Ok(patch)
 }
