@@ -11,7 +11,7 @@ use crate::clone::{
 use crate::deform::{DeformRig, DeformStats, Deformed, Handle, Pin};
 use crate::mesh::{BitMask, Mesh, MeshOptions};
 use crate::pixels::{Canvas, FloatImage};
-use crate::scene::{CloneMode, LaplacianKind, Patch, PatchState, Shape};
+use crate::scene::{BoundaryData, CloneMode, LaplacianKind, Patch, PatchState, Shape};
 
 /// Mask pixels at or above this luminance (or alpha) are inside.
 const MASK_THRESHOLD: f32 = 0.5;
@@ -26,6 +26,7 @@ pub(super) struct LayerSettings {
     laplacian: LaplacianKind,
     mode: CloneMode,
     feather: f64,
+    boundary_data: BoundaryData,
 }
 
 impl LayerSettings {
@@ -37,6 +38,7 @@ impl LayerSettings {
             laplacian: patch.laplacian,
             mode: patch.mode,
             feather: patch.feather,
+            boundary_data: patch.boundary_data,
         }
     }
 }

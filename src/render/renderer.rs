@@ -101,7 +101,7 @@ impl Renderer {
 
     /// Switches to a new version of the scene, keeping every layer (mesh, cloning factor,
     /// deformation rig) whose patch — matched by name — has the same mesh-defining settings
-    /// (source, shape, density, Laplacian kind, mode, feather). Only new or changed patches
+    /// (source, shape, density, Laplacian kind, mode, feather, boundary data). Only new or changed patches
     /// are meshed and factored; a kept patch that gained its first handle or pin gets a rig.
     /// On error the renderer is unchanged.
     pub fn set_scene(&mut self, scene: Scene) -> Result<SceneUpdate, RenderError> {
