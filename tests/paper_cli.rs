@@ -60,6 +60,7 @@ fn quick_json_has_the_documented_keys() {
     for key in ["density", "repeats", "models", "figure", "sweep"] {
         assert!(json.get(key).is_some(), "missing {key}");
     }
+    assert_eq!(json["boundary_data"], "hat-average");
     let model = &json["models"][0];
     for key in [
         "model",

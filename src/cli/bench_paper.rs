@@ -6,7 +6,7 @@
 //! `fig5_spiral.png` into `--out`; with `--sweep`, sweeps the mesh density on the spiral and
 //! writes the markdown table to `--sweep-out` (docs/quality.md).
 //!
-//! JSON keys (`--json`): `density`, `repeats`, `models[]` with `model`, `width`, `height`,
+//! JSON keys (`--json`): `density`, `boundary_data` (`hat-average` or `vertex`), `repeats`, `models[]` with `model`, `width`, `height`,
 //! `inside_pixels`, `vertices`, `triangles`, `boundary_vertices`, `mesh_ms`,
 //! `reference_factor_ms`, `reference_solve_ms`, `uncovered`, and `combinatorial`,
 //! `cotangent`, `mvc` objects with `psnr_db`, `seam_step`, `reference_seam_step`,
@@ -163,6 +163,7 @@ struct SweepRow {
 #[derive(serde::Serialize)]
 struct Report {
     density: f64,
+    boundary_data: &'static str,
     repeats: usize,
     models: Vec<ModelJson>,
     figure: Option<String>,
@@ -223,6 +224,7 @@ pub fn run(args: PaperBenchArgs) -> anyhow::Result<()> {
     };
     let report = Report {
         density: mesh_options.density,
+        boundary_data: args.boundary_data.name(),
         repeats: run_options.repeats,
         models,
         figure: figure.map(|p| p.display().to_string()),
@@ -382,9 +384,9 @@ fn table_text(report: &Report) -> String {
     let mut out = String::new();
     let _ = writeln!(
         out,
-        "Table I (density {} px, best of {}; times in ms; PSNR in dB against the pixel-grid \
-         reference)",
-        report.density, report.repeats
+        "Table I (density {} px, {} boundary data, best of {}; times in ms; PSNR in dB against \
+         the pixel-grid reference)",
+        report.density, report.boundary_data, report.repeats
     );
     let _ = writeln!(
         out,
