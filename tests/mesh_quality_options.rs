@@ -187,6 +187,19 @@ proptest! {
 
 /// Σ_j (x_j − x_i) over the neighbours of every interior vertex: the combinatorial
 /// Laplacian's defect on linear functions.
+/// The smallest angle of any triangle, degrees.
+fn smallest_angle(mesh: &lapclone::mesh::Mesh) -> f64 {
+    let mut smallest = f64::INFINITY;
+    for t in &mesh.triangles {
+        let q = t.map(|c| mesh.positions[c as usize]);
+        for k in 0..3 {
+            let (a, b) = (q[(k + 1) % 3] - q[k], q[(k + 2) % 3] - q[k]);
+            smallest = smallest.min(a.angle_to(b).abs().to_degrees());
+        }
+    }
+    smallest
+}
+
 fn first_moment_defect(mesh: &lapclone::mesh::Mesh) -> f64 {
     let n = mesh.vertex_count();
     let mut sum = vec![glam::DVec2::ZERO; n];
@@ -210,8 +223,10 @@ fn relaxation_keeps_the_boundary_and_the_triangles_and_shrinks_the_linear_defect
     ] {
         let before = mesh_mask(&mask, &MeshOptions::default()).unwrap().mesh;
         let mut after = before.clone();
-        lapclone::mesh::relax_interior(&mut after, 5);
+        lapclone::mesh::relax_interior(&mut after, 5, 25.0);
         after.sanity_check().unwrap();
+        let (was, is) = (smallest_angle(&before), smallest_angle(&after));
+        assert!(is >= was.min(25.0) - 1e-9, "smallest angle {was}° → {is}°");
         assert_eq!(after.triangles, before.triangles);
         for v in before.boundary_vertices() {
             assert_eq!(after.positions[v as usize], before.positions[v as usize]);
@@ -223,7 +238,7 @@ fn relaxation_keeps_the_boundary_and_the_triangles_and_shrinks_the_linear_defect
         assert!(is < 0.5 * was, "defect {was} → {is}");
         // Deterministic: the same sweeps give the same bits.
         let mut again = before.clone();
-        lapclone::mesh::relax_interior(&mut again, 5);
+        lapclone::mesh::relax_interior(&mut again, 5, 25.0);
         assert_eq!(again.positions, after.positions);
     }
 }
@@ -236,7 +251,7 @@ fn the_seam_quality_preset_is_valid_and_relaxes_in_the_clone_stage() {
     let raw = mesh_mask(&mask, &options).unwrap().mesh;
     let patch = mesh_from_mask(&mask, None, (40, 40), &options).unwrap();
     let mut relaxed = raw.clone();
-    lapclone::mesh::relax_interior(&mut relaxed, options.relax_sweeps);
+    lapclone::mesh::relax_interior(&mut relaxed, options.relax_sweeps, options.min_angle_deg);
     assert_eq!(patch.result.mesh.positions, relaxed.positions);
     assert_ne!(relaxed.positions, raw.positions);
     let too_many = MeshOptions {

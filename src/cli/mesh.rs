@@ -50,7 +50,11 @@ pub fn run(args: MeshArgs) -> anyhow::Result<()> {
     // The raw mask mesh (boundary on the pixel cracks unless `--boundary outside-centres`);
     // relaxation is the only finishing step that belongs to the mesh itself.
     if options.relax_sweeps > 0 {
-        mesh::relax_interior(&mut result.mesh, options.relax_sweeps);
+        mesh::relax_interior(
+            &mut result.mesh,
+            options.relax_sweeps,
+            options.min_angle_deg,
+        );
         result.stats.min_angle_deg = mesh::min_angle_deg(&result.mesh);
     }
     let mesh_ms = started.elapsed().as_secs_f64() * 1e3;

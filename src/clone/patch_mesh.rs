@@ -61,7 +61,11 @@ pub fn finish_mask_mesh(result: &mut MeshResult, options: &MeshOptions) {
     if result.stats.boundary == BoundaryPlacement::Cracks {
         expand_boundary(&mut result.mesh, HALF_PIXEL);
     }
-    relax_interior(&mut result.mesh, options.relax_sweeps);
+    relax_interior(
+        &mut result.mesh,
+        options.relax_sweeps,
+        options.min_angle_deg,
+    );
 }
 
 /// Meshes polygons given in source coordinates (interior relaxed as `options` asks).
@@ -70,7 +74,11 @@ pub fn mesh_from_polygons(
     options: &MeshOptions,
 ) -> Result<PatchMesh, CloneError> {
     let mut result = mesh_polygons(polygons, options)?;
-    relax_interior(&mut result.mesh, options.relax_sweeps);
+    relax_interior(
+        &mut result.mesh,
+        options.relax_sweeps,
+        options.min_angle_deg,
+    );
     let mut min = DVec2::splat(f64::INFINITY);
     let mut max = DVec2::splat(f64::NEG_INFINITY);
     for p in polygons.iter().flat_map(|p| &p.outer) {

@@ -29,7 +29,8 @@ pub struct MeshOptions {
     /// the interior (dense at the boundary, coarse inside).
     pub max_area: Option<f64>,
     /// Gauss–Seidel sweeps moving interior vertices towards their neighbours' mean, applied
-    /// by the clone stage once the boundary is in place (`mesh::relax_interior`); 0: none.
+    /// by the clone stage once the boundary is in place (`mesh::relax_interior`; no angle
+    /// falls below `min_angle_deg` or where it already was); 0: none.
     pub relax_sweeps: usize,
 }
 

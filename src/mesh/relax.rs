@@ -9,9 +9,11 @@
 //! sweeps towards that fixed point (Tutte's barycentric embedding) shrink the defect without
 //! adding a vertex, so re-clone cost does not change.
 //!
-//! A move that would leave one of the vertex's triangles with less than a tenth of its
-//! area before the move is skipped, so triangles never fold. Sweeps run in vertex order:
-//! deterministic.
+//! A move must keep each of the vertex's triangles above a tenth of its area before the move
+//! (so triangles never fold) and must not make the smallest angle around the vertex smaller
+//! than the angle bound asked for, or than it already was if that is smaller (so relaxing keeps
+//! the refinement's angle guarantee). A move that fails is halved, twice at most, then skipped.
+//! Sweeps run in vertex order: deterministic.
 
 use glam::DVec2;
 
@@ -20,102 +22,124 @@ use super::Mesh;
 /// Smallest fraction of its area a triangle may keep when a corner moves.
 const MIN_AREA_RATIO: f64 = 0.1;
 
-/// Runs `sweeps` Gauss–Seidel sweeps; gives how many vertex moves were skipped to keep
-/// triangles from folding.
-pub fn relax_interior(mesh: &mut Mesh, sweeps: usize) -> usize {
+/// Halvings tried when a full move towards the neighbours' mean fails a guard.
+const MOVE_HALVINGS: usize = 2;
+
+/// Runs `sweeps` Gauss–Seidel sweeps that keep every angle at or above `min_angle_deg` (or
+/// where it already was); gives how many vertex moves were skipped.
+pub fn relax_interior(mesh: &mut Mesh, sweeps: usize, min_angle_deg: f64) -> usize {
     if sweeps == 0 {
         return 0;
     }
-    let n = mesh.vertex_count();
-    let (triangle_start, incident) = incident_triangles(mesh);
-    let (neighbour_start, neighbours) = neighbour_lists(mesh, &triangle_start, &incident);
+    let fans = InteriorFans::of(mesh);
+    // A triangle's smallest angle is at most 60°, where sin² grows with the angle.
+    let bound = min_angle_deg.clamp(0.0, 60.0).to_radians().sin().powi(2);
+    let mut doubled_areas = Vec::with_capacity(16);
     let mut skipped = 0;
     for _ in 0..sweeps {
-        for v in (0..n).filter(|&v| !mesh.is_boundary[v]) {
-            let around = &neighbours[neighbour_start[v]..neighbour_start[v + 1]];
-            if around.is_empty() {
+        for (k, &v) in fans.vertices.iter().enumerate() {
+            let fan = &fans.corners[fans.start[k]..fans.start[k + 1]];
+            if fan.is_empty() {
                 continue;
             }
-            let sum: DVec2 = around.iter().map(|&u| mesh.positions[u as usize]).sum();
-            let target = sum / around.len() as f64;
-            let triangles = &incident[triangle_start[v]..triangle_start[v + 1]];
-            if keeps_triangles(mesh, v, target, triangles) {
-                mesh.positions[v] = target;
-            } else {
-                skipped += 1;
+            let here = mesh.positions[v as usize];
+            let positions = &mesh.positions;
+            doubled_areas.clear();
+            let mut smallest = f64::INFINITY;
+            let mut sum = DVec2::ZERO;
+            for &[a, b] in fan {
+                let (pa, pb) = (positions[a as usize], positions[b as usize]);
+                let (area, sine) = doubled_area_and_smallest_sine(here, pa, pb);
+                doubled_areas.push(area);
+                smallest = smallest.min(sine);
+                sum += pa + pb;
             }
+            // Each neighbour of a closed fan is a corner of exactly two of its triangles.
+            let mut target = sum / (2 * fan.len()) as f64;
+            let allowed = smallest.min(bound);
+            let mut moved = false;
+            for _ in 0..=MOVE_HALVINGS {
+                let keeps = fan.iter().zip(&doubled_areas).all(|(&[a, b], &before)| {
+                    let (pa, pb) = (positions[a as usize], positions[b as usize]);
+                    let (area, sine) = doubled_area_and_smallest_sine(target, pa, pb);
+                    area > MIN_AREA_RATIO * before && sine >= allowed
+                });
+                if keeps {
+                    moved = true;
+                    break;
+                }
+                target = (target + here) * 0.5;
+            }
+            if moved {
+                mesh.positions[v as usize] = target;
+            }
+            skipped += usize::from(!moved);
         }
     }
     skipped
 }
 
-/// Whether moving `v` to `target` keeps each of its triangles above the area ratio.
-fn keeps_triangles(mesh: &Mesh, v: usize, target: DVec2, triangles: &[u32]) -> bool {
-    triangles.iter().all(|&t| {
-        let corners = mesh.triangles[t as usize];
-        let p = corners.map(|c| mesh.positions[c as usize]);
-        let moved = corners.map(|c| {
-            if c as usize == v {
-                target
-            } else {
-                mesh.positions[c as usize]
-            }
-        });
-        let area = |q: [DVec2; 3]| (q[1] - q[0]).perp_dot(q[2] - q[0]);
-        area(moved) > MIN_AREA_RATIO * area(p)
-    })
+/// Twice the area of the triangle (v, a, b) and the squared sine of its smallest angle.
+fn doubled_area_and_smallest_sine(v: DVec2, a: DVec2, b: DVec2) -> (f64, f64) {
+    let area = (a - v).perp_dot(b - v);
+    let lengths = [
+        (a - v).length_squared(),
+        (b - v).length_squared(),
+        (b - a).length_squared(),
+    ];
+    // The smallest angle faces the shortest side; 2·area = the other two sides · its sine.
+    let shortest = lengths[0].min(lengths[1]).min(lengths[2]);
+    let product = lengths[0] * lengths[1] * lengths[2] / shortest;
+    (area, area * area / product)
 }
 
-/// Sorted, deduplicated neighbours of every vertex, in compressed rows, read off the
-/// incident triangles (linear time; only the short per-vertex lists are sorted).
-fn neighbour_lists(
-    mesh: &Mesh,
-    triangle_start: &[usize],
-    incident: &[u32],
-) -> (Vec<usize>, Vec<u32>) {
-    let n = mesh.vertex_count();
-    let mut start = Vec::with_capacity(n + 1);
-    let mut neighbours = Vec::with_capacity(2 * incident.len());
-    start.push(0);
-    for v in 0..n {
-        let row = neighbours.len();
-        for &t in &incident[triangle_start[v]..triangle_start[v + 1]] {
-            let corners = mesh.triangles[t as usize];
-            neighbours.extend(corners.iter().copied().filter(|&c| c as usize != v));
-        }
-        neighbours[row..].sort_unstable();
-        let mut kept = row;
-        for k in row..neighbours.len() {
-            if k == row || neighbours[k] != neighbours[kept - 1] {
-                neighbours[kept] = neighbours[k];
-                kept += 1;
-            }
-        }
-        neighbours.truncate(kept);
-        start.push(neighbours.len());
-    }
-    (start, neighbours)
+/// The triangles around every interior vertex, as the other two corners in the triangle's
+/// order (so (v, a, b) turns the mesh's way), in compressed rows.
+struct InteriorFans {
+    vertices: Vec<u32>,
+    start: Vec<usize>,
+    corners: Vec<[u32; 2]>,
 }
 
-/// Triangles incident to every vertex, in compressed rows (counting sort: linear time).
-fn incident_triangles(mesh: &Mesh) -> (Vec<usize>, Vec<u32>) {
-    let n = mesh.vertex_count();
-    let mut start = vec![0usize; n + 1];
-    for t in &mesh.triangles {
-        for &c in t {
-            start[c as usize + 1] += 1;
+impl InteriorFans {
+    /// Counting sort of the triangles' corners: linear time.
+    fn of(mesh: &Mesh) -> Self {
+        let n = mesh.vertex_count();
+        let vertices: Vec<u32> = (0..n as u32)
+            .filter(|&v| !mesh.is_boundary[v as usize])
+            .collect();
+        let mut row_of = vec![u32::MAX; n];
+        for (k, &v) in vertices.iter().enumerate() {
+            row_of[v as usize] = k as u32;
+        }
+        let mut start = vec![0usize; vertices.len() + 1];
+        for t in &mesh.triangles {
+            for &c in t {
+                let row = row_of[c as usize];
+                if row != u32::MAX {
+                    start[row as usize + 1] += 1;
+                }
+            }
+        }
+        for k in 0..vertices.len() {
+            start[k + 1] += start[k];
+        }
+        let mut fill = start.clone();
+        let mut corners = vec![[0u32; 2]; start[vertices.len()]];
+        for t in &mesh.triangles {
+            for i in 0..3 {
+                let row = row_of[t[i] as usize];
+                if row != u32::MAX {
+                    let slot = &mut fill[row as usize];
+                    corners[*slot] = [t[(i + 1) % 3], t[(i + 2) % 3]];
+                    *slot += 1;
+                }
+            }
+        }
+        Self {
+            vertices,
+            start,
+            corners,
         }
     }
-    for v in 0..n {
-        start[v + 1] += start[v];
-    }
-    let mut fill = start.clone();
-    let mut incident = vec![0u32; start[n]];
-    for (index, t) in mesh.triangles.iter().enumerate() {
-        for &c in t {
-            incident[fill[c as usize]] = index as u32;
-            fill[c as usize] += 1;
-        }
-    }
-    (start, incident)
 }
