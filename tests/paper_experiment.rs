@@ -62,9 +62,11 @@ fn smooth_disc_meets_measured_psnr_thresholds() {
         .unwrap();
     let combinatorial = run.combinatorial.comparison.psnr_db;
     let cotangent = run.cotangent.comparison.psnr_db;
-    // Measured 37.1 / 38.0 / 37.6 dB (combinatorial / cotangent / MVC; density 1 px, no
-    // simplification); 1.5 dB margin. See docs/quality.md for why this is not higher.
-    assert!(combinatorial >= 35.5, "combinatorial {combinatorial} dB");
+    // Measured 41.4 / 46.8 / 41.6 dB (combinatorial / cotangent / MVC; density 1 px, no
+    // simplification, hat-averaged boundary values, 2 relaxation sweeps; 37.1 / 38.0 / 37.6
+    // before the boundary moved onto the outside pixel centres); 1.5 dB margin. See
+    // docs/quality.md for why this is not higher.
+    assert!(combinatorial >= 39.9, "combinatorial {combinatorial} dB");
     assert!(cotangent >= combinatorial - 0.5, "cotangent {cotangent} dB");
     let mvc = run.mvc.figures().expect("a disc has no holes");
     assert!(mvc.comparison.psnr_db.is_finite() && mvc.comparison.psnr_db > 30.0);
@@ -112,9 +114,11 @@ fn linear_boundary_data_is_reproduced_by_cotangent_and_mvc() {
         boundary_data: BoundaryData::Vertex,
         ..run_options()
     };
-    let run = experiment
-        .run(&exact_cover_options(2.0), &vertex_data)
-        .unwrap();
+    let unrelaxed = MeshOptions {
+        relax_sweeps: 0,
+        ..exact_cover_options(2.0)
+    };
+    let run = experiment.run(&unrelaxed, &vertex_data).unwrap();
     let cotangent = run.cotangent.comparison.psnr_db;
     let mvc = run.mvc.figures().unwrap().comparison.psnr_db;
     let combinatorial = run.combinatorial.comparison.psnr_db;
@@ -125,8 +129,9 @@ fn linear_boundary_data_is_reproduced_by_cotangent_and_mvc() {
         combinatorial < cotangent,
         "combinatorial {combinatorial} dB"
     );
-    // Relaxing the interior towards its neighbours' means restores most of the
-    // combinatorial Laplacian's linear precision.
+    // Relaxing the interior towards its neighbours' means restores part of the
+    // combinatorial Laplacian's linear precision: not at the boundary's first ring, which
+    // relaxation leaves where it is.
     let relaxed = experiment
         .run(
             &MeshOptions {
@@ -137,17 +142,15 @@ fn linear_boundary_data_is_reproduced_by_cotangent_and_mvc() {
         )
         .unwrap();
     let relaxed = relaxed.combinatorial.comparison.psnr_db;
-    // Measured 43.7 → 69.2 dB.
+    // Measured 43.7 → 50.0 dB (69.2 when the ring moved too).
     assert!(
-        relaxed >= 65.0 && relaxed > combinatorial + 20.0,
+        relaxed >= 48.0 && relaxed > combinatorial + 5.0,
         "{combinatorial} → {relaxed} dB"
     );
     // The hat average's weighted mean point lies up to about half a pixel off a vertex
     // where the boundary bends; with this gradient (0.007 per px) that bounds the cotangent
     // membrane's error to about 4e-3 (48 dB). Measured: 64.6 dB.
-    let hat = experiment
-        .run(&exact_cover_options(2.0), &run_options())
-        .unwrap();
+    let hat = experiment.run(&unrelaxed, &run_options()).unwrap();
     let hat_cotangent = hat.cotangent.comparison.psnr_db;
     assert!(
         (48.0..cotangent).contains(&hat_cotangent),

@@ -85,6 +85,9 @@ impl Default for MeshOptions {
     /// - `min_angle_deg` 25°: the usual Ruppert bound that still terminates reliably.
     /// - `max_vertices` 2 000 000: a guard against runaway refinement, not a quality knob.
     /// - `min_piece_area` 4 px: drops isolated specks of 1–3 pixels.
+    /// - `relax_sweeps` 2: evens out the interior beyond the boundary's first ring, for the
+    ///   combinatorial Laplacian's accuracy (+0.7 dB on the paper's spiral, +1.7 on the palm;
+    ///   the seam and the angle bound unchanged, about 0.4 M instructions on the 400² spiral).
     fn default() -> Self {
         Self {
             density: 3.0,
@@ -94,7 +97,7 @@ impl Default for MeshOptions {
             min_piece_area: 4.0,
             boundary: BoundaryPlacement::Cracks,
             max_area: None,
-            relax_sweeps: 0,
+            relax_sweeps: 2,
         }
     }
 }

@@ -1,5 +1,5 @@
 //! Interior relaxation for the combinatorial Laplacian: takes a mesh and moves each interior
-//! vertex towards the mean of its neighbours (boundary vertices stay), giving the same
+//! vertex that has no boundary neighbour towards the mean of its neighbours, giving the same
 //! triangles at new positions.
 //!
 //! Why: the combinatorial Laplacian reproduces a linear function f at vertex i exactly when
@@ -8,6 +8,11 @@
 //! precision), so the combinatorial membrane drifts from the harmonic one. Gauss–Seidel
 //! sweeps towards that fixed point (Tutte's barycentric embedding) shrink the defect without
 //! adding a vertex, so re-clone cost does not change.
+//!
+//! The boundary and its first ring of interior vertices stay: the triangles along the boundary
+//! decide how the membrane meets the target, and pulling the ring towards the dense boundary
+//! made the seam step 3–7 % larger (docs/quality.md), while moving the rest gains most of the
+//! accuracy.
 //!
 //! A move must keep each of the vertex's triangles above a tenth of its area before the move
 //! (so triangles never fold) and must not make the smallest angle around the vertex smaller
@@ -93,8 +98,9 @@ fn doubled_area_and_smallest_sine(v: DVec2, a: DVec2, b: DVec2) -> (f64, f64) {
     (area, area * area / product)
 }
 
-/// The triangles around every interior vertex, as the other two corners in the triangle's
-/// order (so (v, a, b) turns the mesh's way), in compressed rows.
+/// The triangles around every vertex that relaxation moves (interior, no boundary neighbour),
+/// as the other two corners in the triangle's order (so (v, a, b) turns the mesh's way), in
+/// compressed rows.
 struct InteriorFans {
     vertices: Vec<u32>,
     start: Vec<usize>,
@@ -105,9 +111,16 @@ impl InteriorFans {
     /// Counting sort of the triangles' corners: linear time.
     fn of(mesh: &Mesh) -> Self {
         let n = mesh.vertex_count();
-        let vertices: Vec<u32> = (0..n as u32)
-            .filter(|&v| !mesh.is_boundary[v as usize])
-            .collect();
+        // A vertex sharing a triangle with a boundary vertex is on the boundary or its ring.
+        let mut stays = mesh.is_boundary.clone();
+        for t in &mesh.triangles {
+            if t.iter().any(|&c| mesh.is_boundary[c as usize]) {
+                for &c in t {
+                    stays[c as usize] = true;
+                }
+            }
+        }
+        let vertices: Vec<u32> = (0..n as u32).filter(|&v| !stays[v as usize]).collect();
         let mut row_of = vec![u32::MAX; n];
         for (k, &v) in vertices.iter().enumerate() {
             row_of[v as usize] = k as u32;
