@@ -38,7 +38,8 @@ const SWEEP_DENSITIES: [f64; 7] = [4.0, 3.0, 2.0, 1.5, 1.0, 0.75, 0.5];
 /// area px², relaxation sweeps): exact Dirichlet vertices, grading limits, relaxation
 /// (docs/quality.md).
 type SweepConfig = (BoundaryPlacement, f64, f64, Option<f64>, usize);
-const SWEEP_QUALITY: [SweepConfig; 11] = [
+const SWEEP_QUALITY: [SweepConfig; 12] = [
+    (BoundaryPlacement::Cracks, 3.0, 25.0, None, 0),
     (BoundaryPlacement::Cracks, 3.0, 25.0, None, 5),
     (BoundaryPlacement::Cracks, 2.0, 25.0, None, 5),
     (BoundaryPlacement::OutsideCentres, 1.0, 25.0, None, 0),
@@ -528,7 +529,7 @@ fn run_sweep(args: &PaperBenchArgs, run_options: &RunOptions) -> anyhow::Result<
         ..*run_options
     };
     let quality: &[SweepConfig] = if args.quick {
-        &SWEEP_QUALITY[2..3]
+        &SWEEP_QUALITY[3..4]
     } else {
         &SWEEP_QUALITY
     };

@@ -109,7 +109,7 @@ pub const SEAM_QUALITY_RELAX_SWEEPS: usize = 5;
 
 impl MeshOptions {
     /// Meets issue #8's quality bar on the 770×743 spiral (combinatorial ≥ 45 dB, cotangent
-    /// ≥ 52 dB against the pixel-grid clone; measured 46.0 / 54.8) at about three times the
+    /// ≥ 52 dB against the pixel-grid clone; measured 45.8 / 54.3) at about three times the
     /// default's vertices and re-clone time (docs/quality.md): boundary vertices on every
     /// Dirichlet pixel centre, a 29° angle bound, 5 relaxation sweeps.
     pub fn seam_quality() -> Self {
