@@ -44,44 +44,54 @@ pub fn relax_interior(mesh: &mut Mesh, sweeps: usize, min_angle_deg: f64) -> usi
     for _ in 0..sweeps {
         for (k, &v) in fans.vertices.iter().enumerate() {
             let fan = &fans.corners[fans.start[k]..fans.start[k + 1]];
-            if fan.is_empty() {
-                continue;
-            }
-            let here = mesh.positions[v as usize];
-            let positions = &mesh.positions;
-            doubled_areas.clear();
-            let mut smallest = f64::INFINITY;
-            let mut sum = DVec2::ZERO;
-            for &[a, b] in fan {
-                let (pa, pb) = (positions[a as usize], positions[b as usize]);
-                let (area, sine) = doubled_area_and_smallest_sine(here, pa, pb);
-                doubled_areas.push(area);
-                smallest = smallest.min(sine);
-                sum += pa + pb;
-            }
-            // Each neighbour of a closed fan is a corner of exactly two of its triangles.
-            let mut target = sum / (2 * fan.len()) as f64;
-            let allowed = smallest.min(bound);
-            let mut moved = false;
-            for _ in 0..=MOVE_HALVINGS {
-                let keeps = fan.iter().zip(&doubled_areas).all(|(&[a, b], &before)| {
-                    let (pa, pb) = (positions[a as usize], positions[b as usize]);
-                    let (area, sine) = doubled_area_and_smallest_sine(target, pa, pb);
-                    area > MIN_AREA_RATIO * before && sine >= allowed
-                });
-                if keeps {
-                    moved = true;
-                    break;
-                }
-                target = (target + here) * 0.5;
-            }
-            if moved {
-                mesh.positions[v as usize] = target;
-            }
+            let moved = !fan.is_empty()
+                && move_towards_mean(&mut mesh.positions, v, fan, bound, &mut doubled_areas);
             skipped += usize::from(!moved);
         }
     }
     skipped
+}
+
+/// Moves `v` towards the mean of its neighbours, or part of the way, if some move passes
+/// both guards (areas, and `bound` or the smallest sin² around `v` already); gives whether
+/// it moved. `doubled_areas` is scratch.
+fn move_towards_mean(
+    positions: &mut [DVec2],
+    v: u32,
+    fan: &[[u32; 2]],
+    bound: f64,
+    doubled_areas: &mut Vec<f64>,
+) -> bool {
+    let here = positions[v as usize];
+    doubled_areas.clear();
+    let mut smallest = f64::INFINITY;
+    let mut sum = DVec2::ZERO;
+    for &[a, b] in fan {
+        let (pa, pb) = (positions[a as usize], positions[b as usize]);
+        let (area, sine) = doubled_area_and_smallest_sine(here, pa, pb);
+        doubled_areas.push(area);
+        smallest = smallest.min(sine);
+        sum += pa + pb;
+    }
+    // Each neighbour of a closed fan is a corner of exactly two of its triangles.
+    let mut target = sum / (2 * fan.len()) as f64;
+    let allowed = smallest.min(bound);
+    for _ in 0..=MOVE_HALVINGS {
+        let keeps = fan
+            .iter()
+            .zip(doubled_areas.iter())
+            .all(|(&[a, b], &before)| {
+                let (pa, pb) = (positions[a as usize], positions[b as usize]);
+                let (area, sine) = doubled_area_and_smallest_sine(target, pa, pb);
+                area > MIN_AREA_RATIO * before && sine >= allowed
+            });
+        if keeps {
+            positions[v as usize] = target;
+            return true;
+        }
+        target = (target + here) * 0.5;
+    }
+    false
 }
 
 /// Twice the area of the triangle (v, a, b) and the squared sine of its smallest angle.
