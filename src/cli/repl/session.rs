@@ -496,12 +496,13 @@ impl Session {
                 Shape::Polygons(p) => format!("{} polygon(s)", p.len()),
             };
             out.push_str(&format!(
-                "patch \"{}\": source {}, {shape}, {:?}, {:?}, feather {}\n",
+                "patch \"{}\": source {}, {shape}, {:?}, {:?}, feather {}, boundary data {}\n",
                 patch.name,
                 short(&patch.source),
                 patch.laplacian,
                 patch.mode,
-                patch.feather
+                patch.feather,
+                patch.boundary_data.name()
             ));
             let p = &patch.placement;
             out.push_str(&format!(
