@@ -13,8 +13,6 @@
 //! quarter pixel outside their crack instead, which keeps the loops apart; those few
 //! vertices sample mixed pixels.
 
-use std::collections::HashMap;
-
 use glam::DVec2;
 
 use super::contour::CrackLoop;
@@ -38,7 +36,7 @@ const THIN_TOLERANCE: f64 = 0.5;
 /// otherwise drops centres greedily while the chord stays at most `spacing` long and within
 /// [`THIN_TOLERANCE`] of the dropped ones. Points with `keep` set (and the first) stay.
 /// Kept points are still centres, so the boundary data stays unmixed.
-fn thin_loop(points: &[DVec2], keep: &[bool], spacing: f64) -> Vec<DVec2> {
+pub(crate) fn thin_loop(points: &[DVec2], keep: &[bool], spacing: f64) -> Vec<DVec2> {
     let n = points.len();
     if spacing <= std::f64::consts::SQRT_2 + 1e-9 || n <= 3 {
         return points.to_vec();
@@ -70,38 +68,71 @@ fn distance_to_segment(p: DVec2, a: DVec2, b: DVec2) -> f64 {
     p.distance(a + ab * t)
 }
 
+/// A closed loop's points, with the ones thinning must keep marked.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub(crate) struct KeptLoop {
+    pub points: Vec<DVec2>,
+    pub keep: Vec<bool>,
+}
+
 /// Loops through the outside pixel centres, one per crack loop (same order, same
 /// orientation), and how many vertices had to fall back to the quarter-pixel offset.
 /// With `spacing` above √2 px, centres are dropped where the boundary is straight enough
 /// (see `thin_loop`).
 pub fn outside_centre_loops(crack: &[CrackLoop], spacing: f64) -> (Vec<Vec<DVec2>>, usize) {
-    let runs: Vec<Vec<Vec<Edge>>> = crack.iter().map(|c| runs_of(&unit_edges(c))).collect();
-    let mut seen: HashMap<(i64, i64), u32> = HashMap::new();
-    for lp in &runs {
-        for run in lp {
-            *seen.entry(run[0].pixel).or_default() += 1;
-        }
-    }
-    let mut fallbacks = 0;
-    let loops = runs
+    let (loops, fallbacks) = outside_centre_points(crack);
+    let thinned = loops
         .iter()
-        .map(|lp| {
+        .map(|lp| thin_loop(&lp.points, &lp.keep, spacing))
+        .collect();
+    (thinned, fallbacks)
+}
+
+/// Every outside pixel centre of each crack loop (quarter-pixel points where a centre is
+/// shared, marked to be kept), before thinning, and how many points fell back.
+pub(crate) fn outside_centre_points(crack: &[CrackLoop]) -> (Vec<KeptLoop>, usize) {
+    let loops: Vec<(Vec<Edge>, Vec<Run>)> = crack
+        .iter()
+        .map(|c| {
+            let edges = unit_edges(c);
+            let runs = runs_of(&edges);
+            (edges, runs)
+        })
+        .collect();
+    // Pixels reached by more than one run, sorted (a hash set cost 2 M instructions on the
+    // 400² spiral, more than the rest of this function).
+    let mut reached: Vec<(i64, i64)> = (loops.iter())
+        .flat_map(|(edges, runs)| runs.iter().map(|r| edges[r.first].pixel))
+        .collect();
+    reached.sort_unstable();
+    let shared: Vec<(i64, i64)> = reached
+        .windows(2)
+        .filter(|w| w[0] == w[1])
+        .map(|w| w[0])
+        .collect();
+    let mut fallbacks = 0;
+    let loops = loops
+        .iter()
+        .map(|(edges, runs)| {
             // A loop around a single outside pixel (a 1-px hole) has one run.
-            let collapsed = lp.len() < 3;
-            let mut points = Vec::with_capacity(lp.len());
-            let mut keep = Vec::with_capacity(lp.len());
-            for run in lp {
-                if !collapsed && seen[&run[0].pixel] == 1 {
-                    let (x, y) = run[0].pixel;
-                    points.push(DVec2::new(x as f64 + 0.5, y as f64 + 0.5));
-                    keep.push(false);
+            let collapsed = runs.len() < 3;
+            let mut out = KeptLoop::default();
+            for run in runs {
+                let pixel = edges[run.first].pixel;
+                if !collapsed && shared.binary_search(&pixel).is_err() {
+                    out.points
+                        .push(DVec2::new(pixel.0 as f64 + 0.5, pixel.1 as f64 + 0.5));
+                    out.keep.push(false);
                 } else {
-                    fallbacks += run.len();
-                    points.extend(run.iter().map(|e| e.midpoint + e.outward * SHARED_OFFSET));
-                    keep.extend(run.iter().map(|_| true));
+                    fallbacks += run.len;
+                    for k in 0..run.len {
+                        let e = &edges[(run.first + k) % edges.len()];
+                        out.points.push(e.midpoint + e.outward * SHARED_OFFSET);
+                        out.keep.push(true);
+                    }
                 }
             }
-            thin_loop(&points, &keep, spacing)
+            out
         })
         .collect();
     (loops, fallbacks)
@@ -134,18 +165,31 @@ fn unit_edges(crack: &CrackLoop) -> Vec<Edge> {
     edges
 }
 
-/// Maximal cyclic runs of consecutive edges with the same outside pixel.
-fn runs_of(edges: &[Edge]) -> Vec<Vec<Edge>> {
-    let mut runs: Vec<Vec<Edge>> = Vec::new();
-    for &e in edges {
+/// A cyclic run of a loop's edges: `len` edges from `first`, wrapping past the end.
+#[derive(Clone, Copy)]
+struct Run {
+    first: usize,
+    len: usize,
+}
+
+/// Maximal cyclic runs of consecutive edges with the same outside pixel, starting at the
+/// first edge that begins one (so no run is split across the wrap).
+fn runs_of(edges: &[Edge]) -> Vec<Run> {
+    let n = edges.len();
+    let starts_run = |i: usize| edges[i].pixel != edges[(i + n - 1) % n].pixel;
+    let Some(offset) = (0..n).find(|&i| starts_run(i)) else {
+        return if n == 0 {
+            Vec::new()
+        } else {
+            vec![Run { first: 0, len: n }]
+        };
+    };
+    let mut runs: Vec<Run> = Vec::new();
+    for i in (offset..n + offset).map(|i| i % n) {
         match runs.last_mut() {
-            Some(run) if run[0].pixel == e.pixel => run.push(e),
-            _ => runs.push(vec![e]),
+            Some(run) if !starts_run(i) => run.len += 1,
+            _ => runs.push(Run { first: i, len: 1 }),
         }
-    }
-    if runs.len() > 1 && runs[0][0].pixel == runs[runs.len() - 1][0].pixel {
-        let last = runs.pop().unwrap_or_default();
-        runs[0].splice(0..0, last);
     }
     runs
 }

@@ -11,13 +11,14 @@
 use glam::DVec2;
 
 use super::bitmask::crack_edges_by_row;
-use super::centre_loops::outside_centre_loops;
+use super::centre_cut::cut_centre_loops;
+use super::centre_loops::{outside_centre_loops, outside_centre_points, thin_loop, KeptLoop};
 use super::contour::{label_pieces, piece_sizes, trace_crack_loops, CrackLoop};
 use super::options::{min_angle_deg, BoundaryPlacement};
 use super::simplify::{
     doubled_signed_area, simplify_loop, subdivide_loop, subdivide_loop_sharing_row, subdivided_len,
 };
-use super::split::Cut;
+use super::split::{merge, Cut, Interface};
 use super::triangulate::{triangulate_loops, Refinement};
 use super::{BitMask, Mesh, MeshError, MeshOptions, MeshResult, MeshStats};
 
@@ -51,13 +52,15 @@ pub fn mesh_mask(mask: &BitMask, options: &MeshOptions) -> Result<MeshResult, Me
     if edges > max_edges {
         return Err(MeshError::BoundaryTooLong { edges, max_edges });
     }
-    let split = match options.boundary {
-        BoundaryPlacement::Cracks => Cut::choose(kept_mask, &edges_by_row, options.max_vertices)
-            .map(|cut| mesh_in_halves(kept_mask, &cut, pieces, options))
-            .transpose()?
-            .flatten(),
-        BoundaryPlacement::OutsideCentres => None,
-    };
+    let split = Cut::choose(kept_mask, &edges_by_row, options.max_vertices)
+        .map(|cut| match options.boundary {
+            BoundaryPlacement::Cracks => mesh_in_halves(kept_mask, &cut, pieces, options),
+            BoundaryPlacement::OutsideCentres => {
+                mesh_centres_in_halves(kept_mask, &cut, pieces, options)
+            }
+        })
+        .transpose()?
+        .flatten();
     let meshed = match split {
         Some(meshed) => meshed,
         None => mesh_whole(kept_mask, pieces, options, &mut warnings)?,
@@ -114,6 +117,21 @@ struct Meshed {
 struct Topology {
     holes: usize,
     pieces: usize,
+}
+
+impl Topology {
+    /// The topology of the region `loops` bound (outer loops positive, holes negative): each
+    /// piece has one outer loop.
+    fn of_loops(loops: &[Vec<DVec2>]) -> Topology {
+        let holes = loops
+            .iter()
+            .filter(|l| doubled_signed_area(l) < 0.0)
+            .count();
+        Topology {
+            holes,
+            pieces: loops.len() - holes,
+        }
+    }
 }
 
 /// Meshes `mask` in one piece, through the outside pixel centres if asked and possible,
@@ -181,7 +199,7 @@ fn mesh_in_halves(
     };
     let (upper, lower) = rayon::join(|| mesh_half(&top, 0), || mesh_half(&bottom, cut.row));
     let (upper, lower) = (upper?, lower?);
-    let mesh = cut.merge(&upper.mesh, &lower.mesh);
+    let mesh = merge(cut, &upper.mesh, &lower.mesh);
     if cfg!(debug_assertions) {
         mesh.sanity_check()?;
     }
@@ -199,6 +217,68 @@ fn mesh_in_halves(
         fell_back: upper.fell_back || lower.fell_back,
         placement: BoundaryPlacement::Cracks,
         off_centre: 0,
+        cut_row: Some(cut.row),
+    }))
+}
+
+/// Meshes `mask` through its outside pixel centres as two halves at once, cut at `cut`'s row
+/// (`centre_cut`), and joins them; `None` when the loops cannot be cut there, a half cannot
+/// be meshed through its centres, or the joined mesh exceeds the vertex budget (the caller
+/// then meshes the mask whole).
+fn mesh_centres_in_halves(
+    mask: &BitMask,
+    cut: &Cut,
+    pieces: usize,
+    options: &MeshOptions,
+) -> Result<Option<Meshed>, MeshError> {
+    let crack = trace_crack_loops(mask);
+    let whole = Topology {
+        holes: crack.iter().filter(|l| l.is_hole()).count(),
+        pieces,
+    };
+    let (loops, off_centre) = outside_centre_points(&crack);
+    check_budget(
+        loops.iter().map(|l| l.points.len()).sum::<usize>() as f64,
+        options,
+    )?;
+    let Some(parts) = cut_centre_loops(&loops, cut.y(), options.density) else {
+        return Ok(None);
+    };
+    let mesh_half = |half: &[KeptLoop]| {
+        let loops: Vec<Vec<DVec2>> = (half.iter())
+            .map(|l| thin_loop(&l.points, &l.keep, options.density))
+            .collect();
+        // As whole centre loops: boundary edges are not split (`mesh_whole`).
+        triangulate_checked(&loops, true, Topology::of_loops(&loops), options)
+    };
+    let [upper, lower] = &parts.halves;
+    let (upper, lower) = rayon::join(|| mesh_half(upper), || mesh_half(lower));
+    let ((upper, upper_complete), (lower, lower_complete)) = match (upper, lower) {
+        (Ok(upper), Ok(lower)) => (upper, lower),
+        (Err(MeshError::IntersectingBoundary { .. } | MeshError::Sanity(_)), _)
+        | (_, Err(MeshError::IntersectingBoundary { .. } | MeshError::Sanity(_))) => {
+            return Ok(None)
+        }
+        (Err(e), _) | (_, Err(e)) => return Err(e),
+    };
+    let mesh = merge(&parts.interface, &upper, &lower);
+    if cfg!(debug_assertions) {
+        mesh.sanity_check()?;
+    }
+    if mesh.piece_count as usize != whole.pieces
+        || mesh.hole_count() != whole.holes
+        || mesh.vertex_count() > options.max_vertices
+    {
+        return Ok(None);
+    }
+    Ok(Some(Meshed {
+        mesh,
+        complete: upper_complete && lower_complete,
+        deviation: 0.0,
+        simplified: false,
+        fell_back: false,
+        placement: BoundaryPlacement::OutsideCentres,
+        off_centre,
         cut_row: Some(cut.row),
     }))
 }
@@ -585,6 +665,133 @@ mod tests {
             prop_assert_eq!(halves.mesh.hole_count(), whole.mesh.hole_count());
             prop_assert_eq!(crate::mesh::uncovered_mask_pixels(&halves.mesh, &kept), 0);
         }
+    }
+
+    fn centres() -> MeshOptions {
+        MeshOptions {
+            boundary: BoundaryPlacement::OutsideCentres,
+            ..MeshOptions::default()
+        }
+    }
+
+    /// Checks a mask meshed through its outside centres as two halves at `row`: `None`
+    /// when the halves fell back; otherwise a sane mesh with the whole centre mesh's pieces
+    /// and holes, every mask pixel covered, and every boundary vertex a centre of the whole
+    /// mask's centre loops (no vertex of the cut left on the boundary).
+    fn check_centre_halves(mask: &BitMask, row: usize) -> Result<Option<()>, TestCaseError> {
+        let options = centres();
+        let mut warnings = Vec::new();
+        let (kept, _, _, pieces) = drop_small_pieces(mask, options.min_piece_area, &mut warnings);
+        if pieces == 0 {
+            return Ok(None);
+        }
+        let kept = kept.unwrap_or_else(|| mask.clone());
+        let whole = mesh_whole(&kept, pieces, &options, &mut warnings).unwrap();
+        let Some(halves) =
+            mesh_centres_in_halves(&kept, &Cut::at(&kept, row), pieces, &options).unwrap()
+        else {
+            return Ok(None);
+        };
+        prop_assert_eq!(halves.placement, BoundaryPlacement::OutsideCentres);
+        prop_assert_eq!(halves.mesh.sanity_check(), Ok(()));
+        prop_assert_eq!(halves.mesh.piece_count, whole.mesh.piece_count);
+        prop_assert_eq!(halves.mesh.hole_count(), whole.mesh.hole_count());
+        prop_assert_eq!(crate::mesh::uncovered_mask_pixels(&halves.mesh, &kept), 0);
+        // Off the cut, the boundary is the whole mask's centres; on it, only the crossings.
+        let (loops, _) = outside_centre_points(&trace_crack_loops(&kept));
+        let y = row as f64;
+        let crossings = cut_centre_loops(&loops, y, options.density).unwrap();
+        let mut on_loops: Vec<(u64, u64)> = (loops.iter().flat_map(|l| &l.points))
+            .map(|p| (p.x.to_bits(), p.y.to_bits()))
+            .collect();
+        on_loops.sort_unstable();
+        let mut on_cut = 0;
+        for v in halves.mesh.boundary_vertices() {
+            let p = halves.mesh.positions[v as usize];
+            on_cut += usize::from(p.y == y);
+            prop_assert!(
+                p.y == y
+                    || on_loops
+                        .binary_search(&(p.x.to_bits(), p.y.to_bits()))
+                        .is_ok(),
+                "boundary vertex {} is no outside centre (cut at {})",
+                p,
+                row
+            );
+        }
+        prop_assert_eq!(on_cut, 2 * crossings.interface.intervals.len());
+        Ok(Some(()))
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig {
+            cases: 64,
+            rng_seed: proptest::test_runner::RngSeed::Fixed(0x0ce1_70e5),
+            ..ProptestConfig::default()
+        })]
+        /// Discs unions and differences cut at any row: where the whole mask meshes through
+        /// its centres, so do the halves, and they join into the same topology.
+        #[test]
+        fn centre_halves_join_into_the_masks_topology(
+            (width, height) in (16usize..64, 16usize..64),
+            shapes in proptest::collection::vec(
+                (0.0f64..1.0, 0.0f64..1.0, 0.1f64..0.45, proptest::bool::weighted(0.7)),
+                1..6,
+            ),
+            row_share in 0.0f64..1.0,
+        ) {
+            let size = width.min(height) as f64;
+            let discs_px: Vec<_> = shapes
+                .iter()
+                .map(|&(x, y, r, add)| (x * width as f64, y * height as f64, r * size, add))
+                .collect();
+            let mask = discs(width, height, &discs_px);
+            let row = (1 + ((height - 1) as f64 * row_share) as usize).min(height - 1);
+            check_centre_halves(&mask, row)?;
+        }
+
+        /// Pixel noise cut at any row: the halves either join into the mask's topology
+        /// through the centres or fall back, never a broken mesh.
+        #[test]
+        fn noisy_masks_cut_through_their_centres_join_or_fall_back(
+            (width, height, bits) in (8usize..40, 4usize..40).prop_flat_map(|(w, h)| {
+                (Just(w), Just(h), proptest::collection::vec(any::<u8>(), w * h))
+            }),
+            density in 64u8..230,
+            row_share in 0.0f64..1.0,
+        ) {
+            let mask = BitMask::from_fn(width, height, |x, y| bits[y * width + x] < density);
+            let row = (1 + ((height - 1) as f64 * row_share) as usize).min(height - 1);
+            check_centre_halves(&mask, row)?;
+        }
+    }
+
+    /// Simple shapes cut across do go through the centres (the fallback is not what the
+    /// property tests above see).
+    #[test]
+    fn discs_rings_and_the_spiral_are_cut_through_their_centres() {
+        let ring = BitMask::from_fn(60, 60, |x, y| {
+            let d = ((x as f64 - 30.0).powi(2) + (y as f64 - 30.0).powi(2)).sqrt();
+            (10.0..25.0).contains(&d)
+        });
+        let disc = crate::mesh::synth::disc(50, 40, 15.0);
+        for (mask, row) in [(&ring, 30), (&ring, 12), (&disc, 20)] {
+            let checked = check_centre_halves(mask, row).unwrap_or_else(|e| panic!("{e}"));
+            assert_eq!(checked, Some(()), "row {row}");
+        }
+        let spiral = crate::mesh::synth::spiral(400, 400);
+        let options = centres();
+        let meshed = mesh_mask(&spiral, &options).unwrap();
+        assert_eq!(meshed.stats.boundary, BoundaryPlacement::OutsideCentres);
+        let row = meshed.stats.cut_row.expect("the spiral is cut");
+        let checked = check_centre_halves(&spiral, row).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(checked, Some(()));
+        let one_thread = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap();
+        let alone = one_thread.install(|| mesh_mask(&spiral, &options)).unwrap();
+        assert_eq!(alone.mesh, meshed.mesh);
     }
 
     /// A long one-pixel line has its crack edges on two lines; a cut between them would leave

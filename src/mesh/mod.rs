@@ -16,6 +16,7 @@
 //! `coverage`; the Laplacian export in `laplacian_mtx`; test/bench masks in [`synth`].
 
 mod bitmask;
+mod centre_cut;
 mod centre_loops;
 mod contour;
 mod coverage;

@@ -44,6 +44,15 @@ const MAX_INTERFACE_SHARE: usize = 8;
 /// shortest interface, is taken.
 const BALANCE_SLACK: f64 = 0.05;
 
+/// Where two halves meet: the cut line and which edges on it become interior once the
+/// halves are joined (for crack loops [`Cut`], for centre loops `CentreInterface`).
+pub(crate) trait Interface {
+    /// The cut's y coordinate.
+    fn y(&self) -> f64;
+    /// Whether the edge a–b lies on the interface (inside on both sides of the cut).
+    fn is_interface_edge(&self, a: DVec2, b: DVec2) -> bool;
+}
+
 /// Where a mask is cut: along the line y = `row`, between pixel rows `row − 1` and `row`.
 #[derive(Clone, Debug, PartialEq)]
 pub(crate) struct Cut {
@@ -123,11 +132,6 @@ impl Cut {
         }
     }
 
-    /// The cut's y coordinate.
-    pub fn y(&self) -> f64 {
-        self.row as f64
-    }
-
     /// The rows above the cut and the rows below it, each as a mask of its own.
     pub fn halves(&self, mask: &BitMask) -> [BitMask; 2] {
         [mask.rows(0..self.row), mask.rows(self.row..mask.height)]
@@ -189,75 +193,81 @@ impl Cut {
             (to + 1..from).rev().filter(flips).collect()
         }
     }
+}
 
-    /// Whether the edge a–b lies on the interface (its pixels above and below are inside).
+impl Interface for Cut {
+    fn y(&self) -> f64 {
+        self.row as f64
+    }
+
+    /// Its pixels above and below are inside.
     fn is_interface_edge(&self, a: DVec2, b: DVec2) -> bool {
         let y = self.y();
         a.y == y && b.y == y && self.is_interface_column(((a.x + b.x) / 2.0).floor() as i64)
     }
+}
 
-    /// The joined vertex positions (the upper half's, then the lower half's not on the cut
-    /// at an upper position) and each lower vertex's joined index.
-    fn join_vertices(&self, upper: &Mesh, lower: &Mesh) -> (Vec<DVec2>, Vec<u32>) {
-        let y = self.y();
-        let mut positions = upper.positions.clone();
-        let mut on_cut: HashMap<u64, u32> = (upper.positions.iter().enumerate())
-            .filter(|(_, p)| p.y == y)
-            .map(|(v, p)| (p.x.to_bits(), v as u32))
-            .collect();
-        let lower_index = (lower.positions.iter())
-            .map(|&p| {
-                let mut add = || {
-                    positions.push(p);
-                    positions.len() as u32 - 1
-                };
-                match p.y == y {
-                    true => *on_cut.entry(p.x.to_bits()).or_insert_with(add),
-                    false => add(),
-                }
-            })
-            .collect();
-        (positions, lower_index)
-    }
-
-    /// Joins the meshes of the halves above and below the cut: vertices on the cut at the
-    /// same position become one, interface edges that one half split are split in the other
-    /// half too, and the interface edges leave the boundary.
-    pub fn merge(&self, upper: &Mesh, lower: &Mesh) -> Mesh {
-        let y = self.y();
-        let (positions, lower_index) = self.join_vertices(upper, lower);
-        let upper_index: Vec<u32> = (0..upper.positions.len() as u32).collect();
-        let halves = [(upper, &upper_index), (lower, &lower_index)];
-        let interface = InterfaceVertices::of(self, &positions, &halves);
-        let mut triangles = Vec::with_capacity(upper.triangles.len() + lower.triangles.len());
-        let mut boundary = Vec::new();
-        for (half, index) in halves {
-            let split = interface.splits(self, &positions, half, index);
-            let on_cut = |v: &u32| positions[*v as usize].y == y;
-            for t in half.triangles.iter().map(|t| t.map(|v| index[v as usize])) {
-                // Only a triangle with an edge on the cut can have a split edge.
-                match !split.is_empty() && t.iter().filter(|v| on_cut(v)).count() >= 2 {
-                    true => push_split(t, &split, &mut triangles),
-                    false => triangles.push(t),
-                }
+/// The joined vertex positions (the upper half's, then the lower half's not on the cut
+/// at an upper position) and each lower vertex's joined index.
+fn join_vertices(interface: &impl Interface, upper: &Mesh, lower: &Mesh) -> (Vec<DVec2>, Vec<u32>) {
+    let y = interface.y();
+    let mut positions = upper.positions.clone();
+    let mut on_cut: HashMap<u64, u32> = (upper.positions.iter().enumerate())
+        .filter(|(_, p)| p.y == y)
+        .map(|(v, p)| (p.x.to_bits(), v as u32))
+        .collect();
+    let lower_index = (lower.positions.iter())
+        .map(|&p| {
+            let mut add = || {
+                positions.push(p);
+                positions.len() as u32 - 1
+            };
+            match p.y == y {
+                true => *on_cut.entry(p.x.to_bits()).or_insert_with(add),
+                false => add(),
             }
-            for (a, b) in loop_edges(half) {
-                let (a, b) = (index[a as usize], index[b as usize]);
-                if !self.is_interface_edge(positions[a as usize], positions[b as usize]) {
-                    boundary.push((a, b));
-                }
+        })
+        .collect();
+    (positions, lower_index)
+}
+
+/// Joins the meshes of the halves above and below the cut: vertices on the cut at the
+/// same position become one, interface edges that one half split are split in the other
+/// half too, and the interface edges leave the boundary.
+pub(crate) fn merge(interface: &impl Interface, upper: &Mesh, lower: &Mesh) -> Mesh {
+    let y = interface.y();
+    let (positions, lower_index) = join_vertices(interface, upper, lower);
+    let upper_index: Vec<u32> = (0..upper.positions.len() as u32).collect();
+    let halves = [(upper, &upper_index), (lower, &lower_index)];
+    let vertices = InterfaceVertices::of(interface, &positions, &halves);
+    let mut triangles = Vec::with_capacity(upper.triangles.len() + lower.triangles.len());
+    let mut boundary = Vec::new();
+    for (half, index) in halves {
+        let split = vertices.splits(interface, &positions, half, index);
+        let on_cut = |v: &u32| positions[*v as usize].y == y;
+        for t in half.triangles.iter().map(|t| t.map(|v| index[v as usize])) {
+            // Only a triangle with an edge on the cut can have a split edge.
+            match !split.is_empty() && t.iter().filter(|v| on_cut(v)).count() >= 2 {
+                true => push_split(t, &split, &mut triangles),
+                false => triangles.push(t),
             }
         }
-        let boundary = sorted_edges(&boundary, positions.len());
-        assemble_mesh_with_boundary(positions, triangles, boundary)
+        for (a, b) in loop_edges(half) {
+            let (a, b) = (index[a as usize], index[b as usize]);
+            if !interface.is_interface_edge(positions[a as usize], positions[b as usize]) {
+                boundary.push((a, b));
+            }
+        }
     }
+    let boundary = sorted_edges(&boundary, positions.len());
+    assemble_mesh_with_boundary(positions, triangles, boundary)
 }
 
 /// Every joined vertex at an end of an interface edge of either half, by x.
 struct InterfaceVertices(Vec<(f64, u32)>);
 
 impl InterfaceVertices {
-    fn of(cut: &Cut, positions: &[DVec2], halves: &[(&Mesh, &Vec<u32>); 2]) -> Self {
+    fn of(cut: &impl Interface, positions: &[DVec2], halves: &[(&Mesh, &Vec<u32>); 2]) -> Self {
         let mut vertices = Vec::new();
         for (half, index) in halves {
             for (a, b) in loop_edges(half) {
@@ -277,7 +287,7 @@ impl InterfaceVertices {
     /// strictly between its ends: those vertices, from a to b.
     fn splits(
         &self,
-        cut: &Cut,
+        cut: &impl Interface,
         positions: &[DVec2],
         half: &Mesh,
         index: &[u32],
