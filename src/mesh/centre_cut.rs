@@ -104,20 +104,17 @@ fn chains_of(lp: &KeptLoop, y: f64, crossings: &mut Vec<f64>, chains: &mut Vec<C
         let (from, to) = (crossing_edges[k], crossing_edges[(k + 1) % m]);
         let (start, end) = (first + k, first + (k + 1) % m);
         let mut chain = KeptLoop::default();
-        chain.points.push(DVec2::new(crossings[start], y));
-        chain.keep.push(true);
+        chain.push(DVec2::new(crossings[start], y), true);
         // The crossing edges are distinct (a closed loop crosses an even number of times).
         let mut v = from;
         loop {
             v = (v + 1) % n;
-            chain.points.push(points[v]);
-            chain.keep.push(lp.keep[v]);
+            chain.extend_from(lp, v..v + 1);
             if v == to {
                 break;
             }
         }
-        chain.points.push(DVec2::new(crossings[end], y));
-        chain.keep.push(true);
+        chain.push(DVec2::new(crossings[end], y), true);
         let below = points[(from + 1) % n].y > y;
         chains.push(Chain {
             below,
@@ -172,13 +169,11 @@ fn join_chains(
         while !used[chain] {
             used[chain] = true;
             let c = &chains[chain];
-            out.points.extend(&c.points.points);
-            out.keep.extend(&c.points.keep);
+            out.extend_from(&c.points, 0..c.points.points.len());
             let next_start = partner[c.end];
             let (from, to) = (crossings[c.end], crossings[next_start]);
             for x in interval_points(from, to, density) {
-                out.points.push(DVec2::new(x, y));
-                out.keep.push(true);
+                out.push(DVec2::new(x, y), true);
             }
             chain = *starting_at.get(next_start).filter(|&&i| i != usize::MAX)?;
         }

@@ -246,7 +246,7 @@ fn mesh_centres_in_halves(
     };
     let mesh_half = |half: &[KeptLoop]| {
         let loops: Vec<Vec<DVec2>> = (half.iter())
-            .map(|l| thin_loop(&l.points, &l.keep, options.density))
+            .map(|l| thin_loop(l, options.density))
             .collect();
         // As whole centre loops: boundary edges are not split (`mesh_whole`).
         triangulate_checked(&loops, true, Topology::of_loops(&loops), options)
@@ -617,7 +617,7 @@ mod tests {
                 .map(|&(x, y, r, add)| (x * width as f64, y * height as f64, r * size, add))
                 .collect();
             let mask = discs(width, height, &discs_px);
-            let options = MeshOptions::default();
+            let options = cracks();
             let mut warnings = Vec::new();
             let (kept, _, _, pieces) = drop_small_pieces(&mask, options.min_piece_area, &mut warnings);
             prop_assume!(pieces > 0);
@@ -651,7 +651,7 @@ mod tests {
             row_share in 0.0f64..1.0,
         ) {
             let mask = BitMask::from_fn(width, height, |x, y| bits[y * width + x] < density);
-            let options = MeshOptions::default();
+            let options = cracks();
             let mut warnings = Vec::new();
             let (kept, _, _, pieces) = drop_small_pieces(&mask, options.min_piece_area, &mut warnings);
             prop_assume!(pieces > 0);
@@ -664,6 +664,13 @@ mod tests {
             prop_assert_eq!(halves.mesh.piece_count, whole.mesh.piece_count);
             prop_assert_eq!(halves.mesh.hole_count(), whole.mesh.hole_count());
             prop_assert_eq!(crate::mesh::uncovered_mask_pixels(&halves.mesh, &kept), 0);
+        }
+    }
+
+    fn cracks() -> MeshOptions {
+        MeshOptions {
+            boundary: BoundaryPlacement::Cracks,
+            ..MeshOptions::default()
         }
     }
 
@@ -819,7 +826,10 @@ mod tests {
     #[test]
     fn a_large_mask_is_meshed_in_halves_the_same_on_any_thread_count() {
         let mask = crate::mesh::synth::spiral(400, 400);
-        let options = MeshOptions::default();
+        let options = MeshOptions {
+            boundary: BoundaryPlacement::Cracks,
+            ..MeshOptions::default()
+        };
         let by_row = crack_edges_by_row(&mask);
         let cut = Cut::choose(&mask, &by_row, options.max_vertices).unwrap();
         let joined = mesh_in_halves(&mask, &cut, 1, &options).unwrap().unwrap();
@@ -917,9 +927,11 @@ mod tests {
         let disc = BitMask::from_fn(64, 64, |x, y| {
             (x as i64 - 32).pow(2) + (y as i64 - 32).pow(2) < 600
         });
+        // The crack boundary is subdivided to `density` (centre loops stop at every centre).
         let options = MeshOptions {
             max_vertices: 200,
             density: 0.05,
+            boundary: BoundaryPlacement::Cracks,
             ..MeshOptions::default()
         };
         let error = mesh_mask(&disc, &options).unwrap_err();
