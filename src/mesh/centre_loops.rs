@@ -28,6 +28,12 @@ struct Edge {
     pixel: (i64, i64),
 }
 
+/// Whether loops thinned to `spacing` keep every centre (the longest step between
+/// neighbouring centres is √2 px).
+pub(crate) fn keeps_every_centre(spacing: f64) -> bool {
+    spacing <= std::f64::consts::SQRT_2 + 1e-9
+}
+
 /// Largest distance of a dropped centre from the chord that replaces it, px.
 const THIN_TOLERANCE: f64 = 0.5;
 
@@ -41,7 +47,7 @@ const THIN_TOLERANCE: f64 = 0.5;
 pub(crate) fn thin_loop(lp: &KeptLoop, spacing: f64) -> Vec<DVec2> {
     let (points, keep) = (&lp.points, &lp.keep);
     let n = points.len();
-    if spacing <= std::f64::consts::SQRT_2 + 1e-9 || n <= 3 {
+    if keeps_every_centre(spacing) || n <= 3 {
         return points.to_vec();
     }
     let mut out = vec![points[0]];

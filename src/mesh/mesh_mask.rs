@@ -12,7 +12,9 @@ use glam::DVec2;
 
 use super::bitmask::crack_edges_by_row;
 use super::centre_cut::cut_centre_loops;
-use super::centre_loops::{outside_centre_loops, outside_centre_points, thin_loop, KeptLoop};
+use super::centre_loops::{
+    keeps_every_centre, outside_centre_loops, outside_centre_points, thin_loop, KeptLoop,
+};
 use super::contour::{label_pieces, piece_sizes, trace_crack_loops, CrackLoop};
 use super::options::{min_angle_deg, BoundaryPlacement};
 use super::simplify::{
@@ -55,6 +57,10 @@ pub fn mesh_mask(mask: &BitMask, options: &MeshOptions) -> Result<MeshResult, Me
     let split = Cut::choose(kept_mask, &edges_by_row, options.max_vertices)
         .map(|cut| match options.boundary {
             BoundaryPlacement::Cracks => mesh_in_halves(kept_mask, &cut, pieces, options),
+            // Every centre kept is the accuracy preset's boundary: the cut's interface, a
+            // line of vertices refinement may not split, cost it 1.3 dB (combinatorial, on
+            // the spiral model), so such meshes are made whole (docs/quality.md).
+            BoundaryPlacement::OutsideCentres if keeps_every_centre(options.density) => Ok(None),
             BoundaryPlacement::OutsideCentres => {
                 mesh_centres_in_halves(kept_mask, &cut, pieces, options)
             }
@@ -799,6 +805,10 @@ mod tests {
             .unwrap();
         let alone = one_thread.install(|| mesh_mask(&spiral, &options)).unwrap();
         assert_eq!(alone.mesh, meshed.mesh);
+        // Every centre kept (the seam-quality preset): made whole, as it always was.
+        let preset = mesh_mask(&spiral, &MeshOptions::seam_quality()).unwrap();
+        assert_eq!(preset.stats.boundary, BoundaryPlacement::OutsideCentres);
+        assert_eq!(preset.stats.cut_row, None);
     }
 
     /// A long one-pixel line has its crack edges on two lines; a cut between them would leave

@@ -78,8 +78,9 @@ pub const MIN_MAX_AREA: f64 = 0.25;
 
 impl Default for MeshOptions {
     /// - `density` 3 px: on the spiral, PSNR against the pixel-grid clone saturates with
-    ///   boundary density (`lapclone bench paper --sweep`, docs/quality.md: combinatorial /
-    ///   cotangent 36.0 / 39.2 dB at 3 px, 37.1 / 41.2 at 2, 38.6 / 42.5 at 1), while
+    ///   boundary density (`lapclone bench paper --sweep`, docs/quality.md; outside centres,
+    ///   combinatorial / cotangent: 39.3 / 43.3 dB at 4 px, 38.6 / 43.8 at 3, 41.6 / 48.6
+    ///   at 2, 42.0 / 49.5 at 1 with 2 × the vertices of 3 px), while
     ///   vertices, meshing, factor and re-clone time grow as 1/density. Since large masks
     ///   are meshed as two halves at once, the 770×743 spiral meshes in 6–7 ms at 3 px and
     ///   9 ms at 2 px (its 20 ms budget no longer decides); 3 px keeps the first clone and
@@ -96,8 +97,8 @@ impl Default for MeshOptions {
     /// - `boundary` outside centres: every boundary vertex samples exactly one of the pixels
     ///   where the pixel-grid clone fixes its values, instead of the crack's bilinear mix of
     ///   inside and outside pixels. At 3 px, against the crack boundary with the same angle
-    ///   and relaxation, it gives PSNR +0.8 / +2.2 dB on the spiral (combinatorial /
-    ///   cotangent) and +2.2 to +2.9 dB cotangent on every Table I model, with about 2 % fewer
+    ///   and relaxation, it gives PSNR +0.6 / +2.2 dB on the spiral (combinatorial /
+    ///   cotangent) and +1.8 to +2.9 dB cotangent on every Table I model, with about as many
     ///   vertices; the first clone costs about 0.2 ms more on the 400² spiral
     ///   (docs/quality.md).
     fn default() -> Self {
