@@ -73,6 +73,7 @@ fn edits_list_and_write_the_preview() {
     );
     assert!(stdout.contains("patch \"blob\""), "{stdout}");
     assert!(stdout.contains("boundary data hat-average"), "{stdout}");
+    assert!(stdout.contains("boundary outside-centres"), "{stdout}");
     assert!(stdout.contains("keys: position 2, scale 0"), "{stdout}");
     assert!(stdout.contains("variables: blob"), "{stdout}");
     assert!(stdout.lines().any(|l| l == "42"), "{stdout}");

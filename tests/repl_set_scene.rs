@@ -7,7 +7,8 @@ use std::path::Path;
 use glam::DVec2;
 use lapclone::render::{Renderer, SceneUpdate};
 use lapclone::scene::{
-    Background, BoundaryData, Canvas, Easing, Handle, Patch, Polygon, Scene, Shape, Track,
+    Background, BoundaryData, BoundaryPlacement, Canvas, Easing, Handle, Patch, Polygon, Scene,
+    Shape, Track,
 };
 
 fn patch(name: &str, corner: DVec2) -> Patch {
@@ -90,6 +91,15 @@ fn changed_mesh_settings_rebuild_only_that_patch() {
 fn a_changed_boundary_data_rebuilds_that_patch() {
     let mut edited = scene();
     edited.patches[0].boundary_data = BoundaryData::Vertex;
+    let (update, same) = switch_and_compare(scene(), edited, 1);
+    assert_eq!((update.reused, update.rebuilt, update.dropped), (1, 1, 1));
+    assert!(same, "the rebuilt layer must render like a fresh one");
+}
+
+#[test]
+fn a_changed_boundary_rebuilds_that_patch() {
+    let mut edited = scene();
+    edited.patches[0].boundary = BoundaryPlacement::Cracks;
     let (update, same) = switch_and_compare(scene(), edited, 1);
     assert_eq!((update.reused, update.rebuilt, update.dropped), (1, 1, 1));
     assert!(same, "the rebuilt layer must render like a fresh one");

@@ -5,7 +5,9 @@ use std::path::PathBuf;
 use std::sync::atomic::Ordering;
 
 use glam::DVec2;
-use lapclone::scene::{Background, BoundaryData, CloneMode, Easing, LaplacianKind, Scene, Shape};
+use lapclone::scene::{
+    Background, BoundaryData, BoundaryPlacement, CloneMode, Easing, LaplacianKind, Scene, Shape,
+};
 use lapclone::script::{parse_scene, ErrorKind, Limits, SceneError, ScriptOptions};
 
 fn root() -> PathBuf {
@@ -259,6 +261,23 @@ fn bad_inputs_are_positioned() {
     assert_error_at(
         "canvas(64, 48);\nlet p = patch(\"p\", #{ source: \"assets/astronaut.png\", mask: \"assets/horse_mask.png\", boundary_data: \"pointy\" });",
         2, 9, "unknown boundary data \"pointy\"",
+    );
+    assert_error_at(
+        "canvas(64, 48);\nlet p = patch(\"p\", #{ source: \"assets/astronaut.png\", mask: \"assets/horse_mask.png\", boundary: \"edges\" });",
+        2, 9, "unknown boundary placement \"edges\"",
+    );
+}
+
+#[test]
+fn the_boundary_defaults_to_the_outside_centres_and_can_be_the_cracks() {
+    assert_eq!(
+        parse(HEAD).unwrap().patches[0].boundary,
+        BoundaryPlacement::OutsideCentres
+    );
+    let text = HEAD.replace("horse_mask.png\"", "horse_mask.png\", boundary: \"cracks\"");
+    assert_eq!(
+        parse(&text).unwrap().patches[0].boundary,
+        BoundaryPlacement::Cracks
     );
 }
 

@@ -5,8 +5,8 @@ use std::path::PathBuf;
 
 use glam::DVec2;
 use lapclone::scene::{
-    Background, BoundaryData, Canvas, CloneMode, Easing, Handle, LaplacianKind, Patch, Pin,
-    Placement, Polygon, Scene, Shape, Track,
+    Background, BoundaryData, BoundaryPlacement, Canvas, CloneMode, Easing, Handle, LaplacianKind,
+    Patch, Pin, Placement, Polygon, Scene, Shape, Track,
 };
 use lapclone::script::{parse_scene, Limits, ScriptOptions};
 use proptest::prelude::*;
@@ -114,7 +114,7 @@ fn patch(index: usize) -> impl Strategy<Value = Patch> {
         any::<bool>(),
         any::<bool>(),
         prop_oneof![Just(0.0), positive()],
-        any::<bool>(),
+        (any::<bool>(), any::<bool>()),
         (
             track(point()),
             track(positive()),
@@ -132,7 +132,7 @@ fn patch(index: usize) -> impl Strategy<Value = Patch> {
                 cot,
                 mono,
                 feather,
-                vertex_data,
+                (vertex_data, cracks),
                 tracks,
                 handles,
                 pins,
@@ -156,6 +156,11 @@ fn patch(index: usize) -> impl Strategy<Value = Patch> {
                     BoundaryData::Vertex
                 } else {
                     BoundaryData::HatAverage
+                },
+                boundary: if cracks {
+                    BoundaryPlacement::Cracks
+                } else {
+                    BoundaryPlacement::OutsideCentres
                 },
                 placement: Placement {
                     position: tracks.0,

@@ -54,6 +54,16 @@ pub enum BoundaryPlacement {
     OutsideCentres,
 }
 
+impl BoundaryPlacement {
+    /// The name [`FromStr`](std::str::FromStr) reads: `cracks` or `outside-centres`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Cracks => "cracks",
+            Self::OutsideCentres => "outside-centres",
+        }
+    }
+}
+
 impl std::str::FromStr for BoundaryPlacement {
     type Err = String;
 

@@ -11,7 +11,9 @@ use crate::clone::{
 use crate::deform::{DeformRig, DeformStats, Deformed, Handle, Pin};
 use crate::mesh::{BitMask, Mesh, MeshOptions};
 use crate::pixels::{Canvas, FloatImage};
-use crate::scene::{BoundaryData, CloneMode, LaplacianKind, Patch, PatchState, Shape};
+use crate::scene::{
+    BoundaryData, BoundaryPlacement, CloneMode, LaplacianKind, Patch, PatchState, Shape,
+};
 
 /// Mask pixels at or above this luminance (or alpha) are inside.
 const MASK_THRESHOLD: f32 = 0.5;
@@ -27,6 +29,7 @@ pub(super) struct LayerSettings {
     mode: CloneMode,
     feather: f64,
     boundary_data: BoundaryData,
+    boundary: BoundaryPlacement,
 }
 
 impl LayerSettings {
@@ -39,6 +42,7 @@ impl LayerSettings {
             mode: patch.mode,
             feather: patch.feather,
             boundary_data: patch.boundary_data,
+            boundary: patch.boundary,
         }
     }
 }
@@ -70,7 +74,10 @@ impl Layer {
             patch: patch.name.clone(),
             source,
         };
-        let mut mesh_options = MeshOptions::default();
+        let mut mesh_options = MeshOptions {
+            boundary: patch.boundary,
+            ..MeshOptions::default()
+        };
         if let Some(density) = patch.density {
             mesh_options.density = density;
         }

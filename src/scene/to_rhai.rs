@@ -62,6 +62,7 @@ fn write_patch(out: &mut String, patch: &Patch, var: &str) {
     options.push(format!("mode: \"{}\"", patch.mode.name()));
     options.push(format!("feather: {}", num(patch.feather)));
     options.push(format!("boundary_data: \"{}\"", patch.boundary_data.name()));
+    options.push(format!("boundary: \"{}\"", patch.boundary.name()));
     let _ = writeln!(
         out,
         "let {var} = patch({}, #{{ {} }});",

@@ -52,6 +52,7 @@ pub enum Shape {
 }
 
 pub use crate::clone::{BoundaryData, CloneMode};
+pub use crate::mesh::BoundaryPlacement;
 pub use crate::solve::LaplacianKind;
 
 /// Where a patch sits in the canvas over time. Empty tracks take their defaults:
@@ -113,6 +114,8 @@ pub struct Patch {
     pub feather: f64,
     /// How the membrane's boundary values are sampled.
     pub boundary_data: BoundaryData,
+    /// Where a mask patch's mesh boundary runs (polygon patches ignore it).
+    pub boundary: BoundaryPlacement,
     pub placement: Placement,
     pub handles: Vec<Handle>,
     pub pins: Vec<Pin>,
@@ -130,6 +133,7 @@ impl Patch {
             mode: CloneMode::default(),
             feather: 0.0,
             boundary_data: BoundaryData::default(),
+            boundary: BoundaryPlacement::default(),
             placement: Placement::default(),
             handles: Vec::new(),
             pins: Vec::new(),

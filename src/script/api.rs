@@ -153,7 +153,7 @@ fn parse_canvas(
     Ok(canvas)
 }
 
-const PATCH_OPTIONS: [&str; 8] = [
+const PATCH_OPTIONS: [&str; 9] = [
     "source",
     "mask",
     "polygons",
@@ -162,6 +162,7 @@ const PATCH_OPTIONS: [&str; 8] = [
     "mode",
     "feather",
     "boundary_data",
+    "boundary",
 ];
 
 fn new_patch(
@@ -228,6 +229,9 @@ fn parse_patch(base_dir: &Path, name: &Dynamic, options: &Dynamic) -> Result<Pat
     }
     if let Some(v) = options.get("boundary_data") {
         patch.boundary_data = values::string(v, "boundary_data")?.parse()?;
+    }
+    if let Some(v) = options.get("boundary") {
+        patch.boundary = values::string(v, "boundary")?.parse()?;
     }
     Ok(patch)
 }

@@ -496,13 +496,15 @@ impl Session {
                 Shape::Polygons(p) => format!("{} polygon(s)", p.len()),
             };
             out.push_str(&format!(
-                "patch \"{}\": source {}, {shape}, {:?}, {:?}, feather {}, boundary data {}\n",
+                "patch \"{}\": source {}, {shape}, {:?}, {:?}, feather {}, boundary data {}, \
+                 boundary {}\n",
                 patch.name,
                 short(&patch.source),
                 patch.laplacian,
                 patch.mode,
                 patch.feather,
-                patch.boundary_data.name()
+                patch.boundary_data.name(),
+                patch.boundary.name()
             ));
             let p = &patch.placement;
             out.push_str(&format!(
