@@ -10,8 +10,9 @@ pub struct MeshQualityArgs {
     /// the other flags still override it.
     #[arg(long)]
     pub seam_quality: bool,
-    /// Where a mask mesh's boundary runs: `cracks` (simplified, moved half a pixel out) or
-    /// `outside-centres` (exactly the pixel-grid clone's Dirichlet pixel centres).
+    /// Where a mask mesh's boundary runs: `outside-centres` (the default: through the
+    /// pixel-grid clone's Dirichlet pixel centres, thinned to the density where straight) or
+    /// `cracks` (simplified, then moved half a pixel out).
     #[arg(long)]
     pub boundary: Option<BoundaryPlacement>,
     /// Minimum triangle angle of the refinement, degrees (0–35).
