@@ -124,9 +124,9 @@ pub fn run(args: MeshBenchArgs) -> anyhow::Result<()> {
 
 fn print_table(rows: &[Row], options: &MeshOptions) {
     println!(
-        "mesh bench (density {} px, tolerance {} px, min angle {}°){}",
+        "mesh bench (boundary {}, density {} px, min angle {}°){}",
+        options.boundary.name(),
         options.density,
-        options.simplify_tolerance,
         options.min_angle_deg,
         if cfg!(debug_assertions) {
             "  [DEBUG BUILD: timings meaningless]"
