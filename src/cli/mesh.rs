@@ -78,6 +78,8 @@ pub fn run(args: MeshArgs) -> anyhow::Result<()> {
             "min_angle_deg": stats.min_angle_deg,
             "uncovered_mask_pixels": mesh::uncovered_mask_pixels(&result.mesh, &mask),
             "max_boundary_deviation_px": stats.max_boundary_deviation_px,
+            "boundary": stats.boundary.name(),
+            "cut_row": stats.cut_row,
             "mesh_ms": mesh_ms,
         });
         println!("{json}");
@@ -87,8 +89,8 @@ pub fn run(args: MeshArgs) -> anyhow::Result<()> {
             None => String::new(),
         };
         println!(
-            "{} vertices, {} triangles, {} boundary vertices, {} piece(s), {} hole(s), min angle {:.1}°, {:.2} ms{halves}",
-            stats.vertices, stats.triangles, stats.boundary_vertices, stats.pieces, stats.holes, stats.min_angle_deg, mesh_ms
+            "{} vertices, {} triangles, {} boundary vertices ({}), {} piece(s), {} hole(s), min angle {:.1}°, {:.2} ms{halves}",
+            stats.vertices, stats.triangles, stats.boundary_vertices, stats.boundary.name(), stats.pieces, stats.holes, stats.min_angle_deg, mesh_ms
         );
     }
     Ok(())
