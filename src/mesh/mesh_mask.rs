@@ -243,10 +243,12 @@ fn mesh_centres_in_halves(
         pieces,
     };
     let (loops, off_centre) = outside_centre_points(&crack);
-    check_budget(
-        loops.iter().map(|l| l.points.len()).sum::<usize>() as f64,
-        options,
-    )?;
+    // A cut mask's budget is at least 8 × its crack edges (`Cut::choose`), and it has at most
+    // one centre point per crack edge; the whole-mask path checks its own budget.
+    let points: usize = loops.iter().map(|l| l.points.len()).sum();
+    if points > options.max_vertices {
+        return Ok(None);
+    }
     let Some(parts) = cut_centre_loops(&loops, cut.y(), options.density) else {
         return Ok(None);
     };
