@@ -61,6 +61,7 @@ fn quick_json_has_the_documented_keys() {
         assert!(json.get(key).is_some(), "missing {key}");
     }
     assert_eq!(json["boundary_data"], "hat-average");
+    assert_eq!(json["boundary"], "outside-centres");
     let model = &json["models"][0];
     for key in [
         "model",

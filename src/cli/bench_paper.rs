@@ -175,6 +175,7 @@ struct SweepRow {
 #[derive(serde::Serialize)]
 struct Report {
     density: f64,
+    boundary: &'static str,
     boundary_data: &'static str,
     repeats: usize,
     models: Vec<ModelJson>,
@@ -236,6 +237,7 @@ pub fn run(args: PaperBenchArgs) -> anyhow::Result<()> {
     };
     let report = Report {
         density: mesh_options.density,
+        boundary: mesh_options.boundary.name(),
         boundary_data: args.boundary_data.name(),
         repeats: run_options.repeats,
         models,
@@ -396,9 +398,9 @@ fn table_text(report: &Report) -> String {
     let mut out = String::new();
     let _ = writeln!(
         out,
-        "Table I (density {} px, {} boundary data, best of {}; times in ms; PSNR in dB against \
-         the pixel-grid reference)",
-        report.density, report.boundary_data, report.repeats
+        "Table I ({} boundary, density {} px, {} boundary data, best of {}; times in ms; PSNR \
+         in dB against the pixel-grid reference)",
+        report.boundary, report.density, report.boundary_data, report.repeats
     );
     let _ = writeln!(
         out,
