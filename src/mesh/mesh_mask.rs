@@ -1,12 +1,12 @@
 //! The meshing pipeline: [`mesh_mask`] takes a [`BitMask`], [`mesh_polygons`] takes
 //! [`Polygon`]s; both give a [`MeshResult`]. Mask path: drop small pieces → crack loops →
-//! Douglas–Peucker (anchored at saddle corners) → subdivide to `density` → CDT + refinement;
-//! masks with a long boundary go through it as two halves at once, joined afterwards
-//! (`split`).
-//! If simplification makes two loops touch or cross (a thin gap closed by the tolerance), the
-//! mask is meshed again from the raw crack loops, which never cross. With
-//! [`BoundaryPlacement::OutsideCentres`] the loops run through the outside pixel centres
-//! instead (`centre_loops`); if those cannot be meshed, the crack path is taken.
+//! loops through the outside pixel centres, thinned to `density` (the default,
+//! [`BoundaryPlacement::OutsideCentres`]; boundary edges never split) → CDT + refinement; if
+//! those loops cannot be meshed, the crack path is taken: Douglas–Peucker (anchored at saddle
+//! corners) → subdivide to `density` → CDT + refinement, and if simplification makes two loops
+//! touch or cross (a thin gap closed by the tolerance), the raw crack loops, which never
+//! cross. Masks with a long boundary go through either path as two halves at once, joined
+//! afterwards (`split`, `centre_cut`), except centre loops that keep every centre.
 
 use glam::DVec2;
 

@@ -7,12 +7,13 @@
 //! crack boundary runs along integer coordinates.
 //!
 //! Pipeline ([`mesh_mask`](fn@mesh_mask)): [`BitMask`] → small pieces dropped → crack loops
-//! (`contour`) → Douglas–Peucker + subdivision to `density` (`simplify`) → spade CDT + refinement
+//! (`contour`) → loops through the outside pixel centres, thinned to `density` (`centre_loops`,
+//! the default [`BoundaryPlacement::OutsideCentres`]) or, with [`BoundaryPlacement::Cracks`],
+//! Douglas–Peucker + subdivision to `density` (`simplify`) → spade CDT + refinement
 //! (`triangulate`) → [`Mesh`], verified by [`Mesh::sanity_check`]. Large masks are cut along a
-//! pixel row and the two halves meshed at once, then joined (`split`). With
-//! [`BoundaryPlacement::OutsideCentres`] the loops run through the outside pixel centres
-//! instead (`centre_loops`); [`relax_interior`] evens out the interior for the combinatorial
-//! Laplacian (the clone stage applies it). Mask-aware checks are in
+//! pixel row and the two halves meshed at once, then joined (`split`; centre loops are cut
+//! geometrically by `centre_cut`). [`relax_interior`] evens out the interior for the
+//! combinatorial Laplacian (the clone stage applies it). Mask-aware checks are in
 //! `coverage`; the Laplacian export in `laplacian_mtx`; test/bench masks in [`synth`].
 
 mod bitmask;
