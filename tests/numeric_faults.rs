@@ -17,20 +17,9 @@ use lapclone::render::Renderer;
 use lapclone::script::{parse_scene, ScriptOptions};
 use lapclone::solve::{FactorMethod, LaplacianKind, PenaltyOptions};
 
-/// Deterministic pseudo-random numbers in [0, 1) (SplitMix64).
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn range(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.next()
-    }
-}
+#[path = "common/solve_checks.rs"]
+mod checks;
+use checks::Rng;
 
 /// Two discs and a bar: three pieces, one with a hole.
 fn three_piece_mesh() -> Mesh {

@@ -5,53 +5,9 @@ use lapclone::solve::{
     fixtures, laplacian, LaplacianKind, PenaltyFactor, PenaltyOptions, SchedulePolicy, SymmetricCsc,
 };
 
-/// Dense Cholesky solve of a small SPD system (reference).
-#[allow(clippy::needless_range_loop)] // index loops mirror the textbook algorithm
-fn dense_solve(a: &[Vec<f64>], b: &[f64]) -> Vec<f64> {
-    let n = b.len();
-    let mut l = vec![vec![0.0; n]; n];
-    for j in 0..n {
-        let mut d = a[j][j];
-        for k in 0..j {
-            d -= l[j][k] * l[j][k];
-        }
-        assert!(d > 0.0, "reference matrix not SPD");
-        l[j][j] = d.sqrt();
-        for i in j + 1..n {
-            let mut s = a[i][j];
-            for k in 0..j {
-                s -= l[i][k] * l[j][k];
-            }
-            l[i][j] = s / l[j][j];
-        }
-    }
-    let mut y = b.to_vec();
-    for i in 0..n {
-        for k in 0..i {
-            y[i] -= l[i][k] * y[k];
-        }
-        y[i] /= l[i][i];
-    }
-    for i in (0..n).rev() {
-        for k in i + 1..n {
-            y[i] -= l[k][i] * y[k];
-        }
-        y[i] /= l[i][i];
-    }
-    y
-}
-
-/// Deterministic pseudo-random numbers in [0, 1) (SplitMix64).
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
+#[path = "common/solve_checks.rs"]
+mod checks;
+use checks::{dense_solve, rel_diff, Rng};
 
 /// The penalised matrix `L + P + εI` as a dense matrix.
 fn penalised_dense(l: &SymmetricCsc, f: &PenaltyFactor) -> Vec<Vec<f64>> {
@@ -60,22 +16,6 @@ fn penalised_dense(l: &SymmetricCsc, f: &PenaltyFactor) -> Vec<Vec<f64>> {
         row[v] += f.epsilon() + if f.is_constrained(v) { f.alpha() } else { 0.0 };
     }
     a
-}
-
-fn rel_diff(a: &[f64], b: &[f64]) -> f64 {
-    let num: f64 = a
-        .iter()
-        .zip(b)
-        .map(|(x, y)| (x - y) * (x - y))
-        .sum::<f64>()
-        .sqrt();
-    let den: f64 = b
-        .iter()
-        .map(|y| y * y)
-        .sum::<f64>()
-        .sqrt()
-        .max(f64::MIN_POSITIVE);
-    num / den
 }
 
 fn check_against_dense(mesh: &Mesh, kind: LaplacianKind, seed: u64) {

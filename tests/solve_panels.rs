@@ -5,9 +5,7 @@
 
 use lapclone::mesh::Mesh;
 use lapclone::solve::solve::ldlt_solve_interleaved;
-use lapclone::solve::solve_supernodal::{
-    inverse_diagonal, lanes_for, ldlt_solve_supernodal_at, SimdLevel,
-};
+use lapclone::solve::solve_supernodal::{inverse_diagonal, lanes_for, ldlt_solve_supernodal_at};
 use lapclone::solve::symbolic::SymbolicFactor;
 use lapclone::solve::{
     fixtures, laplacian, FactorMethod, LaplacianKind, PenaltyFactor, PenaltyOptions,
@@ -15,34 +13,9 @@ use lapclone::solve::{
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed};
 
-const METHODS: [FactorMethod; 3] = [
-    FactorMethod::Simplicial,
-    FactorMethod::Supernodal,
-    FactorMethod::SupernodalRelaxed,
-];
-
-fn levels() -> Vec<SimdLevel> {
-    [SimdLevel::Portable, SimdLevel::Avx2Fma]
-        .into_iter()
-        .filter(|l| l.is_supported())
-        .collect()
-}
-
-fn rel_diff(a: &[f64], b: &[f64]) -> f64 {
-    let num: f64 = a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum();
-    let den: f64 = b.iter().map(|y| y * y).sum();
-    (num / den.max(f64::MIN_POSITIVE)).sqrt()
-}
-
-/// Meshes with many small supernodes, a few wide ones (a disc's top separators) and two
-/// pieces (two elimination trees).
-fn mesh(kind: u8, size: usize) -> Mesh {
-    match kind % 3 {
-        0 => fixtures::disc(size),
-        1 => fixtures::grid(size + 1, size / 2 + 1),
-        _ => fixtures::disjoint_union(&fixtures::disc(size / 2 + 1), &fixtures::grid(size, 3)),
-    }
-}
+#[path = "common/solve_checks.rs"]
+mod checks;
+use checks::{mixed_mesh as mesh, rel_diff, simd_levels as levels, METHODS};
 
 fn factor(mesh: &Mesh, method: FactorMethod, constrained_every: usize) -> PenaltyFactor {
     let l = laplacian(mesh, LaplacianKind::Cotangent);

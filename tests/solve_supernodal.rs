@@ -3,32 +3,15 @@
 //! reconstruction and fresh factorisations after switching.
 
 use lapclone::solve::symbolic::{SymbolicFactor, SUPERNODAL_MIN_VERTICES};
+
+#[path = "common/solve_checks.rs"]
+mod checks;
+use checks::{dense_solve, rel_diff, Rng};
 use lapclone::solve::{
     fixtures, laplacian, FactorMethod, LaplacianKind, PenaltyFactor, PenaltyOptions, SymmetricCsc,
 };
 
 const SUPERNODAL: [FactorMethod; 2] = [FactorMethod::Supernodal, FactorMethod::SupernodalRelaxed];
-
-/// Deterministic pseudo-random numbers in [0, 1) (SplitMix64).
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() * n as f64) as usize
-    }
-}
-
-fn rel_diff(a: &[f64], b: &[f64]) -> f64 {
-    let num: f64 = a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum::<f64>();
-    let den: f64 = b.iter().map(|y| y * y).sum::<f64>();
-    (num / den.max(f64::MIN_POSITIVE)).sqrt()
-}
 
 fn options(method: FactorMethod) -> PenaltyOptions {
     PenaltyOptions {
@@ -49,29 +32,6 @@ fn solve(f: &mut PenaltyFactor, b: &[f64], k: usize) -> Vec<f64> {
     let mut x = b.to_vec();
     f.solve_in_place(&mut x, k);
     x
-}
-
-/// Dense Cholesky solve of a small SPD system (reference).
-fn dense_solve(a: &[Vec<f64>], b: &[f64]) -> Vec<f64> {
-    let n = b.len();
-    let mut l = vec![vec![0.0; n]; n];
-    for j in 0..n {
-        let d = a[j][j] - (0..j).map(|k| l[j][k] * l[j][k]).sum::<f64>();
-        assert!(d > 0.0, "reference matrix not SPD");
-        l[j][j] = d.sqrt();
-        for i in j + 1..n {
-            let s = a[i][j] - (0..j).map(|k| l[i][k] * l[j][k]).sum::<f64>();
-            l[i][j] = s / l[j][j];
-        }
-    }
-    let mut y = b.to_vec();
-    for i in 0..n {
-        y[i] = (y[i] - (0..i).map(|k| l[i][k] * y[k]).sum::<f64>()) / l[i][i];
-    }
-    for i in (0..n).rev() {
-        y[i] = (y[i] - (i + 1..n).map(|k| l[k][i] * y[k]).sum::<f64>()) / l[i][i];
-    }
-    y
 }
 
 /// Rebuilds L·D·Lᵀ from the converted factor and compares with the permuted penalised
