@@ -5,13 +5,9 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-fn asset(name: &str) -> String {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("assets")
-        .join(name)
-        .display()
-        .to_string()
-}
+#[path = "common/files.rs"]
+mod files;
+use files::asset;
 
 /// 80 × 60, 5 frames: a dragged and pinned triangle over a moving, rotating quad.
 fn write_scene(dir: &Path) -> PathBuf {

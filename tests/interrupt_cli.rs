@@ -9,6 +9,10 @@
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 
+#[path = "common/files.rs"]
+mod files;
+use files::sorted_names;
+
 /// A long scene (2 000 frames) so the render is still running when the signal comes.
 fn write_scene(dir: &Path) -> PathBuf {
     let assets = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets");
@@ -60,15 +64,6 @@ fn interrupt(child: &Child) {
     assert!(status.success());
 }
 
-fn names(dir: &Path) -> Vec<String> {
-    let mut names: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    names.sort();
-    names
-}
-
 #[test]
 fn sigint_leaves_only_complete_frames() {
     let dir = tempfile::tempdir().unwrap();
@@ -85,7 +80,7 @@ fn sigint_leaves_only_complete_frames() {
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert_eq!(output.status.code(), Some(1), "{stderr}");
     assert!(stderr.contains("interrupted"), "{stderr}");
-    let written = names(&frames);
+    let written = sorted_names(&frames);
     assert!(!written.is_empty());
     assert!(
         written.len() < 2000,
@@ -111,7 +106,7 @@ fn sigint_during_an_animation_file_leaves_no_file() {
         let mut child = spawn_render(&scene, &out, &["--format", format]);
         // The writer's temporary file appears once the first frame is being written.
         let started = wait_until(&mut child, || {
-            names(dir.path()).iter().any(|n| n.ends_with(".tmp"))
+            sorted_names(dir.path()).iter().any(|n| n.ends_with(".tmp"))
         });
         assert!(started, "{format}: the render ended before writing");
         interrupt(&child);
@@ -120,7 +115,7 @@ fn sigint_during_an_animation_file_leaves_no_file() {
         assert_eq!(output.status.code(), Some(1), "{format}: {stderr}");
         assert!(stderr.contains("interrupted"), "{format}: {stderr}");
         assert_eq!(
-            names(dir.path()),
+            sorted_names(dir.path()),
             ["long.rhai"],
             "{format}: the interrupted render left files"
         );

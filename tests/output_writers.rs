@@ -11,6 +11,10 @@ use lapclone::output::{
     FrameRef, GifWriter, OutputError, Pixels, PngCompression, PngSequenceWriter,
 };
 
+#[path = "common/files.rs"]
+mod files;
+use files::sorted_names;
+
 /// A deterministic, not-too-compressible test pattern.
 fn frame8(w: u32, h: u32, seed: u32) -> Frame {
     let mut state = seed.wrapping_mul(2654435761).wrapping_add(1);
@@ -57,15 +61,6 @@ fn png_bytes(frame: &Frame) -> Vec<u8> {
     let mut out = Vec::new();
     frame.as_ref().unwrap().write_png_bytes(&mut out);
     out
-}
-
-fn listing(dir: &Path) -> Vec<String> {
-    let mut names: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    names.sort();
-    names
 }
 
 #[test]
@@ -116,8 +111,8 @@ fn png_sequence_is_identical_for_any_job_count_and_decodes_back() {
     let paths = write_sequence(one.path(), &frames, 1);
     write_sequence(two.path(), &frames, 2);
     let expected: Vec<String> = (1..=6).map(|i| format!("frame_{i:04}.png")).collect();
-    assert_eq!(listing(one.path()), expected);
-    assert_eq!(listing(two.path()), expected);
+    assert_eq!(sorted_names(one.path()), expected);
+    assert_eq!(sorted_names(two.path()), expected);
     for (i, frame) in frames.iter().enumerate() {
         let name = &expected[i];
         let a = std::fs::read(one.path().join(name)).unwrap();
@@ -154,7 +149,7 @@ fn a_failed_frame_leaves_no_temporary_files() {
         result.is_err() || finished.is_err(),
         "the failure must be reported"
     );
-    let names = listing(dir.path());
+    let names = sorted_names(dir.path());
     assert!(names.iter().all(|n| !n.ends_with(".tmp")), "{names:?}");
     assert_eq!(
         decode_png(&dir.path().join("frame_0001.png")).3,
@@ -175,7 +170,7 @@ fn cancel_stops_the_sequence_cleanly() {
         Err(OutputError::Cancelled)
     ));
     assert!(matches!(writer.finish(), Err(OutputError::Cancelled)));
-    let names = listing(dir.path());
+    let names = sorted_names(dir.path());
     assert!(names.iter().all(|n| n == "frame_0001.png"), "{names:?}");
 }
 
@@ -218,7 +213,7 @@ fn apng_decodes_back_to_the_same_frames() {
             assert_eq!(canvas, png_bytes(f));
         }
         assert_eq!(
-            listing(dir.path())
+            sorted_names(dir.path())
                 .iter()
                 .filter(|n| n.ends_with(".tmp"))
                 .count(),
@@ -238,7 +233,7 @@ fn unfinished_apng_leaves_nothing() {
         "size mismatch"
     );
     assert!(writer.finish().is_err());
-    assert!(listing(dir.path()).is_empty());
+    assert!(sorted_names(dir.path()).is_empty());
 }
 
 #[test]
@@ -270,7 +265,7 @@ fn gif_has_every_frame_with_exact_delays() {
         25,
         "6 frames at 24 fps = 0.25 s"
     );
-    assert_eq!(listing(dir.path()), vec!["a.gif".to_string()]);
+    assert_eq!(sorted_names(dir.path()), vec!["a.gif".to_string()]);
     // Same frames, same bytes.
     let again = dir.path().join("b.gif");
     let mut writer = GifWriter::create(&again, 24.0).unwrap();

@@ -4,13 +4,9 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-fn asset(name: &str) -> String {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("assets")
-        .join(name)
-        .display()
-        .to_string()
-}
+#[path = "common/files.rs"]
+mod files;
+use files::{asset, sorted_names};
 
 /// A 96×64 scene of 4 frames (fps 4, 1 s): a dragged, moving triangle patch.
 fn write_scene(dir: &Path) -> PathBuf {
@@ -38,15 +34,6 @@ fn os(s: &str) -> &std::ffi::OsStr {
     std::ffi::OsStr::new(s)
 }
 
-fn files(dir: &Path) -> Vec<String> {
-    let mut names: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    names.sort();
-    names
-}
-
 #[test]
 fn png_sequence_is_numbered_from_one_and_identical_for_any_job_count() {
     let dir = tempfile::tempdir().unwrap();
@@ -64,7 +51,7 @@ fn png_sequence_is_numbered_from_one_and_identical_for_any_job_count() {
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
         assert!(String::from_utf8_lossy(&o.stdout).contains("rendered 4 frames"));
     }
-    let names = files(&one);
+    let names = sorted_names(&one);
     assert_eq!(
         names,
         [
@@ -74,7 +61,7 @@ fn png_sequence_is_numbered_from_one_and_identical_for_any_job_count() {
             "frame_0004.png"
         ]
     );
-    assert_eq!(files(&two), names);
+    assert_eq!(sorted_names(&two), names);
     for name in &names {
         assert_eq!(
             std::fs::read(one.join(name)).unwrap(),
@@ -105,8 +92,8 @@ fn frame_range_renders_only_those_frames_and_matches_the_full_render() {
         os("3..4"),
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    assert_eq!(files(&part), ["frame_0003.png", "frame_0004.png"]);
-    for name in files(&part) {
+    assert_eq!(sorted_names(&part), ["frame_0003.png", "frame_0004.png"]);
+    for name in sorted_names(&part) {
         assert_eq!(
             std::fs::read(all.join(&name)).unwrap(),
             std::fs::read(part.join(&name)).unwrap()

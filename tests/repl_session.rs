@@ -6,13 +6,9 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 
-fn asset(name: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("assets")
-        .join(name)
-        .display()
-        .to_string()
-}
+#[path = "common/files.rs"]
+mod files;
+use files::asset;
 
 /// A tiny scene (64×48, 3 frames) with one polygon patch of the cat photo.
 fn tiny_scene(dir: &Path) -> PathBuf {

@@ -1,16 +1,12 @@
 //! `lapclone check`: success summary, positioned errors with a caret, exit codes; and the
 //! `preview` flag group.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 
-fn asset(name: &str) -> String {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("assets")
-        .join(name)
-        .display()
-        .to_string()
-}
+#[path = "common/files.rs"]
+mod files;
+use files::asset;
 
 fn check(dir: &Path, text: &str) -> (i32, String, String) {
     let scene = dir.join("scene.rhai");
