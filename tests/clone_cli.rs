@@ -102,9 +102,13 @@ fn good_input_succeeds_with_stats() {
         "raster_ms",
         "total_ms",
         "reclone_ms",
+        "load_ms",
     ] {
         assert!(stats[key].is_number(), "stats lack {key}: {stats}");
     }
+    // total_ms is the first clone (mesh through raster), decoding the inputs excluded.
+    let ms = |key: &str| stats[key].as_f64().unwrap();
+    assert!(ms("total_ms") >= ms("mesh_ms") + ms("solve_ms"), "{stats}");
     assert_eq!(stats["constrained"], stats["boundary_vertices"]);
     assert!(dir.path().join("out.png").is_file());
 }
