@@ -112,14 +112,7 @@ pub fn run(args: CloneBenchArgs) -> anyhow::Result<()> {
     }
     let target = load_or(asset("hubble_deep_field.jpg"), || synthetic(1000, 872, 0.3))?;
     let photo = load_or(asset("astronaut.png"), || synthetic(512, 512, 1.7))?;
-    let mut mesh_options = MeshOptions::default();
-    args.mesh.apply(&mut mesh_options);
-    if let Some(density) = args.density {
-        mesh_options.density = density;
-    }
-    mesh_options
-        .validate()
-        .map_err(|e| super::UsageError(e.to_string()))?;
+    let mesh_options = args.mesh.options(args.density)?;
     let clone_options = CloneOptions {
         boundary_data: args.boundary_data,
         ..CloneOptions::default()

@@ -184,14 +184,7 @@ struct Report {
 }
 
 pub fn run(args: PaperBenchArgs) -> anyhow::Result<()> {
-    let mut mesh_options = MeshOptions::default();
-    args.mesh.apply(&mut mesh_options);
-    if let Some(density) = args.density {
-        mesh_options.density = density;
-    }
-    mesh_options
-        .validate()
-        .map_err(|e| super::UsageError(e.to_string()))?;
+    let mesh_options = args.mesh.options(args.density)?;
     if args.repeat == 0 {
         return Err(super::UsageError("--repeat must be at least 1".into()).into());
     }

@@ -142,14 +142,7 @@ pub fn run(args: CloneArgs) -> anyhow::Result<()> {
 
     // The first clone: mesh, factor, solve and raster (`total_ms`), inputs already decoded.
     let mesh_started = Instant::now();
-    let mut mesh_options = MeshOptions::default();
-    args.mesh.apply(&mut mesh_options);
-    if let Some(density) = args.density {
-        mesh_options.density = density;
-    }
-    mesh_options
-        .validate()
-        .map_err(|e| super::UsageError(e.to_string()))?;
+    let mesh_options = args.mesh.options(args.density)?;
     let patch = mesh_from_mask(
         &mask,
         args.mask_offset.map(DVec2::from),

@@ -97,15 +97,11 @@ pub fn run(args: MeshArgs) -> anyhow::Result<()> {
 }
 
 fn options_from(args: &MeshArgs) -> anyhow::Result<MeshOptions> {
-    let mut options = MeshOptions::default();
-    args.quality.apply(&mut options);
-    if let Some(density) = args.density {
-        options.density = density;
-    }
+    let mut options = args.quality.options(args.density)?;
     if let Some(max) = args.max_vertices {
         options.max_vertices = max;
+        options.validate().map_err(|e| UsageError(e.to_string()))?;
     }
-    options.validate().map_err(|e| UsageError(e.to_string()))?;
     Ok(options)
 }
 

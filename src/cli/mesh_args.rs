@@ -3,6 +3,8 @@
 
 use lapclone::mesh::{BoundaryPlacement, MeshOptions};
 
+use super::UsageError;
+
 #[derive(clap::Args, Debug, Clone, Default)]
 pub struct MeshQualityArgs {
     /// Start from the seam-quality preset (`MeshOptions::seam_quality`: boundary on every
@@ -28,9 +30,21 @@ pub struct MeshQualityArgs {
 }
 
 impl MeshQualityArgs {
+    /// The library defaults with these flags and `--density` applied, validated (an invalid
+    /// combination is a usage error).
+    pub fn options(&self, density: Option<f64>) -> Result<MeshOptions, UsageError> {
+        let mut options = MeshOptions::default();
+        self.apply(&mut options);
+        if let Some(density) = density {
+            options.density = density;
+        }
+        options.validate().map_err(|e| UsageError(e.to_string()))?;
+        Ok(options)
+    }
+
     /// Overrides the fields whose flags were given; `--seam-quality` replaces all options, so
     /// callers apply their own flags (`--density`) after this.
-    pub fn apply(&self, options: &mut MeshOptions) {
+    fn apply(&self, options: &mut MeshOptions) {
         if self.seam_quality {
             *options = MeshOptions::seam_quality();
         }
