@@ -51,6 +51,17 @@ struct Settings {
     strict: bool,
 }
 
+impl Settings {
+    /// `quick` under `--quick`, `full` otherwise.
+    fn pick<T>(&self, quick: T, full: T) -> T {
+        if self.quick {
+            quick
+        } else {
+            full
+        }
+    }
+}
+
 /// CHOLMOD's figures from issue #3: vertices, numeric factor, 3-RHS solve, one switch (ms).
 const CHOLMOD: [(usize, f64, f64, f64); 3] = [
     (2_034, 1.16, 0.048, 0.030),
@@ -117,7 +128,7 @@ fn measure(settings: &Settings) -> Result<Vec<Check>, String> {
 
 /// Issue #2: the 770×743 spiral meshes in ≤ 20 ms at the defaults.
 fn mesh_checks(settings: &Settings, checks: &mut Vec<Check>) -> Result<(), String> {
-    let repeat = if settings.quick { "3" } else { "9" };
+    let repeat = settings.pick("3", "9");
     let rows = run_bench(&["mesh", "--filter", "spiral-770x743", "--repeat", repeat])?;
     let row = rows
         .as_array()
@@ -134,11 +145,7 @@ fn mesh_checks(settings: &Settings, checks: &mut Vec<Check>) -> Result<(), Strin
 
 /// Issue #3: numeric factor, 3-RHS solve and one rank-1 switch at or below CHOLMOD.
 fn factor_checks(settings: &Settings, checks: &mut Vec<Check>) -> Result<(), String> {
-    let cases = if settings.quick {
-        &CHOLMOD[..2]
-    } else {
-        &CHOLMOD[..]
-    };
+    let cases = settings.pick(&CHOLMOD[..2], &CHOLMOD[..]);
     for &(vertices, factor_ms, solve_ms, switch_ms) in cases {
         let row = run_bench(&["factor", "--sizes", &vertices.to_string()])?;
         let n = number(&row, "/n")?;
@@ -160,11 +167,7 @@ fn factor_checks(settings: &Settings, checks: &mut Vec<Check>) -> Result<(), Str
 
 /// Issues #4 and #5: the spiral's first clone and re-clone, and the deform frame.
 fn clone_checks(settings: &Settings, checks: &mut Vec<Check>) -> Result<(), String> {
-    let (repeats, frames) = if settings.quick {
-        ("5", "30")
-    } else {
-        ("20", "200")
-    };
+    let (repeats, frames) = settings.pick(("5", "30"), ("20", "200"));
     let report = run_bench(&["clone", "--repeats", repeats, "--frames", frames])?;
     let spirals = report
         .pointer("/spiral")
@@ -195,11 +198,7 @@ fn clone_checks(settings: &Settings, checks: &mut Vec<Check>) -> Result<(), Stri
 
 /// Issue #6: a two-patch 1920×1080 scene's frame, and parallel PNG encoding.
 fn render_checks(settings: &Settings, checks: &mut Vec<Check>) -> Result<(), String> {
-    let (frames, encode) = if settings.quick {
-        ("30", "8")
-    } else {
-        ("120", "24")
-    };
+    let (frames, encode) = settings.pick(("30", "8"), ("120", "24"));
     let report = run_bench(&["render", "--frames", frames, "--encode-frames", encode])?;
     checks.push(Check {
         issue: 6,
