@@ -4,10 +4,11 @@
 //! whether it holds. The measuring code lives in the binary's `bench` commands; this file only
 //! runs them and compares, so the two can never disagree.
 //!
-//! Arguments after `--`: `--quick` (fewer repeats, and no 495k-vertex factor) and `--strict`
+//! Arguments after `--`: `--quick` (fewer repeats, and no 495k-vertex factor), `--strict`
 //! (exit 1 when a target is missed; by default a miss is reported, not failed, since wall-clock
-//! figures on a shared machine move with its load). Exit 2 on a bad argument, 1 when a bench
-//! command fails.
+//! figures on a shared machine move with its load) and `--json` (one JSON array on stdout
+//! instead of the table: `issue`, `figure`, `measured`, `bound` ("at_most" or "at_least"),
+//! `target`, `holds`). Exit 2 on a bad argument, 1 when a bench command fails.
 
 use std::path::Path;
 use std::process::{Command, ExitCode};
@@ -49,6 +50,7 @@ struct Check {
 struct Settings {
     quick: bool,
     strict: bool,
+    json: bool,
 }
 
 impl Settings {
@@ -73,7 +75,7 @@ fn main() -> ExitCode {
     let settings = match parse_arguments(std::env::args().skip(1)) {
         Ok(settings) => settings,
         Err(message) => {
-            eprintln!("targets: {message}; arguments: [--quick] [--strict]");
+            eprintln!("targets: {message}; arguments: [--quick] [--strict] [--json]");
             return ExitCode::from(2);
         }
     };
@@ -84,14 +86,18 @@ fn main() -> ExitCode {
             return ExitCode::from(1);
         }
     };
-    print_table(&checks);
     let missed = checks.iter().filter(|c| !c.bound.holds(c.measured)).count();
-    println!(
-        "\n{} of {} targets hold{}",
-        checks.len() - missed,
-        checks.len(),
-        if settings.quick { " (--quick)" } else { "" }
-    );
+    if settings.json {
+        println!("{}", checks_json(&checks));
+    } else {
+        print_table(&checks);
+        println!(
+            "\n{} of {} targets hold{}",
+            checks.len() - missed,
+            checks.len(),
+            if settings.quick { " (--quick)" } else { "" }
+        );
+    }
     if settings.strict && missed > 0 {
         ExitCode::from(1)
     } else {
@@ -103,11 +109,13 @@ fn parse_arguments(arguments: impl Iterator<Item = String>) -> Result<Settings, 
     let mut settings = Settings {
         quick: false,
         strict: false,
+        json: false,
     };
     for argument in arguments {
         match argument.as_str() {
             "--quick" => settings.quick = true,
             "--strict" => settings.strict = true,
+            "--json" => settings.json = true,
             // cargo bench passes --bench to harness-less targets.
             "--bench" => {}
             other => return Err(format!("unknown argument `{other}`")),
@@ -280,6 +288,24 @@ fn number(value: &Value, pointer: &str) -> Result<f64, String> {
         .pointer(pointer)
         .and_then(Value::as_f64)
         .ok_or_else(|| format!("no number at {pointer} in {value}"))
+}
+
+fn checks_json(checks: &[Check]) -> Value {
+    let rows = checks.iter().map(|check| {
+        let (bound, target) = match check.bound {
+            Bound::AtMost(limit) => ("at_most", limit),
+            Bound::AtLeast(limit) => ("at_least", limit),
+        };
+        serde_json::json!({
+            "issue": check.issue,
+            "figure": check.what,
+            "measured": check.measured,
+            "bound": bound,
+            "target": target,
+            "holds": check.bound.holds(check.measured),
+        })
+    });
+    Value::Array(rows.collect())
 }
 
 fn print_table(checks: &[Check]) {
