@@ -8,7 +8,8 @@
 //! (exit 1 when a target is missed; by default a miss is reported, not failed, since wall-clock
 //! figures on a shared machine move with its load) and `--json` (one JSON array on stdout
 //! instead of the table: `issue`, `figure`, `measured`, `bound` ("at_most" or "at_least"),
-//! `target`, `holds`). Exit 2 on a bad argument, 1 when a bench command fails.
+//! `target`, `holds`). Exit 2 on a bad argument, 1 when a bench command fails. Run as a test
+//! (`cargo test --benches`, without cargo bench's `--bench` flag) it checks nothing.
 
 use std::path::Path;
 use std::process::{Command, ExitCode};
