@@ -1,6 +1,6 @@
 //! Small helpers shared by every stage: atomic file output (write to a temporary file in the
-//! destination folder, then rename, so a failure never leaves a partial file), and the two
-//! pieces of thread hand-off the raster and the caches use.
+//! destination folder, then rename, so a failure never leaves a partial file), and a lock that
+//! survives poisoning.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -12,27 +12,6 @@ pub(crate) fn lock<T>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {
     mutex
         .lock()
         .unwrap_or_else(|poisoned| poisoned.into_inner())
-}
-
-/// Waiting for another thread's result that comes within about a solve (tens to hundreds of
-/// µs): spin first (a futex wake-up costs that much again on these machines), then yield the
-/// core between looks.
-#[derive(Default)]
-pub(crate) struct SpinWait {
-    spins: u32,
-}
-
-impl SpinWait {
-    const SPINS_BEFORE_YIELD: u32 = 256;
-
-    pub fn pause(&mut self) {
-        if self.spins < Self::SPINS_BEFORE_YIELD {
-            self.spins += 1;
-            std::hint::spin_loop();
-        } else {
-            std::thread::yield_now();
-        }
-    }
 }
 
 /// Writes `bytes` to `path` through a temporary sibling file and a rename.

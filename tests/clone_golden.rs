@@ -225,7 +225,7 @@ fn horse_overlap_frame() -> OverlapFrame {
         depth: deformed.depth.clone(),
         triangles: cloner.mesh().triangles.clone(),
         boundary: cloner.membrane().boundary_vertices().to_vec(),
-        constrained: cloner.membrane().factor().unwrap().constrained().to_vec(),
+        constrained: cloner.membrane().factor().constrained().to_vec(),
         hidden_count: stats.membrane.hidden,
         outside_count: stats.membrane.outside,
     }

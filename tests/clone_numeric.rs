@@ -35,8 +35,7 @@ fn two_holes_cloner(options: &CloneOptions) -> PatchCloner {
 /// `BoundaryData::Vertex` sampled at the vertex (written out here), for a hat average as
 /// `BoundarySampler` gives it (its own tests check it against the integral it stands for).
 fn boundary_mismatch(cloner: &PatchCloner, target: &Canvas) -> f64 {
-    // invariant: the cloner has cloned, so its factor exists.
-    let factor = cloner.membrane().factor().expect("a factored cloner");
+    let factor = cloner.membrane().factor();
     let boundary = cloner.membrane().boundary_vertices();
     let rgb = |c: [f32; 4]| [c[0], c[1], c[2]];
     let (mut at_target, mut at_source) = (
@@ -168,8 +167,8 @@ fn moving_the_patch_equals_a_fresh_cloner_at_the_new_place() {
         let mut fresh_canvas = target.clone();
         fresh.clone_onto(&mut fresh_canvas, &centred(at)).unwrap();
         assert_eq!(
-            fresh.membrane().factor().unwrap().constrained(),
-            moved.membrane().factor().unwrap().constrained()
+            fresh.membrane().factor().constrained(),
+            moved.membrane().factor().constrained()
         );
         let difference = membrane_difference(&moved, &fresh);
         assert!(
@@ -180,11 +179,10 @@ fn moving_the_patch_equals_a_fresh_cloner_at_the_new_place() {
     }
 }
 
-/// The first clone factors the Laplacian on the solving thread while the raster records its
-/// draw on the other, then composites the record. Its membrane must be an eagerly factored
-/// solver's, bit for bit, and its pixels those of a plain draw (no record, no replay).
+/// A first clone's membrane is a separately built solver's, bit for bit, and its pixels
+/// those of a plain draw of that membrane.
 #[test]
-fn a_first_clone_factors_while_recording_and_draws_the_plain_bytes() {
+fn a_first_clone_solves_then_draws_the_plain_bytes() {
     let target = Canvas::from_image(&smooth_target(120, 100));
     for laplacian in [LaplacianKind::Combinatorial, LaplacianKind::Cotangent] {
         let options = CloneOptions {
@@ -192,10 +190,6 @@ fn a_first_clone_factors_while_recording_and_draws_the_plain_bytes() {
             ..CloneOptions::default()
         };
         let mut cloner = two_holes_cloner(&options);
-        assert!(
-            cloner.membrane().factor().is_none(),
-            "new() factored already"
-        );
         let placement = Placement {
             rotation_deg: -21.0,
             scale: 1.17,
@@ -203,8 +197,6 @@ fn a_first_clone_factors_while_recording_and_draws_the_plain_bytes() {
         };
         let mut canvas = target.clone();
         let first = cloner.clone_onto(&mut canvas, &placement).unwrap();
-        assert!(cloner.membrane().factor().is_some());
-        assert!(!first.raster.replayed);
         assert!(first.raster.written > 1000, "{first:?}");
 
         let data = cloner.membrane().boundary_data();
@@ -226,33 +218,22 @@ fn a_first_clone_factors_while_recording_and_draws_the_plain_bytes() {
             loops: &mesh.loops,
             source: cloner.source(),
         };
-        for threads in [1, 2] {
-            let plain_options = RasterOptions {
-                threads,
-                ..RasterOptions::default()
-            };
-            let mut plain = target.clone();
-            let stats = draw_patch(
-                &mut plain,
-                &patch,
-                &plain_options,
-                &mut RasterScratch::new(),
-            )
-            .unwrap();
-            assert_eq!(stats, first.raster, "{laplacian:?}, {threads} threads");
-            assert!(
-                canvas.pixels() == plain.pixels(),
-                "{laplacian:?}: the first clone differs from a plain draw"
-            );
-        }
+        let mut plain = target.clone();
+        let options = RasterOptions::default();
+        let stats = draw_patch(&mut plain, &patch, &options, &mut RasterScratch::new()).unwrap();
+        assert_eq!(stats, first.raster, "{laplacian:?}");
+        assert!(
+            canvas.pixels() == plain.pixels(),
+            "{laplacian:?}: the first clone differs from a plain draw"
+        );
     }
 }
 
 #[test]
-fn whole_pixel_drags_replay_and_equal_fresh_clones_byte_for_byte() {
+fn whole_pixel_drags_equal_fresh_clones_byte_for_byte() {
     // Fractional position, scale and rotation, and a mesh with free interior vertices:
-    // every whole-pixel move must replay the previous draw (placed points move exactly),
-    // and give the bytes of a fresh cloner at the new place.
+    // every whole-pixel move of a kept cloner gives the bytes of a fresh cloner at the new
+    // place.
     let target = Canvas::from_image(&smooth_target(120, 100));
     let mut dragged = two_holes_cloner(&CloneOptions::default());
     let start = Placement {
@@ -261,8 +242,7 @@ fn whole_pixel_drags_replay_and_equal_fresh_clones_byte_for_byte() {
         ..centred(DVec2::new(55.318, 47.902))
     };
     let mut canvas = target.clone();
-    let first = dragged.clone_onto(&mut canvas, &start).unwrap();
-    assert!(!first.raster.replayed);
+    dragged.clone_onto(&mut canvas, &start).unwrap();
     for shift in [
         DVec2::new(3.0, 2.0),
         DVec2::new(-7.0, 1.0),
@@ -273,14 +253,13 @@ fn whole_pixel_drags_replay_and_equal_fresh_clones_byte_for_byte() {
             ..start
         };
         let mut canvas = target.clone();
-        let stats = dragged.clone_onto(&mut canvas, &placement).unwrap();
-        assert!(stats.raster.replayed, "a move by {shift} drew afresh");
+        dragged.clone_onto(&mut canvas, &placement).unwrap();
         let mut fresh = two_holes_cloner(&CloneOptions::default());
         let mut fresh_canvas = target.clone();
         fresh.clone_onto(&mut fresh_canvas, &placement).unwrap();
         assert!(
             canvas.pixels() == fresh_canvas.pixels(),
-            "a move by {shift}: the replay differs from a fresh clone"
+            "a move by {shift}: the kept cloner differs from a fresh one"
         );
     }
 }
@@ -311,11 +290,7 @@ fn outside_boundary_vertices_switch_off_and_come_back() {
         let p = cloner.placed()[v as usize];
         let outside = p.x < 0.0 || p.y < 0.0 || p.x > width || p.y > f64::from(target.height());
         assert_eq!(
-            cloner
-                .membrane()
-                .factor()
-                .unwrap()
-                .is_constrained(v as usize),
+            cloner.membrane().factor().is_constrained(v as usize),
             !outside,
             "vertex {v} at {p}"
         );

@@ -191,7 +191,7 @@ fn a_piece_losing_its_last_constraint_gets_an_exactly_zero_membrane() {
     // All pieces on the canvas: every boundary vertex constrained.
     let home = Placement::translate(DVec2::new(30.0, 20.0), DVec2::new(30.0, 20.0));
     cloner.clone_onto(&mut canvas, &home).unwrap();
-    let refactors_before = cloner.membrane().factor().unwrap().refactor_count();
+    let refactors_before = cloner.membrane().factor().refactor_count();
     // Shift right by 32 px: the right disc (piece of vertex nearest (42, 14)) leaves the
     // canvas entirely, so its last constraints are released by downdates.
     let shifted = Placement::translate(DVec2::new(30.0, 20.0), DVec2::new(62.0, 20.0));
@@ -205,7 +205,7 @@ fn a_piece_losing_its_last_constraint_gets_an_exactly_zero_membrane() {
         }
     }
     assert!(
-        cloner.membrane().factor().unwrap().refactor_count() > refactors_before,
+        cloner.membrane().factor().refactor_count() > refactors_before,
         "releasing a piece's last constraint must go through the refactor guard"
     );
     // The constrained pieces still match a fresh solve.

@@ -3,11 +3,9 @@
 //! composites the seamless clone onto the canvas.
 //!
 //! Built once: the mesh, the factored Laplacian, the source (grey in monochrome mode), raster
-//! and coverage scratch. Per call: place the vertices, find boundary vertices hidden under
-//! the patch's own front layer, switch constraints, one 3-RHS solve, the raster. The
-//! hidden-vertex query and the solve run while the raster prepares its membrane-free part on
-//! a second thread ([`draw_patch_solving`]). The first call also factors the Laplacian there
-//! ([`MembraneSolver::deferred`]), so the factor overlaps the first draw's preparation.
+//! and coverage scratch. Per call, on the calling thread: place the vertices, find boundary
+//! vertices hidden under the patch's own front layer, switch constraints, one 3-RHS solve,
+//! then one [`draw_patch`] with the solved membrane.
 
 use std::time::Instant;
 
@@ -18,8 +16,8 @@ use super::{BoundaryData, CloneError, Placement};
 use crate::mesh::Mesh;
 use crate::pixels::{Canvas, FloatImage};
 use crate::raster::{
-    covered_boundary_vertices, draw_patch_solving, CoverageGrid, Patch, RasterOptions,
-    RasterScratch, RasterStats,
+    covered_boundary_vertices, draw_patch, CoverageGrid, Patch, RasterOptions, RasterScratch,
+    RasterStats,
 };
 use crate::solve::LaplacianKind;
 
@@ -78,14 +76,9 @@ pub struct CloneStats {
     pub membrane: MembraneStats,
     pub raster: RasterStats,
     /// Hidden-vertex query ([`clone_deformed`](PatchCloner::clone_deformed) only), constraint
-    /// switches and back-substitution, on the calling thread; the raster's first part runs
-    /// meanwhile on a helper thread.
+    /// switches and back-substitution.
     pub solve_ms: f64,
-    /// The Laplacian's factorisation, on the calling thread before the solve: the first
-    /// call's (0 afterwards). The raster's first part overlaps it too.
-    pub factor_ms: f64,
-    /// The rest of the call's wall time: the raster beyond what overlapped the factor and
-    /// the solve.
+    /// The raster's draw.
     pub raster_ms: f64,
 }
 
@@ -101,9 +94,8 @@ pub struct PatchCloner {
 }
 
 impl PatchCloner {
-    /// Assembles the patch's Laplacian and samples the source along the rest boundary. The
-    /// factor is built by the first clone (and its errors reported there), on the thread
-    /// that solves while the raster starts on another.
+    /// Assembles and factors the patch's Laplacian and samples the source along the rest
+    /// boundary.
     pub fn new(source: FloatImage, mesh: Mesh, options: &CloneOptions) -> Result<Self, CloneError> {
         if !(options.feather.is_finite() && options.feather >= 0.0) {
             return Err(CloneError::BadOption(format!(
@@ -116,7 +108,7 @@ impl PatchCloner {
             CloneMode::Monochrome => source.to_grey(),
         };
         let membrane =
-            MembraneSolver::deferred(&mesh, &source, options.laplacian, options.boundary_data);
+            MembraneSolver::new(&mesh, &source, options.laplacian, options.boundary_data)?;
         let n = mesh.vertex_count();
         Ok(Self {
             source,
@@ -124,8 +116,6 @@ impl PatchCloner {
             membrane,
             raster_options: RasterOptions {
                 feather: options.feather,
-                // The cloner owns its source and mesh: a drag by whole pixels replays.
-                replay: true,
                 ..RasterOptions::default()
             },
             placed: Vec::with_capacity(n),
@@ -229,9 +219,7 @@ impl PatchCloner {
         self.clone_placed(canvas, depth, HiddenBy::Preparation)
     }
 
-    /// The membrane solve (after the hidden-vertex query, if it is still to do) on this
-    /// thread while the raster starts its membrane-free work on another
-    /// ([`draw_patch_solving`]).
+    /// The hidden-vertex query (if it is still to do) and the membrane solve, then the draw.
     fn clone_placed(
         &mut self,
         canvas: &mut Canvas,
@@ -243,49 +231,36 @@ impl PatchCloner {
             return Err(CloneError::VertexCountMismatch(self.placed.len(), n));
         }
         let started = Instant::now();
-        let mut solved = None;
+        let frame = (&self.placed[..], &self.mesh.triangles[..]);
+        let hidden = match hidden_by {
+            HiddenBy::Query => {
+                let boundary = self.membrane.boundary_vertices();
+                self.hidden.find(frame, boundary, depth)?
+            }
+            HiddenBy::Preparation => &self.hidden.marks,
+        };
+        let membrane = self.membrane.solve(frame.0, canvas, Some(hidden))?;
+        let solved = Instant::now();
         let patch = Patch {
             rest: &self.mesh.positions,
             placed: &self.placed,
             triangles: &self.mesh.triangles,
-            membrane: &[],
+            membrane: self.membrane.membrane(),
             depth,
             loops: &self.mesh.loops,
             source: &self.source,
         };
-        let frame = (&self.placed[..], &self.mesh.triangles[..]);
-        let (solver, hidden, solved_out) = (&mut self.membrane, &mut self.hidden, &mut solved);
-        let solve = move |canvas: &Canvas| {
-            // Moved (not reborrowed), so the membrane can be lent out for the whole draw.
-            let membrane = solver;
-            let factor_started = Instant::now();
-            membrane.factor_now()?;
-            let solve_started = Instant::now();
-            let hidden = if hidden_by == HiddenBy::Query {
-                hidden.find(frame, membrane.boundary_vertices(), depth)?
-            } else {
-                &hidden.marks
-            };
-            let stats = membrane.solve(frame.0, canvas, Some(hidden))?;
-            let factor_ms = millis(solve_started - factor_started);
-            *solved_out = Some((stats, factor_ms, millis(solve_started.elapsed())));
-            Ok::<_, CloneError>(membrane.membrane())
-        };
-        let raster = draw_patch_solving(
+        let raster = draw_patch(
             canvas,
             &patch,
             &self.raster_options,
             &mut self.raster_scratch,
-            solve,
         )?;
-        // invariant: draw_patch_solving runs the solve exactly once, and it succeeded.
-        let (membrane, factor_ms, solve_ms) = solved.expect("the draw ran the solve");
         Ok(CloneStats {
             membrane,
             raster,
-            solve_ms,
-            factor_ms,
-            raster_ms: millis(started.elapsed()) - factor_ms - solve_ms,
+            solve_ms: millis(solved - started),
+            raster_ms: millis(solved.elapsed()),
         })
     }
 }
@@ -295,7 +270,7 @@ impl PatchCloner {
 enum HiddenBy {
     /// Found by the preparation (or none: a rigid clone).
     Preparation,
-    /// Found with the solve, while the raster starts.
+    /// Found with the solve.
     Query,
 }
 

@@ -6,26 +6,20 @@
 //! switched off (rank-1 downdates of the kept factor) rather than clamped, and switched back
 //! on when they return. Source colours at the rest boundary never change, so they are sampled
 //! once per mesh; per frame only the canvas is sampled.
-//!
-//! The factor can be built eagerly ([`MembraneSolver::new`]) or by the first solve
-//! ([`MembraneSolver::deferred`]): a first clone then factors on the solving thread while the
-//! raster's membrane-free work runs on its helper.
 
 use glam::DVec2;
 
 use super::{BoundaryData, BoundarySampler, CloneError};
 use crate::mesh::Mesh;
 use crate::pixels::{Canvas, FloatImage};
-use crate::solve::{
-    laplacian, LaplacianKind, PenaltyFactor, PenaltyOptions, SwitchStats, SymmetricCsc,
-};
+use crate::solve::{laplacian, LaplacianKind, PenaltyFactor, PenaltyOptions, SwitchStats};
 
 /// Number of colour channels the membrane carries (alpha is never cloned).
 pub const MEMBRANE_CHANNELS: usize = 3;
 
 /// The factored Laplacian of one patch mesh and the scratch buffers of its per-frame solve.
 pub struct MembraneSolver {
-    factor: FactorState,
+    factor: PenaltyFactor,
     sampler: BoundarySampler,
     /// f_S's boundary data at the rest boundary, RGB, one per boundary vertex.
     source_at_boundary: Vec<[f32; 3]>,
@@ -34,13 +28,6 @@ pub struct MembraneSolver {
     wanted: Vec<bool>,
     values: Vec<f64>,
     membrane: Vec<[f32; 3]>,
-}
-
-/// The kept factor, or the Laplacian it will be built from.
-enum FactorState {
-    /// Waiting for the first solve (or [`MembraneSolver::factor_now`]).
-    Pending(SymmetricCsc),
-    Ready(Box<PenaltyFactor>),
 }
 
 /// What one membrane solve did.
@@ -56,37 +43,23 @@ pub struct MembraneStats {
 }
 
 impl MembraneSolver {
-    /// Builds and factors the Laplacian of `mesh` and samples the source at the rest
-    /// boundary, `data` deciding how.
+    /// Builds and factors the Laplacian of `mesh` (with every boundary constraint on, the
+    /// usual state, so a first clone inside the target switches nothing) and samples the
+    /// source at the rest boundary, `data` deciding how.
     pub fn new(
         mesh: &Mesh,
         source: &FloatImage,
         kind: LaplacianKind,
         data: BoundaryData,
     ) -> Result<Self, CloneError> {
-        let mut solver = Self::deferred(mesh, source, kind, data);
-        solver.factor_now()?;
-        Ok(solver)
-    }
-
-    /// Builds the Laplacian of `mesh` and samples the source at the rest boundary; the
-    /// factor waits for the first [`solve`](Self::solve) or [`factor_now`](Self::factor_now),
-    /// which then report its errors.
-    pub fn deferred(
-        mesh: &Mesh,
-        source: &FloatImage,
-        kind: LaplacianKind,
-        data: BoundaryData,
-    ) -> Self {
-        let l = laplacian(mesh, kind);
         let sampler = BoundarySampler::new(mesh, data);
         let boundary = sampler.boundary_vertices();
-        // Factored with every boundary constraint on, the usual state: a first clone inside
-        // the target then switches nothing (switching them all on would refactor).
         let mut wanted = vec![false; mesh.vertex_count()];
         for &v in boundary {
             wanted[v as usize] = true;
         }
+        let l = laplacian(mesh, kind);
+        let factor = PenaltyFactor::with_constrained(&l, &PenaltyOptions::default(), &wanted)?;
         let mut source_at_boundary = vec![[0.0; 3]; boundary.len()];
         sampler.sample(
             &mesh.positions,
@@ -94,27 +67,15 @@ impl MembraneSolver {
             &mut source_at_boundary,
         );
         let n = mesh.vertex_count();
-        Self {
-            factor: FactorState::Pending(l),
+        Ok(Self {
+            factor,
             target_at_boundary: vec![[0.0; 3]; boundary.len()],
             sampler,
             source_at_boundary,
             wanted,
             values: vec![0.0; n * MEMBRANE_CHANNELS],
             membrane: vec![[0.0; 3]; n],
-        }
-    }
-
-    /// Factors the Laplacian if that is still to do (with every boundary constraint on);
-    /// gives whether it did.
-    pub fn factor_now(&mut self) -> Result<bool, CloneError> {
-        let FactorState::Pending(l) = &self.factor else {
-            return Ok(false);
-        };
-        // The boundary marks: `wanted` is the all-on state until the first solve changes it.
-        let factor = PenaltyFactor::with_constrained(l, &PenaltyOptions::default(), &self.wanted)?;
-        self.factor = FactorState::Ready(Box::new(factor));
-        Ok(true)
+        })
     }
 
     /// Solves the membrane for a patch whose vertices sit at `placed` on `canvas`.
@@ -125,11 +86,7 @@ impl MembraneSolver {
         canvas: &Canvas,
         hidden: Option<&[bool]>,
     ) -> Result<MembraneStats, CloneError> {
-        self.factor_now()?;
-        let FactorState::Ready(factor) = &mut self.factor else {
-            // invariant: factor_now either leaves a factor or returned the error above.
-            unreachable!("factor_now leaves a factor");
-        };
+        let factor = &mut self.factor;
         let n = self.wanted.len();
         let mut stats = MembraneStats::default();
         let (width, height) = (f64::from(canvas.width()), f64::from(canvas.height()));
@@ -174,12 +131,9 @@ impl MembraneSolver {
         &self.membrane
     }
 
-    /// The kept factor; `None` until the first solve of a [`deferred`](Self::deferred) one.
-    pub fn factor(&self) -> Option<&PenaltyFactor> {
-        match &self.factor {
-            FactorState::Ready(factor) => Some(factor),
-            FactorState::Pending(_) => None,
-        }
+    /// The kept factor.
+    pub fn factor(&self) -> &PenaltyFactor {
+        &self.factor
     }
 
     pub fn boundary_vertices(&self) -> &[u32] {

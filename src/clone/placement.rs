@@ -52,11 +52,11 @@ impl Placement {
     /// `at − ⌊at⌋`.
     ///
     /// Why: moving `at` by whole pixels then moves every placed point by exactly that many
-    /// pixels (the grid's sums are exact), which is what lets the raster replay its previous
-    /// draw ([`RasterOptions::replay`](crate::raster::RasterOptions::replay)) instead of
-    /// drawing afresh. With the plain affine map the sums rounded differently at each
-    /// position, so a drag of a mesh with free interior vertices never replayed. The grid
-    /// moves a point by at most 2⁻¹⁷ px.
+    /// pixels (the grid's sums are exact), so the raster's per-triangle maps, which depend
+    /// only on differences of placed points, come out bit for bit the same and a whole-pixel
+    /// drag moves the drawn patch without resampling it differently. With the plain affine
+    /// map the sums would round differently at each position. The grid moves a point by at
+    /// most 2⁻¹⁷ px.
     pub fn apply(&self, rest: &[DVec2], out: &mut Vec<DVec2>) {
         let whole = self.at.floor();
         let map = Placement {

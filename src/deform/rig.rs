@@ -5,7 +5,7 @@
 
 use super::falloff::HandleFalloff;
 use super::weights::{assemble_laplacian, edge_shares};
-use super::{DeformError, DeformOptions};
+use super::{DeformError, DeformOptions, Handle};
 use crate::mesh::Mesh;
 use crate::solve::{LaplacianKind, PenaltyFactor, SymmetricCsc};
 use glam::DVec2;
@@ -143,6 +143,17 @@ impl DeformRig {
         }
         best.1
     }
+
+    /// Brings `self.falloff[h]` up to date for each of `handles` (slots grow only).
+    pub(crate) fn update_falloff(&mut self, handles: &[Handle]) {
+        if self.falloff.len() < handles.len() {
+            self.falloff
+                .resize_with(handles.len(), HandleFalloff::default);
+        }
+        for ((h, frame), slot) in handles.iter().zip(&self.frames).zip(&mut self.falloff) {
+            slot.refresh(h.from, frame.rate, &self.centroids, &self.rest);
+        }
+    }
 }
 
 fn validate_mesh(mesh: &Mesh) -> Result<(), DeformError> {
@@ -199,5 +210,51 @@ fn area_weighted_centroid(mesh: &Mesh) -> DVec2 {
         weighted / total
     } else {
         mesh.positions.iter().sum::<DVec2>() / mesh.vertex_count() as f64
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::falloff::gaussian;
+    use super::*;
+    use crate::mesh::{mesh_mask, synth, MeshOptions};
+    use crate::solve::LaplacianKind;
+
+    /// After every update, each slot in use holds exactly the fresh weights of its handle.
+    #[test]
+    fn kept_weights_are_the_fresh_ones_after_any_sequence_of_handles() {
+        let mask = synth::disc(40, 40, 17.0);
+        let mesh = mesh_mask(&mask, &MeshOptions::default()).unwrap().mesh;
+        let mut rig = DeformRig::new(&mesh, LaplacianKind::Combinatorial).unwrap();
+        let a = DVec2::new(15.0, 18.0);
+        let b = DVec2::new(25.0, 21.0);
+        let drag = |from: DVec2, to: DVec2, radius: f64| Handle::drag(from, to, radius);
+        // p1 moves (weights kept), p0 moves, the radius changes, a handle is added, the
+        // handles swap slots, one is dropped and comes back.
+        let frames = [
+            vec![drag(a, b, 10.0)],
+            vec![drag(a, b + DVec2::X, 10.0)],
+            vec![drag(a + DVec2::Y, b, 10.0)],
+            vec![drag(a + DVec2::Y, b, 12.0)],
+            vec![drag(a + DVec2::Y, b, 12.0), drag(b, a, 6.0)],
+            vec![drag(b, a, 6.0), drag(a + DVec2::Y, b, 12.0)],
+            vec![drag(b, a, 6.0)],
+            vec![drag(b, a, 6.0), drag(a + DVec2::Y, b, 12.0)],
+        ];
+        for (k, handles) in frames.iter().enumerate() {
+            rig.prepare_handles(handles).unwrap();
+            rig.update_falloff(handles);
+            for (slot, (h, frame)) in rig.falloff.iter().zip(handles.iter().zip(&rig.frames)) {
+                let fresh = |points: &[DVec2]| -> Vec<u64> {
+                    points
+                        .iter()
+                        .map(|&x| gaussian(frame.rate, x, h.from).to_bits())
+                        .collect()
+                };
+                let bits = |w: &[f64]| -> Vec<u64> { w.iter().map(|v| v.to_bits()).collect() };
+                assert_eq!(bits(&slot.triangles), fresh(&rig.centroids), "frame {k}");
+                assert_eq!(bits(&slot.vertices), fresh(&rig.rest), "frame {k}");
+            }
+        }
     }
 }

@@ -6,8 +6,8 @@
 use std::path::Path;
 
 use super::png_encode::encode_png_rgba;
+use super::PixelRect;
 use super::{sample_bilinear_rgba, Depth, FloatImage, PixelError, PixelFormat};
-use crate::raster::PixelRect;
 
 /// A channel type that stores a value in [0, 1].
 pub trait Texel: Copy + Send + Sync + 'static {
@@ -137,7 +137,7 @@ impl Canvas {
 
     /// Copies the pixels of `rect` (clipped to the canvas) from `other`, which must have the
     /// same size and depth: the cheap per-frame reset that restores only the rectangles the
-    /// previous frame drew into (e.g. [`RasterStats::work`](crate::raster::RasterStats)).
+    /// previous frame drew into (e.g. a raster draw's work rectangle).
     pub fn copy_rect_from(&mut self, other: &Canvas, rect: PixelRect) -> Result<(), PixelError> {
         if (self.width, self.height, self.depth()) != (other.width, other.height, other.depth()) {
             return Err(PixelError::CanvasMismatch {

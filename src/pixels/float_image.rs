@@ -24,38 +24,13 @@ const LEVEL_VALUES: [f32; 256] = {
 
 /// The 8-bit levels `k` of a pixel whose channels are exactly `k / 255` (bit for bit: −0,
 /// NaN and values off the levels or out of [0, 1] give `None`). Called once per pixel when
-/// an image is made, so it avoids libm's `round` and float-to-u8 casts (SSE2 on x86_64).
+/// an image is made, so it rounds by truncating `v·255 + ½` instead of calling libm's
+/// `round`; a wrong level only fails the comparison.
 #[inline]
 fn level_of(pixel: &[f32; 4]) -> Option<[u8; 4]> {
-    #[cfg(target_arch = "x86_64")]
-    {
-        use std::arch::x86_64::*;
-        // SAFETY: SSE2 is part of the x86_64 baseline; the load and store are unaligned.
-        unsafe {
-            let v = _mm_loadu_ps(pixel.as_ptr());
-            // Truncation of v·255 + ½; NaN and out-of-range lanes become i32::MIN, which
-            // the saturating packs map to 0, whose value then differs from the lane.
-            let rounded = _mm_cvttps_epi32(_mm_add_ps(
-                _mm_mul_ps(v, _mm_set1_ps(255.0)),
-                _mm_set1_ps(0.5),
-            ));
-            let bytes = _mm_packus_epi16(_mm_packs_epi32(rounded, rounded), _mm_setzero_si128());
-            let level = _mm_unpacklo_epi16(
-                _mm_unpacklo_epi8(bytes, _mm_setzero_si128()),
-                _mm_setzero_si128(),
-            );
-            // k / 255 by the same correctly rounded division as LEVEL_VALUES.
-            let value = _mm_div_ps(_mm_cvtepi32_ps(level), _mm_set1_ps(255.0));
-            let same = _mm_cmpeq_epi32(_mm_castps_si128(value), _mm_castps_si128(v));
-            (_mm_movemask_epi8(same) == 0xFFFF).then(|| _mm_cvtsi128_si32(bytes).to_le_bytes())
-        }
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        let levels = pixel.map(|v| (v * 255.0 + 0.5) as u8);
-        let values = levels.map(|k| LEVEL_VALUES[usize::from(k)].to_bits());
-        (values == pixel.map(f32::to_bits)).then_some(levels)
-    }
+    let levels = pixel.map(|v| (v * 255.0 + 0.5) as u8);
+    let values = levels.map(|k| LEVEL_VALUES[usize::from(k)].to_bits());
+    (values == pixel.map(f32::to_bits)).then_some(levels)
 }
 
 /// A straight-alpha RGBA float image.

@@ -17,6 +17,7 @@ mod error;
 mod float_image;
 mod format;
 mod png_encode;
+mod rect;
 
 pub use bilinear::sample_bilinear_rgba;
 pub(crate) use canvas::composite_over_straight as canvas_composite_over;
@@ -24,3 +25,4 @@ pub use canvas::{Canvas, CanvasPixels, Texel};
 pub use error::PixelError;
 pub use float_image::FloatImage;
 pub use format::{ColorKind, Depth, PixelFormat};
+pub use rect::PixelRect;

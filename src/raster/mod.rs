@@ -17,18 +17,15 @@
 //!   `out = cov·α·patch + (1 − cov·α)·canvas`.
 //!
 //! [`covered_boundary_vertices`] answers, independently of pixels, which boundary vertices
-//! lie under the patch's own front layer (issue 5 switches their constraints off).
+//! lie under the patch's own front layer (the clone stage switches their constraints off).
 //!
-//! Work is split into row bands of a few dozen rows (`bands.rs`): a band's ids, depths and
-//! coverage stay in cache, and bands are shaded by up to one thread per core in any order —
-//! every band's pixels depend only on the frame's inputs, so any thread count gives the
-//! same bytes. Feathering draws in one piece (its distance transform spans the patch).
+//! A draw is one sequential pass on the calling thread (callers draw different patches or
+//! frames in parallel if they wish); every pixel depends only on the draw's inputs.
 //!
 //! Once-per-mesh vs per-frame: nothing is cached across frames except the buffers in
 //! [`RasterScratch`] and [`CoverageGrid`]; a frame re-does the per-triangle setup (cheap) and
 //! allocates nothing once the buffers have grown to the patch's size.
 
-mod bands;
 mod clip;
 mod coverage;
 mod covered;
@@ -36,24 +33,19 @@ mod draw;
 mod error;
 mod feather;
 mod folds;
-mod helper;
 pub mod overlay;
 mod patch;
 mod prepare;
-mod record;
-mod rect;
-mod replay;
 mod sampler;
 mod scratch;
 mod setup;
 mod shade;
-mod shade_simd;
 mod triangles;
 
+pub use crate::pixels::PixelRect;
 pub use covered::{covered_boundary_vertices, CoverageGrid};
-pub use draw::{draw_patch, draw_patch_solving, RasterOptions, RasterStats};
+pub use draw::{draw_patch, RasterOptions, RasterStats};
 pub use error::RasterError;
 pub use patch::Patch;
-pub use rect::PixelRect;
 pub use scratch::RasterScratch;
 pub use triangles::triangle_pixels;

@@ -1,7 +1,7 @@
 //! The shading sampler: takes the source [`FloatImage`] and gives bilinear samples as SIMD
 //! [`Vec4`]s for the raster's inner loop — branch-free clamped taps, one slice, no per-call
-//! setup. The hot path ([`Sampler::sample_texel_space`]) takes f32 positions and unchecked
-//! (proven in-range) taps; it differs from [`FloatImage::sample_bilinear`] only by the f32
+//! setup. The hot path ([`Sampler::sample_texel_space`]) takes f32 positions and clamped
+//! taps; it differs from [`FloatImage::sample_bilinear`] only by the f32
 //! rounding of the position (tested to 1e-5 per channel). The f64 path, kept for tests, is
 //! bit-identical to it.
 //!
@@ -9,8 +9,7 @@
 //! source, the usual case — its [`eight_bit_texels`](FloatImage::eight_bit_texels), a quarter
 //! of the bytes, which is what the shading loop waits on. An 8-bit sample blends the integer
 //! levels `k` and divides by 255 once at the end: at texel centres that is exactly the image's
-//! `k / 255`, elsewhere it differs from the `f32` blend by an ulp or so (tested). The SIMD
-//! kernel does the same operations, so both paths still give the same bytes.
+//! `k / 255`, elsewhere it differs from the `f32` blend by an ulp or so (tested).
 
 use glam::Vec4;
 
@@ -18,8 +17,6 @@ use crate::pixels::FloatImage;
 
 /// A texel type the sampler reads.
 pub(crate) trait SourceTexel: Copy {
-    /// Whether the texels are 8-bit levels (else `f32` values).
-    const EIGHT_BIT: bool;
     /// The texel's channels in the blend's units.
     fn blend_units(self) -> Vec4;
     /// A blend of texels in channel values.
@@ -27,8 +24,6 @@ pub(crate) trait SourceTexel: Copy {
 }
 
 impl SourceTexel for [f32; 4] {
-    const EIGHT_BIT: bool = false;
-
     #[inline(always)]
     fn blend_units(self) -> Vec4 {
         Vec4::from_array(self)
@@ -41,8 +36,6 @@ impl SourceTexel for [f32; 4] {
 }
 
 impl SourceTexel for [u8; 4] {
-    const EIGHT_BIT: bool = true;
-
     #[inline(always)]
     fn blend_units(self) -> Vec4 {
         Vec4::from_array(self.map(f32::from))
@@ -56,14 +49,12 @@ impl SourceTexel for [u8; 4] {
 
 /// A borrowed view of the source, set up once per draw.
 pub(crate) struct Sampler<'a, S = [f32; 4]> {
-    pub(super) pixels: &'a [S],
-    pub(super) width: usize,
-    pub(super) last_x: usize,
-    pub(super) last_y: usize,
-    pub(super) last_x_f32: f32,
-    pub(super) last_y_f32: f32,
-    /// Every texel's alpha is 1 (so is every sample's, exactly); `false` when unknown.
-    pub(super) opaque: bool,
+    pixels: &'a [S],
+    width: usize,
+    last_x: usize,
+    last_y: usize,
+    last_x_f32: f32,
+    last_y_f32: f32,
 }
 
 impl<'a> Sampler<'a> {
@@ -97,13 +88,7 @@ impl<'a, S: SourceTexel> Sampler<'a, S> {
             last_y: source.height().saturating_sub(1) as usize,
             last_x_f32: last_as_f32(source.width()),
             last_y_f32: last_as_f32(source.height()),
-            opaque: false,
         }
-    }
-
-    /// Declares every texel's alpha 1 (the caller checked it).
-    pub fn known_opaque(self, opaque: bool) -> Sampler<'a, S> {
-        Sampler { opaque, ..self }
     }
 
     /// [`sample`](Self::sample) with `f32` coordinates and tap arithmetic (the shading hot
@@ -121,9 +106,8 @@ impl<'a, S: SourceTexel> Sampler<'a, S> {
         let (x0, x1, tx) = taps_shifted(x, self.last_x, self.last_x_f32);
         let (y0, y1, ty) = taps_shifted(y, self.last_y, self.last_y_f32);
         let (row0, row1) = (y0 * self.width, y1 * self.width);
-        // SAFETY: the taps are ≤ last_x < width and ≤ last_y < height (see `taps_f32`), and
-        // `pixels` holds width · height ≥ 1 texels (a FloatImage is never empty).
-        let texel = |i: usize| unsafe { *self.pixels.get_unchecked(i) }.blend_units();
+        // The taps are ≤ last_x < width and ≤ last_y < height (see `taps_shifted`).
+        let texel = |i: usize| self.pixels[i].blend_units();
         // a + (b − a)·t: one multiply fewer than glam's `lerp` (a·(1 − t) + b·t); differs
         // from the f64 reference only in the last bits.
         let lerp = |a: Vec4, b: Vec4, t: f32| a + (b - a) * t;
@@ -154,9 +138,9 @@ fn taps_shifted(shifted: f32, last: usize, last_f32: f32) -> (usize, usize, f32)
     // Plain comparisons compile to maxss/minss (NaN → 0 by the first), unlike f32::max/min.
     let low = if shifted > 0.0 { shifted } else { 0.0 };
     let u = if low < last_f32 { low } else { last_f32 };
-    // SAFETY: u is finite and in [0, last] ⊂ [0, 2^32) after the clamp (±∞ and NaN included),
-    // so it is representable in i64.
-    let whole = unsafe { u.to_int_unchecked::<i64>() };
+    // u is finite and in [0, last] ⊂ [0, 2^32) after the clamp (±∞ and NaN included), so
+    // the cast truncates exactly.
+    let whole = u as i64;
     // The signed conversion back is one instruction; an unsigned 64-bit one is a branchy
     // sequence on x86_64. Same value either way (0 ≤ whole < 2^32).
     let fraction = u - whole as f32;

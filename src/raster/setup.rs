@@ -42,7 +42,7 @@ pub(crate) struct SpanSetup {
     pub membrane: MembraneSpan,
 }
 
-/// The membrane part of [`SpanSetup`], all a replay needs (see [`replay`](super::replay)).
+/// The membrane part of [`SpanSetup`].
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct MembraneSpan {
     pub origin: [i32; 2],
@@ -52,9 +52,8 @@ pub(crate) struct MembraneSpan {
 
 /// A triangle's barycentric gradients and the pixel centre near vertex `a` that the span
 /// maps are based at. Only differences from `a` enter, so a patch moved by whole pixels
-/// gets bit-identical span maps (the replay of [`replay`](super::replay) relies on it).
-#[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct LocalFrame {
+/// gets bit-identical span maps.
+struct LocalFrame {
     g1: DVec2,
     g2: DVec2,
     origin: [i32; 2],
@@ -104,17 +103,6 @@ impl MembraneSpan {
         }
     }
 
-    /// The membrane maps of a placed triangle alone: for a triangle that a full
-    /// [`TriangleSetup`] finds drawable, bit for bit its `span.membrane`.
-    pub fn of_triangle(placed: [DVec2; 3], membrane: [[f32; 3]; 3]) -> MembraneSpan {
-        let [a, b, c] = placed;
-        let det = (b - a).perp_dot(c - a);
-        MembraneSpan::new(
-            &LocalFrame::new(placed, det != 0.0 && det.is_finite()),
-            membrane,
-        )
-    }
-
     /// The membrane at pixel `(x, y)`'s centre.
     #[inline(always)]
     pub fn at_pixel(&self, x: i32, y: i32) -> Vec4 {
@@ -122,52 +110,6 @@ impl MembraneSpan {
         let dy = (y - self.origin[1]) as f32;
         let [m_origin, m_x, m_y] = self.maps;
         m_origin + m_x * dx + m_y * dy
-    }
-
-    /// [`at_pixel`](Self::at_pixel) along row `y` from column `x0` (see [`RowWalk`]).
-    #[inline(always)]
-    pub fn along_row(&self, x0: i32, y: i32) -> RowWalk<Vec4> {
-        RowWalk::new(self.maps, (x0 - self.origin[0], y - self.origin[1]))
-    }
-}
-
-/// An affine map's values along one row: at dx = dx₀, dx₀ + 1, … it gives
-/// `(m₀ + m_x·dx) + m_y·dy`, the per-pixel evaluation's operations in its order, with the
-/// row's `m_y·dy` computed once and dx stepped by 1.0 (exact: the offsets are integers far
-/// below 2²⁴). So a walk gives the per-pixel values bit for bit.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct RowWalk<T> {
-    origin: T,
-    step: T,
-    row_term: T,
-    dx: f32,
-}
-
-impl<T> RowWalk<T>
-where
-    T: Copy + std::ops::Add<Output = T> + std::ops::Mul<f32, Output = T>,
-{
-    /// The walk of `[m₀, m_x, m_y]` from pixel offset `(dx₀, dy)` relative to the maps' origin.
-    #[inline(always)]
-    pub fn new([origin, step, m_y]: [T; 3], (dx, dy): (i32, i32)) -> RowWalk<T> {
-        RowWalk {
-            origin,
-            step,
-            row_term: m_y * dy as f32,
-            dx: dx as f32,
-        }
-    }
-
-    /// The value at the current pixel.
-    #[inline(always)]
-    pub fn value(&self) -> T {
-        self.origin + self.step * self.dx + self.row_term
-    }
-
-    /// Moves to the next pixel of the row.
-    #[inline(always)]
-    pub fn advance(&mut self) {
-        self.dx += 1.0;
     }
 }
 
@@ -218,21 +160,6 @@ impl TriangleSetup {
         membrane: [[f32; 3]; 3],
         depth: [f32; 3],
     ) -> TriangleSetup {
-        let (mut setup, frame) = TriangleSetup::geometry(placed, snapped, rest, depth);
-        setup.set_membrane(&frame, membrane);
-        setup
-    }
-
-    /// Everything of [`from_snapped`](Self::from_snapped) but the membrane maps (left zero),
-    /// and the frame that [`set_membrane`](Self::set_membrane) needs to add them later: a
-    /// draw computes the geometry while the membrane is still being solved.
-    #[inline]
-    pub fn geometry(
-        placed: [DVec2; 3],
-        snapped: [SnappedVertex; 3],
-        rest: [DVec2; 3],
-        depth: [f32; 3],
-    ) -> (TriangleSetup, LocalFrame) {
         let [a, b, c] = placed;
         let e1 = b - a;
         let e2 = c - a;
@@ -264,15 +191,12 @@ impl TriangleSetup {
             let gradient = frame.gradient(edge1, edge2);
             [at_a - gradient.dot(a), gradient.x, gradient.y]
         };
-        let setup = TriangleSetup {
+        TriangleSetup {
             span: SpanSetup {
                 texel_x: texel(rest[0].x, r1.x, r2.x),
                 texel_y: texel(rest[0].y, r1.y, r2.y),
                 // The texel maps share the membrane's origin.
-                membrane: MembraneSpan {
-                    origin: frame.origin,
-                    maps: [Vec4::ZERO; 3],
-                },
+                membrane: MembraneSpan::new(&frame, membrane),
             },
             fixed,
             drawable,
@@ -281,15 +205,7 @@ impl TriangleSetup {
                 f64::from(depth[1]) - f64::from(depth[0]),
                 f64::from(depth[2]) - f64::from(depth[0]),
             ),
-        };
-        (setup, frame)
-    }
-
-    /// Adds the membrane maps to a setup from [`geometry`](Self::geometry), with the frame
-    /// it gave.
-    #[inline]
-    pub fn set_membrane(&mut self, frame: &LocalFrame, membrane: [[f32; 3]; 3]) {
-        self.span.membrane = MembraneSpan::new(frame, membrane);
+        }
     }
 
     /// Depth at the centre of pixel (x, y) and its step per pixel along the row: a span
@@ -352,57 +268,6 @@ pub(crate) fn edge_function(a: [i64; 2], b: [i64; 2], p: [i64; 2]) -> i64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// Row walks give `at_pixel`'s values bit for bit, for placed triangles anywhere in the
-    /// coordinate range and runs starting on either side of the maps' origin.
-    #[test]
-    fn row_walks_are_the_per_pixel_maps_bit_for_bit() {
-        let mut state = 0x5eed_u64;
-        let mut next = || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
-        let mut walked = 0;
-        for _ in 0..300 {
-            let far = 4000.0 * next() * next();
-            let corner = |next: &mut dyn FnMut() -> f64| {
-                DVec2::new(far * (2.0 * next() - 1.0), far * (2.0 * next() - 1.0))
-            };
-            let placed = [corner(&mut next), corner(&mut next), corner(&mut next)];
-            let rest = [corner(&mut next), corner(&mut next), corner(&mut next)];
-            let membrane = [0, 1, 2].map(|_| [next() as f32, -next() as f32, next() as f32]);
-            let setup = TriangleSetup::new(placed, rest, membrane, [0.0; 3]);
-            if !setup.drawable {
-                continue;
-            }
-            let span = &setup.span;
-            let y = span.membrane.origin[1] + (next() * 200.0) as i32 - 100;
-            let x0 = span.membrane.origin[0] + (next() * 200.0) as i32 - 100;
-            let offset = (x0 - span.membrane.origin[0], y - span.membrane.origin[1]);
-            let (mut u, mut v) = (
-                RowWalk::new(span.texel_x, offset),
-                RowWalk::new(span.texel_y, offset),
-            );
-            let mut m = span.membrane.along_row(x0, y);
-            for x in x0..x0 + 40 {
-                let (eu, ev, em) = span.at_pixel(x, y);
-                assert_eq!(u.value().to_bits(), eu.to_bits(), "u at {x}");
-                assert_eq!(v.value().to_bits(), ev.to_bits(), "v at {x}");
-                assert_eq!(
-                    m.value().to_array().map(f32::to_bits),
-                    em.to_array().map(f32::to_bits),
-                    "membrane at {x}"
-                );
-                u.advance();
-                v.advance();
-                m.advance();
-            }
-            walked += 1;
-        }
-        assert!(walked > 250, "{walked} drawable triangles walked");
-    }
 
     #[test]
     fn floor_to_i32_is_floor_over_the_coordinate_range() {

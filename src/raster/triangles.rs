@@ -40,12 +40,6 @@ pub(crate) fn rasterise_triangles(
     }
 }
 
-/// The canvas rows `[first, last)` whose pixel centres a drawable triangle may own.
-pub(crate) fn centre_rows(setup: &TriangleSetup) -> (i64, i64) {
-    let [a, b, c] = setup.fixed;
-    centre_range(a[1].min(b[1]).min(c[1]), a[1].max(b[1]).max(c[1]))
-}
-
 /// Whether the edge a→b of a positively oriented triangle is a top or left edge.
 #[inline]
 fn is_top_left(a: [i64; 2], b: [i64; 2]) -> bool {
@@ -83,63 +77,17 @@ fn rasterise_one(
     });
 }
 
-/// Spans from this long take the depth test four pixels at a time (SSE2): the short spans
-/// of boundary-dense meshes would pay the set-up for nothing.
-const CHUNKED_SPAN: usize = 12;
-
 /// The depth test along one span: pixel k gets depth `first + step·k` and takes the
-/// triangle when that is ≥ the stored depth (never when it is NaN). Same values whichever
-/// loop runs: the vector lanes do the scalar operations (a multiply, then an add).
+/// triangle when that is ≥ the stored depth (never when it is NaN).
 #[inline]
 fn depth_test_span(index: u32, (first, step): (f32, f32), ids: &mut [u32], depths: &mut [f32]) {
-    let mut done = 0;
-    #[cfg(target_arch = "x86_64")]
-    if ids.len() >= CHUNKED_SPAN {
-        done = depth_test_sse2(index, (first, step), ids, depths);
-    }
-    for (k, (id, stored)) in ids.iter_mut().zip(depths.iter_mut()).enumerate().skip(done) {
+    for (k, (id, stored)) in ids.iter_mut().zip(depths.iter_mut()).enumerate() {
         let depth = first + step * k as i32 as f32;
         if depth >= *stored {
             *stored = depth;
             *id = index;
         }
     }
-}
-
-/// The first `4·⌊len/4⌋` pixels of [`depth_test_span`], four at a time; gives that count.
-/// (LLVM turned the scalar loop's selects into a branch per pixel, so this is explicit.)
-#[cfg(target_arch = "x86_64")]
-#[inline]
-fn depth_test_sse2(
-    index: u32,
-    (first, step): (f32, f32),
-    ids: &mut [u32],
-    depths: &mut [f32],
-) -> usize {
-    use std::arch::x86_64::*;
-    let count = ids.len().min(depths.len()) / 4 * 4;
-    // SAFETY: SSE2 is part of the x86_64 baseline; every access is at k..k + 4 with
-    // k + 4 ≤ count ≤ both lengths, unaligned loads and stores.
-    unsafe {
-        let (first_v, step_v) = (_mm_set1_ps(first), _mm_set1_ps(step));
-        let index_v = _mm_set1_epi32(index as i32);
-        let mut lanes = _mm_setr_epi32(0, 1, 2, 3);
-        for k in (0..count).step_by(4) {
-            let depth = _mm_add_ps(first_v, _mm_mul_ps(step_v, _mm_cvtepi32_ps(lanes)));
-            let stored_at = depths.as_mut_ptr().add(k);
-            let ids_at = ids.as_mut_ptr().add(k) as *mut __m128i;
-            let stored = _mm_loadu_ps(stored_at);
-            let wins = _mm_cmpge_ps(depth, stored);
-            let kept = _mm_or_ps(_mm_and_ps(wins, depth), _mm_andnot_ps(wins, stored));
-            _mm_storeu_ps(stored_at, kept);
-            let wins = _mm_castps_si128(wins);
-            let old = _mm_loadu_si128(ids_at);
-            let id = _mm_or_si128(_mm_and_si128(wins, index_v), _mm_andnot_si128(wins, old));
-            _mm_storeu_si128(ids_at, id);
-            lanes = _mm_add_epi32(lanes, _mm_set1_epi32(4));
-        }
-    }
-    count
 }
 
 /// Calls `visit(x, y)` for every pixel of `clip` whose centre the placed triangle owns under

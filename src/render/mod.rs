@@ -1,9 +1,8 @@
 //! Rendering scenes: takes a [`Scene`](crate::scene::Scene) and a frame index (or a time) and
 //! gives the composited frame as a [`Canvas`](crate::pixels::Canvas).
 //!
-//! Once per scene ([`Renderer::new`]): load images, mesh every patch, assemble its cloning
-//! Laplacian (factored by the patch's first clone, while the raster records that draw) and,
-//! for patches with handles or pins, factor its deformation Laplacian. Per frame:
+//! Once per scene ([`Renderer::new`]): load images, mesh every patch, assemble and factor its
+//! cloning Laplacian and, for patches with handles or pins, factor its deformation Laplacian. Per frame:
 //! evaluate the timeline at t = i / fps, reset the canvas to the background, then for each
 //! patch back to front: deformation solve (rank-1 switches only), visibility switches,
 //! membrane solve, raster — each patch clones onto the composite of the layers below it.

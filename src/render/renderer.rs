@@ -10,8 +10,8 @@ use glam::DVec2;
 use super::layer::{Layer, LayerSettings};
 use super::RenderError;
 use crate::mesh::Mesh;
+use crate::pixels::PixelRect;
 use crate::pixels::{Canvas, Depth, FloatImage, PixelFormat};
-use crate::raster::PixelRect;
 use crate::scene::{frame_time, Background, FrameState, Patch, Scene};
 use crate::util::lock;
 
