@@ -56,7 +56,6 @@ fn identity_reproduces_the_source_inside() {
     let options = RasterOptions {
         anti_alias: false,
         feather: 0.0,
-        ..RasterOptions::default()
     };
     draw(
         &mut canvas,
@@ -100,7 +99,6 @@ fn integer_translation_shifts_the_source_and_membrane_adds_exactly() {
     let options = RasterOptions {
         anti_alias: false,
         feather: 0.0,
-        ..RasterOptions::default()
     };
     draw(
         &mut canvas,
@@ -147,7 +145,6 @@ fn depth_picks_the_front_layer_and_ties_go_to_the_later_triangle() {
     let options = RasterOptions {
         anti_alias: false,
         feather: 0.0,
-        ..RasterOptions::default()
     };
     let red = Some([1.0, 0.0, 0.0, 1.0]);
     let blue = Some([0.0, 0.0, 1.0, 1.0]);
@@ -407,7 +404,6 @@ fn feather_is_monotone_inward_and_softer_than_none() {
         let options = RasterOptions {
             anti_alias: true,
             feather,
-            ..RasterOptions::default()
         };
         draw(
             &mut canvas,
@@ -497,7 +493,6 @@ fn patch_outside_the_canvas_draws_nothing_and_bad_input_is_an_error() {
     let bad_feather = RasterOptions {
         feather: -1.0,
         anti_alias: true,
-        ..RasterOptions::default()
     };
     assert!(draw_patch(&mut canvas, &patch, &bad_feather, &mut RasterScratch::new()).is_err());
     assert_eq!(canvas, before);
