@@ -10,7 +10,7 @@
 //! Folds are rare, so the path stays about the size of the boundary. Without loops, every
 //! triangle goes into the path (same union, slower).
 //!
-//! Large work rectangles are covered by up to four strips, filled at once by two threads. Each
+//! Large work rectangles are covered by up to four horizontal strips, one mask each. Each
 //! strip's path is clipped ([`clip`](super::clip)) to one pixel beyond the strip, so it lies
 //! inside the strip's mask and tiny-skia's own clipping (whose rounding would depend on the
 //! grow-only mask's size, so on earlier frames) never runs.
@@ -23,12 +23,11 @@ use super::folds::{wound, FoldOutline};
 use super::{Patch, PixelRect};
 
 /// Work rectangles are covered by one horizontal strip per this many pixels (at most
-/// [`MAX_STRIPS`]), which threads fill at once. The rule depends on the rectangle alone,
-/// never on the thread count, so every thread count gives the same coverage.
+/// [`MAX_STRIPS`]). Where a strip is cut can move coverage in the last bits near the cut,
+/// so the rule depends on the rectangle alone and never changes with anything else.
 pub(crate) const SPLIT_AREA: usize = 64 * 1024;
 
-/// Strips of the largest work rectangles: enough for two threads to share them evenly when
-/// one starts late.
+/// Strips of the largest work rectangles.
 const MAX_STRIPS: usize = 4;
 
 /// Pixels of mask around a strip: its path is clipped one pixel outside the strip, and
