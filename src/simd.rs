@@ -117,7 +117,7 @@ pub fn add<const S: usize>(x: Row<S>, y: Row<S>) -> Row<S> {
 /// If `x.len()` is not a multiple of `S`.
 pub fn rows_mut<const S: usize>(x: &mut [f64]) -> &mut [Row<S>]
 where
-    Row<S>: pulp::bytemuck::Pod,
+    Row<S>: bytemuck::Pod,
 {
-    pulp::bytemuck::cast_slice_mut(x)
+    bytemuck::cast_slice_mut(x)
 }
