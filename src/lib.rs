@@ -19,5 +19,6 @@ pub mod reference;
 pub mod render;
 pub mod scene;
 pub mod script;
+pub mod simd;
 pub mod solve;
 pub mod util;

@@ -47,9 +47,8 @@ fn stats_json_has_exactly_the_contract_keys() {
         "uncovered_mask_pixels",
         "max_boundary_deviation_px",
         "mesh_ms",
-        // Beyond the contract: where the boundary runs, and the cut of a large mask.
+        // Beyond the contract: where the boundary runs.
         "boundary",
-        "cut_row",
     ];
     expected.sort_unstable();
     assert_eq!(keys, expected);
@@ -57,7 +56,6 @@ fn stats_json_has_exactly_the_contract_keys() {
     assert_eq!(json["holes"], 1);
     assert_eq!(json["uncovered_mask_pixels"], 0);
     assert_eq!(json["boundary"], "outside-centres");
-    assert_eq!(json["cut_row"], serde_json::Value::Null);
     let out = lapclone(&["mesh", &mask, "--stats", "--boundary", "cracks"]);
     let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(json["boundary"], "cracks");

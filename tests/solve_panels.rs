@@ -1,6 +1,7 @@
 //! Supernodal solve: the supernode partition detected from the factor pattern, and the
 //! panel kernel against the column kernel it replaced (≤ 1e-12 relative), for factors with
-//! and without relaxed supernodes, every channel count and both SIMD levels; random meshes
+//! and without relaxed supernodes, every channel count and both SIMD paths (which must agree
+//! bit for bit); random meshes
 //! and right-hand sides by proptest with a fixed seed.
 
 use lapclone::mesh::Mesh;
@@ -82,6 +83,7 @@ fn check_against_column_kernel(f: &PenaltyFactor, channels: usize, seed: u64) {
         channels,
     );
     let lanes = lanes_for(channels);
+    let mut bits: Vec<Vec<u64>> = Vec::new();
     for level in levels() {
         let mut x = vec![0.0; n * lanes];
         for i in 0..n {
@@ -92,6 +94,7 @@ fn check_against_column_kernel(f: &PenaltyFactor, channels: usize, seed: u64) {
         let solved: Vec<f64> = (0..n * channels)
             .map(|k| x[k / channels * lanes + k % channels])
             .collect();
+        bits.push(x.iter().map(|v| v.to_bits()).collect());
         let diff = rel_diff(&solved, &reference);
         assert!(
             diff <= 1e-12,
@@ -99,6 +102,10 @@ fn check_against_column_kernel(f: &PenaltyFactor, channels: usize, seed: u64) {
             symbolic.supernodes().count()
         );
     }
+    assert!(
+        bits.windows(2).all(|w| w[0] == w[1]),
+        "the vector and portable paths must give the same bits"
+    );
 }
 
 #[test]

@@ -34,51 +34,6 @@ fn solve(f: &mut PenaltyFactor, b: &[f64], k: usize) -> Vec<f64> {
     x
 }
 
-/// Rebuilds L·D·Lᵀ from the converted factor and compares with the permuted penalised
-/// matrix: fails if faer's supernodal storage (D on the block diagonal, unit-lower L below
-/// it, the pattern rows under the block) is not what the conversion assumes.
-#[test]
-fn supernodal_factor_converts_to_the_column_layout() {
-    let mesh = fixtures::disc(4);
-    let l = laplacian(&mesh, LaplacianKind::Cotangent);
-    let n = l.n;
-    for method in SUPERNODAL {
-        let f = factor_with(&l, method, &mesh.is_boundary);
-        let sym = f.symbolic();
-        assert!(
-            sym.is_supernodal(),
-            "{method:?} did not build a supernodal factor"
-        );
-        sym.check_layout().unwrap();
-        let (cp, ri, vals) = (sym.col_ptr(), sym.row_idx(), f.factor_values());
-        assert_eq!(vals.len(), ri.len());
-        let mut lower = vec![vec![0.0; n]; n];
-        let mut d = vec![0.0; n];
-        for j in 0..n {
-            d[j] = vals[cp[j] as usize];
-            assert!(d[j] > 0.0, "{method:?}: pivot {j} is {}", d[j]);
-            lower[j][j] = 1.0;
-            for p in cp[j] as usize + 1..cp[j + 1] as usize {
-                lower[ri[p] as usize][j] = vals[p];
-            }
-        }
-        let mut a = l.to_dense();
-        for (v, row) in a.iter_mut().enumerate() {
-            row[v] += f.epsilon() + if f.is_constrained(v) { f.alpha() } else { 0.0 };
-        }
-        let fwd = sym.perm_fwd();
-        let mut worst: f64 = 0.0;
-        for i in 0..n {
-            for j in 0..=i {
-                let ldlt: f64 = (0..=j).map(|k| lower[i][k] * d[k] * lower[j][k]).sum();
-                let reference = a[fwd[i] as usize][fwd[j] as usize];
-                worst = worst.max((ldlt - reference).abs() / f.alpha());
-            }
-        }
-        assert!(worst <= 1e-13, "{method:?}: LDLᵀ off by {worst}");
-    }
-}
-
 #[test]
 fn fundamental_supernodes_keep_the_simplicial_pattern_and_relaxed_ones_add_zeros() {
     let l = laplacian(&fixtures::disc(8), LaplacianKind::Combinatorial);

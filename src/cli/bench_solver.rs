@@ -3,10 +3,9 @@
 //! built-in disc meshes. Release builds only give meaningful figures.
 
 use anyhow::Context;
+use lapclone::simd::Path;
 use lapclone::solve::solve::ldlt_solve_interleaved;
-use lapclone::solve::solve_supernodal::{
-    inverse_diagonal, ldlt_solve_scheduled, ldlt_solve_supernodal,
-};
+use lapclone::solve::solve_supernodal::{inverse_diagonal, ldlt_solve_supernodal_at};
 use lapclone::solve::{
     fixtures, laplacian, read_constrained_list, read_matrix_market, FactorMethod, LaplacianKind,
     PenaltyFactor, PenaltyOptions, SymmetricCsc,
@@ -80,10 +79,10 @@ struct Timings {
     /// Dense right-hand sides (every entry non-zero), as CHOLMOD's reference figures.
     solve3_dense_ms: f64,
     /// The supernodal kernel alone (dense right-hand sides already permuted, 3 channels in
-    /// rows of 4), following the factor's two-thread schedule if it has one.
+    /// rows of 4), compiled for this CPU.
     solve3_kernel_ms: f64,
-    /// The same kernel unscheduled, on one thread.
-    solve3_serial_ms: f64,
+    /// The same kernel on the portable path (baseline instruction set, same bits).
+    solve3_portable_ms: f64,
     /// The column-by-column kernel on the same factor (the pre-supernodal solve), for comparison.
     solve3_column_ms: f64,
     update_ms: f64,
@@ -190,8 +189,8 @@ fn measure(
         factor_ms,
         solve3_ms,
         solve3_dense_ms,
-        solve3_kernel_ms: kernels.scheduled,
-        solve3_serial_ms: kernels.serial,
+        solve3_kernel_ms: kernels.vector,
+        solve3_portable_ms: kernels.portable,
         solve3_column_ms: kernels.column,
         update_ms,
         switch100_ms,
@@ -201,13 +200,13 @@ fn measure(
 
 /// Best-of timings of the solve kernels, ms.
 struct KernelTimings {
-    scheduled: f64,
-    serial: f64,
+    vector: f64,
+    portable: f64,
     column: f64,
 }
 
 /// Best-of timings of the solve kernels on `factor` (3 right-hand sides, already in factor
-/// order): the supernodal one with and without its schedule, and the column one it replaced.
+/// order): the supernodal one on either [`Path`], and the column one it replaced.
 fn kernel_ms(factor: &PenaltyFactor, rhs: &[f64]) -> KernelTimings {
     let symbolic = factor.symbolic();
     let values = factor.factor_values();
@@ -224,32 +223,21 @@ fn kernel_ms(factor: &PenaltyFactor, rhs: &[f64]) -> KernelTimings {
         })
         .collect();
     let mut x = rows.clone();
-    let mut spill = vec![0.0; rows.len()];
-    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let scheduled = best_ms_budgeted(|| {
-        x.copy_from_slice(&rows);
-        ldlt_solve_scheduled(
-            symbolic,
-            values,
-            &inv_diagonal,
-            &mut x,
-            4,
-            &mut spill,
-            threads,
-        );
-    });
-    let serial = best_ms_budgeted(|| {
-        x.copy_from_slice(&rows);
-        ldlt_solve_supernodal(symbolic, values, &inv_diagonal, &mut x, 4);
-    });
+    let mut sweeps = |path: Path| {
+        best_ms_budgeted(|| {
+            x.copy_from_slice(&rows);
+            ldlt_solve_supernodal_at(path, symbolic, values, &inv_diagonal, &mut x, 4);
+        })
+    };
+    let (vector, portable) = (sweeps(Path::Vector), sweeps(Path::Portable));
     let mut x = rhs.to_vec();
     let column = best_ms_budgeted(|| {
         x.copy_from_slice(rhs);
         ldlt_solve_interleaved(symbolic.col_ptr(), symbolic.row_idx(), values, &mut x, 3);
     });
     KernelTimings {
-        scheduled,
-        serial,
+        vector,
+        portable,
         column,
     }
 }
@@ -273,7 +261,7 @@ fn print(rows: &[Timings], json: bool) -> anyhow::Result<()> {
         "solve3 ms",
         "dense3 ms",
         "kernel ms",
-        "1-thread ms",
+        "portable ms",
         "column ms",
         "switch ms",
         "100 switch ms"
@@ -288,7 +276,7 @@ fn print(rows: &[Timings], json: bool) -> anyhow::Result<()> {
             t.solve3_ms,
             t.solve3_dense_ms,
             t.solve3_kernel_ms,
-            t.solve3_serial_ms,
+            t.solve3_portable_ms,
             t.solve3_column_ms,
             t.update_ms,
             t.switch100_ms
@@ -297,7 +285,7 @@ fn print(rows: &[Timings], json: bool) -> anyhow::Result<()> {
     println!(
         "solve3 = PenaltyFactor::solve_dirichlet, 3 channels (permutations included); dense3 = \
          solve_in_place with a dense right-hand side; kernel = the supernodal sweeps alone \
-         (two-thread schedule where the factor has one); 1-thread = the unscheduled sweeps; \
+         (compiled for this CPU); portable = the same sweeps at the baseline instruction set; \
          column = the column-by-column sweeps they replaced"
     );
     Ok(())

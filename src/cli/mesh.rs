@@ -79,17 +79,12 @@ pub fn run(args: MeshArgs) -> anyhow::Result<()> {
             "uncovered_mask_pixels": mesh::uncovered_mask_pixels(&result.mesh, &mask),
             "max_boundary_deviation_px": stats.max_boundary_deviation_px,
             "boundary": stats.boundary.name(),
-            "cut_row": stats.cut_row,
             "mesh_ms": mesh_ms,
         });
         println!("{json}");
     } else {
-        let halves = match stats.cut_row {
-            Some(row) => format!(" (two halves cut at row {row})"),
-            None => String::new(),
-        };
         println!(
-            "{} vertices, {} triangles, {} boundary vertices ({}), {} piece(s), {} hole(s), min angle {:.1}°, {:.2} ms{halves}",
+            "{} vertices, {} triangles, {} boundary vertices ({}), {} piece(s), {} hole(s), min angle {:.1}°, {:.2} ms",
             stats.vertices, stats.triangles, stats.boundary_vertices, stats.boundary.name(), stats.pieces, stats.holes, stats.min_angle_deg, mesh_ms
         );
     }

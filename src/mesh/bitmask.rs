@@ -49,13 +49,13 @@ pub(crate) fn differing_bytes(a: &[u8], b: &[u8]) -> usize {
     whole as usize + rest.filter(|(x, y)| x != y).count()
 }
 
-/// For every y in `0..=height`: the crack edges (pixel edges between inside and outside, the
-/// image border counting as outside) on the line between rows y − 1 and y, plus those between
-/// the columns of row y (none for y = height). Empty for a zero-width mask.
-pub(crate) fn crack_edges_by_row(mask: &BitMask) -> Vec<usize> {
+/// Pixel edges between inside and outside (the image border counting as outside): for every
+/// line between rows y − 1 and y, the vertical neighbours that differ, and along every row
+/// the horizontal ones.
+pub(crate) fn crack_edge_count(mask: &BitMask) -> usize {
     let (width, height) = (mask.width, mask.height);
     if width == 0 {
-        return Vec::new();
+        return 0;
     }
     let outside_row = vec![0u8; width];
     let row = |y: usize| match y {
@@ -73,18 +73,7 @@ pub(crate) fn crack_edges_by_row(mask: &BitMask) -> Vec<usize> {
             }
             edges
         })
-        .collect()
-}
-
-/// Positions where two equally long 0/1 byte slices are both 1, eight per word.
-pub(crate) fn shared_ones(a: &[u8], b: &[u8]) -> usize {
-    let (mut words_a, mut words_b) = (a.chunks_exact(8), b.chunks_exact(8));
-    let whole: u32 = (&mut words_a)
-        .zip(&mut words_b)
-        .map(|(x, y)| (word(x) & word(y)).count_ones())
-        .sum();
-    let rest = words_a.remainder().iter().zip(words_b.remainder());
-    whole as usize + rest.filter(|(&x, &y)| x & y != 0).count()
+        .sum()
 }
 
 /// A width × height grid of inside/outside pixels. Pixel (x, y) covers [x, x+1] × [y, y+1].
@@ -192,19 +181,7 @@ impl BitMask {
 
     /// Row-major inside flags as bytes (1 inside, 0 outside), for word-at-a-time scans.
     pub fn as_bytes(&self) -> &[u8] {
-        // SAFETY: `bool` is one byte holding 0 or 1, so its slice reads as bytes.
-        unsafe { std::slice::from_raw_parts(self.inside.as_ptr().cast(), self.inside.len()) }
-    }
-
-    /// Rows `rows` of the mask as a mask of their own (row `rows.start` becomes row 0).
-    pub fn rows(&self, rows: std::ops::Range<usize>) -> BitMask {
-        let start = rows.start.min(self.height);
-        let rows = start..rows.end.clamp(start, self.height);
-        BitMask {
-            width: self.width,
-            height: rows.len(),
-            inside: self.inside[rows.start * self.width..rows.end * self.width].to_vec(),
-        }
+        bytemuck::cast_slice(&self.inside)
     }
 
     /// Row `y`'s flags as bytes.

@@ -30,7 +30,7 @@ struct Edge {
 
 /// Whether loops thinned to `spacing` keep every centre (the longest step between
 /// neighbouring centres is √2 px).
-pub(crate) fn keeps_every_centre(spacing: f64) -> bool {
+fn keeps_every_centre(spacing: f64) -> bool {
     spacing <= std::f64::consts::SQRT_2 + 1e-9
 }
 
@@ -44,7 +44,7 @@ const THIN_TOLERANCE: f64 = 0.5;
 /// corner pixel (the centre loop touches its corner), but every mask pixel keeps its centre
 /// and at least half its square inside (tested), so the patch's anti-aliased edge leaves it
 /// at least half opaque.
-pub(crate) fn thin_loop(lp: &KeptLoop, spacing: f64) -> Vec<DVec2> {
+fn thin_loop(lp: &KeptLoop, spacing: f64) -> Vec<DVec2> {
     let (points, keep) = (&lp.points, &lp.keep);
     let n = points.len();
     if keeps_every_centre(spacing) || n <= 3 {
@@ -90,12 +90,6 @@ impl KeptLoop {
         self.points.push(point);
         self.keep.push(keep);
     }
-
-    /// Appends `other`'s points `range`.
-    pub fn extend_from(&mut self, other: &KeptLoop, range: std::ops::Range<usize>) {
-        self.points.extend_from_slice(&other.points[range.clone()]);
-        self.keep.extend_from_slice(&other.keep[range]);
-    }
 }
 
 /// Loops through the outside pixel centres, one per crack loop (same order, same
@@ -110,7 +104,7 @@ pub fn outside_centre_loops(crack: &[CrackLoop], spacing: f64) -> (Vec<Vec<DVec2
 
 /// Every outside pixel centre of each crack loop (quarter-pixel points where a centre is
 /// shared, marked to be kept), before thinning, and how many points fell back.
-pub(crate) fn outside_centre_points(crack: &[CrackLoop]) -> (Vec<KeptLoop>, usize) {
+fn outside_centre_points(crack: &[CrackLoop]) -> (Vec<KeptLoop>, usize) {
     let loops: Vec<(Vec<Edge>, Vec<Run>)> = crack
         .iter()
         .map(|c| {

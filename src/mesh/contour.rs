@@ -134,8 +134,7 @@ pub fn trace_crack_loops(mask: &BitMask) -> Vec<CrackLoop> {
 pub(crate) fn for_each_edge_pixel(mask: &BitMask, mut visit: impl FnMut(usize, usize)) {
     let (w, h) = (mask.width, mask.height);
     let inside = mask.as_slice();
-    // SAFETY: `bool` is one byte holding 0 or 1, so its slice reads as bytes.
-    let bytes: &[u8] = unsafe { std::slice::from_raw_parts(inside.as_ptr().cast(), inside.len()) };
+    let bytes = mask.as_bytes();
     let word = |at: usize| {
         // invariant: callers pass `at + 8 ≤ bytes.len()`.
         u64::from_le_bytes(bytes[at..at + 8].try_into().expect("eight bytes"))

@@ -5,22 +5,15 @@
 //! those loops cannot be meshed, the crack path is taken: Douglas–Peucker (anchored at saddle
 //! corners) → subdivide to `density` → CDT + refinement, and if simplification makes two loops
 //! touch or cross (a thin gap closed by the tolerance), the raw crack loops, which never
-//! cross. Masks with a long boundary go through either path as two halves at once, joined
-//! afterwards (`split`, `centre_cut`), except centre loops that keep every centre.
+//! cross. Every mask is meshed whole, so the refinement's angle bound holds everywhere.
 
 use glam::DVec2;
 
-use super::bitmask::crack_edges_by_row;
-use super::centre_cut::cut_centre_loops;
-use super::centre_loops::{
-    keeps_every_centre, outside_centre_loops, outside_centre_points, thin_loop, KeptLoop,
-};
+use super::bitmask::crack_edge_count;
+use super::centre_loops::outside_centre_loops;
 use super::contour::{label_pieces, piece_sizes, trace_crack_loops, CrackLoop};
 use super::options::{min_angle_deg, BoundaryPlacement};
-use super::simplify::{
-    doubled_signed_area, simplify_loop, subdivide_loop, subdivide_loop_sharing_row, subdivided_len,
-};
-use super::split::{merge, Cut, Interface};
+use super::simplify::{doubled_signed_area, simplify_loop, subdivide_loop, subdivided_len};
 use super::triangulate::{triangulate_loops, Refinement};
 use super::{BitMask, Mesh, MeshError, MeshOptions, MeshResult, MeshStats};
 
@@ -46,31 +39,14 @@ pub fn mesh_mask(mask: &BitMask, options: &MeshOptions) -> Result<MeshResult, Me
         });
     }
     let kept_mask = kept.as_ref().unwrap_or(mask);
-    let edges_by_row = crack_edges_by_row(kept_mask);
-    let edges: usize = edges_by_row.iter().sum();
+    let edges = crack_edge_count(kept_mask);
     let max_edges = MAX_CRACK_EDGES_PER_VERTEX
         .saturating_mul(options.max_vertices)
         .max(MIN_CRACK_EDGE_LIMIT);
     if edges > max_edges {
         return Err(MeshError::BoundaryTooLong { edges, max_edges });
     }
-    let split = Cut::choose(kept_mask, &edges_by_row, options.max_vertices)
-        .map(|cut| match options.boundary {
-            BoundaryPlacement::Cracks => mesh_in_halves(kept_mask, &cut, pieces, options),
-            // Every centre kept is the accuracy preset's boundary: the cut's interface, a
-            // line of vertices refinement may not split, cost it 1.3 dB (combinatorial, on
-            // the spiral model), so such meshes are made whole (docs/quality.md).
-            BoundaryPlacement::OutsideCentres if keeps_every_centre(options.density) => Ok(None),
-            BoundaryPlacement::OutsideCentres => {
-                mesh_centres_in_halves(kept_mask, &cut, pieces, options)
-            }
-        })
-        .transpose()?
-        .flatten();
-    let meshed = match split {
-        Some(meshed) => meshed,
-        None => mesh_whole(kept_mask, pieces, options, &mut warnings)?,
-    };
+    let meshed = mesh_whole(kept_mask, pieces, options, &mut warnings)?;
     if meshed.fell_back {
         warnings.push(
             "simplification made boundary loops touch; meshed the unsimplified crack boundary"
@@ -94,7 +70,6 @@ pub fn mesh_mask(mask: &BitMask, options: &MeshOptions) -> Result<MeshResult, Me
     );
     stats.boundary = meshed.placement;
     stats.off_centre_boundary_vertices = meshed.off_centre;
-    stats.cut_row = meshed.cut_row;
     Ok(MeshResult {
         mesh: meshed.mesh,
         warnings,
@@ -114,8 +89,6 @@ struct Meshed {
     fell_back: bool,
     placement: BoundaryPlacement,
     off_centre: usize,
-    /// The row the mask was cut at, when meshed as two halves.
-    cut_row: Option<usize>,
 }
 
 /// The inside-pixel topology a mesh of some crack loops must have.
@@ -123,21 +96,6 @@ struct Meshed {
 struct Topology {
     holes: usize,
     pieces: usize,
-}
-
-impl Topology {
-    /// The topology of the region `loops` bound (outer loops positive, holes negative): each
-    /// piece has one outer loop.
-    fn of_loops(loops: &[Vec<DVec2>]) -> Topology {
-        let holes = loops
-            .iter()
-            .filter(|l| doubled_signed_area(l) < 0.0)
-            .count();
-        Topology {
-            holes,
-            pieces: loops.len() - holes,
-        }
-    }
 }
 
 /// Meshes `mask` in one piece, through the outside pixel centres if asked and possible,
@@ -168,7 +126,6 @@ fn mesh_whole(
                     fell_back: false,
                     placement: BoundaryPlacement::OutsideCentres,
                     off_centre: fallbacks,
-                    cut_row: None,
                 })
             }
             Err(MeshError::IntersectingBoundary { .. } | MeshError::Sanity(_)) => {
@@ -181,127 +138,18 @@ fn mesh_whole(
             Err(e) => return Err(e),
         }
     }
-    mesh_crack_loops(&crack, expected, options, None)
-}
-
-/// Meshes the two halves of `mask` on either side of `cut` at once and joins them; `None`
-/// when the joined mesh exceeds the vertex budget (the caller then meshes the mask whole,
-/// which refines within the budget).
-fn mesh_in_halves(
-    mask: &BitMask,
-    cut: &Cut,
-    pieces: usize,
-    options: &MeshOptions,
-) -> Result<Option<Meshed>, MeshError> {
-    let [top, bottom] = cut.halves(mask);
-    let mesh_half = |half: &BitMask, first_row: usize| {
-        let mut crack = trace_crack_loops(half);
-        cut.pin(&mut crack, first_row as f64);
-        let expected = Topology {
-            holes: crack.iter().filter(|l| l.is_hole()).count(),
-            pieces: piece_sizes(half).len(),
-        };
-        mesh_crack_loops(&crack, expected, options, Some(cut.y()))
-    };
-    let (upper, lower) = rayon::join(|| mesh_half(&top, 0), || mesh_half(&bottom, cut.row));
-    let (upper, lower) = (upper?, lower?);
-    let mesh = merge(cut, &upper.mesh, &lower.mesh);
-    if cfg!(debug_assertions) {
-        mesh.sanity_check()?;
-    }
-    // Joined halves that miss the mask's pieces would be a fault of the join (the tests
-    // check it on every shape family); the whole-mask path is the safe answer.
-    debug_assert_eq!(mesh.piece_count as usize, pieces, "cut at row {}", cut.row);
-    if mesh.piece_count as usize != pieces || mesh.vertex_count() > options.max_vertices {
-        return Ok(None);
-    }
-    Ok(Some(Meshed {
-        mesh,
-        complete: upper.complete && lower.complete,
-        deviation: upper.deviation.max(lower.deviation),
-        simplified: upper.simplified && lower.simplified,
-        fell_back: upper.fell_back || lower.fell_back,
-        placement: BoundaryPlacement::Cracks,
-        off_centre: 0,
-        cut_row: Some(cut.row),
-    }))
-}
-
-/// Meshes `mask` through its outside pixel centres as two halves at once, cut at `cut`'s row
-/// (`centre_cut`), and joins them; `None` when the loops cannot be cut there, a half cannot
-/// be meshed through its centres, or the joined mesh exceeds the vertex budget (the caller
-/// then meshes the mask whole).
-fn mesh_centres_in_halves(
-    mask: &BitMask,
-    cut: &Cut,
-    pieces: usize,
-    options: &MeshOptions,
-) -> Result<Option<Meshed>, MeshError> {
-    let crack = trace_crack_loops(mask);
-    let whole = Topology {
-        holes: crack.iter().filter(|l| l.is_hole()).count(),
-        pieces,
-    };
-    let (loops, off_centre) = outside_centre_points(&crack);
-    // A cut mask's budget is at least 8 × its crack edges (`Cut::choose`), and it has at most
-    // one centre point per crack edge; the whole-mask path checks its own budget.
-    let points: usize = loops.iter().map(|l| l.points.len()).sum();
-    if points > options.max_vertices {
-        return Ok(None);
-    }
-    let Some(parts) = cut_centre_loops(&loops, cut.y(), options.density) else {
-        return Ok(None);
-    };
-    let mesh_half = |half: &[KeptLoop]| {
-        let loops: Vec<Vec<DVec2>> = (half.iter())
-            .map(|l| thin_loop(l, options.density))
-            .collect();
-        // As whole centre loops: boundary edges are not split (`mesh_whole`).
-        triangulate_checked(&loops, true, Topology::of_loops(&loops), options)
-    };
-    let [upper, lower] = &parts.halves;
-    let (upper, lower) = rayon::join(|| mesh_half(upper), || mesh_half(lower));
-    let ((upper, upper_complete), (lower, lower_complete)) = match (upper, lower) {
-        (Ok(upper), Ok(lower)) => (upper, lower),
-        (Err(MeshError::IntersectingBoundary { .. } | MeshError::Sanity(_)), _)
-        | (_, Err(MeshError::IntersectingBoundary { .. } | MeshError::Sanity(_))) => {
-            return Ok(None)
-        }
-        (Err(e), _) | (_, Err(e)) => return Err(e),
-    };
-    let mesh = merge(&parts.interface, &upper, &lower);
-    if cfg!(debug_assertions) {
-        mesh.sanity_check()?;
-    }
-    if mesh.piece_count as usize != whole.pieces
-        || mesh.hole_count() != whole.holes
-        || mesh.vertex_count() > options.max_vertices
-    {
-        return Ok(None);
-    }
-    Ok(Some(Meshed {
-        mesh,
-        complete: upper_complete && lower_complete,
-        deviation: 0.0,
-        simplified: false,
-        fell_back: false,
-        placement: BoundaryPlacement::OutsideCentres,
-        off_centre,
-        cut_row: Some(cut.row),
-    }))
+    mesh_crack_loops(&crack, expected, options)
 }
 
 /// Meshes crack loops simplified with the options' tolerance or, if simplification makes two
-/// loops touch or cross (a thin gap closed by the tolerance), unsimplified. Edges on
-/// `shared_row` are subdivided the same way in either direction.
+/// loops touch or cross (a thin gap closed by the tolerance), unsimplified.
 fn mesh_crack_loops(
     crack: &[CrackLoop],
     expected: Topology,
     options: &MeshOptions,
-    shared_row: Option<f64>,
 ) -> Result<Meshed, MeshError> {
     let attempt = |tolerance: f64| -> Result<(Mesh, bool, f64), MeshError> {
-        let (loops, deviation) = sample_crack_loops(crack, tolerance, options, shared_row)?;
+        let (loops, deviation) = sample_crack_loops(crack, tolerance, options)?;
         let (mesh, complete) = triangulate_checked(&loops, false, expected, options)?;
         Ok((mesh, complete, deviation))
     };
@@ -321,7 +169,6 @@ fn mesh_crack_loops(
         fell_back,
         placement: BoundaryPlacement::Cracks,
         off_centre: 0,
-        cut_row: None,
     })
 }
 
@@ -479,7 +326,6 @@ fn sample_crack_loops(
     crack: &[CrackLoop],
     tolerance: f64,
     options: &MeshOptions,
-    shared_row: Option<f64>,
 ) -> Result<(Vec<Vec<DVec2>>, f64), MeshError> {
     let mut deviation = 0.0f64;
     let mut points = 0.0;
@@ -490,7 +336,7 @@ fn sample_crack_loops(
         points += subdivided_len(&s.points, options.density);
         check_budget(points, options)?;
         let mut out = Vec::new();
-        subdivide_loop_sharing_row(&s.points, options.density, shared_row, &mut out);
+        subdivide_loop(&s.points, options.density, &mut out);
         loops.push(out);
     }
     Ok((loops, deviation))
@@ -514,12 +360,6 @@ const MAX_CRACK_EDGES_PER_VERTEX: usize = 16;
 /// the more useful `VertexBudget` error instead.
 const MIN_CRACK_EDGE_LIMIT: usize = 1 << 20;
 
-/// Pixel edges between inside and outside (the image border counts as outside).
-#[cfg(test)]
-fn crack_edge_count(mask: &BitMask) -> usize {
-    crack_edges_by_row(mask).iter().sum()
-}
-
 fn stats_of(
     mesh: &Mesh,
     deviation: f64,
@@ -542,7 +382,6 @@ fn stats_of(
         dropped_pixels,
         boundary: BoundaryPlacement::Cracks,
         off_centre_boundary_vertices: 0,
-        cut_row: None,
     }
 }
 
@@ -584,305 +423,27 @@ mod tests {
         assert_eq!(crack_edge_count(&BitMask::new(5, 0)), 0);
     }
 
-    /// A mask of a few discs, some of them cut out again (holes, separate pieces).
-    fn discs(width: usize, height: usize, discs: &[(f64, f64, f64, bool)]) -> BitMask {
-        BitMask::from_fn(width, height, |x, y| {
-            let (px, py) = (x as f64 + 0.5, y as f64 + 0.5);
-            let mut inside = false;
-            for &(cx, cy, r, add) in discs {
-                if (px - cx).powi(2) + (py - cy).powi(2) < r * r {
-                    inside = add;
-                }
+    /// Spiral masks of the sizes the two-half mesher once failed on are meshed whole, with
+    /// every angle at the refinement's bound (a 1e-9° tolerance for rounding in the angle
+    /// computation), for either boundary placement.
+    #[test]
+    fn large_spirals_keep_the_angle_bound_everywhere() {
+        for (width, height) in [(770, 743), (800, 800)] {
+            let mask = crate::mesh::synth::spiral(width, height);
+            for boundary in [BoundaryPlacement::OutsideCentres, BoundaryPlacement::Cracks] {
+                let options = MeshOptions {
+                    boundary,
+                    ..MeshOptions::default()
+                };
+                let meshed = mesh_mask(&mask, &options).unwrap();
+                assert!(meshed.stats.refinement_complete, "{width}×{height}");
+                let angle = min_angle_deg(&meshed.mesh);
+                assert!(
+                    angle >= options.min_angle_deg - 1e-9,
+                    "{width}×{height} {boundary:?}: {angle}°"
+                );
             }
-            inside
-        })
-    }
-
-    use proptest::prelude::*;
-
-    proptest! {
-        #![proptest_config(ProptestConfig {
-            cases: 64,
-            rng_seed: proptest::test_runner::RngSeed::Fixed(0x5b11_7000),
-            ..ProptestConfig::default()
-        })]
-        /// A mask meshed as two halves at any row is a sane mesh with the whole mask's pieces
-        /// and holes, covering every mask pixel: the halves share every interface vertex (a
-        /// vertex one half lacks would leave boundary along the cut, which the sanity check
-        /// and the hole count catch).
-        #[test]
-        fn halves_join_into_the_masks_topology(
-            (width, height) in (16usize..64, 16usize..64),
-            shapes in proptest::collection::vec(
-                (0.0f64..1.0, 0.0f64..1.0, 0.1f64..0.45, proptest::bool::weighted(0.7)),
-                1..6,
-            ),
-            row_share in 0.0f64..1.0,
-        ) {
-            let size = width.min(height) as f64;
-            let discs_px: Vec<_> = shapes
-                .iter()
-                .map(|&(x, y, r, add)| (x * width as f64, y * height as f64, r * size, add))
-                .collect();
-            let mask = discs(width, height, &discs_px);
-            let options = cracks();
-            let mut warnings = Vec::new();
-            let (kept, _, _, pieces) = drop_small_pieces(&mask, options.min_piece_area, &mut warnings);
-            prop_assume!(pieces > 0);
-            let kept = kept.unwrap_or(mask);
-            let whole = mesh_whole(&kept, pieces, &options, &mut warnings).unwrap();
-            let row = 1 + ((height - 1) as f64 * row_share) as usize;
-            let row = row.min(height - 1);
-            let cut = Cut::at(&kept, row);
-            let halves = mesh_in_halves(&kept, &cut, pieces, &options).unwrap().unwrap();
-            prop_assert_eq!(halves.mesh.sanity_check(), Ok(()));
-            prop_assert_eq!(halves.mesh.piece_count, whole.mesh.piece_count);
-            prop_assert_eq!(halves.mesh.hole_count(), whole.mesh.hole_count());
-            prop_assert_eq!(crate::mesh::uncovered_mask_pixels(&halves.mesh, &kept), 0);
         }
-    }
-
-    proptest! {
-        #![proptest_config(ProptestConfig {
-            cases: 200,
-            rng_seed: proptest::test_runner::RngSeed::Fixed(0x5b11_7001),
-            ..ProptestConfig::default()
-        })]
-        /// Pixel noise cut at any row: pieces touching at a corner across the cut, one-pixel
-        /// interface runs, steps on the cut line, holes cut in two.
-        #[test]
-        fn noisy_masks_cut_at_any_row_join_into_the_masks_topology(
-            (width, height, bits) in (8usize..40, 4usize..40).prop_flat_map(|(w, h)| {
-                (Just(w), Just(h), proptest::collection::vec(any::<u8>(), w * h))
-            }),
-            density in 64u8..230,
-            row_share in 0.0f64..1.0,
-        ) {
-            let mask = BitMask::from_fn(width, height, |x, y| bits[y * width + x] < density);
-            let options = cracks();
-            let mut warnings = Vec::new();
-            let (kept, _, _, pieces) = drop_small_pieces(&mask, options.min_piece_area, &mut warnings);
-            prop_assume!(pieces > 0);
-            let kept = kept.unwrap_or(mask);
-            let whole = mesh_whole(&kept, pieces, &options, &mut warnings).unwrap();
-            let row = (1 + ((height - 1) as f64 * row_share) as usize).min(height - 1);
-            let halves = mesh_in_halves(&kept, &Cut::at(&kept, row), pieces, &options).unwrap();
-            let halves = halves.expect("the joined mesh has the mask's pieces");
-            prop_assert_eq!(halves.mesh.sanity_check(), Ok(()));
-            prop_assert_eq!(halves.mesh.piece_count, whole.mesh.piece_count);
-            prop_assert_eq!(halves.mesh.hole_count(), whole.mesh.hole_count());
-            prop_assert_eq!(crate::mesh::uncovered_mask_pixels(&halves.mesh, &kept), 0);
-        }
-    }
-
-    fn cracks() -> MeshOptions {
-        MeshOptions {
-            boundary: BoundaryPlacement::Cracks,
-            ..MeshOptions::default()
-        }
-    }
-
-    fn centres() -> MeshOptions {
-        MeshOptions {
-            boundary: BoundaryPlacement::OutsideCentres,
-            ..MeshOptions::default()
-        }
-    }
-
-    /// Checks a mask meshed through its outside centres as two halves at `row`: `None`
-    /// when the halves fell back; otherwise a sane mesh with the whole centre mesh's pieces
-    /// and holes, every mask pixel covered, and every boundary vertex a centre of the whole
-    /// mask's centre loops (no vertex of the cut left on the boundary).
-    fn check_centre_halves(mask: &BitMask, row: usize) -> Result<Option<()>, TestCaseError> {
-        let options = centres();
-        let mut warnings = Vec::new();
-        let (kept, _, _, pieces) = drop_small_pieces(mask, options.min_piece_area, &mut warnings);
-        if pieces == 0 {
-            return Ok(None);
-        }
-        let kept = kept.unwrap_or_else(|| mask.clone());
-        let whole = mesh_whole(&kept, pieces, &options, &mut warnings).unwrap();
-        let Some(halves) =
-            mesh_centres_in_halves(&kept, &Cut::at(&kept, row), pieces, &options).unwrap()
-        else {
-            return Ok(None);
-        };
-        prop_assert_eq!(halves.placement, BoundaryPlacement::OutsideCentres);
-        prop_assert_eq!(halves.mesh.sanity_check(), Ok(()));
-        prop_assert_eq!(halves.mesh.piece_count, whole.mesh.piece_count);
-        prop_assert_eq!(halves.mesh.hole_count(), whole.mesh.hole_count());
-        prop_assert_eq!(crate::mesh::uncovered_mask_pixels(&halves.mesh, &kept), 0);
-        // Off the cut, the boundary is the whole mask's centres; on it, only the crossings.
-        let (loops, _) = outside_centre_points(&trace_crack_loops(&kept));
-        let y = row as f64;
-        let crossings = cut_centre_loops(&loops, y, options.density).unwrap();
-        let mut on_loops: Vec<(u64, u64)> = (loops.iter().flat_map(|l| &l.points))
-            .map(|p| (p.x.to_bits(), p.y.to_bits()))
-            .collect();
-        on_loops.sort_unstable();
-        let mut on_cut = 0;
-        for v in halves.mesh.boundary_vertices() {
-            let p = halves.mesh.positions[v as usize];
-            on_cut += usize::from(p.y == y);
-            prop_assert!(
-                p.y == y
-                    || on_loops
-                        .binary_search(&(p.x.to_bits(), p.y.to_bits()))
-                        .is_ok(),
-                "boundary vertex {} is no outside centre (cut at {})",
-                p,
-                row
-            );
-        }
-        prop_assert_eq!(on_cut, 2 * crossings.interface.intervals.len());
-        Ok(Some(()))
-    }
-
-    proptest! {
-        #![proptest_config(ProptestConfig {
-            cases: 64,
-            rng_seed: proptest::test_runner::RngSeed::Fixed(0x0ce1_70e5),
-            ..ProptestConfig::default()
-        })]
-        /// Discs unions and differences cut at any row: where the whole mask meshes through
-        /// its centres, so do the halves, and they join into the same topology.
-        #[test]
-        fn centre_halves_join_into_the_masks_topology(
-            (width, height) in (16usize..64, 16usize..64),
-            shapes in proptest::collection::vec(
-                (0.0f64..1.0, 0.0f64..1.0, 0.1f64..0.45, proptest::bool::weighted(0.7)),
-                1..6,
-            ),
-            row_share in 0.0f64..1.0,
-        ) {
-            let size = width.min(height) as f64;
-            let discs_px: Vec<_> = shapes
-                .iter()
-                .map(|&(x, y, r, add)| (x * width as f64, y * height as f64, r * size, add))
-                .collect();
-            let mask = discs(width, height, &discs_px);
-            let row = (1 + ((height - 1) as f64 * row_share) as usize).min(height - 1);
-            check_centre_halves(&mask, row)?;
-        }
-
-        /// Pixel noise cut at any row: the halves either join into the mask's topology
-        /// through the centres or fall back, never a broken mesh.
-        #[test]
-        fn noisy_masks_cut_through_their_centres_join_or_fall_back(
-            (width, height, bits) in (8usize..40, 4usize..40).prop_flat_map(|(w, h)| {
-                (Just(w), Just(h), proptest::collection::vec(any::<u8>(), w * h))
-            }),
-            density in 64u8..230,
-            row_share in 0.0f64..1.0,
-        ) {
-            let mask = BitMask::from_fn(width, height, |x, y| bits[y * width + x] < density);
-            let row = (1 + ((height - 1) as f64 * row_share) as usize).min(height - 1);
-            check_centre_halves(&mask, row)?;
-        }
-    }
-
-    /// Simple shapes cut across do go through the centres (the fallback is not what the
-    /// property tests above see).
-    #[test]
-    fn discs_rings_and_the_spiral_are_cut_through_their_centres() {
-        let ring = BitMask::from_fn(60, 60, |x, y| {
-            let d = ((x as f64 - 30.0).powi(2) + (y as f64 - 30.0).powi(2)).sqrt();
-            (10.0..25.0).contains(&d)
-        });
-        let disc = crate::mesh::synth::disc(50, 40, 15.0);
-        for (mask, row) in [(&ring, 30), (&ring, 12), (&disc, 20)] {
-            let checked = check_centre_halves(mask, row).unwrap_or_else(|e| panic!("{e}"));
-            assert_eq!(checked, Some(()), "row {row}");
-        }
-        let spiral = crate::mesh::synth::spiral(400, 400);
-        let options = centres();
-        let meshed = mesh_mask(&spiral, &options).unwrap();
-        assert_eq!(meshed.stats.boundary, BoundaryPlacement::OutsideCentres);
-        let row = meshed.stats.cut_row.expect("the spiral is cut");
-        let checked = check_centre_halves(&spiral, row).unwrap_or_else(|e| panic!("{e}"));
-        assert_eq!(checked, Some(()));
-        let one_thread = rayon::ThreadPoolBuilder::new()
-            .num_threads(1)
-            .build()
-            .unwrap();
-        let alone = one_thread.install(|| mesh_mask(&spiral, &options)).unwrap();
-        assert_eq!(alone.mesh, meshed.mesh);
-        // Every centre kept (the seam-quality preset): made whole, as it always was.
-        let preset = mesh_mask(&spiral, &MeshOptions::seam_quality()).unwrap();
-        assert_eq!(preset.stats.boundary, BoundaryPlacement::OutsideCentres);
-        assert_eq!(preset.stats.cut_row, None);
-    }
-
-    /// A long one-pixel line has its crack edges on two lines; a cut between them would leave
-    /// one half empty. Cuts lie strictly between the first and the last inside row.
-    #[test]
-    fn a_cut_leaves_inside_pixels_on_both_sides() {
-        let line = BitMask::from_fn(4000, 4, |x, y| y == 1 && x > 10);
-        let by_row = crack_edges_by_row(&line);
-        assert!(by_row.iter().sum::<usize>() >= crate::mesh::split::SPLIT_MIN_CRACK_EDGES);
-        assert_eq!(
-            Cut::choose(&line, &by_row, 2_000_000).map(|cut| cut.row),
-            None
-        );
-        let result = mesh_mask(&line, &MeshOptions::default()).unwrap();
-        assert_eq!(result.mesh.sanity_check(), Ok(()));
-        let band = BitMask::from_fn(4000, 6, |x, y| (1..5).contains(&y) && x > 10);
-        let cut = Cut::choose(&band, &crack_edges_by_row(&band), 2_000_000).map(|cut| cut.row);
-        assert!(cut.is_none_or(|row| (2..5).contains(&row)), "{cut:?}");
-        let result = mesh_mask(&band, &MeshOptions::default()).unwrap();
-        assert_eq!(result.mesh.sanity_check(), Ok(()));
-    }
-
-    /// The paper's spiral is large enough to be cut; its mesh is the join of the halves and
-    /// the same on one thread as on two.
-    #[test]
-    fn a_large_mask_is_meshed_in_halves_the_same_on_any_thread_count() {
-        let mask = crate::mesh::synth::spiral(400, 400);
-        let options = MeshOptions {
-            boundary: BoundaryPlacement::Cracks,
-            ..MeshOptions::default()
-        };
-        let by_row = crack_edges_by_row(&mask);
-        let cut = Cut::choose(&mask, &by_row, options.max_vertices).unwrap();
-        let joined = mesh_in_halves(&mask, &cut, 1, &options).unwrap().unwrap();
-        let meshed = mesh_mask(&mask, &options).unwrap();
-        assert_eq!(meshed.mesh, joined.mesh);
-        assert_eq!(meshed.stats.cut_row, Some(cut.row));
-        let one_thread = rayon::ThreadPoolBuilder::new()
-            .num_threads(1)
-            .build()
-            .unwrap();
-        let alone = one_thread.install(|| mesh_mask(&mask, &options)).unwrap();
-        assert_eq!(alone.mesh, meshed.mesh);
-        // Some vertex on the cut is interior: the halves were joined, not just put side by side.
-        let y = cut.y();
-        let interior_on_cut = (0..meshed.mesh.vertex_count())
-            .filter(|&v| meshed.mesh.positions[v].y == y && !meshed.mesh.is_boundary[v])
-            .count();
-        assert!(interior_on_cut > 10, "{interior_on_cut}");
-    }
-
-    /// Small masks (the golden cases, most scene patches), tight vertex budgets and masks
-    /// whose every balanced cut would be long (a large disc) are meshed whole.
-    #[test]
-    fn small_masks_tight_budgets_and_wide_insides_are_not_cut() {
-        let disc = crate::mesh::synth::disc(200, 200, 90.0);
-        assert!(crack_edge_count(&disc) < crate::mesh::split::SPLIT_MIN_CRACK_EDGES);
-        assert_eq!(
-            Cut::choose(&disc, &crack_edges_by_row(&disc), 2_000_000),
-            None
-        );
-        let whole = mesh_mask(&disc, &MeshOptions::default()).unwrap();
-        assert_eq!(whole.stats.cut_row, None);
-        let spiral = crate::mesh::synth::spiral(400, 400);
-        let by_row = crack_edges_by_row(&spiral);
-        let edges = crack_edge_count(&spiral);
-        assert!(Cut::choose(&spiral, &by_row, 2_000_000).is_some());
-        assert_eq!(Cut::choose(&spiral, &by_row, 4 * edges), None);
-        let wide = crate::mesh::synth::disc(2000, 2000, 990.0);
-        let by_row = crack_edges_by_row(&wide);
-        assert!(crack_edge_count(&wide) >= crate::mesh::split::SPLIT_MIN_CRACK_EDGES);
-        assert_eq!(Cut::choose(&wide, &by_row, 2_000_000), None);
     }
 
     fn triangle(far: f64) -> Vec<Polygon> {

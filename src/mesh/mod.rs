@@ -10,14 +10,12 @@
 //! (`contour`) → loops through the outside pixel centres, thinned to `density` (`centre_loops`,
 //! the default [`BoundaryPlacement::OutsideCentres`]) or, with [`BoundaryPlacement::Cracks`],
 //! Douglas–Peucker + subdivision to `density` (`simplify`) → spade CDT + refinement
-//! (`triangulate`) → [`Mesh`], verified by [`Mesh::sanity_check`]. Large masks are cut along a
-//! pixel row and the two halves meshed at once, then joined (`split`; centre loops are cut
-//! geometrically by `centre_cut`). [`relax_interior`] evens out the interior for the
+//! (`triangulate`) → [`Mesh`], verified by [`Mesh::sanity_check`]. Every mask is meshed
+//! whole, on the calling thread. [`relax_interior`] evens out the interior for the
 //! combinatorial Laplacian (the clone stage applies it). Mask-aware checks are in
 //! `coverage`; the Laplacian export in `laplacian_mtx`; test/bench masks in [`synth`].
 
 mod bitmask;
-mod centre_cut;
 mod centre_loops;
 mod contour;
 mod coverage;
@@ -28,7 +26,6 @@ mod options;
 mod relax;
 mod sanity;
 mod simplify;
-mod split;
 pub mod synth;
 mod triangulate;
 mod types;

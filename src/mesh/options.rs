@@ -218,9 +218,6 @@ pub struct MeshStats {
     /// With `OutsideCentres`: boundary vertices a quarter pixel outside a crack instead of on
     /// an outside centre (pixels reached from two sides of a 1-px notch, gap or hole).
     pub off_centre_boundary_vertices: usize,
-    /// The pixel row along which the mask was cut and its halves meshed at once (`None`:
-    /// meshed whole); the mesh then has a line of vertices along y = `cut_row`.
-    pub cut_row: Option<usize>,
 }
 
 /// A mesh with warnings (dropped pieces, budget exhausted, fallbacks) and statistics.

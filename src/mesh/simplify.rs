@@ -123,38 +123,13 @@ pub fn subdivided_len(points: &[DVec2], density: f64) -> f64 {
 
 /// Splits every edge of a closed loop into the fewest equal parts no longer than `density`.
 pub fn subdivide_loop(points: &[DVec2], density: f64, out: &mut Vec<DVec2>) {
-    subdivide_loop_sharing_row(points, density, None, out);
-}
-
-/// [`subdivide_loop`], except that an edge lying on the row `y = shared_row` is split at
-/// the same points whichever way it runs: two loops that traverse it in opposite
-/// directions (the halves of a cut mask, see `split`) then share its vertices bit for bit.
-pub(crate) fn subdivide_loop_sharing_row(
-    points: &[DVec2],
-    density: f64,
-    shared_row: Option<f64>,
-    out: &mut Vec<DVec2>,
-) {
     out.clear();
     let n = points.len();
     for i in 0..n {
         let (a, b) = (points[i], points[(i + 1) % n]);
         let parts = (a.distance(b) / density).ceil().max(1.0) as usize;
         out.push(a);
-        match shared_row.filter(|&y| a.y == y && b.y == y) {
-            // From the left end, as the loop running the other way does, and exactly on
-            // the row (a lerp between equal values may leave it by an ulp).
-            Some(y) => {
-                let (left, right) = (a.x.min(b.x), a.x.max(b.x));
-                let at =
-                    |k: usize| DVec2::new(left + (right - left) * (k as f64 / parts as f64), y);
-                match a.x < b.x {
-                    true => out.extend((1..parts).map(at)),
-                    false => out.extend((1..parts).rev().map(at)),
-                }
-            }
-            None => out.extend((1..parts).map(|k| a.lerp(b, k as f64 / parts as f64))),
-        }
+        out.extend((1..parts).map(|k| a.lerp(b, k as f64 / parts as f64)));
     }
 }
 
@@ -216,39 +191,6 @@ mod tests {
         let s = simplify_loop(&pts, &[false; 5], 2.0);
         assert_eq!(s.points, pts);
         assert_eq!(s.max_deviation, 0.0);
-    }
-
-    /// An edge on the shared row gets the same points from loops running either way, and
-    /// they lie exactly on the row (a lerp of two equal values may leave it by an ulp).
-    #[test]
-    fn edges_on_the_shared_row_split_alike_both_ways() {
-        let row = 388.0;
-        let forward = vec![
-            DVec2::new(27.0, row),
-            DVec2::new(47.0, row),
-            DVec2::new(37.0, 380.0),
-        ];
-        let backward = vec![
-            DVec2::new(47.0, row),
-            DVec2::new(27.0, row),
-            DVec2::new(37.0, 396.0),
-        ];
-        let (mut a, mut b) = (Vec::new(), Vec::new());
-        subdivide_loop_sharing_row(&forward, 3.0, Some(row), &mut a);
-        subdivide_loop_sharing_row(&backward, 3.0, Some(row), &mut b);
-        let on_row = |points: &[DVec2]| {
-            let mut xs: Vec<u64> = (points.iter())
-                .filter(|p| p.y == row)
-                .map(|p| p.x.to_bits())
-                .collect();
-            xs.sort_unstable();
-            xs
-        };
-        assert_eq!(on_row(&a).len(), 8);
-        assert_eq!(on_row(&a), on_row(&b));
-        let mut plain = Vec::new();
-        subdivide_loop(&forward, 3.0, &mut plain);
-        assert_eq!(plain.len(), a.len());
     }
 
     #[test]

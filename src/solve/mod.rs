@@ -5,11 +5,11 @@
 //! Work is split as in faer: [`symbolic`] (AMD ordering, elimination tree, factor pattern,
 //! its [`supernodes`] — once per mesh), [`numeric`] (LDLᵀ values — once, and again only when
 //! a guard fires), [`update`] (the rank-1 kernel, per constraint change) and
-//! [`solve_supernodal`] (forward/back substitution over dense supernode panels, per frame;
-//! [`solve`](mod@solve) keeps the column-by-column reference; large factors follow a
-//! [`schedule`] that sweeps two subtree groups on two threads). [`penalty`] ties them
-//! together in [`PenaltyFactor`]. One value array serves all kernels: the supernodal solve
-//! reads the column layout the rank-1 kernel updates, so no conversion follows a switch.
+//! [`solve_supernodal`] (forward/back substitution over dense supernode panels, per frame,
+//! on one thread; [`solve`](mod@solve) keeps the column-by-column reference). [`penalty`]
+//! ties them together in [`PenaltyFactor`]. One value array serves all kernels: the
+//! supernodal solve reads the column layout the rank-1 kernel updates, so no conversion
+//! follows a switch; [`faer_layout`] holds that layout's contract with faer.
 //!
 //! # Numerical rules (documented here once, used throughout)
 //! * **Penalty α.** Default `α = 1e8 · s`, `s = max |l_ii|` (1 if the matrix is zero). At a
@@ -32,14 +32,13 @@
 //!   a refactorisation from the stored matrix and the current constrained set.
 
 pub mod csc;
+pub mod faer_layout;
 #[doc(hidden)]
 pub mod fixtures;
-mod lanes;
 pub mod laplacian;
 pub mod matrix_market;
 pub mod numeric;
 pub mod penalty;
-pub mod schedule;
 #[allow(clippy::module_inception)]
 pub mod solve;
 pub mod solve_supernodal;
@@ -51,7 +50,6 @@ pub use csc::SymmetricCsc;
 pub use laplacian::{laplacian, LaplacianKind};
 pub use matrix_market::{read_constrained_list, read_matrix_market, write_matrix_market};
 pub use penalty::{PenaltyFactor, PenaltyOptions, SwitchStats};
-pub use schedule::SchedulePolicy;
 pub use symbolic::FactorMethod;
 
 use std::path::PathBuf;

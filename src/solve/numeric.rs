@@ -2,13 +2,14 @@
 //! [`symbolic`](super::symbolic): takes the matrix values (lower triangle, original order)
 //! and fills the factor values in place. Runs once per mesh and whenever a guard fires.
 //! A supernodal factor is compacted in place into the column layout of
-//! [`symbolic`](super::symbolic) afterwards (one pass of `memmove`s, O(nnz)).
+//! [`faer_layout`](super::faer_layout) afterwards (one pass of `memmove`s, O(nnz)).
 
+use super::faer_layout;
 use super::symbolic::SymbolicFactor;
 use super::SolveError;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
-use faer::sparse::linalg::cholesky::{supernodal::SymbolicSupernodalCholesky, SymbolicCholeskyRaw};
+use faer::sparse::linalg::cholesky::SymbolicCholeskyRaw;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Par, Side};
 
@@ -65,25 +66,7 @@ pub fn factor_numeric(
         )
         .map_err(|e| SolveError::Numeric(format!("{e:?}")))?;
     if let SymbolicCholeskyRaw::Supernodal(s) = symbolic.faer.raw() {
-        compact_supernodes(s, &symbolic.col_ptr, l_values);
+        faer_layout::compact_supernodes(s, &symbolic.col_ptr, l_values);
     }
     Ok(())
-}
-
-/// Moves each supernode's columns, minus the zero upper triangle of its diagonal block, to
-/// the column layout `col_ptr`. Destinations never pass their sources
-/// ([`SymbolicFactor::check_layout`] verifies it), so one forward pass works in place.
-fn compact_supernodes(s: &SymbolicSupernodalCholesky<u32>, col_ptr: &[u32], values: &mut [f64]) {
-    for sn in 0..s.n_supernodes() {
-        let (begin, end) = (
-            s.supernode_begin()[sn] as usize,
-            s.supernode_end()[sn] as usize,
-        );
-        let nrows = end - begin + s.supernode(sn).pattern().len();
-        let block_start = s.col_ptr_for_val()[sn] as usize;
-        for c in 0..end - begin {
-            let source = block_start + c * nrows + c;
-            values.copy_within(source..source + nrows - c, col_ptr[begin + c] as usize);
-        }
-    }
 }

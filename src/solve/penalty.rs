@@ -21,8 +21,7 @@
 //! Updates alone never trigger a refactor: they add positive terms and are stable.
 
 use super::numeric::{factor_numeric, NumericWorkspace};
-use super::schedule::SchedulePolicy;
-use super::solve_supernodal::{inverse_diagonal, lanes_for, ldlt_solve_scheduled};
+use super::solve_supernodal::{inverse_diagonal, lanes_for, ldlt_solve_supernodal};
 use super::symbolic::{FactorMethod, SymbolicFactor};
 use super::update::{pivot_from_row, rank1_diagonal, Rank1Outcome, RowScratch};
 use super::{SolveError, SymmetricCsc};
@@ -37,8 +36,6 @@ pub struct PenaltyOptions {
     pub drift_budget: f64,
     /// Simplicial or supernodal numeric factorisation (default: by size).
     pub method: FactorMethod,
-    /// Whether solves split into two subtree groups for two threads (default: by size).
-    pub schedule: SchedulePolicy,
 }
 
 impl Default for PenaltyOptions {
@@ -48,7 +45,6 @@ impl Default for PenaltyOptions {
             epsilon: None,
             drift_budget: DEFAULT_DRIFT_BUDGET,
             method: FactorMethod::Auto,
-            schedule: SchedulePolicy::Auto,
         }
     }
 }
@@ -73,115 +69,47 @@ enum RhsKind {
 /// `x[position[v]][c] = rhs[c][v]` (or the Dirichlet right-hand side `α · rhs[c][v]` at
 /// constrained vertices, 0 elsewhere, when `dirichlet` is given) for the `K` channels, and 0
 /// in the padding lanes of rows of `L`. Walks the vertices in order: `rhs` streams, one
-/// random row per vertex (measured at 52k vertices: 0.11 ms, against 0.15 ms walking the
-/// positions with random reads of `rhs`). With two threads each takes half of the
-/// positions instead (so that each writes its own half of `x`).
+/// random row of `x` per vertex.
 fn permute_in<const K: usize, const L: usize>(
     rhs: &[f64],
     symbolic: &SymbolicFactor,
     dirichlet: Option<(&[bool], f64)>,
     x: &mut [f64],
-    threads: usize,
 ) {
     let n = symbolic.n();
     let columns: [&[f64]; K] = std::array::from_fn(|c| &rhs[c * n..(c + 1) * n]);
     assert!(x.len() == n * L && dirichlet.is_none_or(|(constrained, _)| constrained.len() == n));
-    if threads >= 2 && symbolic.schedule().is_some() {
-        let fwd = symbolic.perm_fwd();
-        let (front, back) = x.split_at_mut(n / 2 * L);
-        rayon::join(
-            || gather::<K, L>(&columns, &fwd[..n / 2], dirichlet, front),
-            || gather::<K, L>(&columns, &fwd[n / 2..], dirichlet, back),
-        );
-        return;
-    }
     for (v, &p) in symbolic.perm_inv.iter().enumerate() {
-        fill_row::<K, L>(&mut x[p as usize * L..][..L], &columns, v, dirichlet);
-    }
-}
-
-/// Rows of `x` for the positions whose vertices `fwd` lists, in order.
-fn gather<const K: usize, const L: usize>(
-    columns: &[&[f64]; K],
-    fwd: &[u32],
-    dirichlet: Option<(&[bool], f64)>,
-    x: &mut [f64],
-) {
-    for (row, &v) in x.chunks_exact_mut(L).zip(fwd) {
-        fill_row::<K, L>(row, columns, v as usize, dirichlet);
-    }
-}
-
-/// One row of [`permute_in`]: vertex `v`'s channels, scaled for a Dirichlet right-hand side.
-#[inline(always)]
-fn fill_row<const K: usize, const L: usize>(
-    row: &mut [f64],
-    columns: &[&[f64]; K],
-    v: usize,
-    dirichlet: Option<(&[bool], f64)>,
-) {
-    let scale = match dirichlet {
-        None => 1.0,
-        Some((constrained, alpha)) if constrained[v] => alpha,
-        Some(_) => 0.0,
-    };
-    for c in 0..L {
-        // The Dirichlet input is ignored, not scaled, where unconstrained (it may be NaN).
-        row[c] = if c < K && scale != 0.0 {
-            scale * columns[c][v]
-        } else {
-            0.0
+        let scale = match dirichlet {
+            None => 1.0,
+            Some((constrained, alpha)) if constrained[v] => alpha,
+            Some(_) => 0.0,
         };
+        for (c, value) in x[p as usize * L..][..L].iter_mut().enumerate() {
+            // The Dirichlet input is ignored, not scaled, where unconstrained (it may be NaN).
+            *value = if c < K && scale != 0.0 {
+                scale * columns[c][v]
+            } else {
+                0.0
+            };
+        }
     }
 }
 
 /// `rhs[c][v] = x[position[v]][c]` for the `K` channels: one pass over the vertices, one
-/// random row of `x` each, `rhs` written as `K` streams (with two threads, each takes half
-/// of the vertices).
+/// random row of `x` each, `rhs` written as `K` streams.
 fn permute_out<const K: usize, const L: usize>(
     x: &[f64],
     symbolic: &SymbolicFactor,
     rhs: &mut [f64],
-    threads: usize,
 ) {
-    let position = &symbolic.perm_inv[..];
-    let n = position.len();
-    let mut columns: [&mut [f64]; K] = std::array::from_fn(|_| -> &mut [f64] { &mut [] });
-    for (slot, column) in columns.iter_mut().zip(rhs.chunks_exact_mut(n.max(1))) {
-        *slot = column;
-    }
-    if threads >= 2 && symbolic.schedule().is_some() {
-        let mut front: [&mut [f64]; K] = std::array::from_fn(|_| -> &mut [f64] { &mut [] });
-        let mut back: [&mut [f64]; K] = std::array::from_fn(|_| -> &mut [f64] { &mut [] });
-        for (c, column) in columns.into_iter().enumerate() {
-            (front[c], back[c]) = column.split_at_mut(n / 2);
-        }
-        rayon::join(
-            || scatter::<K, L>(x, &position[..n / 2], &mut front),
-            || scatter::<K, L>(x, &position[n / 2..], &mut back),
-        );
-        return;
-    }
-    scatter::<K, L>(x, position, &mut columns);
-}
-
-/// `columns[c][i] = x[position[i]][c]`.
-fn scatter<const K: usize, const L: usize>(
-    x: &[f64],
-    position: &[u32],
-    columns: &mut [&mut [f64]; K],
-) {
-    for (i, &p) in position.iter().enumerate() {
+    let n = symbolic.n();
+    for (v, &p) in symbolic.perm_inv.iter().enumerate() {
         let row = &x[p as usize * L..][..L];
         for c in 0..K {
-            columns[c][i] = row[c];
+            rhs[c * n + v] = row[c];
         }
     }
-}
-
-/// Cores available, at most the two a [`SolveSchedule`](super::schedule::SolveSchedule) uses.
-fn default_solve_threads() -> usize {
-    std::thread::available_parallelism().map_or(1, |n| n.get().min(2))
 }
 
 /// What one batch of switches did.
@@ -214,10 +142,6 @@ pub struct PenaltyFactor {
     update_scratch: Vec<f64>,
     /// Permuted right-hand sides, rows of up to 4 channels.
     solve_scratch: Vec<f64>,
-    /// All zero between solves: the second subtree group's spill (scheduled factors only).
-    spill: Vec<f64>,
-    /// Threads a scheduled solve may use (see [`set_solve_threads`](Self::set_solve_threads)).
-    solve_threads: usize,
     /// Per-vertex pending state of the current batch: 0 none, 1 on, 2 off.
     pending: Vec<u8>,
     touched: Vec<usize>,
@@ -252,7 +176,7 @@ impl PenaltyFactor {
         opts: &PenaltyOptions,
         constrained: Option<&[bool]>,
     ) -> Result<Self, SolveError> {
-        let symbolic = SymbolicFactor::analyse_scheduled(l, opts.method, opts.schedule)?;
+        let symbolic = SymbolicFactor::analyse_with(l, opts.method)?;
         let scale = l.diagonal_scale();
         let alpha = opts.alpha.unwrap_or(DEFAULT_ALPHA_RELATIVE * scale);
         if !(alpha.is_finite() && alpha > 0.0) {
@@ -270,7 +194,6 @@ impl PenaltyFactor {
         }
         let n = l.n;
         let workspace = NumericWorkspace::new(&symbolic);
-        let symbolic_has_schedule = symbolic.schedule().is_some();
         let mut this = Self {
             factor_values: vec![0.0; symbolic.factor_buffer_len()],
             inv_diagonal: vec![0.0; n],
@@ -287,12 +210,6 @@ impl PenaltyFactor {
             refactor_count: 0,
             update_scratch: vec![0.0; n],
             solve_scratch: vec![0.0; 4 * n],
-            spill: if symbolic_has_schedule {
-                vec![0.0; 4 * n]
-            } else {
-                Vec::new()
-            },
-            solve_threads: default_solve_threads(),
             pending: vec![0; n],
             touched: Vec::new(),
             row_scratch: RowScratch::new(n),
@@ -303,13 +220,6 @@ impl PenaltyFactor {
 
     pub fn n(&self) -> usize {
         self.symbolic.n()
-    }
-
-    /// Threads a solve may use (default: the machine's cores, at most 2). Only factors with a
-    /// [`SolveSchedule`](super::schedule::SolveSchedule) use a second thread, and their
-    /// results are the same bits for every count.
-    pub fn set_solve_threads(&mut self, threads: usize) {
-        self.solve_threads = threads.max(1);
     }
 
     pub fn alpha(&self) -> f64 {
@@ -352,7 +262,7 @@ impl PenaltyFactor {
         &self.symbolic
     }
 
-    /// Factor values in the layout documented in [`symbolic`](super::symbolic).
+    /// Factor values in the layout documented in [`faer_layout`](super::faer_layout).
     pub fn factor_values(&self) -> &[f64] {
         &self.factor_values[..self.symbolic.nnz_factor()]
     }
@@ -434,31 +344,29 @@ impl PenaltyFactor {
             }
             let x = &mut self.solve_scratch[..n * lanes];
             let rhs = &mut rhs[group * n..(group + channels) * n];
-            let (symbolic, threads) = (&self.symbolic, self.solve_threads);
+            let symbolic = &self.symbolic;
             let kind = match kind {
                 RhsKind::Plain => None,
                 RhsKind::Dirichlet => Some((&self.constrained[..], self.alpha)),
             };
             match channels {
-                1 => permute_in::<1, 1>(rhs, symbolic, kind, x, threads),
-                2 => permute_in::<2, 2>(rhs, symbolic, kind, x, threads),
-                3 => permute_in::<3, 4>(rhs, symbolic, kind, x, threads),
-                _ => permute_in::<4, 4>(rhs, symbolic, kind, x, threads),
+                1 => permute_in::<1, 1>(rhs, symbolic, kind, x),
+                2 => permute_in::<2, 2>(rhs, symbolic, kind, x),
+                3 => permute_in::<3, 4>(rhs, symbolic, kind, x),
+                _ => permute_in::<4, 4>(rhs, symbolic, kind, x),
             }
-            ldlt_solve_scheduled(
-                &self.symbolic,
-                &self.factor_values[..self.symbolic.nnz_factor()],
+            ldlt_solve_supernodal(
+                symbolic,
+                &self.factor_values[..symbolic.nnz_factor()],
                 &self.inv_diagonal,
                 x,
                 lanes,
-                &mut self.spill,
-                self.solve_threads,
             );
             match channels {
-                1 => permute_out::<1, 1>(x, symbolic, rhs, threads),
-                2 => permute_out::<2, 2>(x, symbolic, rhs, threads),
-                3 => permute_out::<3, 4>(x, symbolic, rhs, threads),
-                _ => permute_out::<4, 4>(x, symbolic, rhs, threads),
+                1 => permute_out::<1, 1>(x, symbolic, rhs),
+                2 => permute_out::<2, 2>(x, symbolic, rhs),
+                3 => permute_out::<3, 4>(x, symbolic, rhs),
+                _ => permute_out::<4, 4>(x, symbolic, rhs),
             }
         }
     }

@@ -4,29 +4,16 @@
 //! refactorisation.
 //!
 //! faer builds either a simplicial or a supernodal factor ([`FactorMethod`]; supernodal pays
-//! off on large meshes, see [`SUPERNODAL_MIN_VERTICES`]). Either way the kernels here read
-//! one simplicial-style layout:
-//!
-//! Layout contract read by [`update`](super::update) and [`solve`](super::solve):
-//! column `j` of the factor occupies `col_ptr[j]..col_ptr[j+1]`; its first entry has row `j`
-//! and holds `D_jj`; the remaining rows are strictly increasing and hold `L_ij`, so the first
-//! of them is the elimination-tree parent of `j`; and patterns nest along the tree: every row
-//! of column `j` below its parent also occurs in the parent's column. For a supernodal factor
-//! (faer =0.24.4: supernode `s` covers columns `begin..end`, its values are one column-major
-//! `(ncols + |P|) × ncols` block whose top square holds `D` on the diagonal and unit-lower `L`
-//! below it, the bottom `|P|` rows — the supernode's pattern `P` — holding `L`) column `j`
-//! gets the rows `j..end` of the diagonal block followed by `P`; relaxed supernodes then
-//! store explicit zeros, which the kernels carry along harmlessly (they stay exactly zero).
-//! [`SymbolicFactor::check_layout`] verifies all of this at analysis time, so the unchecked
-//! indexing in the kernels cannot go out of bounds, and [`numeric`](super::numeric) compacts
-//! faer's supernodal values into this layout in place after each factorisation.
+//! off on large meshes, see [`SUPERNODAL_MIN_VERTICES`]). Either way the kernels read one
+//! simplicial-style column layout, whose contract with faer lives in
+//! [`faer_layout`](super::faer_layout) and is checked there at analysis time.
 
-use super::schedule::{SchedulePolicy, SolveSchedule};
+use super::faer_layout;
 use super::supernodes::SupernodePartition;
 use super::{SolveError, SymmetricCsc};
 use faer::sparse::linalg::cholesky::{
-    factorize_symbolic_cholesky, supernodal::SymbolicSupernodalCholesky, CholeskySymbolicParams,
-    SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
+    factorize_symbolic_cholesky, CholeskySymbolicParams, SymbolicCholesky, SymbolicCholeskyRaw,
+    SymmetricOrdering,
 };
 use faer::sparse::linalg::{SupernodalThreshold, SymbolicSupernodalParams};
 
@@ -68,7 +55,7 @@ use faer::Side;
 pub struct SymbolicFactor {
     pub(crate) n: usize,
     pub(crate) faer: SymbolicCholesky<u32>,
-    /// Factor column pointers and row indices in the layout of the module doc.
+    /// Factor column pointers and row indices in the layout of [`faer_layout`](super::faer_layout).
     pub(crate) col_ptr: Vec<u32>,
     pub(crate) row_idx: Vec<u32>,
     /// [`refactor_cost`](Self::refactor_cost), computed once.
@@ -85,8 +72,6 @@ pub struct SymbolicFactor {
     pub(crate) adj_idx: Vec<u32>,
     /// Supernodes of the factor pattern, for the supernodal solve.
     pub(crate) supernodes: SupernodePartition,
-    /// Two-thread split of the solve, for large factors with a wide elimination tree.
-    pub(crate) schedule: Option<SolveSchedule>,
 }
 
 impl SymbolicFactor {
@@ -97,16 +82,6 @@ impl SymbolicFactor {
 
     /// AMD ordering plus symbolic factorisation of `a`'s pattern for the given method.
     pub fn analyse_with(a: &SymmetricCsc, method: FactorMethod) -> Result<Self, SolveError> {
-        Self::analyse_scheduled(a, method, SchedulePolicy::Auto)
-    }
-
-    /// As [`analyse_with`](Self::analyse_with), with the solve's two-thread split chosen by
-    /// `policy`.
-    pub fn analyse_scheduled(
-        a: &SymmetricCsc,
-        method: FactorMethod,
-        policy: SchedulePolicy,
-    ) -> Result<Self, SolveError> {
         a.sanity_check()?;
         let to_u32 = |v: usize| u32::try_from(v).map_err(|_| SolveError::TooLarge(a.n));
         let a_col_ptr: Vec<u32> = a
@@ -149,19 +124,14 @@ impl SymbolicFactor {
             None => ((0..a.n as u32).collect(), (0..a.n as u32).collect()),
         };
         let (adj_ptr, adj_idx) = permuted_adjacency(a, &perm_inv);
-        let (col_ptr, row_idx) = match faer.raw() {
-            SymbolicCholeskyRaw::Simplicial(s) => (s.col_ptr().to_vec(), s.row_idx().to_vec()),
-            SymbolicCholeskyRaw::Supernodal(s) => supernodal_columns(s)?,
-        };
+        let (col_ptr, row_idx) = faer_layout::columns(&faer)?;
         let refactor_cost = refactor_cost(
             &col_ptr,
             matches!(faer.raw(), SymbolicCholeskyRaw::Supernodal(_)),
         );
         let supernodes = SupernodePartition::detect(&col_ptr, &row_idx);
-        let schedule = SolveSchedule::choose(policy, &supernodes, row_idx.len());
         let this = Self {
             supernodes,
-            schedule,
             refactor_cost,
             col_ptr,
             row_idx,
@@ -231,12 +201,6 @@ impl SymbolicFactor {
         &self.supernodes
     }
 
-    /// The two-thread split of the solve, if this factor has one (see
-    /// [`schedule`](super::schedule)).
-    pub fn schedule(&self) -> Option<&SolveSchedule> {
-        self.schedule.as_ref()
-    }
-
     /// Whether faer factors this pattern supernodally.
     pub fn is_supernodal(&self) -> bool {
         matches!(self.faer.raw(), SymbolicCholeskyRaw::Supernodal(_))
@@ -252,71 +216,20 @@ impl SymbolicFactor {
         &self.perm_fwd
     }
 
-    /// Factor column pointers (see the module doc for the layout).
+    /// Factor column pointers (layout: [`faer_layout`](super::faer_layout)).
     pub fn col_ptr(&self) -> &[u32] {
         &self.col_ptr
     }
 
-    /// Factor row indices (see the module doc for the layout).
+    /// Factor row indices (layout: [`faer_layout`](super::faer_layout)).
     pub fn row_idx(&self) -> &[u32] {
         &self.row_idx
     }
 
-    /// Verifies the layout contract in the module doc; an error here means the pinned faer
-    /// version changed its representation.
+    /// Verifies the layout contract of [`faer_layout`](super::faer_layout); an error here
+    /// means the pinned faer version changed its representation.
     pub fn check_layout(&self) -> Result<(), SolveError> {
-        let (col_ptr, row_idx) = (self.col_ptr(), self.row_idx());
-        let broken = |m: String| {
-            Err(SolveError::Symbolic(format!(
-                "unexpected faer factor layout: {m}"
-            )))
-        };
-        if col_ptr.len() != self.n + 1 || col_ptr[self.n] as usize != row_idx.len() {
-            return broken("column pointers".into());
-        }
-        if self.perm_fwd.len() != self.n || self.perm_inv.len() != self.n {
-            return broken("permutation length".into());
-        }
-        for j in 0..self.n {
-            let rows = &row_idx[col_ptr[j] as usize..col_ptr[j + 1] as usize];
-            if rows.first() != Some(&(j as u32)) {
-                return broken(format!("column {j} does not start with its diagonal"));
-            }
-            if rows.windows(2).any(|w| w[0] >= w[1]) || rows.iter().any(|&r| r as usize >= self.n) {
-                return broken(format!("column {j} rows not strictly increasing in range"));
-            }
-            if let Some(&parent) = rows.get(1) {
-                let parent = parent as usize;
-                let parent_rows = &row_idx[col_ptr[parent] as usize..col_ptr[parent + 1] as usize];
-                if !is_sorted_subset(&rows[2..], &parent_rows[1..]) {
-                    return broken(format!("column {j} is not nested in its parent {parent}"));
-                }
-            }
-        }
-        for (pos, &v) in self.perm_fwd.iter().enumerate() {
-            if v as usize >= self.n || self.perm_inv[v as usize] as usize != pos {
-                return broken("permutation is not a bijection".into());
-            }
-        }
-        self.supernodes.sanity_check(col_ptr, row_idx)?;
-        if let Some(schedule) = &self.schedule {
-            schedule.sanity_check(&self.supernodes)?;
-        }
-        if let SymbolicCholeskyRaw::Supernodal(s) = self.faer.raw() {
-            for sn in 0..s.n_supernodes() {
-                let (begin, end) = (
-                    s.supernode_begin()[sn] as usize,
-                    s.supernode_end()[sn] as usize,
-                );
-                let ncols = end - begin;
-                let nrows = ncols + s.supernode(sn).pattern().len();
-                let block = s.col_ptr_for_val()[sn] as usize..s.col_ptr_for_val()[sn + 1] as usize;
-                if block.len() != nrows * ncols || col_ptr[begin] as usize > block.start {
-                    return broken(format!("supernode {sn} value block"));
-                }
-            }
-        }
-        Ok(())
+        faer_layout::check(self)
     }
 }
 
@@ -337,37 +250,6 @@ fn refactor_cost(col_ptr: &[u32], supernodal: bool) -> f64 {
         .sum();
     let nnz = col_ptr.last().copied().unwrap_or(0) as f64;
     weight * squares + 2.0 * nnz
-}
-
-/// Whether every element of the increasing `part` occurs in the increasing `whole`.
-fn is_sorted_subset(part: &[u32], whole: &[u32]) -> bool {
-    let mut rest = whole.iter();
-    part.iter().all(|p| rest.any(|w| w == p))
-}
-
-/// Simplicial-style columns of a supernodal pattern (see the module doc): column `j` of
-/// supernode `begin..end` with pattern `P` holds rows `j..end` then `P`.
-fn supernodal_columns(
-    s: &SymbolicSupernodalCholesky<u32>,
-) -> Result<(Vec<u32>, Vec<u32>), SolveError> {
-    let n = s.nrows();
-    let mut col_ptr = Vec::with_capacity(n + 1);
-    col_ptr.push(0u32);
-    let mut row_idx = Vec::new();
-    for sn in 0..s.n_supernodes() {
-        let (begin, end) = (
-            s.supernode_begin()[sn] as usize,
-            s.supernode_end()[sn] as usize,
-        );
-        let pattern = s.supernode(sn).pattern();
-        for j in begin..end {
-            row_idx.extend(j as u32..end as u32);
-            row_idx.extend_from_slice(pattern);
-            let len = u32::try_from(row_idx.len()).map_err(|_| SolveError::TooLarge(n))?;
-            col_ptr.push(len);
-        }
-    }
-    Ok((col_ptr, row_idx))
 }
 
 /// Both-triangle adjacency of `a` re-indexed by factor position.

@@ -1,5 +1,5 @@
 //! Rank-1 modification of a simplicial LDLᵀ factor, in place: takes the factor (faer layout,
-//! see [`symbolic`](super::symbolic)), a position `p` and a weight `σ`, and turns the factor of
+//! see [`faer_layout`](super::faer_layout)), a position `p` and a weight `σ`, and turns the factor of
 //! `A` into the factor of `A + σ e_p e_pᵀ` (σ > 0 update, σ < 0 downdate).
 //!
 //! Algorithm: method C1 of Gill, Golub, Murray & Saunders (1974) in the sparse form of Davis &
@@ -30,8 +30,7 @@ pub enum Rank1Outcome {
 /// Applies `A + σ e_p e_pᵀ` to the factor `(col_ptr, row_idx, values)`.
 /// `w` is an all-zero scratch of length n and is all-zero again on return.
 ///
-/// The pattern must satisfy the layout contract checked by
-/// [`SymbolicFactor::check_layout`](super::symbolic::SymbolicFactor::check_layout).
+/// The pattern must satisfy the layout contract of [`faer_layout`](super::faer_layout).
 #[allow(clippy::too_many_arguments)]
 pub fn rank1_diagonal(
     col_ptr: &[u32],
@@ -84,8 +83,7 @@ pub fn rank1_diagonal(
             // ratio, because 1 − γ cancels catastrophically when σ ≫ d_p (a penalty update).
             let ratio = d / d_bar;
             for (&i, l) in rows.iter().zip(vals.iter_mut()) {
-                // SAFETY: the layout check guarantees every row index is < n = w.len().
-                unsafe { *w.get_unchecked_mut(i as usize) = -*l };
+                w[i as usize] = -*l;
                 *l *= ratio;
             }
         } else {
@@ -101,13 +99,10 @@ pub fn rank1_diagonal(
 /// The C1 inner loop for one column below the diagonal.
 #[inline(always)]
 fn column_step(rows: &[u32], vals: &mut [f64], w: &mut [f64], wj: f64, gamma: f64) {
-    {
-        for (&i, l) in rows.iter().zip(vals.iter_mut()) {
-            // SAFETY: the layout check guarantees every row index is < n = w.len().
-            let wi = unsafe { w.get_unchecked_mut(i as usize) };
-            *wi -= wj * *l;
-            *l += gamma * *wi;
-        }
+    for (&i, l) in rows.iter().zip(vals.iter_mut()) {
+        let wi = &mut w[i as usize];
+        *wi -= wj * *l;
+        *l += gamma * *wi;
     }
 }
 

@@ -6,8 +6,8 @@
 #![allow(dead_code)]
 
 use lapclone::mesh::Mesh;
+use lapclone::simd::Path;
 use lapclone::solve::fixtures;
-use lapclone::solve::solve_supernodal::SimdLevel;
 use lapclone::solve::FactorMethod;
 
 /// Every numeric factorisation the solver offers.
@@ -70,12 +70,9 @@ pub fn dense_solve(a: &[Vec<f64>], b: &[f64]) -> Vec<f64> {
     y
 }
 
-/// The SIMD levels this CPU runs.
-pub fn simd_levels() -> Vec<SimdLevel> {
-    [SimdLevel::Portable, SimdLevel::Avx2Fma]
-        .into_iter()
-        .filter(|l| l.is_supported())
-        .collect()
+/// Both kernel paths (the vector one is the portable one on a CPU without anything better).
+pub fn simd_levels() -> Vec<Path> {
+    vec![Path::Portable, Path::Vector]
 }
 
 /// A disc, a grid, or a disc beside a grid (two pieces, two elimination trees), chosen by
