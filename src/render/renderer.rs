@@ -8,6 +8,7 @@ use std::time::Instant;
 use glam::DVec2;
 
 use super::layer::{Layer, LayerSettings};
+use super::opacity::blend_over_below;
 use super::RenderError;
 use crate::mesh::Mesh;
 use crate::pixels::{Canvas, Depth, FloatImage, PixelFormat};
@@ -69,6 +70,8 @@ pub struct Renderer {
     /// background outside them.
     dirty: Vec<PixelRect>,
     dirty_valid: bool,
+    /// The frame before a translucent layer was drawn (allocated by the first one).
+    below: Option<Canvas>,
 }
 
 impl Renderer {
@@ -92,6 +95,7 @@ impl Renderer {
             stats: FrameStats::default(),
             dirty: Vec::new(),
             dirty_valid: true,
+            below: None,
         })
     }
 
@@ -220,8 +224,21 @@ impl Renderer {
         stats.deform_switches = self.prepare_layers()?;
         stats.deform_ms = millis(prepare_started.elapsed());
         for &index in &self.state.draw_order {
+            let opacity = self.state.patches[index].opacity;
+            if opacity <= 0.0 {
+                continue;
+            }
             let composite_started = Instant::now();
+            if opacity < 1.0 {
+                let frame = &self.frame;
+                self.below
+                    .get_or_insert_with(|| frame.clone())
+                    .copy_from(frame);
+            }
             let clone = self.layers[index].composite(&mut self.frame)?;
+            if let Some(below) = self.below.as_ref().filter(|_| opacity < 1.0) {
+                blend_over_below(&mut self.frame, below, clone.raster.work, opacity);
+            }
             stats.deform_ms +=
                 millis(composite_started.elapsed()) - clone.solve_ms - clone.raster_ms;
             stats.solve_ms += clone.solve_ms;
