@@ -428,8 +428,9 @@ fn entry(edit: &Edit, scene: &lapclone::script::Draft) -> Option<String> {
             }
         }
         Edit::Rename { patch: p, name } => {
+            let target = patch(*p)?;
             let taken = patches.iter().any(|q| &q.name == name);
-            (!taken).then(|| format!("{}.rename(\"{name}\");", patch(*p).unwrap()))?
+            (!taken).then(|| format!("{target}.rename(\"{name}\");"))?
         }
         Edit::Reorder { patch: p, front } => {
             let call = if *front { "to_front" } else { "to_back" };
