@@ -337,6 +337,77 @@ fn the_repl_goes_on_after_refused_edits() {
 }
 
 #[test]
+fn undo_takes_back_every_kind_of_edit_and_save_follows() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("scene.rhai"), base()).unwrap();
+    let entries = ":list
+remove_patch(\"b\");
+a.rename(\"cat\");
+a.opacity(0, 0.5).to_front();
+a.at(0.5, [20, 10]);
+a.remove_key(0.5);
+a.move_key(0, 0.25);
+:save one_edit_left.rhai
+:undo
+:undo
+:undo
+:undo
+:undo
+:undo
+:list
+:save saved.rhai
+";
+    let out = Command::new(env!("CARGO_BIN_EXE_lapclone"))
+        .args(["repl", "scene.rhai", "--preview", "preview.png", "--script"])
+        .arg(write(dir.path(), "entries.txt", entries))
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let lists: Vec<&str> = stdout
+        .split("canvas 64×48")
+        .skip(1)
+        .map(|l| l.split("variables").next().unwrap())
+        .collect();
+    assert_eq!(lists.len(), 2, "{stdout}");
+    assert_eq!(lists[0], lists[1]);
+    assert!(
+        lists[0].contains("layers at t = 0 s, back to front: \"a\" (depth 0), \"b\" (depth 1)"),
+        "{stdout}"
+    );
+    let saved = std::fs::read_to_string(dir.path().join("saved.rhai")).unwrap();
+    assert_eq!(saved, base());
+    let one_left = std::fs::read_to_string(dir.path().join("one_edit_left.rhai")).unwrap();
+    assert!(
+        one_left.ends_with("a.remove_key(0.5);\na.move_key(0, 0.25);\n"),
+        "{one_left}"
+    );
+}
+
+#[test]
+fn check_warns_about_keys_past_the_end() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write(dir.path(), "late.rhai", &(base() + "a.at(3.5, [1, 1]);"));
+    let out = Command::new(env!("CARGO_BIN_EXE_lapclone"))
+        .arg("check")
+        .arg(&scene)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stderr
+            .contains("warning: patch \"a\": \"at\" key(s) at t = 3.5 after the scene's end (1 s)"),
+        "{stderr}"
+    );
+}
+
+#[test]
 fn keys_past_the_end_are_warned_about() {
     let scene = load(&(base() + "a.at(3.5, [1, 1]); b.opacity(1, 0.5);"));
     let warnings = scene.warnings();

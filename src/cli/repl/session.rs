@@ -54,6 +54,8 @@ pub struct Session {
     base_text: Option<String>,
     /// Every successful Rhai entry since the load, in order (undo drops its share).
     edits: Vec<String>,
+    /// The warnings already printed, so each is printed once while it holds.
+    warned: Vec<String>,
     undo: Vec<Snapshot>,
     renderer: Option<Renderer>,
     last_update: Option<SceneUpdate>,
@@ -92,6 +94,7 @@ impl Session {
             imports: Vec::new(),
             base_text: None,
             edits: Vec::new(),
+            warned: Vec::new(),
             undo: Vec::new(),
             renderer: None,
             last_update: None,
@@ -165,6 +168,7 @@ impl Session {
         self.imports = import_statements(&text);
         self.base_text = Some(text);
         self.edits.clear();
+        self.warned.clear();
         self.undo.clear();
         self.file = Some(file.clone());
         self.refresh_words();
@@ -417,13 +421,16 @@ impl Session {
         Ok(())
     }
 
-    /// Prints the scene's warnings (keys no frame shows) to stderr.
-    fn warn(&self) {
-        if let Ok((scene, _)) = self.engine.scene(Path::new("<repl>")) {
-            for warning in scene.warnings() {
-                eprintln!("warning: {warning}");
-            }
+    /// Prints the scene's new warnings (keys no frame shows) to stderr.
+    fn warn(&mut self) {
+        let Ok((scene, _)) = self.engine.scene(Path::new("<repl>")) else {
+            return;
+        };
+        let warnings = scene.warnings();
+        for warning in warnings.iter().filter(|w| !self.warned.contains(w)) {
+            eprintln!("warning: {warning}");
         }
+        self.warned = warnings;
     }
 
     /// The `:keys NAME` table.
@@ -555,11 +562,12 @@ impl Session {
             ));
             let p = &patch.placement;
             out.push_str(&format!(
-                "  keys: position {}, scale {}, rotation {}, depth {}\n",
+                "  keys: position {}, scale {}, rotation {}, depth {}, opacity {}\n",
                 p.position.keys().len(),
                 p.scale.keys().len(),
                 p.rotation.keys().len(),
-                p.depth.keys().len()
+                p.depth.keys().len(),
+                p.opacity.keys().len()
             ));
             for (i, h) in patch.handles.iter().enumerate() {
                 out.push_str(&format!(
