@@ -587,8 +587,8 @@ fn hostile_scenes_fail_at_a_position_without_output() {
         // Rhai does not size-check `m[k] = v`: such growth ends at the operation limit.
         ("growing_map", with_head("let m = #{}; let i = 0; loop { m[`k${i}`] = i; i += 1; }\n"), "operations"),
         ("unknown_easing", with_head("p.at(0, [1, 2]).at(1, [3, 4], \"bouncy\");\n"), "bouncy"),
-        ("keys_out_of_order", with_head("p.at(1, [1, 2]).at(0.5, [3, 4]);\n"), "out of order"),
-        ("key_repeated", with_head("p.scale(0.5, 1).scale(0.5, 2);\n"), "out of order"),
+        ("missing_key", with_head("p.at(1, [1, 2]).remove_key(0.5);\n"), "no key at t = 0.5"),
+        ("opacity_above_one", with_head("p.opacity(0.5, 2);\n"), "in [0, 1]"),
         ("negative_time", with_head("p.at(-1, [1, 2]);\n"), "≥ 0"),
         ("nan_position", with_head("p.at(0, [0.0 / 0.0, 2]);\n"), "finite"),
         ("inf_scale", with_head("p.scale(0, 1.0 / 0.0);\n"), "finite"),

@@ -133,8 +133,8 @@ blob.scale(0, 1.2);
     assert_eq!(
         lists,
         [
-            "  keys: position 2, scale 0, rotation 0, depth 0",
-            "  keys: position 1, scale 0, rotation 0, depth 0"
+            "  keys: position 2, scale 0, rotation 0, depth 0, opacity 0",
+            "  keys: position 1, scale 0, rotation 0, depth 0, opacity 0"
         ],
         "{stdout}"
     );

@@ -106,12 +106,17 @@ fn a_changed_boundary_rebuilds_that_patch() {
 }
 
 #[test]
-fn removed_and_renamed_patches_drop_and_build() {
+fn removed_patches_drop_and_renamed_ones_keep_their_layer() {
     let mut edited = scene();
     edited.patches.remove(0);
     edited.patches[0].name = "renamed".into();
+    let (update, same) = switch_and_compare(scene(), edited.clone(), 0);
+    assert_eq!((update.reused, update.rebuilt, update.dropped), (1, 0, 1));
+    assert!(same);
+    // A new patch with the settings of a kept one still gets its own layer.
+    edited.patches.push(patch("b", DVec2::new(60.0, 100.0)));
     let (update, same) = switch_and_compare(scene(), edited, 0);
-    assert_eq!((update.reused, update.rebuilt, update.dropped), (0, 1, 2));
+    assert_eq!((update.reused, update.rebuilt, update.dropped), (1, 1, 1));
     assert!(same);
 }
 

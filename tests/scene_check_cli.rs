@@ -50,18 +50,23 @@ fn a_valid_scene_passes_with_a_summary() {
 }
 
 #[test]
-fn out_of_order_keys_are_shown_with_a_caret() {
+fn a_missing_key_is_shown_with_a_caret() {
     let dir = tempfile::tempdir().unwrap();
     let (code, _, stderr) = check(
         dir.path(),
-        &format!("{}p.at(1, [0, 0]);\n  p.at(0.5, [1, 1]);\n", head()),
+        &format!("{}p.at(1, [0, 0]);\n  p.remove_key(0.5, \"at\");\n", head()),
     );
     assert_eq!(code, 1);
     let scene = dir.path().join("scene.rhai");
-    let expected = format!("{}:4:5: ", scene.display());
+    let expected = format!(
+        "{}:4:5: no \"at\" key at t = 0.5 on patch \"tri\"; its keys are at 1",
+        scene.display()
+    );
     assert!(stderr.contains(&expected), "{stderr}");
-    assert!(stderr.contains("out of order"), "{stderr}");
-    assert!(stderr.contains("\n  p.at(0.5, [1, 1]);\n    ^"), "{stderr}");
+    assert!(
+        stderr.contains("\n  p.remove_key(0.5, \"at\");\n    ^"),
+        "{stderr}"
+    );
 }
 
 #[test]

@@ -221,10 +221,10 @@ fn bad_inputs_are_positioned() {
         2, 9, "nope.png",
     );
     assert_error_at(
-        &format!("{HEAD}p.key(1, #{{ at: [1, 2] }});\np.key(0.5, #{{ at: [1, 2] }});"),
+        &format!("{HEAD}p.key(1, #{{ at: [1, 2] }});\np.remove_key(0.5);"),
         4,
         3,
-        "out of order",
+        "no key at t = 0.5 on patch \"p\"; its keys are at 1",
     );
     assert_error_at(
         &format!("{HEAD}p.at(-1, [0, 0]);"),
@@ -253,10 +253,10 @@ fn bad_inputs_are_positioned() {
         "radius must be > 0",
     );
     assert_error_at(
-        &format!("{HEAD}\np.drag([1, 1], 2).key(1, [2, 2]).key(0, [3, 3]);"),
+        &format!("{HEAD}\np.drag([1, 1], 2).key(1, [2, 2]).remove_key(0);"),
         4,
         34,
-        "out of order",
+        "no key at t = 0 on handle 0 of patch \"p\"; its keys are at 1",
     );
     assert_error_at(
         "canvas(64, 48);\nlet p = patch(\"p\", #{ source: \"assets/astronaut.png\", mask: \"assets/horse_mask.png\", boundary_data: \"pointy\" });",

@@ -1,5 +1,8 @@
 //! `Scene::to_rhai` round trip: parsing the written scene gives back an equal scene, over
-//! random scenes (fixed seed) with every feature, awkward floats and awkward names.
+//! random scenes (fixed seed) with every feature, awkward floats and awkward names; and over
+//! random edit sessions (inserted, replaced, removed and moved keys, removed handles, pins
+//! and patches, renames, reordering, opacity) run as REPL entries, where both forms `:save`
+//! writes — the text plus the entries, and every key written out — rebuild the same scene.
 
 use std::path::PathBuf;
 
@@ -120,6 +123,7 @@ fn patch(index: usize) -> impl Strategy<Value = Patch> {
             track(positive()),
             track(awkward_f64()),
             track(awkward_f64()),
+            track(0.0..=1.0f64),
         ),
         prop::collection::vec(handle(), 0..3),
         prop::collection::vec(pin(), 0..3),
@@ -167,6 +171,7 @@ fn patch(index: usize) -> impl Strategy<Value = Patch> {
                     scale: tracks.1,
                     rotation: tracks.2,
                     depth: tracks.3,
+                    opacity: tracks.4,
                 },
                 handles,
                 pins,
@@ -225,5 +230,282 @@ proptest! {
         prop_assert_eq!(&parsed.scene, &original, "{}", text);
         // Writing again is a fixed point.
         prop_assert_eq!(parsed.scene.to_rhai(), text);
+    }
+}
+
+/// One edit as a REPL user would type it; indices pick among what exists when it runs.
+#[derive(Clone, Debug)]
+enum Edit {
+    /// A key at a new time or (`existing`) at the time of an existing key: a replacement.
+    Key {
+        patch: usize,
+        track: usize,
+        t: f64,
+        existing: Option<usize>,
+        value: f64,
+        easing: Easing,
+    },
+    Opacity {
+        patch: usize,
+        t: f64,
+        value: f64,
+    },
+    RemoveKey {
+        patch: usize,
+        key: usize,
+        one_track: Option<usize>,
+    },
+    MoveKey {
+        patch: usize,
+        key: usize,
+        to: f64,
+    },
+    RemoveHandle {
+        patch: usize,
+        handle: usize,
+        by_value: bool,
+    },
+    RemovePin {
+        patch: usize,
+        pin: usize,
+    },
+    Rename {
+        patch: usize,
+        name: String,
+    },
+    Reorder {
+        patch: usize,
+        front: bool,
+    },
+    RemovePatch {
+        patch: usize,
+    },
+}
+
+fn edit() -> impl Strategy<Value = Edit> {
+    let i = || 0usize..8;
+    let t = || prop_oneof![0.0..4.0f64, (0u8..8).prop_map(|k| f64::from(k) * 0.5)];
+    prop_oneof![
+        4 => (i(), 0usize..4, t(), prop::option::of(i()), -50.0..50.0f64, easing()).prop_map(
+            |(patch, track, t, existing, value, easing)| Edit::Key { patch, track, t, existing, value, easing }
+        ),
+        2 => (i(), t(), 0.0..=1.0f64).prop_map(|(patch, t, value)| Edit::Opacity { patch, t, value }),
+        2 => (i(), i(), prop::option::of(0usize..5)).prop_map(|(patch, key, one_track)| Edit::RemoveKey { patch, key, one_track }),
+        1 => (i(), i(), t()).prop_map(|(patch, key, to)| Edit::MoveKey { patch, key, to }),
+        1 => (i(), i(), any::<bool>()).prop_map(|(patch, handle, by_value)| Edit::RemoveHandle { patch, handle, by_value }),
+        1 => (i(), i()).prop_map(|(patch, pin)| Edit::RemovePin { patch, pin }),
+        1 => (i(), "[a-z]{1,3}").prop_map(|(patch, name)| Edit::Rename { patch, name }),
+        1 => (i(), any::<bool>()).prop_map(|(patch, front)| Edit::Reorder { patch, front }),
+        1 => i().prop_map(|patch| Edit::RemovePatch { patch }),
+    ]
+}
+
+const TRACKS: [&str; 5] = ["at", "scale", "rotate", "depth", "opacity"];
+
+/// The Rhai entry for `edit` against `scene` as it is now (`None`: nothing to edit).
+fn entry(edit: &Edit, scene: &lapclone::script::Draft) -> Option<String> {
+    let patches = &scene.patches;
+    let pick = |i: usize| (!patches.is_empty()).then(|| i % patches.len());
+    let patch = |i: usize| {
+        pick(i).map(|p| {
+            format!(
+                "get_patch({})",
+                lapclone::scene::rhai_string_literal(&patches[p].name)
+            )
+        })
+    };
+    let times = |p: usize| -> Vec<f64> {
+        let pl = &patches[p].placement;
+        let mut all: Vec<f64> = pl
+            .position
+            .times()
+            .chain(pl.scale.times())
+            .chain(pl.rotation.times())
+            .chain(pl.depth.times())
+            .chain(pl.opacity.times())
+            .collect();
+        all.sort_by(f64::total_cmp);
+        all.dedup();
+        all
+    };
+    let literal = |v: f64| format!("{v:?}");
+    Some(match edit {
+        Edit::Key {
+            patch: p,
+            track,
+            t,
+            existing,
+            value,
+            easing,
+        } => {
+            let known = times(pick(*p)?);
+            let t = match existing {
+                Some(k) if !known.is_empty() => known[k % known.len()],
+                _ => *t,
+            };
+            let value = match TRACKS[*track] {
+                "at" => format!("[{}, 1.5]", literal(*value)),
+                "scale" => literal(value.abs() + 0.1),
+                _ => literal(*value),
+            };
+            format!(
+                "{}.{}({}, {value}, \"{}\");",
+                patch(*p)?,
+                TRACKS[*track],
+                literal(t),
+                easing.name()
+            )
+        }
+        Edit::Opacity { patch: p, t, value } => {
+            format!(
+                "{}.key({}, #{{ opacity: {} }});",
+                patch(*p)?,
+                literal(*t),
+                literal(*value)
+            )
+        }
+        Edit::RemoveKey {
+            patch: p,
+            key,
+            one_track,
+        } => {
+            let known = times(pick(*p)?);
+            let t = *known.get(key % known.len().max(1))?;
+            let pl = &patches[pick(*p)?].placement;
+            match one_track {
+                Some(k) => {
+                    let name = TRACKS[*k];
+                    let has = match name {
+                        "at" => pl.position.has_key_at(t),
+                        "scale" => pl.scale.has_key_at(t),
+                        "rotate" => pl.rotation.has_key_at(t),
+                        "depth" => pl.depth.has_key_at(t),
+                        _ => pl.opacity.has_key_at(t),
+                    };
+                    has.then(|| {
+                        format!(
+                            "{}.remove_key({}, \"{name}\");",
+                            patch(*p).unwrap(),
+                            literal(t)
+                        )
+                    })?
+                }
+                None => format!("{}.remove_key({});", patch(*p)?, literal(t)),
+            }
+        }
+        Edit::MoveKey { patch: p, key, to } => {
+            let known = times(pick(*p)?);
+            let t = *known.get(key % known.len().max(1))?;
+            format!("{}.move_key({}, {});", patch(*p)?, literal(t), literal(*to))
+        }
+        Edit::RemoveHandle {
+            patch: p,
+            handle,
+            by_value,
+        } => {
+            let handles = patches[pick(*p)?].handles.len();
+            let h = (handles > 0).then(|| handle % handles)?;
+            if *by_value {
+                // The handle value a user kept from `drag`: here a fresh one, appended.
+                format!("{0}.remove_handle({0}.drag([1.0, 2.0], 3.0));", patch(*p)?)
+            } else {
+                format!("{}.remove_handle({h});", patch(*p)?)
+            }
+        }
+        Edit::RemovePin { patch: p, pin } => {
+            let pins = &patches[pick(*p)?].pins;
+            let i = (!pins.is_empty()).then(|| pin % pins.len())?;
+            let at = pins[i].at;
+            if i % 2 == 0 {
+                format!(
+                    "{}.remove_pin([{}, {}]);",
+                    patch(*p)?,
+                    literal(at.x),
+                    literal(at.y)
+                )
+            } else {
+                format!("{}.remove_pin({i});", patch(*p)?)
+            }
+        }
+        Edit::Rename { patch: p, name } => {
+            let target = patch(*p)?;
+            let taken = patches.iter().any(|q| &q.name == name);
+            (!taken).then(|| format!("{target}.rename(\"{name}\");"))?
+        }
+        Edit::Reorder { patch: p, front } => {
+            let call = if *front { "to_front" } else { "to_back" };
+            format!("{}.{call}();", patch(*p)?)
+        }
+        Edit::RemovePatch { patch: p } => {
+            let name = &patches[pick(*p)?].name;
+            format!(
+                "remove_patch({});",
+                lapclone::scene::rhai_string_literal(name)
+            )
+        }
+    })
+}
+
+/// The scene with its image paths made canonical (`scenes/../assets/a.png` = `assets/a.png`).
+fn canonical(mut scene: Scene) -> Scene {
+    let fix = |p: &mut PathBuf| *p = p.canonicalize().unwrap();
+    if let Background::Image(p) = &mut scene.canvas.background {
+        fix(p);
+    }
+    for patch in &mut scene.patches {
+        fix(&mut patch.source);
+        if let Shape::Mask(p) = &mut patch.shape {
+            fix(p);
+        }
+    }
+    scene
+}
+
+fn temp_options() -> ScriptOptions {
+    ScriptOptions {
+        scene_dir: std::env::temp_dir(),
+        scripts_dir: None,
+        limits: Limits::default(),
+        cancel: Default::default(),
+    }
+}
+
+proptest! {
+    #![proptest_config(Config {
+        rng_seed: RngSeed::Fixed(0xED17),
+        cases: 64,
+        ..Config::default()
+    })]
+
+    #[test]
+    fn edit_sessions_save_and_load_back(original in scene(), edits in prop::collection::vec(edit(), 1..12)) {
+        let file = PathBuf::from("saved.rhai");
+        let start = original.to_rhai();
+        let engine = lapclone::script::SceneEngine::new(&temp_options());
+        let mut scope = rhai::Scope::new();
+        let _ = engine.run(&mut scope, &start, &file).map_err(|e| TestCaseError::fail(e.to_string()))?;
+        let mut entries = Vec::new();
+        for edit in &edits {
+            let Some(line) = entry(edit, &engine.draft()) else { continue };
+            let _ = engine
+                .run(&mut scope, &line, &file)
+                .map_err(|e| TestCaseError::fail(format!("{line}: {e}")))?;
+            entries.push(line);
+        }
+        let (edited, _) = engine.scene(&file).map_err(|e| TestCaseError::fail(e.to_string()))?;
+        // The text form: the original text followed by the entries.
+        let script = format!("{start}\n{}\n", entries.join("\n"));
+        let replayed = parse_scene(&script, &file, &temp_options())
+            .map_err(|e| TestCaseError::fail(format!("{e}\n---\n{script}")))?;
+        prop_assert_eq!(&replayed.scene, &edited, "{}", script);
+        // The keys form, written for a file in the project's scenes/ folder: paths relative
+        // to it name the same files.
+        let folder = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes");
+        let keys = edited.to_rhai_in(&folder);
+        prop_assert!(!keys.contains(env!("CARGO_MANIFEST_DIR")), "{}", keys);
+        let options = ScriptOptions { scene_dir: folder, ..temp_options() };
+        let parsed = parse_scene(&keys, &file, &options)
+            .map_err(|e| TestCaseError::fail(format!("{e}\n---\n{keys}")))?;
+        prop_assert_eq!(canonical(parsed.scene), canonical(edited), "{}", keys);
     }
 }

@@ -192,6 +192,9 @@ pub fn run_check(args: CheckArgs) -> anyhow::Result<()> {
         c.frame_count(),
         loaded.scene.patches.len(),
     );
+    for warning in loaded.scene.warnings() {
+        eprintln!("warning: {warning}");
+    }
     Ok(())
 }
 

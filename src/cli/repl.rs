@@ -8,7 +8,9 @@ mod commands;
 mod completion;
 mod helper;
 mod hints;
+mod keys;
 mod preview;
+mod save;
 mod session;
 mod sixel;
 mod validator;
@@ -54,6 +56,11 @@ pub fn run(args: ReplArgs) -> anyhow::Result<()> {
     preview::check_preview_path(&preview_path)?;
     let cancel = Arc::new(AtomicBool::new(false));
     let words = Arc::new(Mutex::new(completion::Words::default()));
+    // The default preview is this process's own temp file: removed when the session ends.
+    let _cleanup = args
+        .preview
+        .is_none()
+        .then(|| RemoveOnExit(preview_path.clone()));
     let preview = Preview::new(preview_path, interactive, Inline::detect(interactive));
     let mut session = Session::new(cancel.clone(), preview, words.clone(), interactive);
     let mut failures = 0;
@@ -78,6 +85,15 @@ pub fn run(args: ReplArgs) -> anyhow::Result<()> {
             return Err(EntriesFailed(failures).into());
         }
         Ok(())
+    }
+}
+
+/// Removes its file when dropped (a file that was never written is no error).
+struct RemoveOnExit(PathBuf);
+
+impl Drop for RemoveOnExit {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_file(&self.0);
     }
 }
 

@@ -191,6 +191,7 @@ impl Layer {
 
     /// Takes the new version of its patch (same [`LayerSettings`]) and, if given, its new rig.
     pub fn update(&mut self, patch: &Patch, rig: Option<DeformRig>) {
+        patch.name.clone_into(&mut self.name);
         if rig.is_some() {
             self.rig = rig;
         }

@@ -5,11 +5,14 @@
 //! cloning Laplacian and, for patches with handles or pins, factor its deformation Laplacian. Per frame:
 //! evaluate the timeline at t = i / fps, reset the canvas to the background, then for each
 //! patch back to front: deformation solve (rank-1 switches only), visibility switches,
-//! membrane solve, raster — each patch clones onto the composite of the layers below it.
+//! membrane solve, raster — each patch clones onto the composite of the layers below it; a
+//! layer with opacity below 1 is then blended over a copy of the pixels below it, and a
+//! layer with opacity 0 is not drawn.
 //! After an edit ([`Renderer::set_scene`]) only new or changed patches are built again.
 
 mod error;
 mod layer;
+mod opacity;
 mod renderer;
 
 pub use error::RenderError;

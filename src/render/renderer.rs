@@ -8,6 +8,7 @@ use std::time::Instant;
 use glam::DVec2;
 
 use super::layer::{Layer, LayerSettings};
+use super::opacity::blend_over_below;
 use super::RenderError;
 use crate::mesh::Mesh;
 use crate::pixels::PixelRect;
@@ -22,7 +23,8 @@ pub struct SceneUpdate {
     pub reused: usize,
     /// Layers meshed and factored anew (new patches, or changed mesh-defining settings).
     pub rebuilt: usize,
-    /// Old layers not kept: their patch was removed, renamed or changed its mesh settings.
+    /// Old layers not kept: their patch was removed or changed its mesh settings (a renamed
+    /// patch keeps its layer).
     pub dropped: usize,
     /// Deformation rigs built for kept layers whose patch gained its first handle or pin.
     pub rigs_built: usize,
@@ -69,6 +71,8 @@ pub struct Renderer {
     /// background outside them.
     dirty: Vec<PixelRect>,
     dirty_valid: bool,
+    /// The frame before a translucent layer was drawn (allocated by the first one).
+    below: Option<Canvas>,
 }
 
 impl Renderer {
@@ -92,6 +96,7 @@ impl Renderer {
             stats: FrameStats::default(),
             dirty: Vec::new(),
             dirty_valid: true,
+            below: None,
         })
     }
 
@@ -100,7 +105,7 @@ impl Renderer {
     }
 
     /// Switches to a new version of the scene, keeping every layer (mesh, cloning factor,
-    /// deformation rig) whose patch — matched by name — has the same mesh-defining settings
+    /// deformation rig) whose patch — matched by name, else (a rename) by settings alone — has the same mesh-defining settings
     /// (source, shape, density, Laplacian kind, mode, feather, boundary data). Only new or changed patches
     /// are meshed and factored; a kept patch that gained its first handle or pin gets a rig.
     /// On error the renderer is unchanged.
@@ -151,23 +156,16 @@ impl Renderer {
     /// For each new patch, the old layer it keeps (and a rig it still needs) or a new layer.
     /// Does all fallible work without touching `self`.
     fn plan_layers(&self, patches: &[Patch]) -> Result<Vec<Planned>, RenderError> {
-        let mut taken = vec![false; self.layers.len()];
+        let kept = self.match_layers(patches);
         let mut sources: HashMap<PathBuf, FloatImage> = self
             .layers
             .iter()
             .map(|l| (l.settings_source().to_path_buf(), l.source().clone()))
             .collect();
         let mut plan = Vec::with_capacity(patches.len());
-        for patch in patches {
-            let settings = LayerSettings::of(patch);
-            let kept = self
-                .layers
-                .iter()
-                .enumerate()
-                .position(|(i, l)| !taken[i] && l.name == patch.name && l.settings == settings);
+        for (patch, kept) in patches.iter().zip(kept) {
             plan.push(match kept {
                 Some(index) => {
-                    taken[index] = true;
                     let rig = self.layers[index].missing_rig(patch)?.map(Box::new);
                     Planned::Keep { index, rig }
                 }
@@ -178,6 +176,29 @@ impl Renderer {
             });
         }
         Ok(plan)
+    }
+
+    /// The old layer each new patch keeps: first one of its own name with equal settings, then
+    /// (a renamed patch) any unclaimed layer with equal settings — a layer's mesh, factor and
+    /// rig depend on the settings alone.
+    fn match_layers(&self, patches: &[Patch]) -> Vec<Option<usize>> {
+        let settings: Vec<LayerSettings> = patches.iter().map(LayerSettings::of).collect();
+        let mut taken = vec![false; self.layers.len()];
+        let mut kept = vec![None; patches.len()];
+        for by_name in [true, false] {
+            for (i, patch) in patches.iter().enumerate() {
+                if kept[i].is_some() {
+                    continue;
+                }
+                kept[i] = self.layers.iter().enumerate().position(|(j, l)| {
+                    !taken[j] && (!by_name || l.name == patch.name) && l.settings == settings[i]
+                });
+                if let Some(j) = kept[i] {
+                    taken[j] = true;
+                }
+            }
+        }
+        kept
     }
 
     /// Each patch's mesh and where the last frame placed it, in scene order.
@@ -220,8 +241,21 @@ impl Renderer {
         stats.deform_switches = self.prepare_layers()?;
         stats.deform_ms = millis(prepare_started.elapsed());
         for &index in &self.state.draw_order {
+            let opacity = self.state.patches[index].opacity;
+            if opacity <= 0.0 {
+                continue;
+            }
             let composite_started = Instant::now();
+            if opacity < 1.0 {
+                let frame = &self.frame;
+                self.below
+                    .get_or_insert_with(|| frame.clone())
+                    .copy_from(frame);
+            }
             let clone = self.layers[index].composite(&mut self.frame)?;
+            if let Some(below) = self.below.as_ref().filter(|_| opacity < 1.0) {
+                blend_over_below(&mut self.frame, below, clone.raster.work, opacity);
+            }
             stats.deform_ms +=
                 millis(composite_started.elapsed()) - clone.solve_ms - clone.raster_ms;
             stats.solve_ms += clone.solve_ms;

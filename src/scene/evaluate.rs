@@ -15,6 +15,8 @@ pub struct PatchState {
     /// Degrees, clockwise on screen.
     pub rotation: f64,
     pub depth: f64,
+    /// In [0, 1]; 1 draws the clone as is, 0 leaves the layers below untouched.
+    pub opacity: f64,
     pub handles: Vec<HandleState>,
     /// Rest points of the pins active at this time.
     pub pins: Vec<DVec2>,
@@ -84,6 +86,7 @@ fn evaluate_patch(patch: &Patch, t: f64, out: &mut PatchState) {
     out.scale = p.scale.value_at(t).unwrap_or(1.0);
     out.rotation = p.rotation.value_at(t).unwrap_or(0.0);
     out.depth = p.depth.value_at(t).unwrap_or(0.0);
+    out.opacity = p.opacity.value_at(t).unwrap_or(1.0);
     out.handles.clear();
     out.handles
         .extend(patch.handles.iter().map(|h| HandleState {

@@ -1,11 +1,13 @@
 //! The scene: a canvas and layered, keyframed patches as plain Rust values ([`Scene`]), their
 //! evaluation at a time ([`Scene::evaluate`] → [`FrameState`]) and their writing back as a
-//! Rhai scene file ([`Scene::to_rhai`]). Parsing scene files lives in [`crate::script`].
+//! Rhai scene file ([`Scene::to_rhai`]), and warnings about what no frame shows
+//! ([`Scene::warnings`]). Parsing scene files lives in [`crate::script`].
 
 mod evaluate;
 mod to_rhai;
 mod track;
 mod types;
+mod warnings;
 
 pub use evaluate::{frame_time, FrameState, HandleState, PatchState};
 pub use to_rhai::rhai_string_literal;

@@ -1,9 +1,11 @@
-//! Writing a [`Scene`] back as a Rhai scene file (the REPL's `:save`): takes a scene and gives
+//! Writing a [`Scene`] back as a Rhai scene file (the REPL's `:save` when the session's own
+//! text cannot be kept): takes a scene (and the folder the file will live in) and gives
 //! source text that the scene language parses back into an equal scene. Numbers are written
-//! in Rust's shortest round-trip form, so no value changes on the way.
+//! in Rust's shortest round-trip form, so no value changes on the way; paths are written
+//! relative to the file's folder where they can be; each patch's variable is named after it.
 
 use std::fmt::Write as _;
-use std::path::Path;
+use std::path::{Component, Path, PathBuf};
 
 use glam::DVec2;
 
@@ -13,19 +15,188 @@ use super::types::{Background, Canvas, Handle, Patch, Pin, Polygon, Scene, Shape
 impl Scene {
     /// Rhai source that re-creates this scene (paths written as stored, i.e. resolved).
     pub fn to_rhai(&self) -> String {
+        self.write_rhai(None)
+    }
+
+    /// Rhai source for a file in `folder`: paths relative to it (when both it and the file
+    /// exist), otherwise as [`Scene::to_rhai`].
+    pub fn to_rhai_in(&self, folder: &Path) -> String {
+        self.write_rhai(Some(folder))
+    }
+
+    fn write_rhai(&self, folder: Option<&Path>) -> String {
         let mut out = String::from("// Scene written by lapclone.\n");
-        write_canvas(&mut out, &self.canvas);
-        for (i, patch) in self.patches.iter().enumerate() {
+        let paths = Paths(folder.and_then(|f| f.canonicalize().ok()));
+        write_canvas(&mut out, &self.canvas, &paths);
+        let mut taken = Vec::new();
+        for patch in &self.patches {
             out.push('\n');
-            write_patch(&mut out, patch, &format!("p{}", i + 1));
+            let var = variable_name(&patch.name, &taken);
+            write_patch(&mut out, patch, &var, &paths);
+            taken.push(var);
         }
         out
     }
 }
 
-fn write_canvas(out: &mut String, canvas: &Canvas) {
+/// How paths are written: relative to this (canonical) folder, or as stored.
+struct Paths(Option<PathBuf>);
+
+impl Paths {
+    fn literal(&self, path: &Path) -> String {
+        let relative = self
+            .0
+            .as_ref()
+            .and_then(|folder| relative_path(folder, path));
+        path_literal(relative.as_deref().unwrap_or(path))
+    }
+}
+
+/// `path` relative to `folder` (both made canonical), with `..` where needed; `None` when
+/// they share no more than the file-system root (the absolute path reads better then).
+fn relative_path(folder: &Path, path: &Path) -> Option<PathBuf> {
+    let path = path.canonicalize().ok()?;
+    let common = folder
+        .components()
+        .zip(path.components())
+        .take_while(|(a, b)| a == b)
+        .count();
+    let roots = folder
+        .components()
+        .take_while(|c| matches!(c, Component::Prefix(_) | Component::RootDir))
+        .count();
+    if common <= roots {
+        return None;
+    }
+    let mut out = PathBuf::new();
+    for _ in folder.components().skip(common) {
+        out.push("..");
+    }
+    for part in path.components().skip(common) {
+        out.push(part);
+    }
+    Some(out)
+}
+
+/// Rhai's keywords and reserved words, which cannot name a variable.
+const RESERVED: &[&str] = &[
+    "let",
+    "const",
+    "fn",
+    "if",
+    "else",
+    "for",
+    "in",
+    "while",
+    "loop",
+    "do",
+    "until",
+    "return",
+    "throw",
+    "try",
+    "catch",
+    "true",
+    "false",
+    "import",
+    "export",
+    "as",
+    "private",
+    "this",
+    "switch",
+    "break",
+    "continue",
+    "global",
+    "Fn",
+    "call",
+    "curry",
+    "eval",
+    "is_def_var",
+    "is_def_fn",
+    "is_shared",
+    "print",
+    "debug",
+    "type_of",
+    "var",
+    "static",
+    "shared",
+    "with",
+    "go",
+    "sync",
+    "async",
+    "await",
+    "yield",
+    "default",
+    "void",
+    "null",
+    "nil",
+    "spawn",
+    "thread",
+    "module",
+    "package",
+    "super",
+    "new",
+    "use",
+    "public",
+    "protected",
+    "match",
+    "case",
+    "goto",
+    "exit",
+    "sizeof",
+    "function",
+    "include",
+    "static",
+    "enum",
+    "struct",
+    "type",
+    "impl",
+    "trait",
+];
+
+/// A Rhai variable named after the patch (`cat`, `big_dog`), unique among `taken`.
+fn variable_name(patch: &str, taken: &[String]) -> String {
+    let mut base: String = patch
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() {
+                c.to_ascii_lowercase()
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    base = base.trim_matches('_').to_string();
+    if base.is_empty() || base.starts_with(|c: char| c.is_ascii_digit()) {
+        base = format!("patch_{base}");
+    }
+    if RESERVED.contains(&base.as_str()) {
+        base.push_str("_patch");
+    }
+    let mut name = base.clone();
+    let mut n = 2;
+    // Handles are written as `{patch variable}_h1`, `_h2`, …: no patch variable may look like one.
+    let clashes = |name: &str| {
+        taken
+            .iter()
+            .any(|t| t == name || is_handle_of(name, t) || is_handle_of(t, name))
+    };
+    while clashes(&name) {
+        name = format!("{base}_{n}");
+        n += 1;
+    }
+    name
+}
+
+/// Whether `var` has the form of a handle variable of `patch_var` (`{patch_var}_h12`).
+fn is_handle_of(var: &str, patch_var: &str) -> bool {
+    var.strip_prefix(patch_var)
+        .and_then(|rest| rest.strip_prefix("_h"))
+        .is_some_and(|n| !n.is_empty() && n.bytes().all(|b| b.is_ascii_digit()))
+}
+
+fn write_canvas(out: &mut String, canvas: &Canvas, paths: &Paths) {
     let background = match &canvas.background {
-        Background::Image(path) => path_literal(path),
+        Background::Image(path) => paths.literal(path),
         Background::Colour(c) => format!(
             "[{}, {}, {}, {}]",
             num_f32(c[0]),
@@ -47,10 +218,10 @@ fn write_canvas(out: &mut String, canvas: &Canvas) {
     .expect("write to String"); // invariant: writing to a String cannot fail
 }
 
-fn write_patch(out: &mut String, patch: &Patch, var: &str) {
-    let mut options = vec![format!("source: {}", path_literal(&patch.source))];
+fn write_patch(out: &mut String, patch: &Patch, var: &str, paths: &Paths) {
+    let mut options = vec![format!("source: {}", paths.literal(&patch.source))];
     match &patch.shape {
-        Shape::Mask(path) => options.push(format!("mask: {}", path_literal(path))),
+        Shape::Mask(path) => options.push(format!("mask: {}", paths.literal(path))),
         Shape::Polygons(polygons) => {
             options.push(format!("polygons: {}", polygons_literal(polygons)))
         }
@@ -74,6 +245,7 @@ fn write_patch(out: &mut String, patch: &Patch, var: &str) {
     write_track(out, var, "scale", &p.scale, |v| num(*v));
     write_track(out, var, "rotate", &p.rotation, |v| num(*v));
     write_track(out, var, "depth", &p.depth, |v| num(*v));
+    write_track(out, var, "opacity", &p.opacity, |v| num(*v));
     for (i, handle) in patch.handles.iter().enumerate() {
         write_handle(out, handle, &format!("{var}_h{}", i + 1), var);
     }

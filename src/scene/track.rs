@@ -1,10 +1,12 @@
-//! Keyframe tracks: takes keys (time, value, easing) in strictly increasing time order and
-//! gives the value at any time `t`, pure and deterministic.
+//! Keyframe tracks: takes keys (time, value, easing) in any order — each is inserted at its
+//! time, replacing a key already there — and gives the value at any time `t` by binary
+//! search, pure and deterministic. Keys can be removed and moved by their exact time.
 //!
 //! **Which segment a key's easing governs:** the segment that *ends* at the key. The easing
 //! passed with `key(1.5, value, "ease_in_out")` says how the value *arrives* at `value` by
-//! t = 1.5, so every call is self-contained, appending a key never changes a segment that was
-//! already defined, and the first key's easing is unused (nothing arrives at it). Before the
+//! t = 1.5, so every call is self-contained, and the first key's easing is unused (nothing
+//! arrives at it). Inserting a key k between keys a and b splits the segment a → b in two:
+//! a → k takes k's easing, k → b keeps b's easing (now over the shorter span). Before the
 //! first key the track holds the first value; after the last key it holds the last value.
 
 use glam::DVec2;
@@ -120,7 +122,7 @@ pub enum KeyError {
     NegativeTime(f64),
     #[error("key value is not finite")]
     NonFiniteValue,
-    #[error("key at t = {time} is out of order: the previous key is at t = {previous} (keys must be added in increasing time)")]
+    #[error("key at t = {time} is out of order: the previous key is at t = {previous}")]
     OutOfOrder { time: f64, previous: f64 },
 }
 
@@ -134,6 +136,17 @@ impl<T> Default for Track<T> {
     fn default() -> Self {
         Track { keys: Vec::new() }
     }
+}
+
+/// A key time must be finite and ≥ 0.
+fn check_time(time: f64) -> Result<(), KeyError> {
+    if !time.is_finite() {
+        return Err(KeyError::NonFiniteTime(time));
+    }
+    if time < 0.0 {
+        return Err(KeyError::NegativeTime(time));
+    }
+    Ok(())
 }
 
 impl<T: Interpolate> Track<T> {
@@ -160,31 +173,61 @@ impl<T: Interpolate> Track<T> {
         self.keys.is_empty()
     }
 
-    /// Appends a key after the last one; refuses negative, non-finite or out-of-order times.
+    /// Puts a key at `time`: inserted in time order, or replacing (value and easing) the key
+    /// already at exactly that time. Refuses negative or non-finite times and values.
     pub fn push(&mut self, time: f64, value: T, easing: Easing) -> Result<(), KeyError> {
-        if !time.is_finite() {
-            return Err(KeyError::NonFiniteTime(time));
-        }
-        if time < 0.0 {
-            return Err(KeyError::NegativeTime(time));
-        }
+        check_time(time)?;
         if !value.is_finite_value() {
             return Err(KeyError::NonFiniteValue);
         }
-        if let Some(last) = self.keys.last() {
-            if time <= last.time {
-                return Err(KeyError::OutOfOrder {
-                    time,
-                    previous: last.time,
-                });
-            }
-        }
-        self.keys.push(Key {
-            time,
+        let key = Key {
+            time: time + 0.0,
             value,
             easing,
-        });
+        };
+        match self.find(time) {
+            Ok(index) => self.keys[index] = key,
+            Err(index) => self.keys.insert(index, key),
+        }
         Ok(())
+    }
+
+    /// The index of the key at exactly `time` (`Ok`), or where one would be inserted (`Err`).
+    fn find(&self, time: f64) -> Result<usize, usize> {
+        // Adding 0 turns −0 into +0, so the two zeros name one time.
+        let time = time + 0.0;
+        self.keys.binary_search_by(|k| k.time.total_cmp(&time))
+    }
+
+    /// Whether a key sits at exactly `time`.
+    pub fn has_key_at(&self, time: f64) -> bool {
+        self.find(time).is_ok()
+    }
+
+    /// Removes and gives the key at exactly `time`, if there is one.
+    pub fn remove(&mut self, time: f64) -> Option<Key<T>> {
+        self.find(time).ok().map(|index| self.keys.remove(index))
+    }
+
+    /// Moves the key at exactly `from` to `to` (value and easing kept), replacing a key at
+    /// `to`. Gives `false` (and changes nothing) when no key is at `from` or `to` is not a
+    /// valid time.
+    pub fn move_key(&mut self, from: f64, to: f64) -> bool {
+        if check_time(to).is_err() {
+            return false;
+        }
+        let Some(key) = self.remove(from) else {
+            return false;
+        };
+        // invariant: `to` was checked and the value came from this (valid) track.
+        self.push(to, key.value, key.easing)
+            .expect("a checked time and a stored value are accepted");
+        true
+    }
+
+    /// The key times in increasing order.
+    pub fn times(&self) -> impl Iterator<Item = f64> + '_ {
+        self.keys.iter().map(|k| k.time)
     }
 
     /// The value at time `t`, or `None` for an empty track.
@@ -245,17 +288,40 @@ mod tests {
     }
 
     #[test]
-    fn out_of_order_is_refused() {
+    fn keys_insert_in_order_and_replace_at_equal_times() {
         let mut t = Track::<f64>::new();
         t.push(1.0, 0.0, Easing::Linear).unwrap();
+        t.push(3.0, 3.0, Easing::Linear).unwrap();
+        t.push(0.5, 1.0, Easing::Smooth).unwrap();
+        assert_eq!(t.times().collect::<Vec<_>>(), [0.5, 1.0, 3.0]);
+        t.push(1.0, 7.0, Easing::Hold).unwrap();
+        assert_eq!(t.keys().len(), 3);
+        assert_eq!(t.keys()[1].value, 7.0);
+        assert_eq!(t.keys()[1].easing, Easing::Hold);
+        assert!(t.sanity_check().is_ok());
         assert!(matches!(
-            t.push(0.5, 1.0, Easing::Linear),
-            Err(KeyError::OutOfOrder { .. })
+            t.push(-1.0, 0.0, Easing::Linear),
+            Err(KeyError::NegativeTime(_))
         ));
         assert!(matches!(
-            t.push(1.0, 1.0, Easing::Linear),
-            Err(KeyError::OutOfOrder { .. })
+            t.push(f64::NAN, 0.0, Easing::Linear),
+            Err(KeyError::NonFiniteTime(_))
         ));
-        assert_eq!(t.keys().len(), 1);
+        assert_eq!(t.keys().len(), 3);
+    }
+
+    #[test]
+    fn remove_and_move_find_exact_times() {
+        let mut t = Track::<f64>::new();
+        for (time, v) in [(0.0, 0.0), (1.5, 1.0), (3.0, 2.0)] {
+            t.push(time, v, Easing::Linear).unwrap();
+        }
+        assert!(t.remove(1.5000001).is_none());
+        assert_eq!(t.remove(1.5).map(|k| k.value), Some(1.0));
+        assert!(t.move_key(3.0, 0.5));
+        assert_eq!(t.times().collect::<Vec<_>>(), [0.0, 0.5]);
+        assert!(!t.move_key(2.0, 1.0));
+        assert!(!t.move_key(0.5, -1.0));
+        assert_eq!(t.times().collect::<Vec<_>>(), [0.0, 0.5]);
     }
 }

@@ -57,7 +57,7 @@ pub use crate::solve::LaplacianKind;
 
 /// Where a patch sits in the canvas over time. Empty tracks take their defaults:
 /// `position` = the patch stays where it is in the source (its bounding-box centre keeps its
-/// source coordinates), `scale` 1, `rotation` 0°, `depth` 0.
+/// source coordinates), `scale` 1, `rotation` 0°, `depth` 0, `opacity` 1.
 #[derive(Clone, Debug, PartialEq, Default)]
 pub struct Placement {
     /// Canvas position of the centre of the patch's bounding box.
@@ -68,6 +68,8 @@ pub struct Placement {
     pub rotation: Track<f64>,
     /// Layering: higher depth is drawn later (in front); ties keep scene order.
     pub depth: Track<f64>,
+    /// In [0, 1]: how much of the cloned patch shows over the layers below (1 = all of it).
+    pub opacity: Track<f64>,
 }
 
 /// A drag of the patch's rest point `from` (source coordinates) to `to(t)`.
@@ -240,8 +242,16 @@ impl Patch {
         p.scale.sanity_check().map_err(|e| key("scale", e))?;
         p.rotation.sanity_check().map_err(|e| key("rotation", e))?;
         p.depth.sanity_check().map_err(|e| key("depth", e))?;
+        p.opacity.sanity_check().map_err(|e| key("opacity", e))?;
         if p.scale.keys().iter().any(|k| k.value <= 0.0) {
             return Err(fail("scale must be > 0".into()));
+        }
+        if p.opacity
+            .keys()
+            .iter()
+            .any(|k| !(0.0..=1.0).contains(&k.value))
+        {
+            return Err(fail("opacity must be in [0, 1]".into()));
         }
         for (i, h) in self.handles.iter().enumerate() {
             if !(h.from.is_finite() && h.radius.is_finite() && h.radius > 0.0) {

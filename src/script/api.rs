@@ -15,10 +15,10 @@ use crate::scene::{
     Background, Canvas, CloneMode, Easing, Handle, LaplacianKind, Patch, Pin, Polygon, Shape, Track,
 };
 
-type Fallible<T> = Result<T, Box<EvalAltResult>>;
+pub(super) type Fallible<T> = Result<T, Box<EvalAltResult>>;
 
 /// A runtime error at the position of the current call.
-fn fail(ctx: &NativeCallContext, message: impl Into<String>) -> Box<EvalAltResult> {
+pub(super) fn fail(ctx: &NativeCallContext, message: impl Into<String>) -> Box<EvalAltResult> {
     EvalAltResult::ErrorRuntime(message.into().into(), ctx.call_position()).into()
 }
 
@@ -45,19 +45,20 @@ fn existing_file(base_dir: &Path, text: &str, what: &str) -> Result<PathBuf, Str
     }
 }
 
-/// A patch of the scene, as seen from a script. Cloning it in Rhai shares the patch.
+/// A patch of the scene, as seen from a script. Cloning it in Rhai shares the patch; it
+/// names the patch by a stable id, so it survives renames, reordering and other removals.
 #[derive(Clone, Debug)]
 pub struct PatchRef {
-    draft: SharedDraft,
-    index: usize,
+    pub(super) draft: SharedDraft,
+    pub(super) id: u64,
 }
 
-/// A handle (drag) of a patch, as seen from a script.
+/// A handle (drag) of a patch, as seen from a script (stable ids, like [`PatchRef`]).
 #[derive(Clone, Debug)]
 pub struct HandleRef {
-    draft: SharedDraft,
-    patch: usize,
-    handle: usize,
+    pub(super) draft: SharedDraft,
+    pub(super) patch: u64,
+    pub(super) handle: u64,
 }
 
 pub fn register(engine: &mut Engine, draft: &SharedDraft) {
@@ -85,14 +86,16 @@ pub fn register(engine: &mut Engine, draft: &SharedDraft) {
     );
     let d = draft.clone();
     engine.register_fn("get_patch", move |ctx: NativeCallContext, name: &str| {
-        let index = d.lock().patches.iter().position(|p| p.name == name);
+        let guard = d.lock();
+        let index = guard.patches.iter().position(|p| p.name == name);
         index
             .map(|index| PatchRef {
                 draft: d.clone(),
-                index,
+                id: guard.ids.patches[index],
             })
-            .ok_or_else(|| fail(&ctx, format!("no patch named `{name}`")))
+            .ok_or_else(|| fail(&ctx, guard.no_patch_message(name)))
     });
+    super::edit_api::register(engine, draft);
     engine.register_fn("easings", || -> rhai::Array {
         Easing::ALL
             .iter()
@@ -180,11 +183,10 @@ fn new_patch(
         ));
     }
     let o = origin(ctx, &d.base_dir);
-    d.patches.push(patch);
-    d.origins.patches.push(o);
+    let id = d.push_patch(patch, o);
     Ok(PatchRef {
         draft: draft.clone(),
-        index: d.patches.len() - 1,
+        id,
     })
 }
 
@@ -277,26 +279,25 @@ fn ring(value: &Dynamic) -> Result<Vec<DVec2>, String> {
 impl PatchRef {
     /// Applies `edit` to a copy of the patch and commits it only if it succeeds, so a failed
     /// call leaves the scene unchanged.
-    fn edit<R>(
+    pub(super) fn edit<R>(
         &self,
         ctx: &NativeCallContext,
         edit: impl FnOnce(&mut Patch) -> Result<R, String>,
     ) -> Fallible<R> {
         let mut d = self.draft.lock();
-        let Some(current) = d.patches.get(self.index) else {
+        let Some(index) = d.patch_index(self.id) else {
             return Err(fail(ctx, "this patch no longer exists in the scene"));
         };
-        let mut patch = current.clone();
+        let mut patch = d.patches[index].clone();
         let result = edit(&mut patch).map_err(|m| fail(ctx, m))?;
-        d.patches[self.index] = patch;
+        d.patches[index] = patch;
         Ok(result)
     }
 
-    fn name(&mut self) -> String {
+    pub(super) fn name(&mut self) -> String {
         let d = self.draft.lock();
-        d.patches
-            .get(self.index)
-            .map(|p| p.name.clone())
+        d.patch_index(self.id)
+            .map(|i| d.patches[i].name.clone())
             .unwrap_or_default()
     }
 
@@ -353,7 +354,7 @@ impl PatchRef {
         radius: Dynamic,
         options: Map,
     ) -> Fallible<HandleRef> {
-        let handle = self.edit(&ctx, |p| {
+        self.edit(&ctx, |p| {
             values::check_keys(&options, &["depth", "pivot"], "drag")?;
             let handle = Handle {
                 from: values::point(&from, "drag rest point")?,
@@ -370,11 +371,15 @@ impl PatchRef {
                 rotation: Track::new(),
             };
             p.handles.push(handle);
-            Ok(p.handles.len() - 1)
+            Ok(())
         })?;
+        let mut d = self.draft.lock();
+        // invariant: the edit above found the patch, and nothing ran in between.
+        let index = d.patch_index(self.id).expect("patch edited just now");
+        let handle = d.register_handle(index);
         Ok(HandleRef {
             draft: self.draft.clone(),
-            patch: self.index,
+            patch: self.id,
             handle,
         })
     }
@@ -402,24 +407,38 @@ impl PatchRef {
 }
 
 /// The keyframable placement properties, by their scene-language names.
-#[derive(Clone, Copy)]
-enum Placed {
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Placed {
     At,
     Scale,
     Rotate,
     Depth,
+    Opacity,
 }
 
-const PLACEMENT_KEYS: [&str; 4] = ["at", "scale", "rotate", "depth"];
+pub(super) const PLACEMENT_KEYS: [&str; 5] = ["at", "scale", "rotate", "depth", "opacity"];
 
 impl Placed {
-    fn from_name(name: &str) -> Option<Placed> {
-        match name {
-            "at" => Some(Placed::At),
-            "scale" => Some(Placed::Scale),
-            "rotate" => Some(Placed::Rotate),
-            "depth" => Some(Placed::Depth),
-            _ => None,
+    pub(super) const ALL: [Placed; 5] = [
+        Placed::At,
+        Placed::Scale,
+        Placed::Rotate,
+        Placed::Depth,
+        Placed::Opacity,
+    ];
+
+    pub(super) fn from_name(name: &str) -> Option<Placed> {
+        Placed::ALL.into_iter().find(|p| p.name() == name)
+    }
+
+    /// The track's scene-language name.
+    pub(super) fn name(self) -> &'static str {
+        match self {
+            Placed::At => "at",
+            Placed::Scale => "scale",
+            Placed::Rotate => "rotate",
+            Placed::Depth => "depth",
+            Placed::Opacity => "opacity",
         }
     }
 
@@ -436,6 +455,7 @@ impl Placed {
             Placed::Scale => p.scale.push(t, values::positive(value, "`scale`")?, easing),
             Placed::Rotate => p.rotation.push(t, number(value, "`rotate`")?, easing),
             Placed::Depth => p.depth.push(t, number(value, "`depth`")?, easing),
+            Placed::Opacity => p.opacity.push(t, values::unit(value, "`opacity`")?, easing),
         };
         result.map_err(|e| e.to_string())
     }
@@ -444,7 +464,7 @@ impl Placed {
 fn add_placement_keys(patch: &mut Patch, t: f64, keys: &Map, easing: Easing) -> Result<(), String> {
     values::check_keys(keys, &PLACEMENT_KEYS, "key")?;
     if keys.is_empty() {
-        return Err("a key needs at least one of: at, scale, rotate, depth".into());
+        return Err("a key needs at least one of: at, scale, rotate, depth, opacity".into());
     }
     for (name, value) in keys {
         let which = Placed::from_name(name).expect("checked key name"); // invariant: check_keys admitted only placement names.
@@ -462,22 +482,24 @@ fn take_easing(m: &mut Map) -> Result<Easing, String> {
 }
 
 impl HandleRef {
-    fn edit(
+    /// The (patch, handle) indices this handle has now, if it still exists.
+    pub(super) fn indices(&self, d: &super::draft::Draft) -> Option<(usize, usize)> {
+        let p = d.patch_index(self.patch)?;
+        Some((p, d.handle_index(p, self.handle)?))
+    }
+
+    pub(super) fn edit(
         &self,
         ctx: &NativeCallContext,
         edit: impl FnOnce(&mut Handle) -> Result<(), String>,
     ) -> Fallible<Self> {
         let mut d = self.draft.lock();
-        let Some(current) = d
-            .patches
-            .get(self.patch)
-            .and_then(|p| p.handles.get(self.handle))
-        else {
+        let Some((p, h)) = self.indices(&d) else {
             return Err(fail(ctx, "this handle no longer exists in the scene"));
         };
-        let mut handle = current.clone();
+        let mut handle = d.patches[p].handles[h].clone();
         edit(&mut handle).map_err(|m| fail(ctx, m))?;
-        d.patches[self.patch].handles[self.handle] = handle;
+        d.patches[p].handles[h] = handle;
         Ok(self.clone())
     }
 
@@ -579,12 +601,9 @@ impl CustomType for PatchRef {
                 "pin",
                 |ctx: NativeCallContext, p: &mut PatchRef, at: Dynamic, o: Map| p.pin(ctx, at, o),
             );
-        for (name, which) in [
-            ("at", Placed::At),
-            ("scale", Placed::Scale),
-            ("rotate", Placed::Rotate),
-            ("depth", Placed::Depth),
-        ] {
+        super::edit_api::build_patch(&mut b);
+        for which in Placed::ALL {
+            let name = which.name();
             b.with_fn(
                 name,
                 move |ctx: NativeCallContext, p: &mut PatchRef, t: Dynamic, v: Dynamic| {
@@ -633,5 +652,6 @@ impl CustomType for HandleRef {
                     h.rotate(ctx, t, r, e)
                 },
             );
+        super::edit_api::build_handle(&mut b);
     }
 }

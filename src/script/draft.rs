@@ -1,5 +1,6 @@
 //! The scene being built by a running script: the canvas (once set), the patches, and where
-//! in the source each was created (so later checks can point at the call that named a file).
+//! in the source each was created (so later checks can point at the call that named a file),
+//! and stable ids for the script's references to patches and handles.
 
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, MutexGuard};
@@ -23,6 +24,24 @@ pub struct Origins {
     pub patches: Vec<Origin>,
 }
 
+/// Stable identities of the draft's patches and handles, so a script's `Patch` and `Handle`
+/// values keep naming the same object when others are removed or reordered.
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct Ids {
+    /// `patches[i]` is the id of `Draft::patches[i]`.
+    pub patches: Vec<u64>,
+    /// `handles[i][j]` is the id of `Draft::patches[i].handles[j]`.
+    pub handles: Vec<Vec<u64>>,
+    next: u64,
+}
+
+impl Ids {
+    fn fresh(&mut self) -> u64 {
+        self.next += 1;
+        self.next
+    }
+}
+
 /// A scene under construction; `canvas` is `None` until `canvas(...)` runs.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Draft {
@@ -31,6 +50,7 @@ pub struct Draft {
     pub canvas: Option<Canvas>,
     pub patches: Vec<Patch>,
     pub origins: Origins,
+    pub ids: Ids,
 }
 
 impl Draft {
@@ -40,7 +60,65 @@ impl Draft {
             canvas: None,
             patches: Vec::new(),
             origins: Origins::default(),
+            ids: Ids::default(),
         }
+    }
+
+    /// Adds a patch (with handles already in it) last in scene order; gives its id.
+    pub fn push_patch(&mut self, patch: Patch, origin: Origin) -> u64 {
+        let id = self.ids.fresh();
+        let handles = (0..patch.handles.len()).map(|_| self.ids.fresh()).collect();
+        self.patches.push(patch);
+        self.origins.patches.push(origin);
+        self.ids.patches.push(id);
+        self.ids.handles.push(handles);
+        id
+    }
+
+    /// The scene-order index of the patch with this id.
+    pub fn patch_index(&self, id: u64) -> Option<usize> {
+        self.ids.patches.iter().position(|&p| p == id)
+    }
+
+    /// The index of a patch's handle with this id.
+    pub fn handle_index(&self, patch: usize, id: u64) -> Option<usize> {
+        self.ids.handles.get(patch)?.iter().position(|&h| h == id)
+    }
+
+    /// A new id for a handle just pushed onto `patches[patch].handles`.
+    pub fn register_handle(&mut self, patch: usize) -> u64 {
+        let id = self.ids.fresh();
+        self.ids.handles[patch].push(id);
+        id
+    }
+
+    /// Removes the patch at `index` with its origin and ids.
+    pub fn remove_patch(&mut self, index: usize) -> Patch {
+        self.origins.patches.remove(index);
+        self.ids.patches.remove(index);
+        self.ids.handles.remove(index);
+        self.patches.remove(index)
+    }
+
+    /// Moves the patch at `from` to scene-order position `to` (after removing it).
+    pub fn move_patch(&mut self, from: usize, to: usize) {
+        let origin = self.origins.patches.remove(from);
+        let id = self.ids.patches.remove(from);
+        let handles = self.ids.handles.remove(from);
+        let patch = self.patches.remove(from);
+        self.origins.patches.insert(to, origin);
+        self.ids.patches.insert(to, id);
+        self.ids.handles.insert(to, handles);
+        self.patches.insert(to, patch);
+    }
+
+    /// `no patch "dog"; patches: cat, horse` (or `there are no patches`).
+    pub fn no_patch_message(&self, name: &str) -> String {
+        if self.patches.is_empty() {
+            return format!("no patch {name:?}; there are no patches");
+        }
+        let names: Vec<&str> = self.patches.iter().map(|p| p.name.as_str()).collect();
+        format!("no patch {name:?}; patches: {}", names.join(", "))
     }
 }
 

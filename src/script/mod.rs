@@ -5,6 +5,7 @@
 
 mod api;
 mod draft;
+mod edit_api;
 mod engine;
 mod error;
 mod sandbox;
@@ -12,7 +13,7 @@ mod validate;
 mod values;
 
 pub use api::{HandleRef, PatchRef};
-pub use draft::{Draft, Origin, Origins};
+pub use draft::{Draft, Ids, Origin, Origins};
 pub use engine::{
     find_scripts_dir, load_scene, parse_scene, LoadedScene, SceneEngine, ScriptOptions,
 };

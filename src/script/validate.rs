@@ -127,5 +127,6 @@ fn state_is_finite(p: &crate::scene::PatchState) -> bool {
         && p.scale.is_finite()
         && p.rotation.is_finite()
         && p.depth.is_finite()
+        && p.opacity.is_finite()
         && p.handles.iter().all(|h| h.to.is_finite())
 }

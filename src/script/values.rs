@@ -41,6 +41,16 @@ pub fn non_negative(value: &Dynamic, what: &str) -> Result<f64, String> {
     }
 }
 
+/// A number in [0, 1] (opacity).
+pub fn unit(value: &Dynamic, what: &str) -> Result<f64, String> {
+    let v = number(value, what)?;
+    if (0.0..=1.0).contains(&v) {
+        Ok(v)
+    } else {
+        Err(format!("{what} must be in [0, 1], got {v}"))
+    }
+}
+
 /// A key time: finite and ≥ 0.
 pub fn time(value: &Dynamic) -> Result<f64, String> {
     let t = number(value, "key time")?;

@@ -58,7 +58,12 @@ pub const COMMANDS: &[CommandInfo] = &[
     CommandInfo {
         name: "list",
         usage: "",
-        help: "canvas, patches, keys, handles, pins and variables",
+        help: "canvas, patches, keys, handles, pins, layer order and variables",
+    },
+    CommandInfo {
+        name: "keys",
+        usage: "NAME",
+        help: "a patch's keys as a table: track, time, value, easing (and its handles')",
     },
     CommandInfo {
         name: "undo",
@@ -101,6 +106,7 @@ pub enum Command {
     Show,
     Mesh,
     List,
+    Keys(String),
     Undo,
     Render {
         range: Option<FrameRange>,
@@ -153,6 +159,8 @@ pub fn parse_command(line: &str) -> Result<Command, String> {
         "show" => no_args(Command::Show),
         "mesh" => no_args(Command::Mesh),
         "list" => no_args(Command::List),
+        "keys" if rest.is_empty() => Err(usage()),
+        "keys" => Ok(Command::Keys(unquote(rest).to_string())),
         "undo" => no_args(Command::Undo),
         "render" => parse_render(rest).map_err(|e| format!("{}: {e}", usage())),
         "gif" => path().map(Command::Gif),
@@ -231,6 +239,11 @@ mod tests {
             })
         );
         assert_eq!(parse_command("  :quit  "), Ok(Command::Quit));
+        assert_eq!(
+            parse_command(":keys \"big cat\""),
+            Ok(Command::Keys("big cat".into()))
+        );
+        assert!(parse_command(":keys").is_err());
     }
 
     #[test]

@@ -77,6 +77,14 @@ pub fn classify(before: &str) -> Completion {
         if PATH_COMMANDS.contains(&name) || previous == Some("-o") {
             return Completion::Path;
         }
+        if name == "keys" {
+            // The patch name after `:keys`.
+            let start = before.trim_end_matches(|c: char| !c.is_whitespace()).len();
+            return Completion::Word {
+                start,
+                in_string: true,
+            };
+        }
         return Completion::Word {
             start: before.len(),
             in_string: false,
@@ -225,6 +233,34 @@ mod tests {
         assert_eq!(word_candidates("c", true, &words()), ["cat", "coffee_cup"]);
         assert_eq!(word_candidates("le", false, &words()), ["let"]);
         assert!(word_candidates("zz", false, &words()).is_empty());
+    }
+
+    #[test]
+    fn editing_calls_and_keys_patch_names_complete() {
+        let options =
+            lapclone::script::ScriptOptions::for_scene_file(std::path::Path::new("a.rhai"));
+        let engine = lapclone::script::SceneEngine::new(&options);
+        let names = function_names(engine.engine());
+        for call in [
+            "remove_key",
+            "move_key",
+            "remove_patch",
+            "remove_handle",
+            "remove_pin",
+            "rename",
+            "to_front",
+            "to_back",
+            "opacity",
+        ] {
+            assert!(names.iter().any(|n| n == call), "{call}");
+        }
+        assert_eq!(
+            classify(":keys ca"),
+            Completion::Word {
+                start: 6,
+                in_string: true
+            }
+        );
     }
 
     #[test]

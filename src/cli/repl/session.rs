@@ -18,7 +18,9 @@ use rhai::{Dynamic, Scope, AST};
 
 use super::commands::{help_text, parse_command, Command};
 use super::completion::{function_names, SharedWords, Words};
+use super::keys::key_table;
 use super::preview::Preview;
+use super::save::{saved_text, SaveForm};
 use crate::cli::render::{default_jobs, positioned, FrameRange, FrameSink, OutputFormat};
 
 /// What an entry did.
@@ -34,6 +36,8 @@ pub enum Step {
 struct Snapshot {
     draft: Draft,
     scope: Scope<'static>,
+    /// How many entries `edits` had.
+    edits: usize,
 }
 
 pub struct Session {
@@ -46,6 +50,12 @@ pub struct Session {
     functions: AST,
     /// `import` statements of every successful entry, re-run before each entry.
     imports: Vec<String>,
+    /// The loaded scene file's text, the start of what `:save` writes.
+    base_text: Option<String>,
+    /// Every successful Rhai entry since the load, in order (undo drops its share).
+    edits: Vec<String>,
+    /// The warnings already printed, so each is printed once while it holds.
+    warned: Vec<String>,
     undo: Vec<Snapshot>,
     renderer: Option<Renderer>,
     last_update: Option<SceneUpdate>,
@@ -82,6 +92,9 @@ impl Session {
             scope: Scope::new(),
             functions: AST::empty(),
             imports: Vec::new(),
+            base_text: None,
+            edits: Vec::new(),
+            warned: Vec::new(),
             undo: Vec::new(),
             renderer: None,
             last_update: None,
@@ -153,10 +166,14 @@ impl Session {
         self.scope = scope;
         self.functions = ast.clone_functions_only();
         self.imports = import_statements(&text);
+        self.base_text = Some(text);
+        self.edits.clear();
+        self.warned.clear();
         self.undo.clear();
         self.file = Some(file.clone());
         self.refresh_words();
         println!("loaded {}", file.display());
+        self.warn();
         self.show_frame()
     }
 
@@ -195,6 +212,7 @@ impl Session {
                 }
             }
             Command::List => print!("{}", self.listing()),
+            Command::Keys(name) => print!("{}", self.keys(&name)?),
             Command::Undo => self.undo()?,
             Command::Render { range, output } => {
                 self.render_to(OutputFormat::Png, &output, range)?
@@ -224,7 +242,9 @@ impl Session {
                 return Err(error);
             }
             self.undo.push(before);
+            self.warn();
         }
+        self.edits.push(text.to_string());
         self.functions = self.functions.merge(&ast.clone_functions_only());
         self.imports.extend(import_statements(text));
         self.refresh_words();
@@ -336,6 +356,7 @@ impl Session {
         Snapshot {
             draft: self.engine.draft(),
             scope: self.scope.clone(),
+            edits: self.edits.len(),
         }
     }
 
@@ -343,6 +364,7 @@ impl Session {
     fn restore(&mut self, snapshot: Snapshot) {
         self.engine.restore(snapshot.draft);
         self.scope = snapshot.scope;
+        self.edits.truncate(snapshot.edits);
         if let (Some(renderer), Ok((scene, _))) = (
             self.renderer.as_mut(),
             self.engine.scene(Path::new("<undo>")),
@@ -381,13 +403,45 @@ impl Session {
         Ok(scene)
     }
 
+    /// Writes the live scene (see `save.rs` for the two forms it takes).
     fn save(&mut self, path: &Path) -> anyhow::Result<()> {
         let scene = self.current_scene()?;
         crate::cli::clone::check_output_folder(path)?;
-        lapclone::util::write_atomic(path, scene.to_rhai().as_bytes())
+        let (text, form) = saved_text(&scene, self.base_text.as_deref(), &self.edits, path);
+        lapclone::util::write_atomic(path, text.as_bytes())
             .with_context(|| format!("writing {}", path.display()))?;
-        println!("saved {}", path.display());
+        match form {
+            SaveForm::Script => println!("saved {}", path.display()),
+            SaveForm::Keys => println!(
+                "saved {} (every key written out: the session's text does not rebuild this \
+                 scene from that folder)",
+                path.display()
+            ),
+        }
         Ok(())
+    }
+
+    /// Prints the scene's new warnings (keys no frame shows) to stderr.
+    fn warn(&mut self) {
+        let Ok((scene, _)) = self.engine.scene(Path::new("<repl>")) else {
+            return;
+        };
+        let warnings = scene.warnings();
+        for warning in warnings.iter().filter(|w| !self.warned.contains(w)) {
+            eprintln!("warning: {warning}");
+        }
+        self.warned = warnings;
+    }
+
+    /// The `:keys NAME` table.
+    fn keys(&self, name: &str) -> anyhow::Result<String> {
+        let draft = self.engine.draft();
+        let patch = draft
+            .patches
+            .iter()
+            .find(|p| p.name == name)
+            .ok_or_else(|| anyhow::anyhow!(draft.no_patch_message(name)))?;
+        Ok(key_table(patch))
     }
 
     /// Renders frames with a fresh renderer, so the files are byte-identical to
@@ -508,11 +562,12 @@ impl Session {
             ));
             let p = &patch.placement;
             out.push_str(&format!(
-                "  keys: position {}, scale {}, rotation {}, depth {}\n",
+                "  keys: position {}, scale {}, rotation {}, depth {}, opacity {}\n",
                 p.position.keys().len(),
                 p.scale.keys().len(),
                 p.rotation.keys().len(),
-                p.depth.keys().len()
+                p.depth.keys().len(),
+                p.opacity.keys().len()
             ));
             for (i, h) in patch.handles.iter().enumerate() {
                 out.push_str(&format!(
@@ -531,6 +586,7 @@ impl Session {
                 ));
             }
         }
+        out.push_str(&layer_order(&draft, self.time));
         let names: Vec<&str> = self.scope.iter_raw().map(|(name, _, _)| name).collect();
         if !names.is_empty() {
             out.push_str(&format!("variables: {}\n", names.join(", ")));
@@ -560,6 +616,37 @@ impl Session {
         };
         *self.words.lock().unwrap_or_else(|p| p.into_inner()) = words;
     }
+}
+
+/// `layers at t = 1.5 s, back to front: horse, cat (opacity 0.5)`.
+fn layer_order(draft: &Draft, t: f64) -> String {
+    let Some(canvas) = draft.canvas.clone() else {
+        return String::new();
+    };
+    if draft.patches.is_empty() {
+        return String::new();
+    }
+    let scene = Scene {
+        canvas,
+        patches: draft.patches.clone(),
+    };
+    let state = scene.evaluate(t);
+    let layers: Vec<String> = state
+        .draw_order
+        .iter()
+        .map(|&i| {
+            let (patch, s) = (&scene.patches[i], &state.patches[i]);
+            let mut text = format!("{:?} (depth {}", patch.name, s.depth);
+            if s.opacity < 1.0 {
+                text.push_str(&format!(", opacity {}", s.opacity));
+            }
+            text + ")"
+        })
+        .collect();
+    format!(
+        "layers at t = {t} s, back to front: {}\n",
+        layers.join(", ")
+    )
 }
 
 /// A render error (it names its patch; no source position, as the scene may come from many

@@ -1,0 +1,424 @@
+//! The scene language's editing calls, registered next to [`super::api`]: takes the shared
+//! draft and gives `remove_patch(...)` and, on `Patch` and `Handle` values, `remove_key`,
+//! `move_key`, `remove_handle`, `remove_pin`, `rename`, `to_front` and `to_back`. Every
+//! call is checked in full before it changes anything, so a refusal (a positioned runtime
+//! error that says what exists) leaves the scene as it was.
+
+use rhai::{Dynamic, Engine, NativeCallContext, TypeBuilder};
+
+use super::api::{fail, Fallible, HandleRef, PatchRef, Placed};
+use super::draft::{Draft, SharedDraft};
+use super::values;
+use crate::scene::{Interpolate, Patch, Track};
+
+/// What removing and moving keys needs of a track, whatever its value type.
+trait KeyTimes {
+    fn has_key_at(&self, t: f64) -> bool;
+    fn remove(&mut self, t: f64);
+    fn move_key(&mut self, from: f64, to: f64);
+    fn key_times(&self) -> Vec<f64>;
+}
+
+impl<T: Interpolate> KeyTimes for Track<T> {
+    fn has_key_at(&self, t: f64) -> bool {
+        Track::has_key_at(self, t)
+    }
+    fn remove(&mut self, t: f64) {
+        Track::remove(self, t);
+    }
+    fn move_key(&mut self, from: f64, to: f64) {
+        Track::move_key(self, from, to);
+    }
+    fn key_times(&self) -> Vec<f64> {
+        self.times().collect()
+    }
+}
+
+/// The keyframed tracks of one patch or handle, by name, and how errors name their owner.
+struct Tracks<'a> {
+    owner: String,
+    tracks: Vec<(&'static str, &'a mut dyn KeyTimes)>,
+}
+
+fn patch_tracks(patch: &mut Patch) -> Tracks<'_> {
+    let owner = format!("patch {:?}", patch.name);
+    let p = &mut patch.placement;
+    // The same order and names as `Placed::ALL`.
+    let tracks: Vec<(&'static str, &mut dyn KeyTimes)> = vec![
+        (Placed::At.name(), &mut p.position),
+        (Placed::Scale.name(), &mut p.scale),
+        (Placed::Rotate.name(), &mut p.rotation),
+        (Placed::Depth.name(), &mut p.depth),
+        (Placed::Opacity.name(), &mut p.opacity),
+    ];
+    Tracks { owner, tracks }
+}
+
+impl<'a> Tracks<'a> {
+    /// The tracks `name` selects (all of them for `None`), or an error naming the tracks.
+    fn select(&mut self, name: Option<&str>) -> Result<Vec<&mut &'a mut dyn KeyTimes>, String> {
+        let names: Vec<&str> = self.tracks.iter().map(|(n, _)| *n).collect();
+        if let Some(name) = name {
+            if !names.contains(&name) {
+                return Err(format!(
+                    "unknown track {name:?} on {}; tracks: {}",
+                    self.owner,
+                    names.join(", ")
+                ));
+            }
+        }
+        Ok(self
+            .tracks
+            .iter_mut()
+            .filter(|(n, _)| name.is_none_or(|name| name == *n))
+            .map(|(_, t)| t)
+            .collect())
+    }
+
+    /// Checks that some selected track has a key at `t`; the error lists the keys there are.
+    fn find(&mut self, t: f64, name: Option<&str>) -> Result<(), String> {
+        let owner = self.owner.clone();
+        let selected = self.select(name)?;
+        if selected.iter().any(|track| track.has_key_at(t)) {
+            return Ok(());
+        }
+        let mut times: Vec<f64> = selected.iter().flat_map(|t| t.key_times()).collect();
+        times.sort_by(f64::total_cmp);
+        times.dedup();
+        let what = match name {
+            Some(name) => format!("no {name:?} key"),
+            None => "no key".to_string(),
+        };
+        let keys = if times.is_empty() {
+            "it has no keys".to_string()
+        } else {
+            let listed: Vec<String> = times.iter().map(|t| t.to_string()).collect();
+            format!("its keys are at {}", listed.join(", "))
+        };
+        Err(format!("{what} at t = {t} on {owner}; {keys}"))
+    }
+
+    fn remove_key(&mut self, t: f64, name: Option<&str>) -> Result<(), String> {
+        self.find(t, name)?;
+        for track in self.select(name)? {
+            track.remove(t);
+        }
+        Ok(())
+    }
+
+    fn move_key(&mut self, from: f64, to: f64, name: Option<&str>) -> Result<(), String> {
+        self.find(from, name)?;
+        for track in self.select(name)? {
+            if track.has_key_at(from) {
+                track.move_key(from, to);
+            }
+        }
+        Ok(())
+    }
+}
+
+fn handle_tracks(handle: &mut crate::scene::Handle, owner: String) -> Tracks<'_> {
+    let tracks: Vec<(&'static str, &mut dyn KeyTimes)> =
+        vec![("at", &mut handle.to), ("rotate", &mut handle.rotation)];
+    Tracks { owner, tracks }
+}
+
+/// Applies `edit` to a copy of the whole draft and commits it only if it succeeds.
+fn edit_draft<R>(
+    draft: &SharedDraft,
+    ctx: &NativeCallContext,
+    edit: impl FnOnce(&mut Draft) -> Result<R, String>,
+) -> Fallible<R> {
+    let mut d = draft.lock();
+    let mut copy = d.clone();
+    let result = edit(&mut copy).map_err(|m| fail(ctx, m))?;
+    *d = copy;
+    Ok(result)
+}
+
+/// The patch's current index, or the error for a patch removed since.
+fn index_of(d: &Draft, patch: &PatchRef) -> Result<usize, String> {
+    d.patch_index(patch.id)
+        .ok_or_else(|| "this patch no longer exists in the scene".to_string())
+}
+
+pub fn register(engine: &mut Engine, draft: &SharedDraft) {
+    let d = draft.clone();
+    engine.register_fn(
+        "remove_patch",
+        move |ctx: NativeCallContext, name: &str| -> Fallible<()> {
+            edit_draft(&d, &ctx, |draft| {
+                let index = draft
+                    .patches
+                    .iter()
+                    .position(|p| p.name == name)
+                    .ok_or_else(|| draft.no_patch_message(name))?;
+                draft.remove_patch(index);
+                Ok(())
+            })
+        },
+    );
+    engine.register_fn(
+        "remove_patch",
+        move |ctx: NativeCallContext, patch: PatchRef| -> Fallible<()> {
+            edit_draft(&patch.draft, &ctx, |draft| {
+                let index = index_of(draft, &patch)?;
+                draft.remove_patch(index);
+                Ok(())
+            })
+        },
+    );
+}
+
+impl PatchRef {
+    fn remove_key(
+        &mut self,
+        ctx: NativeCallContext,
+        t: Dynamic,
+        track: Option<&str>,
+    ) -> Fallible<Self> {
+        self.edit(&ctx, |p| {
+            let t = values::time(&t)?;
+            patch_tracks(p).remove_key(t, track)
+        })?;
+        Ok(self.clone())
+    }
+
+    fn move_key(
+        &mut self,
+        ctx: NativeCallContext,
+        from: Dynamic,
+        to: Dynamic,
+        track: Option<&str>,
+    ) -> Fallible<Self> {
+        self.edit(&ctx, |p| {
+            let (from, to) = (values::time(&from)?, values::time(&to)?);
+            patch_tracks(p).move_key(from, to, track)
+        })?;
+        Ok(self.clone())
+    }
+
+    fn remove_handle(&mut self, ctx: NativeCallContext, which: Dynamic) -> Fallible<Self> {
+        let this = self.clone();
+        edit_draft(&self.draft, &ctx, |d| {
+            let p = index_of(d, &this)?;
+            let h = match which.clone().try_cast::<HandleRef>() {
+                Some(handle) => {
+                    let (hp, h) = handle
+                        .indices(d)
+                        .ok_or("this handle no longer exists in the scene")?;
+                    if hp != p {
+                        return Err(format!(
+                            "this handle belongs to patch {:?}, not {:?}",
+                            d.patches[hp].name, d.patches[p].name
+                        ));
+                    }
+                    h
+                }
+                None => index(&which, "handle", d.patches[p].handles.len()).map_err(|m| {
+                    format!(
+                        "{m} on patch {:?}; {}",
+                        d.patches[p].name,
+                        handles_listed(&d.patches[p])
+                    )
+                })?,
+            };
+            d.patches[p].handles.remove(h);
+            d.ids.handles[p].remove(h);
+            Ok(())
+        })?;
+        Ok(self.clone())
+    }
+
+    fn remove_pin(&mut self, ctx: NativeCallContext, which: Dynamic) -> Fallible<Self> {
+        self.edit(&ctx, |p| {
+            let i = if which.is_array() {
+                let at = values::point(&which, "pin point")?;
+                p.pins.iter().position(|pin| pin.at == at).ok_or_else(|| {
+                    format!(
+                        "no pin at [{}, {}] on patch {:?}; {}",
+                        at.x,
+                        at.y,
+                        p.name,
+                        pins_listed(p)
+                    )
+                })?
+            } else {
+                index(&which, "pin", p.pins.len())
+                    .map_err(|m| format!("{m} on patch {:?}; {}", p.name, pins_listed(p)))?
+            };
+            p.pins.remove(i);
+            Ok(())
+        })?;
+        Ok(self.clone())
+    }
+
+    fn rename(&mut self, ctx: NativeCallContext, name: Dynamic) -> Fallible<Self> {
+        let this = self.clone();
+        edit_draft(&self.draft, &ctx, |d| {
+            let p = index_of(d, &this)?;
+            let name = values::string(&name, "patch name")?;
+            if name.is_empty() {
+                return Err("patch name must not be empty".into());
+            }
+            if let Some(other) = d.patches.iter().position(|q| q.name == name) {
+                if other != p {
+                    let names: Vec<&str> = d.patches.iter().map(|q| q.name.as_str()).collect();
+                    return Err(format!(
+                        "a patch named {name:?} already exists; patches: {}",
+                        names.join(", ")
+                    ));
+                }
+            }
+            d.patches[p].name = name;
+            Ok(())
+        })?;
+        Ok(self.clone())
+    }
+
+    /// Moves the patch to the end (front) or start (back) of scene order.
+    fn reorder(&mut self, ctx: NativeCallContext, front: bool) -> Fallible<Self> {
+        let this = self.clone();
+        edit_draft(&self.draft, &ctx, |d| {
+            let p = index_of(d, &this)?;
+            let to = if front { d.patches.len() - 1 } else { 0 };
+            d.move_patch(p, to);
+            Ok(())
+        })?;
+        Ok(self.clone())
+    }
+}
+
+/// A whole-number index below `len`.
+fn index(value: &Dynamic, what: &str, len: usize) -> Result<usize, String> {
+    let Ok(i) = value.as_int() else {
+        return Err(format!(
+            "{what} must be given by its index (an integer) or its value, got {}",
+            value.type_name()
+        ));
+    };
+    usize::try_from(i)
+        .ok()
+        .filter(|&i| i < len)
+        .ok_or_else(|| format!("no {what} {i}"))
+}
+
+fn handles_listed(p: &Patch) -> String {
+    if p.handles.is_empty() {
+        return "it has no handles".into();
+    }
+    let listed: Vec<String> = p
+        .handles
+        .iter()
+        .enumerate()
+        .map(|(i, h)| format!("{i} from [{}, {}]", h.from.x, h.from.y))
+        .collect();
+    format!("its handles: {}", listed.join(", "))
+}
+
+fn pins_listed(p: &Patch) -> String {
+    if p.pins.is_empty() {
+        return "it has no pins".into();
+    }
+    let listed: Vec<String> = p
+        .pins
+        .iter()
+        .enumerate()
+        .map(|(i, pin)| format!("{i} at [{}, {}]", pin.at.x, pin.at.y))
+        .collect();
+    format!("its pins: {}", listed.join(", "))
+}
+
+impl HandleRef {
+    fn edit_tracks(
+        &mut self,
+        ctx: NativeCallContext,
+        edit: impl FnOnce(&mut Tracks) -> Result<(), String>,
+    ) -> Fallible<Self> {
+        let this = self.clone();
+        edit_draft(&self.draft, &ctx, |d| {
+            let (p, h) = this
+                .indices(d)
+                .ok_or("this handle no longer exists in the scene")?;
+            let owner = format!("handle {h} of patch {:?}", d.patches[p].name);
+            edit(&mut handle_tracks(&mut d.patches[p].handles[h], owner))
+        })?;
+        Ok(self.clone())
+    }
+}
+
+pub fn build_patch(b: &mut TypeBuilder<PatchRef>) {
+    b.with_fn(
+        "remove_key",
+        |ctx: NativeCallContext, p: &mut PatchRef, t: Dynamic| p.remove_key(ctx, t, None),
+    )
+    .with_fn(
+        "remove_key",
+        |ctx: NativeCallContext, p: &mut PatchRef, t: Dynamic, track: &str| {
+            p.remove_key(ctx, t, Some(track))
+        },
+    )
+    .with_fn(
+        "move_key",
+        |ctx: NativeCallContext, p: &mut PatchRef, from: Dynamic, to: Dynamic| {
+            p.move_key(ctx, from, to, None)
+        },
+    )
+    .with_fn(
+        "move_key",
+        |ctx: NativeCallContext, p: &mut PatchRef, from: Dynamic, to: Dynamic, track: &str| {
+            p.move_key(ctx, from, to, Some(track))
+        },
+    )
+    .with_fn(
+        "remove_handle",
+        |ctx: NativeCallContext, p: &mut PatchRef, h: Dynamic| p.remove_handle(ctx, h),
+    )
+    .with_fn(
+        "remove_pin",
+        |ctx: NativeCallContext, p: &mut PatchRef, pin: Dynamic| p.remove_pin(ctx, pin),
+    )
+    .with_fn(
+        "rename",
+        |ctx: NativeCallContext, p: &mut PatchRef, name: Dynamic| p.rename(ctx, name),
+    )
+    .with_fn("to_front", |ctx: NativeCallContext, p: &mut PatchRef| {
+        p.reorder(ctx, true)
+    })
+    .with_fn("to_back", |ctx: NativeCallContext, p: &mut PatchRef| {
+        p.reorder(ctx, false)
+    });
+}
+
+pub fn build_handle(b: &mut TypeBuilder<HandleRef>) {
+    b.with_fn(
+        "remove_key",
+        |ctx: NativeCallContext, h: &mut HandleRef, t: Dynamic| {
+            h.edit_tracks(ctx, |tracks| tracks.remove_key(values::time(&t)?, None))
+        },
+    )
+    .with_fn(
+        "remove_key",
+        |ctx: NativeCallContext, h: &mut HandleRef, t: Dynamic, track: &str| {
+            h.edit_tracks(ctx, |tracks| {
+                tracks.remove_key(values::time(&t)?, Some(track))
+            })
+        },
+    )
+    .with_fn(
+        "move_key",
+        |ctx: NativeCallContext, h: &mut HandleRef, from: Dynamic, to: Dynamic| {
+            h.edit_tracks(ctx, |tracks| {
+                tracks.move_key(values::time(&from)?, values::time(&to)?, None)
+            })
+        },
+    )
+    .with_fn(
+        "move_key",
+        |ctx: NativeCallContext, h: &mut HandleRef, from: Dynamic, to: Dynamic, track: &str| {
+            h.edit_tracks(ctx, |tracks| {
+                tracks.move_key(values::time(&from)?, values::time(&to)?, Some(track))
+            })
+        },
+    );
+}
