@@ -61,30 +61,6 @@ fn stats_json_has_exactly_the_contract_keys() {
     assert_eq!(json["boundary"], "cracks");
 }
 
-/// The plain summary says when a mask was meshed as two halves, and where it was cut.
-#[test]
-fn the_summary_names_the_cut_of_a_large_mask() {
-    let dir = tempfile::tempdir().unwrap();
-    for (name, mask, cut) in [
-        ("ring.png", synth::annulus(80, 80, 12.0, 35.0), false),
-        ("spiral.png", synth::spiral(400, 400), true),
-    ] {
-        let path = save_mask(dir.path(), name, &mask);
-        let out = lapclone(&["mesh", &path]);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let summary = String::from_utf8_lossy(&out.stdout);
-        assert_eq!(
-            summary.contains("two halves cut at row"),
-            cut,
-            "{name}: {summary}"
-        );
-    }
-}
-
 #[test]
 fn picture_and_laplacian_are_written() {
     let dir = tempfile::tempdir().unwrap();
