@@ -31,6 +31,7 @@ pub struct Draft {
     pub canvas: Option<Canvas>,
     pub patches: Vec<Patch>,
     pub origins: Origins,
+    pub golden: Option<crate::golden::GoldenSettings>,
 }
 
 impl Draft {
@@ -40,6 +41,7 @@ impl Draft {
             canvas: None,
             patches: Vec::new(),
             origins: Origins::default(),
+            golden: None,
         }
     }
 }
