@@ -150,7 +150,10 @@ fn goldens_made_by_update_pass_byte_exact() {
         assert_eq!(line["verdict"], "pass");
         assert_eq!(line["max_error"], 0.0);
         assert_eq!(line["failing_pixels"], 0);
-        assert!(line["psnr"].is_null(), "identical frames have infinite PSNR");
+        assert!(
+            line["psnr"].is_null(),
+            "identical frames have infinite PSNR"
+        );
     }
     // The goldens are the frames `lapclone render` writes, byte for byte.
     let rendered = fixture.root.join("rendered");
@@ -182,12 +185,18 @@ fn a_patch_moved_by_two_pixels_fails_with_the_hand_computed_largest_error() {
     assert!(out.join("tiny/frame_0001.diff.png").is_file());
     assert!(out.join("tiny/frame_0001.actual.png").is_file());
     let html = std::fs::read_to_string(out.join("index.html")).unwrap();
-    assert!(html.contains("src=\"tiny/frame_0001.triptych.png\""), "{html}");
+    assert!(
+        html.contains("src=\"tiny/frame_0001.triptych.png\""),
+        "{html}"
+    );
     let triptych = image::open(out.join("tiny/frame_0001.triptych.png")).unwrap();
     assert_eq!((triptych.width(), triptych.height()), (24 * 3 + 4, 16));
 
     let (value, x, y, channel) = reference_max(&fixture.golden(1), &pending);
-    assert!(value > 1, "moving the patch changes pixels by more than a level");
+    assert!(
+        value > 1,
+        "moving the patch changes pixels by more than a level"
+    );
     let expected = format!("max {value} @ ({x}, {y}, {channel})");
     let text = stdout(&check);
     assert!(
@@ -298,12 +307,20 @@ fn bad_inputs_give_clear_messages_and_exit_codes() {
     // No goldens folder: every frame is new, exit 1, and the message says so.
     let missing = fixture.run(&[]);
     assert_eq!(code(&missing), 1);
-    assert!(stdout(&missing).contains("no goldens folder"), "{}", stdout(&missing));
+    assert!(
+        stdout(&missing).contains("no goldens folder"),
+        "{}",
+        stdout(&missing)
+    );
     assert_eq!(code(&fixture.run(&["--reject"])), 0);
     // A named goldens folder that does not exist is a usage error.
     let named = fixture.run(&["--goldens", "nowhere"]);
     assert_eq!(code(&named), 2);
-    assert!(stderr(&named).contains("--goldens nowhere"), "{}", stderr(&named));
+    assert!(
+        stderr(&named).contains("--goldens nowhere"),
+        "{}",
+        stderr(&named)
+    );
 
     assert_eq!(code(&fixture.run(&["--update"])), 0);
     // A golden of another size.
@@ -319,7 +336,11 @@ fn bad_inputs_give_clear_messages_and_exit_codes() {
     std::fs::write(fixture.golden(2), b"\x89PNG\r\n\x1a\nnot really").unwrap();
     let corrupt = fixture.run(&["--frames", "2"]);
     assert_eq!(code(&corrupt), 1);
-    assert!(stdout(&corrupt).contains("is not a readable PNG"), "{}", stdout(&corrupt));
+    assert!(
+        stdout(&corrupt).contains("is not a readable PNG"),
+        "{}",
+        stdout(&corrupt)
+    );
     // A frame number past the end, from the flag and from the scene.
     let past = fixture.run(&["--frames", "9"]);
     assert_eq!(code(&past), 2);
@@ -336,7 +357,11 @@ fn bad_inputs_give_clear_messages_and_exit_codes() {
     fixture.write_scene(10, "let = ;\n");
     let syntax = fixture.run(&[]);
     assert_eq!(code(&syntax), 2);
-    assert!(stderr(&syntax).contains("tiny.rhai:4:"), "{}", stderr(&syntax));
+    assert!(
+        stderr(&syntax).contains("tiny.rhai:4:"),
+        "{}",
+        stderr(&syntax)
+    );
     // No temporary or partial files anywhere.
     assert!(
         fixture.files().iter().all(|f| !f.ends_with(".tmp")),
@@ -368,9 +393,14 @@ fn junit_counts_match_the_printed_summary() {
     let check = fixture.run(&["--junit", "report.xml"]);
     assert_eq!(code(&check), 2, "a scene that does not load wins");
     let summary = stdout(&check);
-    let summary = summary.lines().find(|l| l.starts_with("test result")).unwrap();
+    let summary = summary
+        .lines()
+        .find(|l| l.starts_with("test result"))
+        .unwrap();
     assert!(
-        summary.contains("2 passed; 0 warned; 3 failed; 0 new; 1 scene error(s) — 5 frames in 3 scenes"),
+        summary.contains(
+            "2 passed; 0 warned; 3 failed; 0 new; 1 scene error(s) — 5 frames in 3 scenes"
+        ),
         "{summary}"
     );
     let xml = std::fs::read_to_string(fixture.root.join("report.xml")).unwrap();

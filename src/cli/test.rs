@@ -16,8 +16,8 @@ use std::time::Instant;
 
 use anyhow::Context as _;
 use lapclone::golden::{
-    compare, encode_rgba_png, triptych, Comparison, GoldenError, GoldenFrame, Mismatch,
-    Thresholds, Verdict,
+    compare, encode_rgba_png, triptych, Comparison, GoldenError, GoldenFrame, Mismatch, Thresholds,
+    Verdict,
 };
 use lapclone::output::{frame_digits, frame_file_name};
 use lapclone::pixels::Canvas;
@@ -193,7 +193,9 @@ pub enum Outcome {
     Compared(Comparison),
     Mismatch(Mismatch),
     /// No golden file; whether its folder existed.
-    Missing { folder: bool },
+    Missing {
+        folder: bool,
+    },
     /// The golden exists but cannot be read.
     Unreadable(String),
     /// `--update` wrote the golden.
@@ -290,11 +292,9 @@ pub fn run(args: TestArgs) -> anyhow::Result<()> {
     }
     let scenes = find_scenes(&paths, &args.out)?;
     if scenes.is_empty() {
-        return Err(UsageError(format!(
-            "no scene files (*.rhai) found in {}",
-            list(&paths)
-        ))
-        .into());
+        return Err(
+            UsageError(format!("no scene files (*.rhai) found in {}", list(&paths))).into(),
+        );
     }
     check_all(&args, &scenes)
 }
@@ -441,7 +441,15 @@ fn check_scene(job: &Job, scene: &Path) -> SceneResult {
             pending: pending_path(&golden),
             golden,
         };
-        let mut frame = check_frame(job, scene, number, paths, canvas, format, &result.thresholds);
+        let mut frame = check_frame(
+            job,
+            scene,
+            number,
+            paths,
+            canvas,
+            format,
+            &result.thresholds,
+        );
         frame.seconds = frame_started.elapsed().as_secs_f64();
         result.frames.push(frame);
     }
@@ -528,7 +536,15 @@ fn check_frame(
             write_png(&result.paths.pending, &png)?;
             result.pending_written = Some(result.paths.pending.clone());
         }
-        let pictures = write_pictures(job, scene, number, &png, expected.as_ref(), &actual, thresholds)?;
+        let pictures = write_pictures(
+            job,
+            scene,
+            number,
+            &png,
+            expected.as_ref(),
+            &actual,
+            thresholds,
+        )?;
         result.pictures = Some(pictures);
         Ok(())
     })();

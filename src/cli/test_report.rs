@@ -316,7 +316,10 @@ fn write_index(
             continue;
         };
         let status = status_word(frame.outcome.status());
-        let image = pictures.triptych.strip_prefix(out).unwrap_or(&pictures.triptych);
+        let image = pictures
+            .triptych
+            .strip_prefix(out)
+            .unwrap_or(&pictures.triptych);
         let _ = writeln!(
             html,
             "<section><h2 class=\"{status}\">{status} {} — frame {}</h2>\n<p>{}</p>\n\

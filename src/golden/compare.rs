@@ -209,3 +209,183 @@ fn ssim(expected: &GoldenFrame, actual: &GoldenFrame) -> f64 {
         Err(_) => 0.0,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::pixels::Depth;
+
+    fn frame(width: u32, height: u32, depth: Depth, pixels: Vec<[u16; 4]>) -> GoldenFrame {
+        GoldenFrame {
+            width,
+            height,
+            depth,
+            alpha: false,
+            pixels,
+        }
+    }
+
+    fn flat(value: u16, n: usize, depth: Depth) -> GoldenFrame {
+        let max = if depth == Depth::Eight { 255 } else { 65535 };
+        frame(
+            3,
+            (n / 3) as u32,
+            depth,
+            vec![[value, value, value, max]; n],
+        )
+    }
+
+    #[test]
+    fn figures_match_a_hand_computed_difference() {
+        let expected = flat(100, 6, Depth::Eight);
+        let mut actual = expected.clone();
+        actual.pixels[0][0] = 101; // (0, 0) R: one level
+        actual.pixels[5][1] = 63; // (2, 1) G: 37 levels
+        let c = compare(&expected, &actual, &Thresholds::default()).unwrap();
+        let f = c.figures;
+        assert_eq!(
+            f.max,
+            MaxError {
+                value: 37.0,
+                x: 2,
+                y: 1,
+                channel: Channel::G
+            }
+        );
+        // Three channels (no alpha) × 6 pixels.
+        assert!((f.mean_error - 38.0 / 18.0).abs() < 1e-12);
+        let rms = (1370.0f64 / 18.0).sqrt();
+        assert!((f.rms_error - rms).abs() < 1e-12);
+        let psnr = f.psnr.unwrap();
+        assert!((psnr - 20.0 * (255.0 / rms).log10()).abs() < 1e-9);
+        assert_eq!((f.failing_pixels, f.warning_pixels), (1, 2));
+        assert!((f.failing_percent - 100.0 / 6.0).abs() < 1e-12);
+        assert_eq!(c.verdict, Verdict::Fail);
+        let lenient = Thresholds {
+            fail_percent: 20.0,
+            ..Thresholds::default()
+        };
+        assert_eq!(
+            compare(&expected, &actual, &lenient).unwrap().verdict,
+            Verdict::Warn
+        );
+        let hard = Thresholds {
+            hard_fail: 30.0,
+            ..lenient
+        };
+        assert_eq!(
+            compare(&expected, &actual, &hard).unwrap().verdict,
+            Verdict::Fail
+        );
+        let silent = Thresholds {
+            warn: 40.0,
+            ..lenient
+        };
+        assert_eq!(
+            compare(&expected, &actual, &silent).unwrap().verdict,
+            Verdict::Pass
+        );
+    }
+
+    #[test]
+    fn identical_frames_pass_with_infinite_psnr_and_unit_ssim() {
+        let a = flat(7, 6, Depth::Sixteen);
+        let c = compare(&a, &a, &Thresholds::default()).unwrap();
+        assert_eq!(c.verdict, Verdict::Pass);
+        assert_eq!(c.figures.psnr, None);
+        assert_eq!(c.figures.ssim, 1.0);
+        assert_eq!(c.figures.max.value, 0.0);
+    }
+
+    #[test]
+    fn sixteen_bit_differences_are_in_eight_bit_units() {
+        let a = flat(1000, 6, Depth::Sixteen);
+        let mut b = a.clone();
+        b.pixels[1][2] += 257; // exactly one 8-bit level: not over fail = 1
+        let c = compare(&a, &b, &Thresholds::default()).unwrap();
+        assert_eq!(c.figures.max.value, 1.0);
+        assert_eq!(c.verdict, Verdict::Warn);
+        b.pixels[1][2] += 1;
+        let c = compare(&a, &b, &Thresholds::default()).unwrap();
+        assert_eq!(c.verdict, Verdict::Fail);
+    }
+
+    #[test]
+    fn the_first_largest_error_in_row_order_is_reported() {
+        let a = flat(50, 6, Depth::Eight);
+        let mut b = a.clone();
+        b.pixels[4][2] = 60;
+        b.pixels[2][0] = 40;
+        let max = compare(&a, &b, &Thresholds::default()).unwrap().figures.max;
+        assert_eq!((max.x, max.y, max.channel), (2, 0, Channel::R));
+    }
+
+    #[test]
+    fn size_and_depth_mismatches_are_refused() {
+        let a = flat(0, 6, Depth::Eight);
+        let b = flat(0, 9, Depth::Eight);
+        assert_eq!(
+            compare(&a, &b, &Thresholds::default())
+                .unwrap_err()
+                .to_string(),
+            "size mismatch: golden is 3×2, frame is 3×3"
+        );
+        let c = flat(0, 6, Depth::Sixteen);
+        assert!(matches!(
+            compare(&a, &c, &Thresholds::default()),
+            Err(Mismatch::Depth {
+                expected: 8,
+                actual: 16
+            })
+        ));
+    }
+
+    #[test]
+    fn a_visible_seam_lowers_ssim_below_noise() {
+        // 32×32 texture; noise of one level everywhere versus a bright seam along a line.
+        let texture: Vec<[u16; 4]> = (0..32 * 32)
+            .map(|i| {
+                let v = ((i * 37) % 200) as u16;
+                [v, v / 2, 255 - v, 255]
+            })
+            .collect();
+        let base = frame(32, 32, Depth::Eight, texture);
+        let mut noise = base.clone();
+        for (i, px) in noise.pixels.iter_mut().enumerate() {
+            px[0] = if i % 2 == 0 { px[0] + 1 } else { px[0] };
+        }
+        let mut seam = base.clone();
+        for y in 0..32 {
+            seam.pixels[y * 32 + 16][1] = 255;
+        }
+        let t = Thresholds::default();
+        let noise_ssim = compare(&base, &noise, &t).unwrap().figures.ssim;
+        let seam_ssim = compare(&base, &seam, &t).unwrap().figures.ssim;
+        assert!(noise_ssim > 0.99, "{noise_ssim}");
+        assert!(seam_ssim < noise_ssim - 0.05, "{seam_ssim} vs {noise_ssim}");
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::test_runner::Config {
+            cases: 64,
+            rng_seed: proptest::test_runner::RngSeed::Fixed(0x901d_e17),
+            ..Default::default()
+        })]
+        #[test]
+        fn figures_are_symmetric_and_the_max_bounds_the_mean(
+            a in proptest::collection::vec(0u16..256, 36),
+            b in proptest::collection::vec(0u16..256, 36),
+        ) {
+            let to_frame = |v: &[u16]| frame(3, 3, Depth::Eight,
+                v.chunks(4).map(|c| [c[0], c[1], c[2], c[3]]).collect());
+            let (x, y) = (to_frame(&a), to_frame(&b));
+            let t = Thresholds::default();
+            let (p, q) = (compare(&x, &y, &t).unwrap(), compare(&y, &x, &t).unwrap());
+            proptest::prop_assert_eq!(p.figures.max, q.figures.max);
+            proptest::prop_assert_eq!(p.figures.failing_pixels, q.figures.failing_pixels);
+            proptest::prop_assert!((p.figures.mean_error - q.figures.mean_error).abs() < 1e-9);
+            proptest::prop_assert!(p.figures.mean_error <= p.figures.rms_error + 1e-9);
+            proptest::prop_assert!(p.figures.rms_error <= p.figures.max.value + 1e-9);
+        }
+    }
+}

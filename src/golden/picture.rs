@@ -36,7 +36,10 @@ pub fn difference_image(
         if !same_depth {
             return Rgba(FAILING);
         }
-        let d = (0..channels).map(|c| e[c].abs_diff(a[c])).max().unwrap_or(0);
+        let d = (0..channels)
+            .map(|c| e[c].abs_diff(a[c]))
+            .max()
+            .unwrap_or(0);
         let error = f64::from(d) * unit;
         if d == 0 {
             Rgba(dim(actual.rgba8_at(x, y).unwrap_or(EMPTY)))
@@ -61,7 +64,10 @@ pub fn triptych(
     let difference = expected.map(|e| difference_image(e, actual, thresholds));
     let width = panel_w * 3 + SEPARATOR_WIDTH * 2;
     RgbaImage::from_fn(width, panel_h, |x, y| {
-        let (panel, i) = (x / (panel_w + SEPARATOR_WIDTH), x % (panel_w + SEPARATOR_WIDTH));
+        let (panel, i) = (
+            x / (panel_w + SEPARATOR_WIDTH),
+            x % (panel_w + SEPARATOR_WIDTH),
+        );
         if i >= panel_w {
             return Rgba(SEPARATOR);
         }
@@ -104,4 +110,50 @@ fn opaque(px: [u8; 4]) -> [u8; 4] {
         mix(px[2], EMPTY[2]),
         255,
     ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::pixels::Depth;
+
+    fn frame(width: u32, height: u32, value: u16) -> GoldenFrame {
+        GoldenFrame {
+            width,
+            height,
+            depth: Depth::Eight,
+            alpha: false,
+            pixels: vec![[value, value, value, 255]; (width * height) as usize],
+        }
+    }
+
+    #[test]
+    fn the_difference_image_marks_failing_pixels_red_and_small_ones_grey() {
+        let expected = frame(4, 2, 100);
+        let mut actual = expected.clone();
+        actual.pixels[1][0] = 101; // one level: within fail = 1
+        actual.pixels[6][2] = 150; // fails
+        let d = difference_image(&expected, &actual, &Thresholds::default());
+        assert_eq!(d.get_pixel(2, 1).0, FAILING);
+        let small = d.get_pixel(1, 0).0;
+        assert!(small[0] == small[1] && small[0] >= 96, "{small:?}");
+        let same = d.get_pixel(0, 0).0;
+        assert!(same[0] < 64, "identical pixels are dim: {same:?}");
+    }
+
+    #[test]
+    fn the_triptych_puts_expected_difference_and_actual_side_by_side() {
+        let expected = frame(4, 2, 10);
+        let actual = frame(5, 3, 200);
+        let t = triptych(Some(&expected), &actual, &Thresholds::default());
+        assert_eq!((t.width(), t.height()), (5 * 3 + 2 * SEPARATOR_WIDTH, 3));
+        assert_eq!(t.get_pixel(0, 0).0, [10, 10, 10, 255]);
+        assert_eq!(t.get_pixel(4, 2).0, EMPTY, "outside the smaller golden");
+        assert_eq!(t.get_pixel(5, 0).0, SEPARATOR);
+        assert_eq!(t.get_pixel(7 + 4, 2).0, FAILING, "only one frame has it");
+        assert_eq!(t.get_pixel(14 + 4, 2).0, [200, 200, 200, 255]);
+        let png = encode_rgba_png(&t);
+        let back = image::load_from_memory(&png).unwrap().to_rgba8();
+        assert_eq!(back, t);
+    }
 }

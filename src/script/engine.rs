@@ -7,10 +7,10 @@ use std::sync::Arc;
 
 use rhai::{Dynamic, Engine, Scope, AST};
 
-use super::{api, golden};
 use super::draft::{Draft, Origins, SharedDraft};
 use super::error::{ErrorKind, SceneError};
 use super::sandbox::{sandboxed_engine, Limits, ModuleFiles, SandboxResolver};
+use super::{api, golden};
 use crate::scene::Scene;
 
 /// Where a script may import from, how far it may run, and how to stop it.

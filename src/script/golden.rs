@@ -82,11 +82,64 @@ fn frames(options: &Map, frame_count: Option<u64>) -> Result<Option<Vec<u64>>, S
         }
         let n = n as u64;
         if let Some(count) = frame_count.filter(|&c| n > c) {
-            return Err(format!("frame {n} is past the end: the scene has {count} frames"));
+            return Err(format!(
+                "frame {n} is past the end: the scene has {count} frames"
+            ));
         }
         numbers.push(n);
     }
     numbers.sort_unstable();
     numbers.dedup();
     Ok(Some(numbers))
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    use crate::script::{parse_scene, ScriptOptions};
+
+    fn run(text: &str) -> Result<Option<GoldenSettings>, String> {
+        let options = ScriptOptions::for_scene_file(Path::new("scene.rhai"));
+        parse_scene(text, Path::new("scene.rhai"), &options)
+            .map(|loaded| loaded.scene.golden)
+            .map_err(|e| e.to_string())
+    }
+
+    use super::GoldenSettings;
+
+    #[test]
+    fn golden_stores_frames_and_thresholds() {
+        let settings = run("canvas(8, 8, #{ fps: 4, duration: 12 });\n\
+             golden(#{ frames: [47, 0 + 1, 12], fail: 2, fail_percent: 0.1, min_ssim: 0.98 });")
+        .unwrap()
+        .unwrap();
+        assert_eq!(settings.frames, Some(vec![1, 12, 47]));
+        assert_eq!(settings.fail, Some(2.0));
+        assert_eq!(settings.fail_percent, Some(0.1));
+        assert_eq!(settings.min_ssim, Some(0.98));
+        assert_eq!(settings.hard_fail, None);
+        assert_eq!(run("canvas(8, 8);").unwrap(), None);
+    }
+
+    #[test]
+    fn bad_golden_calls_are_positioned_errors() {
+        let head = "canvas(8, 8, #{ fps: 4, duration: 1 });\n";
+        for (call, message) in [
+            ("golden(#{ frames: [0] });", "count from 1"),
+            (
+                "golden(#{ frames: [5] });",
+                "frame 5 is past the end: the scene has 4 frames",
+            ),
+            ("golden(#{ frames: [] });", "at least one frame"),
+            ("golden(#{ fail: -1 });", "fail must be ≥ 0"),
+            ("golden(#{ fail_percent: 101 });", "percentage"),
+            ("golden(#{ min_ssim: 2 });", "min_ssim must be in 0..=1"),
+            ("golden(#{ tolerance: 1 });", "tolerance"),
+        ] {
+            let error = run(&format!("{head}{call}")).unwrap_err();
+            assert!(error.contains(message), "{call}: {error}");
+            assert!(error.contains("scene.rhai:2:1"), "{call}: {error}");
+        }
+    }
 }
