@@ -466,7 +466,7 @@ fn load(scene: &Path) -> anyhow::Result<(lapclone::script::LoadedScene, Renderer
 }
 
 /// Flags win over the scene's settings.
-fn overrides(args: &TestArgs, base: Thresholds) -> Thresholds {
+pub fn overrides(args: &TestArgs, base: Thresholds) -> Thresholds {
     Thresholds {
         fail: args.fail.unwrap_or(base.fail),
         fail_percent: args.fail_percent.unwrap_or(base.fail_percent),

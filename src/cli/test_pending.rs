@@ -3,7 +3,7 @@
 //! and `--review` (each shown with its figures and triptych — inline where the terminal can
 //! show images — and accepted, rejected or skipped as the user answers).
 
-use std::io::{BufRead, Write as _};
+use std::io::{BufRead, IsTerminal as _, Write as _};
 use std::path::{Path, PathBuf};
 
 use anyhow::Context as _;
@@ -73,7 +73,7 @@ fn collect_in(dir: &Path, found: &mut Vec<PathBuf>) -> anyhow::Result<()> {
         let path = entry?.path();
         let name = path.file_name().unwrap_or_default().to_string_lossy();
         if path.is_file() && is_pending_name(&name) {
-            found.push(path);
+            found.push(tidy(&path));
         }
     }
     Ok(())
@@ -84,12 +84,19 @@ fn walk(dir: &Path, out: &Path, found: &mut Vec<PathBuf>) -> anyhow::Result<()> 
     for entry in std::fs::read_dir(dir).with_context(|| format!("reading {}", dir.display()))? {
         let path = entry?.path();
         let name = path.file_name().unwrap_or_default().to_string_lossy();
-        let skipped = name.starts_with('.') || name == "target" || path == out;
+        let skipped = name.starts_with('.') || name == "target" || tidy(&path) == tidy(out);
         if path.is_dir() && !skipped {
             walk(&path, out, found)?;
         }
     }
     Ok(())
+}
+
+/// The path without `.` components, so one file found two ways is listed once.
+fn tidy(path: &Path) -> PathBuf {
+    path.components()
+        .filter(|c| !matches!(c, std::path::Component::CurDir))
+        .collect()
 }
 
 fn accept(pending: &Path) -> anyhow::Result<()> {
@@ -112,6 +119,9 @@ fn review(args: &TestArgs, pending: &[PathBuf]) -> anyhow::Result<()> {
             let Some(line) = lines.next().transpose()? else {
                 break "q".to_string();
             };
+            if !std::io::stdin().is_terminal() {
+                println!("{}", line.trim());
+            }
             let word = line.trim().to_lowercase();
             if ["a", "r", "s", "q"].contains(&word.as_str()) {
                 break word;
@@ -156,7 +166,7 @@ fn show(args: &TestArgs, file: &Path) -> anyhow::Result<()> {
         println!("  new: no golden {}", golden_path.display());
         None
     };
-    let thresholds = Thresholds::default();
+    let thresholds = super::test::overrides(args, Thresholds::default());
     if let Some(expected) = &expected {
         match compare(expected, &actual, &thresholds) {
             Ok(c) => println!(
