@@ -416,3 +416,28 @@ fn junit_counts_match_the_printed_summary() {
     assert!(xml.contains("max "), "figures in the failure message");
     assert!(xml.trim_end().ends_with("</testsuites>"));
 }
+
+#[test]
+fn pending_frames_are_the_same_bytes_on_one_thread_or_several() {
+    let fixture = moved_fixture();
+    std::fs::copy(fixture.scene(), fixture.root.join("twin.rhai")).unwrap();
+    let mut runs = Vec::new();
+    for jobs in ["1", "3"] {
+        let _ = std::fs::remove_dir_all(fixture.root.join("goldens/twin"));
+        let check = fixture.run(&["--jobs", jobs, "--json"]);
+        assert_eq!(code(&check), 1);
+        let mut bytes = Vec::new();
+        for dir in ["goldens/tiny", "goldens/twin"] {
+            for frame in [1, 2, 4] {
+                let path = fixture
+                    .root
+                    .join(dir)
+                    .join(format!("frame_{frame:04}.new.png"));
+                bytes.push(std::fs::read(path).unwrap());
+            }
+        }
+        let lines: Vec<String> = stdout(&check).lines().map(str::to_string).collect();
+        runs.push((bytes, lines));
+    }
+    assert_eq!(runs[0], runs[1]);
+}

@@ -180,8 +180,7 @@ pub fn golden_dir(scene: &Path, root: Option<&Path>) -> PathBuf {
         Some(root) => root.join(stem),
         None => scene
             .parent()
-            .filter(|p| !p.as_os_str().is_empty())
-            .unwrap_or(Path::new("."))
+            .unwrap_or(Path::new(""))
             .join("goldens")
             .join(stem),
     }

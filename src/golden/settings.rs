@@ -60,6 +60,30 @@ impl GoldenSettings {
         "min_ssim",
     ];
 
+    /// The `golden(#{ … })` call that gives these settings back (floats in Rust's shortest
+    /// round-trip form, so a written scene reads back equal).
+    pub fn to_rhai(&self) -> String {
+        let mut keys = Vec::new();
+        if let Some(frames) = &self.frames {
+            let list: Vec<String> = frames.iter().map(u64::to_string).collect();
+            keys.push(format!("frames: [{}]", list.join(", ")));
+        }
+        let values = [
+            ("fail", self.fail),
+            ("fail_percent", self.fail_percent),
+            ("hard_fail", self.hard_fail),
+            ("warn", self.warn),
+            ("warn_percent", self.warn_percent),
+            ("min_ssim", self.min_ssim),
+        ];
+        for (key, value) in values {
+            if let Some(v) = value {
+                keys.push(format!("{key}: {v:?}"));
+            }
+        }
+        format!("golden(#{{ {} }});\n", keys.join(", "))
+    }
+
     /// `base` with every value this scene sets replaced.
     pub fn apply(&self, base: Thresholds) -> Thresholds {
         Thresholds {

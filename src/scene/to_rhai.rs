@@ -19,6 +19,10 @@ impl Scene {
             out.push('\n');
             write_patch(&mut out, patch, &format!("p{}", i + 1));
         }
+        if let Some(golden) = &self.golden {
+            out.push('\n');
+            out.push_str(&golden.to_rhai());
+        }
         out
     }
 }

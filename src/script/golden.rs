@@ -108,6 +108,13 @@ mod tests {
 
     use super::GoldenSettings;
 
+    fn run_scene(text: &str) -> crate::scene::Scene {
+        let options = ScriptOptions::for_scene_file(Path::new("scene.rhai"));
+        parse_scene(text, Path::new("scene.rhai"), &options)
+            .unwrap()
+            .scene
+    }
+
     #[test]
     fn golden_stores_frames_and_thresholds() {
         let settings = run("canvas(8, 8, #{ fps: 4, duration: 12 });\n\
@@ -120,6 +127,12 @@ mod tests {
         assert_eq!(settings.min_ssim, Some(0.98));
         assert_eq!(settings.hard_fail, None);
         assert_eq!(run("canvas(8, 8);").unwrap(), None);
+        // Written back by `Scene::to_rhai` (the REPL's :save), it reads back equal.
+        let scene = run_scene(
+            "canvas(8, 8, #{ fps: 4, duration: 12 });\n\
+             golden(#{ frames: [3, 40], warn: 0.5, hard_fail: 9, min_ssim: 0.875 });",
+        );
+        assert_eq!(run_scene(&scene.to_rhai()), scene);
     }
 
     #[test]
