@@ -515,7 +515,7 @@ fn check_frame(
     };
     let written = (|| -> anyhow::Result<()> {
         if job.args.update {
-            write_png(&result.paths.golden, &canvas.encode_png(format)?)?;
+            write_file(&result.paths.golden, &canvas.encode_png(format)?)?;
             remove_if_present(&result.paths.pending)?;
             result.outcome = Outcome::Updated;
             return Ok(());
@@ -532,7 +532,7 @@ fn check_frame(
         }
         let png = canvas.encode_png(format)?;
         if !job.ci {
-            write_png(&result.paths.pending, &png)?;
+            write_file(&result.paths.pending, &png)?;
             result.pending_written = Some(result.paths.pending.clone());
         }
         let pictures = write_pictures(
@@ -594,18 +594,18 @@ fn write_pictures(
         difference: expected.map(|_| dir.join(format!("{stem}.diff.png"))),
         triptych: dir.join(format!("{stem}.triptych.png")),
     };
-    write_png(&pictures.actual, png)?;
+    write_file(&pictures.actual, png)?;
     if let (Some(expected), Some(path)) = (expected, &pictures.difference) {
         let difference = lapclone::golden::difference_image(expected, actual, thresholds);
-        write_png(path, &encode_rgba_png(&difference))?;
+        write_file(path, &encode_rgba_png(&difference))?;
     }
     let sheet = triptych(expected, actual, thresholds);
-    write_png(&pictures.triptych, &encode_rgba_png(&sheet))?;
+    write_file(&pictures.triptych, &encode_rgba_png(&sheet))?;
     Ok(pictures)
 }
 
 /// Writes `bytes` atomically, creating the folder first.
-pub fn write_png(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
+pub fn write_file(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }

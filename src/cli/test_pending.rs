@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use anyhow::Context as _;
 use lapclone::golden::{compare, triptych, GoldenFrame, Thresholds};
 
-use super::test::{find_scenes, golden_dir, remove_if_present, write_png, TestArgs};
+use super::test::{find_scenes, golden_dir, remove_if_present, write_file, TestArgs};
 use super::test_report::scene_slug;
 
 pub fn run(args: &TestArgs, paths: &[PathBuf]) -> anyhow::Result<()> {
@@ -190,7 +190,7 @@ fn show(args: &TestArgs, file: &Path) -> anyhow::Result<()> {
     if !show_inline(&sheet) {
         let name = format!("{}.png", scene_slug(&file.with_extension("")));
         let path = args.out.join("review").join(name);
-        write_png(&path, &lapclone::golden::encode_rgba_png(&sheet))?;
+        write_file(&path, &lapclone::golden::encode_rgba_png(&sheet))?;
         println!("  expected | difference | actual: {}", path.display());
     }
     Ok(())

@@ -96,7 +96,7 @@ pub fn finish(
     }
     if let Some(path) = &args.junit {
         let xml = junit_xml(results, &counts, seconds);
-        super::test::write_png(path, xml.as_bytes())?;
+        super::test::write_file(path, xml.as_bytes())?;
     }
     let summary = summary_line(&counts, seconds);
     let pending = results
@@ -121,7 +121,11 @@ pub fn finish(
         notes.iter().for_each(|n| println!("{n}"));
     }
     if counts.load_errors > 0 {
-        return Err(UsageError(format!("{} scene(s) did not load", counts.load_errors)).into());
+        return Err(UsageError(format!(
+            "{} scene(s) could not be checked (see the ERROR lines)",
+            counts.load_errors
+        ))
+        .into());
     }
     if bad > 0 {
         anyhow::bail!(
@@ -338,7 +342,7 @@ fn write_index(
         );
     }
     html.push_str("</body></html>\n");
-    super::test::write_png(&out.join("index.html"), html.as_bytes())
+    super::test::write_file(&out.join("index.html"), html.as_bytes())
 }
 
 /// JUnit XML: a suite per scene, a case per frame; a scene that did not load or render is
