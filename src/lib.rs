@@ -6,10 +6,12 @@
 //! The modules follow the pipeline: [`mesh`] → [`solve`] → [`clone`] / [`deform`] →
 //! [`raster`], driven per frame by [`scene`]. [`pixels`] holds the float image type shared by
 //! all stages; [`reference`](mod@reference) holds the pixel-grid and MVC baselines used by tests and benches;
-//! [`limits`] the documented resource limits every input is checked against.
+//! [`limits`] the documented resource limits every input is checked against; [`golden`]
+//! compares rendered frames with reference frames (`lapclone test` and the project's tests).
 
 pub mod clone;
 pub mod deform;
+pub mod golden;
 pub mod limits;
 pub mod mesh;
 pub mod output;

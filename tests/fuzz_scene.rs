@@ -167,7 +167,12 @@ impl World {
         write_tiny_images(&scenes);
         let mut seeds: Vec<String> = SEEDS.iter().map(|s| s.to_string()).collect();
         for entry in std::fs::read_dir(project.join("scenes")).unwrap() {
-            let text = std::fs::read_to_string(entry.unwrap().path()).unwrap();
+            // Scene files only: scenes/goldens/ holds their golden frames.
+            let path = entry.unwrap().path();
+            if path.extension().is_none_or(|e| e != "rhai") {
+                continue;
+            }
+            let text = std::fs::read_to_string(path).unwrap();
             for path in quoted_png_paths(&text) {
                 let target = scenes.join(&path);
                 if let Some(parent) = target.parent() {

@@ -44,6 +44,7 @@ fn scene() -> Scene {
             patch("a", DVec2::new(150.0, 60.0)),
             patch("b", DVec2::new(60.0, 100.0)),
         ],
+        golden: None,
     }
 }
 

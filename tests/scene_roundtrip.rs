@@ -205,7 +205,11 @@ fn scene() -> impl Strategy<Value = Scene> {
                 patches,
             )
         })
-        .prop_map(|(canvas, patches)| Scene { canvas, patches })
+        .prop_map(|(canvas, patches)| Scene {
+            canvas,
+            patches,
+            golden: None,
+        })
 }
 
 proptest! {

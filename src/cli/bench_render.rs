@@ -206,6 +206,7 @@ fn bench_scene(assets: &Path, frames: u64) -> Scene {
             background: Background::Image(assets.join("hubble_deep_field.jpg")),
         },
         patches,
+        golden: None,
     }
 }
 

@@ -16,6 +16,9 @@ pub mod mesh;
 pub mod mesh_args;
 pub mod render;
 pub mod repl;
+pub mod test;
+pub mod test_pending;
+pub mod test_report;
 
 /// An argument combination clap cannot reject by itself; exits with code 2.
 #[derive(Debug, thiserror::Error)]
@@ -64,6 +67,8 @@ pub enum Command {
     Check(render::CheckArgs),
     /// Edit a scene interactively.
     Repl(repl::ReplArgs),
+    /// Compare scenes' frames with their golden frames (accept, reject, review changes).
+    Test(test::TestArgs),
     /// Benchmarks (release builds only give meaningful figures).
     Bench(bench::BenchArgs),
 }
@@ -76,6 +81,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Preview(args) => render::run_preview(args),
         Command::Check(args) => render::run_check(args),
         Command::Repl(args) => repl::run(args),
+        Command::Test(args) => test::run(args),
         Command::Bench(args) => bench::run(args),
     }
 }

@@ -26,6 +26,7 @@ use rustyline::history::FileHistory;
 use rustyline::{Config, Editor};
 
 use helper::ReplHelper;
+pub(crate) use preview::show_picture;
 use preview::{default_preview_path, Inline, Preview};
 use session::{Session, Step};
 use validator::InputValidator;

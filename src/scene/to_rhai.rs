@@ -35,6 +35,10 @@ impl Scene {
             write_patch(&mut out, patch, &var, &paths);
             taken.push(var);
         }
+        if let Some(golden) = &self.golden {
+            out.push('\n');
+            out.push_str(&golden.to_rhai());
+        }
         out
     }
 }

@@ -18,6 +18,8 @@ pub const MAX_CANVAS_SIDE: u32 = 16384;
 pub struct Scene {
     pub canvas: Canvas,
     pub patches: Vec<Patch>,
+    /// What `lapclone test` checks and how strictly (`golden(#{ … })`); rendering ignores it.
+    pub golden: Option<crate::golden::GoldenSettings>,
 }
 
 /// Output size, timing and what lies under every patch.

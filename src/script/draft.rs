@@ -51,6 +51,7 @@ pub struct Draft {
     pub patches: Vec<Patch>,
     pub origins: Origins,
     pub ids: Ids,
+    pub golden: Option<crate::golden::GoldenSettings>,
 }
 
 impl Draft {
@@ -61,6 +62,7 @@ impl Draft {
             patches: Vec::new(),
             origins: Origins::default(),
             ids: Ids::default(),
+            golden: None,
         }
     }
 

@@ -7,10 +7,10 @@ use std::sync::Arc;
 
 use rhai::{Dynamic, Engine, Scope, AST};
 
-use super::api;
 use super::draft::{Draft, Origins, SharedDraft};
 use super::error::{ErrorKind, SceneError};
 use super::sandbox::{sandboxed_engine, Limits, ModuleFiles, SandboxResolver};
+use super::{api, golden};
 use crate::scene::Scene;
 
 /// Where a script may import from, how far it may run, and how to stop it.
@@ -78,6 +78,7 @@ impl SceneEngine {
         let mut engine = sandboxed_engine(resolver, &options.limits, options.cancel.clone());
         let draft = SharedDraft::new(Draft::new(&options.scene_dir));
         api::register(&mut engine, &draft);
+        golden::register(&mut engine, &draft);
         SceneEngine {
             engine,
             draft,
@@ -152,6 +153,7 @@ impl SceneEngine {
         let scene = Scene {
             canvas,
             patches: draft.patches,
+            golden: draft.golden,
         };
         scene.sanity_check().map_err(|e| {
             SceneError::new(

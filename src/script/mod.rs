@@ -8,6 +8,7 @@ mod draft;
 mod edit_api;
 mod engine;
 mod error;
+mod golden;
 mod sandbox;
 mod validate;
 mod values;

@@ -138,6 +138,32 @@ impl Preview {
     }
 }
 
+/// Shows `picture` inline when stdout is a terminal that speaks an image protocol; returns
+/// false, having printed nothing, otherwise.
+pub fn show_picture(picture: &image::RgbaImage) -> bool {
+    use std::io::IsTerminal as _;
+    match Inline::detect(std::io::stdout().is_terminal()) {
+        Inline::None => false,
+        Inline::Sixel => {
+            let text =
+                super::sixel::encode_sixel(picture.as_raw(), picture.width(), picture.height());
+            let mut out = std::io::stdout().lock();
+            let _ = writeln!(out, "{text}");
+            let _ = out.flush();
+            true
+        }
+        protocol => {
+            let mut png = Vec::new();
+            let encoded =
+                picture.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png);
+            if encoded.is_ok() {
+                print_inline(protocol, &png);
+            }
+            encoded.is_ok()
+        }
+    }
+}
+
 /// The default preview file: one per process in the system temp folder.
 pub fn default_preview_path() -> PathBuf {
     std::env::temp_dir().join(format!("lapclone-preview-{}.png", std::process::id()))

@@ -1,0 +1,202 @@
+//! Pending golden frames: takes scene paths (files or folders) and gives `--accept`
+//! (each `frame_NNNN.new.png` renamed onto its `frame_NNNN.png`), `--reject` (each deleted)
+//! and `--review` (each shown with its figures and triptych — inline where the terminal can
+//! show images — and accepted, rejected or skipped as the user answers).
+
+use std::io::{BufRead, IsTerminal as _, Write as _};
+use std::path::{Path, PathBuf};
+
+use anyhow::Context as _;
+use lapclone::golden::{compare, triptych, GoldenFrame, Thresholds};
+
+use super::test::{find_scenes, golden_dir, remove_if_present, write_file, TestArgs};
+use super::test_report::scene_slug;
+
+pub fn run(args: &TestArgs, paths: &[PathBuf]) -> anyhow::Result<()> {
+    let pending = find_pending(args, paths)?;
+    if pending.is_empty() {
+        println!("no pending frames under {}", list(paths));
+        return Ok(());
+    }
+    if args.review {
+        return review(args, &pending);
+    }
+    for file in &pending {
+        if args.accept {
+            accept(file)?;
+            println!("accepted {}", golden_of(file).display());
+        } else {
+            remove_if_present(file)?;
+            println!("rejected {}", file.display());
+        }
+    }
+    Ok(())
+}
+
+fn list(paths: &[PathBuf]) -> String {
+    let names: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
+    names.join(", ")
+}
+
+/// `frame_NNNN.new.png` → `frame_NNNN.png`.
+pub fn golden_of(pending: &Path) -> PathBuf {
+    let name = pending.file_name().unwrap_or_default().to_string_lossy();
+    pending.with_file_name(name.replace(".new.png", ".png"))
+}
+
+fn is_pending_name(name: &str) -> bool {
+    name.strip_prefix("frame_")
+        .and_then(|rest| rest.strip_suffix(".new.png"))
+        .is_some_and(|digits| !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit()))
+}
+
+/// Pending files in the golden folders of the scenes under `paths` and anywhere under the
+/// folders given, sorted.
+fn find_pending(args: &TestArgs, paths: &[PathBuf]) -> anyhow::Result<Vec<PathBuf>> {
+    let mut found = Vec::new();
+    for path in paths.iter().filter(|p| p.is_dir()) {
+        walk(path, &args.out, &mut found)?;
+    }
+    for scene in find_scenes(paths, &args.out)? {
+        let dir = golden_dir(&scene, args.goldens.as_deref());
+        if dir.is_dir() {
+            collect_in(&dir, &mut found)?;
+        }
+    }
+    found.sort();
+    found.dedup();
+    Ok(found)
+}
+
+fn collect_in(dir: &Path, found: &mut Vec<PathBuf>) -> anyhow::Result<()> {
+    for entry in std::fs::read_dir(dir).with_context(|| format!("reading {}", dir.display()))? {
+        let path = entry?.path();
+        let name = path.file_name().unwrap_or_default().to_string_lossy();
+        if path.is_file() && is_pending_name(&name) {
+            found.push(tidy(&path));
+        }
+    }
+    Ok(())
+}
+
+fn walk(dir: &Path, out: &Path, found: &mut Vec<PathBuf>) -> anyhow::Result<()> {
+    collect_in(dir, found)?;
+    for entry in std::fs::read_dir(dir).with_context(|| format!("reading {}", dir.display()))? {
+        let path = entry?.path();
+        let name = path.file_name().unwrap_or_default().to_string_lossy();
+        let skipped = name.starts_with('.') || name == "target" || tidy(&path) == tidy(out);
+        if path.is_dir() && !skipped {
+            walk(&path, out, found)?;
+        }
+    }
+    Ok(())
+}
+
+/// The path without `.` components, so one file found two ways is listed once.
+fn tidy(path: &Path) -> PathBuf {
+    path.components()
+        .filter(|c| !matches!(c, std::path::Component::CurDir))
+        .collect()
+}
+
+fn accept(pending: &Path) -> anyhow::Result<()> {
+    let golden = golden_of(pending);
+    std::fs::rename(pending, &golden)
+        .with_context(|| format!("renaming {} to {}", pending.display(), golden.display()))
+}
+
+/// Asks about each pending frame in turn; end of input skips the rest.
+fn review(args: &TestArgs, pending: &[PathBuf]) -> anyhow::Result<()> {
+    let stdin = std::io::stdin();
+    let mut lines = stdin.lock().lines();
+    let (mut accepted, mut rejected, mut skipped) = (0, 0, 0);
+    for (index, file) in pending.iter().enumerate() {
+        println!("[{}/{}] {}", index + 1, pending.len(), file.display());
+        show(args, file)?;
+        let answer = loop {
+            print!("accept, reject or skip? [a/r/s/q] ");
+            let _ = std::io::stdout().flush();
+            let Some(line) = lines.next().transpose()? else {
+                break "q".to_string();
+            };
+            if !std::io::stdin().is_terminal() {
+                println!("{}", line.trim());
+            }
+            let word = line.trim().to_lowercase();
+            if ["a", "r", "s", "q"].contains(&word.as_str()) {
+                break word;
+            }
+        };
+        match answer.as_str() {
+            "a" => {
+                accept(file)?;
+                accepted += 1;
+                println!("accepted {}", golden_of(file).display());
+            }
+            "r" => {
+                remove_if_present(file)?;
+                rejected += 1;
+                println!("rejected {}", file.display());
+            }
+            "s" => skipped += 1,
+            _ => {
+                skipped += pending.len() - index;
+                println!();
+                break;
+            }
+        }
+    }
+    println!("review: {accepted} accepted, {rejected} rejected, {skipped} skipped");
+    Ok(())
+}
+
+/// Prints the figures against the current golden and shows (or names) the triptych.
+fn show(args: &TestArgs, file: &Path) -> anyhow::Result<()> {
+    let actual = GoldenFrame::load(file)?;
+    let golden_path = golden_of(file);
+    let expected = if golden_path.is_file() {
+        match GoldenFrame::load(&golden_path) {
+            Ok(frame) => Some(frame),
+            Err(error) => {
+                println!("  golden unreadable: {error}");
+                None
+            }
+        }
+    } else {
+        println!("  new: no golden {}", golden_path.display());
+        None
+    };
+    let thresholds = super::test::overrides(args, Thresholds::default());
+    if let Some(expected) = &expected {
+        match compare(expected, &actual, &thresholds) {
+            Ok(c) => println!(
+                "  max {} @ ({}, {}, {}), {} px over {} ({:.3}%), PSNR {}, SSIM {:.4}",
+                c.figures.max.value,
+                c.figures.max.x,
+                c.figures.max.y,
+                c.figures.max.channel,
+                c.figures.failing_pixels,
+                thresholds.fail,
+                c.figures.failing_percent,
+                c.figures
+                    .psnr
+                    .map_or_else(|| "inf".into(), |p| format!("{p:.2} dB")),
+                c.figures.ssim
+            ),
+            Err(mismatch) => println!("  {mismatch}"),
+        }
+    }
+    let sheet = triptych(expected.as_ref(), &actual, &thresholds);
+    if !show_inline(&sheet) {
+        let name = format!("{}.png", scene_slug(&file.with_extension("")));
+        let path = args.out.join("review").join(name);
+        write_file(&path, &lapclone::golden::encode_rgba_png(&sheet))?;
+        println!("  expected | difference | actual: {}", path.display());
+    }
+    Ok(())
+}
+
+/// The one place `--review` reaches the terminal-image code it shares with the REPL preview.
+fn show_inline(picture: &image::RgbaImage) -> bool {
+    super::repl::show_picture(picture)
+}
