@@ -629,6 +629,7 @@ fn layer_order(draft: &Draft, t: f64) -> String {
     let scene = Scene {
         canvas,
         patches: draft.patches.clone(),
+        golden: None,
     };
     let state = scene.evaluate(t);
     let layers: Vec<String> = state
