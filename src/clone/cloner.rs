@@ -4,7 +4,8 @@
 //!
 //! Built once: the mesh, the factored Laplacian, the source (grey in monochrome mode), raster
 //! and coverage scratch. Per call: place the vertices, find boundary vertices hidden under
-//! the patch's own front layer, switch constraints, one 3-RHS solve, the raster. The
+//! the patch's own front layer, switch constraints, one 3-RHS solve (and, where the patch
+//! lies over itself, the glue's few back-substitutions: [`Glue`]), the raster. The
 //! hidden-vertex query and the solve run while the raster prepares its membrane-free part on
 //! a second thread ([`draw_patch_solving`]). The first call also factors the Laplacian there
 //! ([`MembraneSolver::deferred`]), so the factor overlaps the first draw's preparation.
@@ -13,6 +14,7 @@ use std::time::Instant;
 
 use glam::DVec2;
 
+use super::glue::{Glue, GlueFrame};
 use super::membrane::{MembraneSolver, MembraneStats};
 use super::{BoundaryData, CloneError, Placement};
 use crate::mesh::Mesh;
@@ -97,6 +99,7 @@ pub struct PatchCloner {
     raster_options: RasterOptions,
     placed: Vec<DVec2>,
     hidden: HiddenVertices,
+    glue: Glue,
     raster_scratch: RasterScratch,
 }
 
@@ -118,6 +121,7 @@ impl PatchCloner {
         let membrane =
             MembraneSolver::deferred(&mesh, &source, options.laplacian, options.boundary_data);
         let n = mesh.vertex_count();
+        let glue = Glue::new(&mesh, membrane.boundary_vertices(), options.boundary_data);
         Ok(Self {
             source,
             mesh,
@@ -134,6 +138,7 @@ impl PatchCloner {
                 covered: Vec::new(),
                 grid: CoverageGrid::new(),
             },
+            glue,
             raster_scratch: RasterScratch::new(),
         })
     }
@@ -154,6 +159,11 @@ impl PatchCloner {
     /// The membrane of the last clone.
     pub fn membrane(&self) -> &MembraneSolver {
         &self.membrane
+    }
+
+    /// The glued vertices of the last clone (see [`Glue`]).
+    pub fn glue(&self) -> &Glue {
+        &self.glue
     }
 
     /// Clones the undeformed patch onto `canvas` at `placement`.
@@ -186,11 +196,13 @@ impl PatchCloner {
         check_placement(placement)?;
         placement.apply(&self.mesh.positions, &mut self.placed);
         self.hidden.marks.fill(false);
+        self.glue.clear();
         Ok(())
     }
 
     /// The canvas-independent half of [`clone_deformed`](Self::clone_deformed): places the
-    /// deformed vertices and finds the boundary vertices hidden under the patch itself.
+    /// deformed vertices and finds the boundary vertices hidden under the patch itself and
+    /// those glued over it.
     pub fn prepare_deformed(
         &mut self,
         placement: &Placement,
@@ -200,7 +212,9 @@ impl PatchCloner {
         self.place_deformed(placement, deformed, depth)?;
         let boundary = self.membrane.boundary_vertices();
         let frame = (&self.placed[..], &self.mesh.triangles[..]);
-        self.hidden.find(frame, boundary, depth)?;
+        let hidden = self.hidden.find(frame, boundary, depth)?;
+        let rest = &self.mesh.positions[..];
+        find_glue(&mut self.glue, (rest, frame), depth, boundary, hidden, &self.source);
         Ok(())
     }
 
@@ -254,7 +268,9 @@ impl PatchCloner {
             source: &self.source,
         };
         let frame = (&self.placed[..], &self.mesh.triangles[..]);
+        let (rest, source) = (&self.mesh.positions[..], &self.source);
         let (solver, hidden, solved_out) = (&mut self.membrane, &mut self.hidden, &mut solved);
+        let glue = &mut self.glue;
         let solve = move |canvas: &Canvas| {
             // Moved (not reborrowed), so the membrane can be lent out for the whole draw.
             let membrane = solver;
@@ -262,11 +278,16 @@ impl PatchCloner {
             membrane.factor_now()?;
             let solve_started = Instant::now();
             let hidden = if hidden_by == HiddenBy::Query {
-                hidden.find(frame, membrane.boundary_vertices(), depth)?
+                let boundary = membrane.boundary_vertices();
+                let hidden = hidden.find(frame, boundary, depth)?;
+                find_glue(glue, (rest, frame), depth, boundary, hidden, source);
+                hidden
             } else {
                 &hidden.marks
             };
-            let stats = membrane.solve(frame.0, canvas, Some(hidden))?;
+            let mut stats = membrane.solve(frame.0, canvas, Some(hidden))?;
+            let glued = membrane.solve_glue(glue);
+            (stats.glued, stats.glue_iterations) = (glued.glued, glued.iterations);
             let factor_ms = millis(solve_started - factor_started);
             *solved_out = Some((stats, factor_ms, millis(solve_started.elapsed())));
             Ok::<_, CloneError>(membrane.membrane())
@@ -325,6 +346,29 @@ impl HiddenVertices {
             }
         }
         Ok(&self.marks)
+    }
+}
+
+/// The glue of a deformed frame (none without depth: nothing is in front of anything).
+fn find_glue(
+    glue: &mut Glue,
+    (rest, (placed, triangles)): (&[DVec2], (&[DVec2], &[[u32; 3]])),
+    depth: Option<&[f32]>,
+    boundary: &[u32],
+    hidden: &[bool],
+    source: &FloatImage,
+) {
+    match depth {
+        Some(depth) => {
+            let frame = GlueFrame {
+                rest,
+                placed,
+                triangles,
+                depth,
+            };
+            glue.find(frame, boundary, hidden, source);
+        }
+        None => glue.clear(),
     }
 }
 
