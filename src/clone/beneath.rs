@@ -65,7 +65,8 @@ impl TriangleGrid {
             self.cell_start[i + 1] += self.cell_start[i];
         }
         self.cell_triangles.clear();
-        self.cell_triangles.resize(self.cell_start[cells] as usize, 0);
+        self.cell_triangles
+            .resize(self.cell_start[cells] as usize, 0);
         // Counting sort as in the coverage query: the start serves as the cursor, then the
         // starts are restored by shifting one cell.
         for (t, tri) in triangles.iter().enumerate() {
@@ -79,7 +80,12 @@ impl TriangleGrid {
         self.cell_start[0] = 0;
     }
 
-    fn for_cells(&mut self, placed: &[DVec2], tri: &[u32; 3], mut visit: impl FnMut(&mut Self, usize)) {
+    fn for_cells(
+        &mut self,
+        placed: &[DVec2],
+        tri: &[u32; 3],
+        mut visit: impl FnMut(&mut Self, usize),
+    ) {
         let [a, b, c] = tri.map(|v| placed[v as usize]);
         let ((c0, r0), (c1, r1)) = (self.cell_of(a.min(b).min(c)), self.cell_of(a.max(b).max(c)));
         for r in r0..=r1 {

@@ -214,7 +214,14 @@ impl PatchCloner {
         let frame = (&self.placed[..], &self.mesh.triangles[..]);
         let hidden = self.hidden.find(frame, boundary, depth)?;
         let rest = &self.mesh.positions[..];
-        find_glue(&mut self.glue, (rest, frame), depth, boundary, hidden, &self.source);
+        find_glue(
+            &mut self.glue,
+            (rest, frame),
+            depth,
+            boundary,
+            hidden,
+            &self.source,
+        );
         Ok(())
     }
 

@@ -121,12 +121,24 @@ impl Glue {
 
     /// Finds the boundary vertices (`boundary`, slot order) not `hidden` that lie over a
     /// lower layer of the patch in `frame`, and samples `source` beneath them.
-    pub fn find(&mut self, frame: GlueFrame, boundary: &[u32], hidden: &[bool], source: &FloatImage) {
+    pub fn find(
+        &mut self,
+        frame: GlueFrame,
+        boundary: &[u32],
+        hidden: &[bool],
+        source: &FloatImage,
+    ) {
         let candidates = (0..boundary.len() as u32)
             .map(|slot| (slot, boundary[slot as usize]))
             .filter(|&(_, v)| !hidden[v as usize]);
         let geometry = (frame.placed, frame.triangles);
-        find_beneath(geometry, frame.depth, candidates, &mut self.grid, &mut self.found);
+        find_beneath(
+            geometry,
+            frame.depth,
+            candidates,
+            &mut self.grid,
+            &mut self.found,
+        );
         self.glued.clear();
         for &beneath in &self.found {
             let source_beneath = self.sample_beneath(frame, &beneath, source);
@@ -194,7 +206,8 @@ impl Glue {
         own: &[[f32; 3]],
     ) -> GlueStats {
         let n = factor.n();
-        self.glued.retain(|g| factor.is_constrained(g.beneath.vertex as usize));
+        self.glued
+            .retain(|g| factor.is_constrained(g.beneath.vertex as usize));
         let mut stats = GlueStats {
             glued: self.glued.len(),
             iterations: 0,
@@ -203,7 +216,8 @@ impl Glue {
             return stats;
         }
         self.current.clear();
-        self.current.extend(self.glued.iter().map(|g| initial(g.beneath.slot as usize)));
+        self.current
+            .extend(self.glued.iter().map(|g| initial(g.beneath.slot as usize)));
         self.correction.clear();
         self.correction.resize(n * MEMBRANE_CHANNELS, 0.0);
         while self.next_correction(values, own, n) > GLUE_TOLERANCE
