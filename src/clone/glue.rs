@@ -22,7 +22,7 @@
 
 use glam::DVec2;
 
-use super::beneath::{find_beneath, Beneath, TriangleGrid};
+use super::beneath::{find_beneath, Beneath, CandidateGrid};
 use super::membrane::MEMBRANE_CHANNELS;
 use super::{BoundaryData, HAT_SAMPLE_SPACING};
 use crate::mesh::Mesh;
@@ -68,7 +68,7 @@ pub struct Glue {
     kind: BoundaryData,
     /// Per boundary slot: its neighbours along its loop (`u32::MAX` where there is none).
     neighbours: Vec<[u32; 2]>,
-    grid: TriangleGrid,
+    grid: CandidateGrid,
     found: Vec<Beneath>,
     glued: Vec<GluedVertex>,
     /// Per glued vertex: its Dirichlet value in the last solve.
@@ -101,7 +101,7 @@ impl Glue {
         Self {
             kind,
             neighbours,
-            grid: TriangleGrid::default(),
+            grid: CandidateGrid::default(),
             found: Vec::new(),
             glued: Vec::new(),
             current: Vec::new(),
