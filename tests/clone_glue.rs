@@ -256,16 +256,19 @@ fn dense_solve(mut a: Vec<Vec<f64>>, mut b: Vec<[f64; 3]>) -> Vec<[f64; 3]> {
             .unwrap();
         a.swap(col, pivot);
         b.swap(col, pivot);
-        for row in col + 1..n {
-            let factor = a[row][col] / a[col][col];
+        let (top, below) = a.split_at_mut(col + 1);
+        let (top_b, below_b) = b.split_at_mut(col + 1);
+        let (pivot_row, pivot_b) = (&top[col], top_b[col]);
+        for (row, rhs) in below.iter_mut().zip(below_b.iter_mut()) {
+            let factor = row[col] / pivot_row[col];
             if factor == 0.0 {
                 continue;
             }
-            for k in col..n {
-                a[row][k] -= factor * a[col][k];
+            for (x, p) in row[col..].iter_mut().zip(&pivot_row[col..]) {
+                *x -= factor * p;
             }
-            for c in 0..3 {
-                b[row][c] -= factor * b[col][c];
+            for (x, p) in rhs.iter_mut().zip(pivot_b) {
+                *x -= factor * p;
             }
         }
     }
@@ -289,13 +292,14 @@ fn dense_glued_membrane(cloner: &PatchCloner) -> Vec<[f64; 3]> {
     let l = laplacian(cloner.mesh(), LaplacianKind::Combinatorial);
     let n = l.n;
     let mut a = vec![vec![0.0; n]; n];
-    for j in 0..n {
-        for k in l.col_ptr[j]..l.col_ptr[j + 1] {
+    for (j, column) in l.col_ptr.windows(2).enumerate() {
+        for k in column[0]..column[1] {
             let i = l.row_idx[k];
-            a[i][j] = l.values[k];
-            a[j][i] = l.values[k];
+            (a[i][j], a[j][i]) = (l.values[k], l.values[k]);
         }
-        a[j][j] += epsilon;
+    }
+    for (j, row) in a.iter_mut().enumerate() {
+        row[j] += epsilon;
     }
     let mut b = vec![[0.0; 3]; n];
     let (target, own) = (membrane.target_at_boundary(), membrane.source_at_boundary());

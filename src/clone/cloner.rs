@@ -216,7 +216,8 @@ impl PatchCloner {
         let rest = &self.mesh.positions[..];
         find_glue(
             &mut self.glue,
-            (rest, frame),
+            rest,
+            frame,
             depth,
             boundary,
             hidden,
@@ -287,7 +288,7 @@ impl PatchCloner {
             let hidden = if hidden_by == HiddenBy::Query {
                 let boundary = membrane.boundary_vertices();
                 let hidden = hidden.find(frame, boundary, depth)?;
-                find_glue(glue, (rest, frame), depth, boundary, hidden, source);
+                find_glue(glue, rest, frame, depth, boundary, hidden, source);
                 hidden
             } else {
                 &hidden.marks
@@ -356,10 +357,14 @@ impl HiddenVertices {
     }
 }
 
+/// Placed positions and triangles.
+type Frame<'a> = (&'a [DVec2], &'a [[u32; 3]]);
+
 /// The glue of a deformed frame (none without depth: nothing is in front of anything).
 fn find_glue(
     glue: &mut Glue,
-    (rest, (placed, triangles)): (&[DVec2], (&[DVec2], &[[u32; 3]])),
+    rest: &[DVec2],
+    (placed, triangles): Frame,
     depth: Option<&[f32]>,
     boundary: &[u32],
     hidden: &[bool],
