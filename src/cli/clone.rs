@@ -201,6 +201,8 @@ pub fn run(args: CloneArgs) -> anyhow::Result<()> {
             "constrained": stats.membrane.constrained,
             "outside": stats.membrane.outside,
             "hidden": stats.membrane.hidden,
+            "glued_vertices": stats.membrane.glued,
+            "glue_iterations": stats.membrane.glue_iterations,
             "switched": stats.membrane.switches.updates + stats.membrane.switches.downdates,
             "mesh_ms": mesh_ms,
             "factor_ms": factor_ms,

@@ -4,13 +4,15 @@
 //!
 //! Built once: the mesh, the factored Laplacian, the source (grey in monochrome mode), raster
 //! and coverage scratch. Per call, on the calling thread: place the vertices, find boundary
-//! vertices hidden under the patch's own front layer, switch constraints, one 3-RHS solve,
-//! then one [`draw_patch`] with the solved membrane.
+//! vertices hidden under the patch's own front layer, switch constraints, one 3-RHS solve
+//! (and, where the patch lies over itself, the glue's few back-substitutions: [`Glue`]), then
+//! one [`draw_patch`] with the solved membrane.
 
 use std::time::Instant;
 
 use glam::DVec2;
 
+use super::glue::{Glue, GlueFrame};
 use super::membrane::{MembraneSolver, MembraneStats};
 use super::{BoundaryData, CloneError, Placement};
 use crate::mesh::Mesh;
@@ -90,6 +92,7 @@ pub struct PatchCloner {
     raster_options: RasterOptions,
     placed: Vec<DVec2>,
     hidden: HiddenVertices,
+    glue: Glue,
     raster_scratch: RasterScratch,
 }
 
@@ -110,6 +113,7 @@ impl PatchCloner {
         let membrane =
             MembraneSolver::new(&mesh, &source, options.laplacian, options.boundary_data)?;
         let n = mesh.vertex_count();
+        let glue = Glue::new(&mesh, membrane.boundary_vertices(), options.boundary_data);
         Ok(Self {
             source,
             mesh,
@@ -124,6 +128,7 @@ impl PatchCloner {
                 covered: Vec::new(),
                 grid: CoverageGrid::new(),
             },
+            glue,
             raster_scratch: RasterScratch::new(),
         })
     }
@@ -144,6 +149,11 @@ impl PatchCloner {
     /// The membrane of the last clone.
     pub fn membrane(&self) -> &MembraneSolver {
         &self.membrane
+    }
+
+    /// The glued vertices of the last clone (see [`Glue`]).
+    pub fn glue(&self) -> &Glue {
+        &self.glue
     }
 
     /// Clones the undeformed patch onto `canvas` at `placement`.
@@ -176,11 +186,13 @@ impl PatchCloner {
         check_placement(placement)?;
         placement.apply(&self.mesh.positions, &mut self.placed);
         self.hidden.marks.fill(false);
+        self.glue.clear();
         Ok(())
     }
 
     /// The canvas-independent half of [`clone_deformed`](Self::clone_deformed): places the
-    /// deformed vertices and finds the boundary vertices hidden under the patch itself.
+    /// deformed vertices and finds the boundary vertices hidden under the patch itself and
+    /// those glued over it.
     pub fn prepare_deformed(
         &mut self,
         placement: &Placement,
@@ -190,7 +202,17 @@ impl PatchCloner {
         self.place_deformed(placement, deformed, depth)?;
         let boundary = self.membrane.boundary_vertices();
         let frame = (&self.placed[..], &self.mesh.triangles[..]);
-        self.hidden.find(frame, boundary, depth)?;
+        let hidden = self.hidden.find(frame, boundary, depth)?;
+        let rest = &self.mesh.positions[..];
+        find_glue(
+            &mut self.glue,
+            rest,
+            frame,
+            depth,
+            boundary,
+            hidden,
+            &self.source,
+        );
         Ok(())
     }
 
@@ -235,11 +257,16 @@ impl PatchCloner {
         let hidden = match hidden_by {
             HiddenBy::Query => {
                 let boundary = self.membrane.boundary_vertices();
-                self.hidden.find(frame, boundary, depth)?
+                let hidden = self.hidden.find(frame, boundary, depth)?;
+                let rest = &self.mesh.positions[..];
+                find_glue(&mut self.glue, rest, frame, depth, boundary, hidden, &self.source);
+                hidden
             }
             HiddenBy::Preparation => &self.hidden.marks,
         };
-        let membrane = self.membrane.solve(frame.0, canvas, Some(hidden))?;
+        let mut membrane = self.membrane.solve(frame.0, canvas, Some(hidden))?;
+        let glued = self.membrane.solve_glue(&mut self.glue);
+        (membrane.glued, membrane.glue_iterations) = (glued.glued, glued.iterations);
         let solved = Instant::now();
         let patch = Patch {
             rest: &self.mesh.positions,
@@ -300,6 +327,33 @@ impl HiddenVertices {
             }
         }
         Ok(&self.marks)
+    }
+}
+
+/// Placed positions and triangles.
+type Frame<'a> = (&'a [DVec2], &'a [[u32; 3]]);
+
+/// The glue of a deformed frame (none without depth: nothing is in front of anything).
+fn find_glue(
+    glue: &mut Glue,
+    rest: &[DVec2],
+    (placed, triangles): Frame,
+    depth: Option<&[f32]>,
+    boundary: &[u32],
+    hidden: &[bool],
+    source: &FloatImage,
+) {
+    match depth {
+        Some(depth) => {
+            let frame = GlueFrame {
+                rest,
+                placed,
+                triangles,
+                depth,
+            };
+            glue.find(frame, boundary, hidden, source);
+        }
+        None => glue.clear(),
     }
 }
 

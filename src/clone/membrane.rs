@@ -9,6 +9,7 @@
 
 use glam::DVec2;
 
+use super::glue::{Glue, GlueStats};
 use super::{BoundaryData, BoundarySampler, CloneError};
 use crate::mesh::Mesh;
 use crate::pixels::{Canvas, FloatImage};
@@ -39,6 +40,10 @@ pub struct MembraneStats {
     pub outside: usize,
     /// Boundary vertices switched off because the patch's own front layer covers them.
     pub hidden: usize,
+    /// Front-layer boundary vertices over the patch itself, glued to what lies beneath.
+    pub glued: usize,
+    /// Back-substitutions the glue added.
+    pub glue_iterations: usize,
     pub switches: SwitchStats,
 }
 
@@ -124,6 +129,35 @@ impl MembraneSolver {
             *m = [0, 1, 2].map(|c| self.values[c * n + v] as f32);
         }
         Ok(stats)
+    }
+
+    /// Glue (see [`Glue`]): refines the last [`solve`](Self::solve)'s membrane so that the
+    /// glued vertices continue the patch's composite beneath them. Switches nothing.
+    pub fn solve_glue(&mut self, glue: &mut Glue) -> GlueStats {
+        let FactorState::Ready(factor) = &mut self.factor else {
+            return GlueStats::default();
+        };
+        let (target, source) = (&self.target_at_boundary, &self.source_at_boundary);
+        // Exactly the value the solve gave each constrained slot.
+        let initial = |slot: usize| [0, 1, 2].map(|c| f64::from(target[slot][c] - source[slot][c]));
+        let stats = glue.solve(factor, &mut self.values, initial, source);
+        if stats.iterations > 0 {
+            let n = self.wanted.len();
+            for (v, m) in self.membrane.iter_mut().enumerate() {
+                *m = [0, 1, 2].map(|c| self.values[c * n + v] as f32);
+            }
+        }
+        stats
+    }
+
+    /// The source's boundary data at the rest boundary, one RGB value per boundary slot.
+    pub fn source_at_boundary(&self) -> &[[f32; 3]] {
+        &self.source_at_boundary
+    }
+
+    /// The canvas's boundary data in the last solve, one RGB value per boundary slot.
+    pub fn target_at_boundary(&self) -> &[[f32; 3]] {
+        &self.target_at_boundary
     }
 
     /// The membrane of the last solve, one RGB offset per vertex.

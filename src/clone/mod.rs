@@ -6,18 +6,22 @@
 //! move or a deformation costs only constraint switches, one multi-RHS back-substitution
 //! and the raster.
 
+mod beneath;
 mod boundary_data;
 mod cloner;
 mod error;
 mod expand;
+mod glue;
 mod membrane;
 mod patch_mesh;
 mod placement;
 
+pub use beneath::{find_beneath, weights_if_strictly_inside, Beneath, CandidateGrid};
 pub use boundary_data::{BoundaryData, BoundarySampler, HAT_SAMPLE_SPACING};
 pub use cloner::{CloneMode, CloneOptions, CloneStats, PatchCloner};
 pub use error::CloneError;
 pub use expand::{expand_boundary, HALF_PIXEL};
+pub use glue::{Glue, GlueFrame, GlueStats, GluedVertex, GLUE_TOLERANCE, MAX_GLUE_ITERATIONS};
 pub use membrane::{MembraneSolver, MembraneStats, MEMBRANE_CHANNELS};
 pub use patch_mesh::{finish_mask_mesh, mesh_from_mask, mesh_from_polygons, PatchMesh};
 pub use placement::{Anchor, Placement};

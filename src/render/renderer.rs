@@ -53,6 +53,8 @@ pub struct FrameStats {
     pub hidden: usize,
     /// Boundary vertices outside the canvas.
     pub outside: usize,
+    /// Front-layer boundary vertices glued to their own patch beneath them.
+    pub glued: usize,
     pub deform_ms: f64,
     pub solve_ms: f64,
     pub raster_ms: f64,
@@ -264,6 +266,7 @@ impl Renderer {
             stats.clone_switches += switches.updates + switches.downdates;
             stats.hidden += clone.membrane.hidden;
             stats.outside += clone.membrane.outside;
+            stats.glued += clone.membrane.glued;
             self.dirty.push(clone.raster.work);
         }
         self.dirty_valid = true;

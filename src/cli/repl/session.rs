@@ -501,7 +501,7 @@ impl Session {
         let s = renderer.last_stats();
         let mut out = format!(
             "t = {} s: {:.2} ms total (deform {:.2}, solve {:.2}, raster {:.2}); \
-             switches: {} deform, {} clone; boundary hidden {}, outside {}\n",
+             switches: {} deform, {} clone; boundary hidden {}, outside {}, glued {}\n",
             s.time,
             s.total_ms,
             s.deform_ms,
@@ -510,7 +510,8 @@ impl Session {
             s.deform_switches,
             s.clone_switches,
             s.hidden,
-            s.outside
+            s.outside,
+            s.glued
         );
         let vertices = renderer.vertex_counts();
         out.push_str(&format!("mesh vertices per patch: {vertices:?}\n"));
