@@ -134,9 +134,7 @@ impl MembraneSolver {
     /// Glue (see [`Glue`]): refines the last [`solve`](Self::solve)'s membrane so that the
     /// glued vertices continue the patch's composite beneath them. Switches nothing.
     pub fn solve_glue(&mut self, glue: &mut Glue) -> GlueStats {
-        let FactorState::Ready(factor) = &mut self.factor else {
-            return GlueStats::default();
-        };
+        let factor = &mut self.factor;
         let (target, source) = (&self.target_at_boundary, &self.source_at_boundary);
         // Exactly the value the solve gave each constrained slot.
         let initial = |slot: usize| [0, 1, 2].map(|c| f64::from(target[slot][c] - source[slot][c]));
