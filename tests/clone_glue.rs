@@ -287,7 +287,7 @@ fn dense_solve(mut a: Vec<Vec<f64>>, mut b: Vec<[f64; 3]>) -> Vec<[f64; 3]> {
 /// divided by α, so the dense matrix is well scaled.
 fn dense_glued_membrane(cloner: &PatchCloner) -> Vec<[f64; 3]> {
     let membrane = cloner.membrane();
-    let factor = membrane.factor().unwrap();
+    let factor = membrane.factor();
     let (alpha, epsilon) = (factor.alpha(), factor.epsilon());
     let l = laplacian(cloner.mesh(), LaplacianKind::Combinatorial);
     let n = l.n;
@@ -330,7 +330,7 @@ fn dense_glued_membrane(cloner: &PatchCloner) -> Vec<[f64; 3]> {
 /// Brute force: the constrained boundary vertices that lie over a lower layer.
 fn glued_by_brute_force(cloner: &PatchCloner, depth: &[f32]) -> Vec<u32> {
     let (placed, triangles) = (cloner.placed(), &cloner.mesh().triangles);
-    let factor = cloner.membrane().factor().unwrap();
+    let factor = cloner.membrane().factor();
     let boundary = cloner.membrane().boundary_vertices();
     boundary
         .iter()
