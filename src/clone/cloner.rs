@@ -92,6 +92,7 @@ pub struct CloneStats {
 /// Everything kept between clones of one patch. See the module doc.
 pub struct PatchCloner {
     source: FloatImage,
+    mode: CloneMode,
     mesh: Mesh,
     membrane: MembraneSolver,
     raster_options: RasterOptions,
@@ -120,6 +121,7 @@ impl PatchCloner {
         let n = mesh.vertex_count();
         Ok(Self {
             source,
+            mode: options.mode,
             mesh,
             membrane,
             raster_options: RasterOptions {
@@ -140,6 +142,28 @@ impl PatchCloner {
 
     pub fn mesh(&self) -> &Mesh {
         &self.mesh
+    }
+
+    /// Replaces the source (the next frame of an animated source; the mesh, and so the
+    /// factor, stay): resamples it along the rest boundary. Draws are no longer replayed,
+    /// since a recorded draw holds the old source's samples.
+    pub fn set_source(&mut self, source: FloatImage) {
+        let source = match self.mode {
+            CloneMode::Normal => source,
+            CloneMode::Monochrome => source.to_grey(),
+        };
+        self.membrane.resample_source(&self.mesh, &source);
+        self.source = source;
+        if self.raster_options.replay {
+            self.raster_options.replay = false;
+            self.raster_scratch = RasterScratch::new();
+        }
+    }
+
+    /// Factorisations of the cloning Laplacian so far: the first, plus any rebuild a
+    /// guard of the rank-1 updates made.
+    pub fn factorisations(&self) -> usize {
+        self.membrane.factorisations()
     }
 
     pub fn source(&self) -> &FloatImage {

@@ -105,6 +105,24 @@ impl MembraneSolver {
         }
     }
 
+    /// Samples a new source along the rest boundary (an animated source's next frame).
+    pub fn resample_source(&mut self, mesh: &Mesh, source: &FloatImage) {
+        self.sampler.sample(
+            &mesh.positions,
+            |p| rgb(source.sample_bilinear(p.x, p.y)),
+            &mut self.source_at_boundary,
+        );
+    }
+
+    /// Factorisations so far: none before the first solve, then one plus the guards'
+    /// rebuilds.
+    pub fn factorisations(&self) -> usize {
+        match &self.factor {
+            FactorState::Pending(_) => 0,
+            FactorState::Ready(factor) => 1 + factor.refactor_count(),
+        }
+    }
+
     /// Factors the Laplacian if that is still to do (with every boundary constraint on);
     /// gives whether it did.
     pub fn factor_now(&mut self) -> Result<bool, CloneError> {

@@ -8,7 +8,9 @@ use std::path::Path;
 use glam::DVec2;
 
 use super::track::{Interpolate, Track};
-use super::types::{Background, Canvas, Handle, Patch, Pin, Polygon, Scene, Shape};
+use super::types::{
+    Background, Canvas, Footage, FootageSource, Handle, Patch, Pin, Polygon, Scene, Shape,
+};
 
 impl Scene {
     /// Rhai source that re-creates this scene (paths written as stored, i.e. resolved).
@@ -33,6 +35,7 @@ fn write_canvas(out: &mut String, canvas: &Canvas) {
             num_f32(c[2]),
             num_f32(c[3])
         ),
+        Background::Footage(footage) => footage_options(footage, "background"),
     };
     // invariant: writing to a String cannot fail.
     writeln!(
@@ -47,8 +50,30 @@ fn write_canvas(out: &mut String, canvas: &Canvas) {
     .expect("write to String"); // invariant: writing to a String cannot fail
 }
 
+/// `KEY: "pattern or video", KEY_start: N, KEY_hold: b`, with `background: ` left out of the
+/// background's own text (the caller writes the key).
+fn footage_options(footage: &Footage, key: &str) -> String {
+    let mut text = match &footage.source {
+        FootageSource::Sequence { pattern, start } => format!(
+            "{}, {key}_start: {start}",
+            rhai_string_literal(pattern.text())
+        ),
+        FootageSource::Video(path) => path_literal(path),
+    };
+    if footage.hold {
+        text.push_str(&format!(", {key}_hold: true"));
+    }
+    if key == "source" {
+        text.insert_str(0, "source: ");
+    }
+    text
+}
+
 fn write_patch(out: &mut String, patch: &Patch, var: &str) {
-    let mut options = vec![format!("source: {}", path_literal(&patch.source))];
+    let mut options = vec![match &patch.footage {
+        Some(footage) => footage_options(footage, "source"),
+        None => format!("source: {}", path_literal(&patch.source)),
+    }];
     match &patch.shape {
         Shape::Mask(path) => options.push(format!("mask: {}", path_literal(path))),
         Shape::Polygons(polygons) => {

@@ -7,6 +7,7 @@ mod api;
 mod draft;
 mod engine;
 mod error;
+mod footage_options;
 mod sandbox;
 mod validate;
 mod values;
