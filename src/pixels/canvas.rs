@@ -115,6 +115,14 @@ impl Canvas {
         &self.pixels
     }
 
+    /// Whether every pixel's alpha is full.
+    pub fn pixels_opaque(&self) -> bool {
+        match &self.pixels {
+            CanvasPixels::Eight(p) => p.iter().all(|px| px[3] == u8::MAX),
+            CanvasPixels::Sixteen(p) => p.iter().all(|px| px[3] == u16::MAX),
+        }
+    }
+
     pub fn pixels_mut(&mut self) -> &mut CanvasPixels {
         &mut self.pixels
     }
