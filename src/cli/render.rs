@@ -248,12 +248,13 @@ pub fn run_render(args: RenderArgs) -> anyhow::Result<()> {
     };
     let frames = range.last - range.first + 1;
     let seconds = started.elapsed().as_secs_f64();
+    let factorisations = renderer.factorisations();
     let summary = format!(
-        "rendered {frames} frames to {} in {seconds:.2} s ({:.1} fps; {:.2} ms/frame compute; {} factorisations)",
+        "rendered {frames} frames to {} in {seconds:.2} s ({:.1} fps; {:.2} ms/frame compute; {factorisations} factorisation{})",
         written.display(),
         frames as f64 / seconds,
         compute_ms / frames as f64,
-        renderer.factorisations()
+        if factorisations == 1 { "" } else { "s" }
     );
     // Standard output may be the video stream itself.
     if args.output.as_os_str() == "-" {

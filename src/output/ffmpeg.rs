@@ -87,7 +87,7 @@ impl VideoOptions {
         } else {
             match self.kind {
                 VideoKind::Mp4 | VideoKind::Mov => &[
-                    "-c:v", "libx264", "-preset", "fast", "-pix_fmt", "yuv420p", "-crf",
+                    "-c:v", "libx264", "-preset", "veryfast", "-pix_fmt", "yuv420p", "-crf",
                 ],
                 VideoKind::Webm => &[
                     "-c:v", "libvpx-vp9", "-pix_fmt", "yuv420p", "-b:v", "0", "-row-mt", "1",

@@ -277,21 +277,33 @@ impl Footage {
         }
     }
 
-    /// Checks, before anything is rendered, that frames `0..frames` exist (or hold): every
-    /// file of a sequence, a video's duration from ffprobe.
+    /// Checks, before anything is rendered, that frames `0..frames` exist (or hold) and have
+    /// the footage's size: every file of a sequence (its header), a video's duration from
+    /// ffprobe.
     pub fn check_covers(&self, frames: u64, fps: f64) -> Result<(), FootageError> {
         match &self.source {
             FootageSource::Sequence { pattern, start } => {
-                if self.hold {
-                    return Ok(());
-                }
                 for i in 0..frames {
                     let file = pattern.path(start + i);
                     if !file.is_file() {
+                        if self.hold && i > 0 {
+                            return Ok(());
+                        }
                         return Err(FootageError::MissingFrame {
                             frame: i + 1,
                             file,
                             hold_key: self.hold_key.clone(),
+                        });
+                    }
+                    let (width, height) = image_size(&file)?;
+                    if (width, height) != (self.width, self.height) {
+                        return Err(FootageError::SizeChanged {
+                            file,
+                            frame: i + 1,
+                            width,
+                            height,
+                            expected_width: self.width,
+                            expected_height: self.height,
                         });
                     }
                 }
