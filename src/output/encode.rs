@@ -18,9 +18,9 @@ pub enum PngCompression {
 impl PngCompression {
     fn to_png(self) -> png::Compression {
         match self {
-            PngCompression::Fast => png::Compression::Fast,
-            PngCompression::Default => png::Compression::Default,
-            PngCompression::Best => png::Compression::Best,
+            PngCompression::Fast => png::Compression::Fastest,
+            PngCompression::Default => png::Compression::Balanced,
+            PngCompression::Best => png::Compression::High,
         }
     }
 }

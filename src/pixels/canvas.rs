@@ -83,6 +83,25 @@ impl Canvas {
         })
     }
 
+    /// An 8-bit canvas holding `pixels` (straight RGBA, row-major).
+    pub fn from_rgba8(width: u32, height: u32, pixels: Vec<[u8; 4]>) -> Result<Canvas, PixelError> {
+        if width == 0 || height == 0 {
+            return Err(PixelError::EmptyImage { width, height });
+        }
+        if pixels.len() != width as usize * height as usize {
+            return Err(PixelError::BufferSize {
+                width,
+                height,
+                actual: pixels.len(),
+            });
+        }
+        Ok(Canvas {
+            width,
+            height,
+            pixels: CanvasPixels::Eight(pixels),
+        })
+    }
+
     /// The image quantised to its own bit depth.
     pub fn from_image(image: &FloatImage) -> Canvas {
         let pixels = match image.format().depth {

@@ -79,13 +79,17 @@ impl Renderer {
     pub fn new(scene: Scene) -> Result<Self, RenderError> {
         scene.sanity_check()?;
         check_footage(&scene)?;
-        let (background, plates) = background_canvas(&scene)?;
-        let mut sources: HashMap<PathBuf, FloatImage> = HashMap::new();
-        let mut layers = Vec::with_capacity(scene.patches.len());
-        for patch in &scene.patches {
-            let source = source_image(&mut sources, patch)?;
-            layers.push(Layer::new(patch, source, scene.canvas.fps)?);
-        }
+        // The background decodes on a thread of its own while the layers load and mesh.
+        let (background, layers) = std::thread::scope(|scope| {
+            let background = scope.spawn(|| background_canvas(&scene));
+            let layers = build_layers(&scene);
+            let background = background
+                .join()
+                .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+            (background, layers)
+        });
+        let (background, plates) = background?;
+        let layers = layers?;
         let frame = background.clone();
         Ok(Self {
             scene,
@@ -368,6 +372,16 @@ enum Planned {
     Build(Box<Layer>),
 }
 
+fn build_layers(scene: &Scene) -> Result<Vec<Layer>, RenderError> {
+    let mut sources: HashMap<PathBuf, FloatImage> = HashMap::new();
+    let mut layers = Vec::with_capacity(scene.patches.len());
+    for patch in &scene.patches {
+        let source = source_image(&mut sources, patch)?;
+        layers.push(Layer::new(patch, source, scene.canvas.fps)?);
+    }
+    Ok(layers)
+}
+
 /// The patch's source image, loaded once per path (an animated source's first frame).
 fn source_image(
     sources: &mut HashMap<PathBuf, FloatImage>,
@@ -424,7 +438,11 @@ fn background_canvas(scene: &Scene) -> Result<(Canvas, Option<(FootageReader, u6
             Ok((Canvas::from_image(&image), None))
         }
         Background::Image(path) => {
-            let picture = FloatImage::load(path)?;
+            let decoded = FloatImage::decode(path)?;
+            if let Some(canvas) = eight_bit_canvas(&decoded, width, height)? {
+                return Ok((canvas, None));
+            }
+            let picture = FloatImage::from_dynamic(&decoded)?;
             Ok((canvas_over(&picture, width, height)?, None))
         }
         Background::Footage(footage) => {
@@ -437,6 +455,26 @@ fn background_canvas(scene: &Scene) -> Result<(Canvas, Option<(FootageReader, u6
             Ok((canvas, Some((reader, 0))))
         }
     }
+}
+
+/// A decoded 8-bit image of the canvas's size as the canvas, straight from its bytes (no
+/// float copy; the same bytes as the float path); `None` for other depths and sizes.
+fn eight_bit_canvas(
+    decoded: &image::DynamicImage,
+    width: u32,
+    height: u32,
+) -> Result<Option<Canvas>, RenderError> {
+    use image::DynamicImage as D;
+    let eight_bit = matches!(
+        decoded,
+        D::ImageLuma8(_) | D::ImageLumaA8(_) | D::ImageRgb8(_) | D::ImageRgba8(_)
+    );
+    if !eight_bit || (decoded.width(), decoded.height()) != (width, height) {
+        return Ok(None);
+    }
+    let rgba = decoded.to_rgba8().into_raw();
+    let pixels = rgba.chunks_exact(4).map(|p| [p[0], p[1], p[2], p[3]]).collect();
+    Ok(Some(Canvas::from_rgba8(width, height, pixels)?))
 }
 
 /// `picture` at the origin of a `width`×`height` canvas, opaque black where it does not
