@@ -1,5 +1,5 @@
 """Test images for the large one-shot clone benchmark (not committed): a 6000x5000 target,
-a 4200x3600 source (15.1 MP) and its mask (an ellipse filling most of it, about 11.9 MP
+a 4400x3700 source (16.3 MP) and its mask (an ellipse filling most of it, about 12.6 MP
 inside), written as 8-bit PNGs into the folder given (default /tmp/lapclone_big).
 
     python3 benches/make_big_images.py /tmp/lapclone_big
@@ -33,7 +33,7 @@ def main(out):
     os.makedirs(out, exist_ok=True)
     rng = np.random.default_rng(7)
     cv2.imwrite(os.path.join(out, "target.png"), picture(rng, 5000, 6000, np.array([0.5, 0.6, 0.4], np.float32)))
-    sh, sw = 3600, 4200
+    sh, sw = 3700, 4400
     cv2.imwrite(os.path.join(out, "source.png"), picture(rng, sh, sw, np.array([0.3, 0.2, 0.6], np.float32)))
     mask = np.zeros((sh, sw), np.uint8)
     cv2.ellipse(mask, (sw // 2, sh // 2), (sw // 2 - 20, sh // 2 - 20), 0, 0, 360, 255, -1)

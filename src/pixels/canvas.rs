@@ -102,6 +102,21 @@ impl Canvas {
         })
     }
 
+    /// A decoded 8-bit image (grey, grey+alpha, RGB, RGBA) as a canvas, straight from its
+    /// bytes: the same canvas as [`from_image`](Self::from_image) of its [`FloatImage`],
+    /// without the float copy. `None` for other formats.
+    pub fn from_eight_bit(decoded: &image::DynamicImage) -> Option<Canvas> {
+        use image::DynamicImage as D;
+        let pixels: Vec<[u8; 4]> = match decoded {
+            D::ImageRgb8(img) => img.pixels().map(|p| [p[0], p[1], p[2], 255]).collect(),
+            D::ImageRgba8(img) => img.pixels().map(|p| p.0).collect(),
+            D::ImageLuma8(img) => img.pixels().map(|p| [p[0], p[0], p[0], 255]).collect(),
+            D::ImageLumaA8(img) => img.pixels().map(|p| [p[0], p[0], p[0], p[1]]).collect(),
+            _ => return None,
+        };
+        Canvas::from_rgba8(decoded.width(), decoded.height(), pixels).ok()
+    }
+
     /// The image quantised to its own bit depth.
     pub fn from_image(image: &FloatImage) -> Canvas {
         let pixels = match image.format().depth {

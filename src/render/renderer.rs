@@ -464,17 +464,10 @@ fn eight_bit_canvas(
     width: u32,
     height: u32,
 ) -> Result<Option<Canvas>, RenderError> {
-    use image::DynamicImage as D;
-    let eight_bit = matches!(
-        decoded,
-        D::ImageLuma8(_) | D::ImageLumaA8(_) | D::ImageRgb8(_) | D::ImageRgba8(_)
-    );
-    if !eight_bit || (decoded.width(), decoded.height()) != (width, height) {
+    if (decoded.width(), decoded.height()) != (width, height) {
         return Ok(None);
     }
-    let rgba = decoded.to_rgba8().into_raw();
-    let pixels = rgba.chunks_exact(4).map(|p| [p[0], p[1], p[2], p[3]]).collect();
-    Ok(Some(Canvas::from_rgba8(width, height, pixels)?))
+    Ok(Canvas::from_eight_bit(decoded))
 }
 
 /// `picture` at the origin of a `width`×`height` canvas, opaque black where it does not
