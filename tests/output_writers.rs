@@ -49,9 +49,9 @@ fn frame16(w: u32, h: u32, seed: u32) -> Frame {
 }
 
 fn decode_png(path: &Path) -> (u32, u32, png::BitDepth, Vec<u8>) {
-    let decoder = png::Decoder::new(std::fs::File::open(path).unwrap());
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap()));
     let mut reader = decoder.read_info().unwrap();
-    let mut buf = vec![0; reader.output_buffer_size()];
+    let mut buf = vec![0; reader.output_buffer_size().unwrap()];
     let info = reader.next_frame(&mut buf).unwrap();
     buf.truncate(info.buffer_size());
     (info.width, info.height, info.bit_depth, buf)
@@ -193,12 +193,12 @@ fn apng_decodes_back_to_the_same_frames() {
             writer.add(&f.as_ref().unwrap()).unwrap();
         }
         writer.finish().unwrap();
-        let decoder = png::Decoder::new(std::fs::File::open(&path).unwrap());
+        let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&path).unwrap()));
         let mut reader = decoder.read_info().unwrap();
         let control = reader.info().animation_control().copied().unwrap();
         assert_eq!((control.num_frames, control.num_plays), (4, 0));
-        let mut buf = vec![0; reader.output_buffer_size()];
-        let mut canvas = vec![0; reader.output_buffer_size()];
+        let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+        let mut canvas = vec![0; reader.output_buffer_size().unwrap()];
         let pixel = if sixteen { 8 } else { 4 };
         for f in &frames {
             let info = reader.next_frame(&mut buf).unwrap();

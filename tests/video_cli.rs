@@ -42,7 +42,11 @@ fn has_ffmpeg() -> bool {
 fn plate(k: u32, width: u32, height: u32) -> image::RgbImage {
     image::RgbImage::from_fn(width, height, |x, y| {
         let v = x * 7 + y * 13 + k * 50;
-        image::Rgb([(v % 251) as u8, ((v * 3 + k * 17) % 253) as u8, (k * 80 + 20) as u8])
+        image::Rgb([
+            (v % 251) as u8,
+            ((v * 3 + k * 17) % 253) as u8,
+            (k * 80 + 20) as u8,
+        ])
     })
 }
 
@@ -60,7 +64,11 @@ const PATCH: &str = "patch(\"p\", #{ source: SOURCE, polygons: [[[10, 10], [40, 
 fn write_scene(dir: &Path, canvas: &str, patch: &str) -> PathBuf {
     let scene = dir.join("scene.rhai");
     let source = format!("\"{}\"", asset("chelsea.png"));
-    std::fs::write(&scene, format!("{canvas}\n{}\n", patch.replace("SOURCE", &source))).unwrap();
+    std::fs::write(
+        &scene,
+        format!("{canvas}\n{}\n", patch.replace("SOURCE", &source)),
+    )
+    .unwrap();
     scene
 }
 
@@ -87,7 +95,11 @@ fn each_frame_lies_over_its_own_plate() {
     assert_eq!(sorted_names(&out).len(), 3);
     for i in 0..3u32 {
         let frame = rgba(&out.join(format!("frame_{:04}.png", i + 1)));
-        assert_eq!(frame.dimensions(), (W, H), "the canvas takes the plate's size");
+        assert_eq!(
+            frame.dimensions(),
+            (W, H),
+            "the canvas takes the plate's size"
+        );
         let expected = plate(i, W, H);
         let mut compared = 0;
         for (x, y, px) in frame.enumerate_pixels() {
@@ -113,7 +125,11 @@ fn start_number_and_hold_pick_the_plates() {
     let out = dir.path().join("out");
     let o = render(&scene, &out, &[]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let corner = |n: u32| rgba(&out.join(format!("frame_{n:04}.png"))).get_pixel(1, 60).0;
+    let corner = |n: u32| {
+        rgba(&out.join(format!("frame_{n:04}.png")))
+            .get_pixel(1, 60)
+            .0
+    };
     let plate_corner = |k: u32| plate(k, W, H).get_pixel(1, 60).0;
     assert_eq!(corner(1)[..3], plate_corner(0));
     assert_eq!(corner(2)[..3], plate_corner(1));
@@ -129,7 +145,9 @@ fn an_alternating_source_alternates_the_patch_with_one_factorisation() {
     image::imageops::invert(&mut inverted);
     for n in 1..=4 {
         let frame = if n % 2 == 1 { &chelsea } else { &inverted };
-        frame.save(dir.path().join(format!("src/f_{n}.png"))).unwrap();
+        frame
+            .save(dir.path().join(format!("src/f_{n}.png")))
+            .unwrap();
     }
     let canvas = format!(
         "canvas({W}, {H}, #{{ fps: 4, duration: 1, background: \"{}\" }});",
@@ -146,12 +164,18 @@ fn an_alternating_source_alternates_the_patch_with_one_factorisation() {
     assert_eq!(bytes(1), bytes(3));
     assert_eq!(bytes(2), bytes(4));
     // Frames 1 and 2 differ in the patch (its texture is inverted) and nowhere else.
-    let (a, b) = (rgba(&out.join("frame_0001.png")), rgba(&out.join("frame_0002.png")));
+    let (a, b) = (
+        rgba(&out.join("frame_0001.png")),
+        rgba(&out.join("frame_0002.png")),
+    );
     let mut differing = 0;
     for (x, y, pa) in a.enumerate_pixels() {
         if pa != b.get_pixel(x, y) {
             differing += 1;
-            assert!((30..=72).contains(&x) && (12..=50).contains(&y), "{x},{y} outside the patch");
+            assert!(
+                (30..=72).contains(&x) && (12..=50).contains(&y),
+                "{x},{y} outside the patch"
+            );
         }
     }
     assert!(differing > 200, "only {differing} patch pixels differ");
@@ -218,7 +242,11 @@ fn y4m_matches_the_png_frames_within_one_level() {
             let want = ycbcr(px.0);
             for c in 0..3 {
                 let got = planes[c * n + k] as f64;
-                assert!((got - want[c]).abs() <= 1.0, "frame {i} pixel {k} channel {c}: {got} vs {}", want[c]);
+                assert!(
+                    (got - want[c]).abs() <= 1.0,
+                    "frame {i} pixel {k} channel {c}: {got} vs {}",
+                    want[c]
+                );
             }
         }
     }
@@ -237,11 +265,18 @@ fn slices_rendered_separately_equal_the_whole_render() {
     );
     let patch = "let p = patch(\"p\", #{ source: SOURCE, polygons: [[[10, 10], [40, 12], [20, 36]]] }); p.at(0, [30, 30]).at(1, [66, 34]); p.scale(0, 1).scale(1, 1.4);";
     let scene = write_scene(dir.path(), &canvas, patch);
-    let (whole, a, b) = (dir.path().join("whole"), dir.path().join("a"), dir.path().join("b"));
+    let (whole, a, b) = (
+        dir.path().join("whole"),
+        dir.path().join("a"),
+        dir.path().join("b"),
+    );
     assert!(render(&scene, &whole, &[]).status.success());
     assert!(render(&scene, &a, &["--frames", "1..2"]).status.success());
     assert!(render(&scene, &b, &["--frames", "3..4"]).status.success());
-    for (slice, names) in [(&a, ["frame_0001.png", "frame_0002.png"]), (&b, ["frame_0003.png", "frame_0004.png"])] {
+    for (slice, names) in [
+        (&a, ["frame_0001.png", "frame_0002.png"]),
+        (&b, ["frame_0003.png", "frame_0004.png"]),
+    ] {
         assert_eq!(sorted_names(slice), names);
         for name in names {
             assert_eq!(
@@ -268,13 +303,20 @@ fn the_output_extension_names_the_format_and_old_frames_need_force() {
     assert!(render(&scene, &png, &[]).status.success());
     let bytes = std::fs::read(&png).unwrap();
     assert_eq!(&bytes[1..4], b"PNG");
-    assert!(bytes.windows(4).any(|w| w == b"acTL"), ".png is an animated PNG");
+    assert!(
+        bytes.windows(4).any(|w| w == b"acTL"),
+        ".png is an animated PNG"
+    );
     // A folder with all four frames, then a 2-frame slice into it: refused, then forced.
     let folder = dir.path().join("frames");
     assert!(render(&scene, &folder, &[]).status.success());
     let o = render(&scene, &folder, &["--frames", "1..2"]);
     assert_eq!(o.status.code(), Some(1));
-    assert!(stderr(&o).contains("frame files of another render"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("frame files of another render"),
+        "{}",
+        stderr(&o)
+    );
     assert_eq!(sorted_names(&folder).len(), 4);
     let o = render(&scene, &folder, &["--frames", "1..2", "--force"]);
     assert!(o.status.success(), "{}", stderr(&o));
@@ -296,7 +338,11 @@ fn assert_refused(dir: &Path, canvas: &str, patch: &str, message: &str) {
     let out = dir.join("refused");
     let o = render(&scene, &out, &[]);
     assert_eq!(o.status.code(), Some(1), "{canvas} {patch}: {}", stderr(&o));
-    assert!(stderr(&o).contains(message), "wanted `{message}` in: {}", stderr(&o));
+    assert!(
+        stderr(&o).contains(message),
+        "wanted `{message}` in: {}",
+        stderr(&o)
+    );
     assert!(!out.exists(), "{} was written", out.display());
 }
 
@@ -311,23 +357,60 @@ fn bad_footage_is_refused_before_anything_is_written() {
         PATCH,
         "has no frame number",
     );
-    assert_refused(d, "canvas(#{ fps: 3, background: \"plates/frame_%s.png\" });", PATCH, "must start %d");
-    assert_refused(d, "canvas(#{ fps: 3, background: \"plates/shot_%04d.png\" });", PATCH, "matches no files");
-    assert_refused(d, "canvas(#{ fps: 4, background: \"plates/frame_%04d.png\" });", PATCH, "frame_0004.png, which does not exist");
-    plate(9, W + 2, H).save(d.join("plates/frame_0004.png")).unwrap();
-    assert_refused(d, "canvas(#{ fps: 4, background: \"plates/frame_%04d.png\" });", PATCH, "98×64, but the footage is 96×64");
+    assert_refused(
+        d,
+        "canvas(#{ fps: 3, background: \"plates/frame_%s.png\" });",
+        PATCH,
+        "must start %d",
+    );
+    assert_refused(
+        d,
+        "canvas(#{ fps: 3, background: \"plates/shot_%04d.png\" });",
+        PATCH,
+        "matches no files",
+    );
+    assert_refused(
+        d,
+        "canvas(#{ fps: 4, background: \"plates/frame_%04d.png\" });",
+        PATCH,
+        "frame_0004.png, which does not exist",
+    );
+    plate(9, W + 2, H)
+        .save(d.join("plates/frame_0004.png"))
+        .unwrap();
+    assert_refused(
+        d,
+        "canvas(#{ fps: 4, background: \"plates/frame_%04d.png\" });",
+        PATCH,
+        "98×64, but the footage is 96×64",
+    );
     // A source sequence shorter than the scene.
     std::fs::create_dir_all(d.join("src")).unwrap();
     std::fs::copy(asset("chelsea.png"), d.join("src/s_1.png")).unwrap();
-    let short = "patch(\"p\", #{ source: \"src/s_%d.png\", polygons: [[[10, 10], [40, 12], [20, 36]]] });";
-    assert_refused(d, "canvas(96, 64, #{ fps: 3 });", short, "s_2.png, which does not exist (add `source_hold: true`");
+    let short =
+        "patch(\"p\", #{ source: \"src/s_%d.png\", polygons: [[[10, 10], [40, 12], [20, 36]]] });";
+    assert_refused(
+        d,
+        "canvas(96, 64, #{ fps: 3 });",
+        short,
+        "s_2.png, which does not exist (add `source_hold: true`",
+    );
     let held = "patch(\"p\", #{ source: \"src/s_%d.png\", source_hold: true, polygons: [[[10, 10], [40, 12], [20, 36]]] });";
     let scene = write_scene(d, "canvas(96, 64, #{ fps: 3 });", held);
     assert!(render(&scene, &d.join("held"), &[]).status.success());
     // A 0-byte video: refused by ffprobe, or for want of ffmpeg; either way clearly.
     std::fs::write(d.join("empty.mp4"), b"").unwrap();
-    let expected = if has_ffmpeg() { "cannot read video" } else { "ffmpeg not found on PATH" };
-    assert_refused(d, "canvas(#{ fps: 3, background: \"empty.mp4\" });", PATCH, expected);
+    let expected = if has_ffmpeg() {
+        "cannot read video"
+    } else {
+        "ffmpeg not found on PATH"
+    };
+    assert_refused(
+        d,
+        "canvas(#{ fps: 3, background: \"empty.mp4\" });",
+        PATCH,
+        expected,
+    );
 }
 
 #[test]
@@ -343,7 +426,10 @@ fn mp4_has_the_frames_size_and_rate_and_video_footage_reads_back() {
     assert!(o.status.success(), "{}", stderr(&o));
     let probe = Command::new("ffprobe")
         .args(["-v", "error", "-count_frames", "-select_streams", "v:0"])
-        .args(["-show_entries", "stream=width,height,r_frame_rate,nb_read_frames"])
+        .args([
+            "-show_entries",
+            "stream=width,height,r_frame_rate,nb_read_frames",
+        ])
         .args(["-of", "default=noprint_wrappers=1"])
         .arg(&mp4)
         .output()
@@ -352,15 +438,28 @@ fn mp4_has_the_frames_size_and_rate_and_video_footage_reads_back() {
     let preview = lapclone(&[os("check"), demo.as_os_str()]);
     let check = String::from_utf8_lossy(&preview.stdout);
     // `check` prints e.g. "…: ok — 600×400, 24 fps, …".
-    let size = check.split(" — ").nth(1).unwrap().split(',').next().unwrap();
+    let size = check
+        .split(" — ")
+        .nth(1)
+        .unwrap()
+        .split(',')
+        .next()
+        .unwrap();
     let (w, h) = size.split_once('×').unwrap();
     let fps = check.split(", ").nth(1).unwrap().trim_end_matches(" fps");
     assert!(text.contains(&format!("width={w}")), "{text} vs {check}");
     assert!(text.contains(&format!("height={h}")), "{text} vs {check}");
-    assert!(text.contains(&format!("r_frame_rate={fps}/1")), "{text} vs {check}");
+    assert!(
+        text.contains(&format!("r_frame_rate={fps}/1")),
+        "{text} vs {check}"
+    );
     assert!(text.contains("nb_read_frames=12"), "{text}");
     // The video as footage: its plates have its size, and a corrupt video is refused.
-    let scene = write_scene(dir.path(), "canvas(#{ fps: 24, duration: 0.25, background: \"cat.mp4\" });", PATCH);
+    let scene = write_scene(
+        dir.path(),
+        "canvas(#{ fps: 24, duration: 0.25, background: \"cat.mp4\" });",
+        PATCH,
+    );
     let out = dir.path().join("from_video");
     let o = render(&scene, &out, &[]);
     assert!(o.status.success(), "{}", stderr(&o));
@@ -369,13 +468,21 @@ fn mp4_has_the_frames_size_and_rate_and_video_footage_reads_back() {
     bytes.truncate(bytes.len() / 3);
     bytes[..64].fill(0x5a);
     std::fs::write(dir.path().join("bad.mp4"), bytes).unwrap();
-    assert_refused(dir.path(), "canvas(#{ fps: 24, background: \"bad.mp4\" });", PATCH, "cannot read video");
+    assert_refused(
+        dir.path(),
+        "canvas(#{ fps: 24, background: \"bad.mp4\" });",
+        PATCH,
+        "cannot read video",
+    );
 }
 
 #[test]
 fn without_ffmpeg_video_output_is_refused_and_nothing_is_written() {
     let dir = tempfile::tempdir().unwrap();
-    let canvas = format!("canvas(95, 63, #{{ fps: 4, duration: 1, background: \"{}\" }});", asset("coffee.png"));
+    let canvas = format!(
+        "canvas(95, 63, #{{ fps: 4, duration: 1, background: \"{}\" }});",
+        asset("coffee.png")
+    );
     let scene = write_scene(dir.path(), &canvas, PATCH);
     let mp4 = dir.path().join("out.mp4");
     let o = Command::new(env!("CARGO_BIN_EXE_lapclone"))
@@ -385,7 +492,11 @@ fn without_ffmpeg_video_output_is_refused_and_nothing_is_written() {
         .unwrap();
     assert_eq!(o.status.code(), Some(1));
     assert!(stderr(&o).contains("ffmpeg not found on PATH: install it (for example: apt-get install ffmpeg) or use --format png|gif|apng|y4m"), "{}", stderr(&o));
-    assert!(std::fs::read_dir(dir.path()).unwrap().all(|e| !e.unwrap().file_name().to_string_lossy().contains("mp4")));
+    assert!(std::fs::read_dir(dir.path()).unwrap().all(|e| !e
+        .unwrap()
+        .file_name()
+        .to_string_lossy()
+        .contains("mp4")));
     // With ffmpeg, the odd-sized canvas is padded to even sides, with a note.
     if has_ffmpeg() {
         let o = render(&scene, &mp4, &[]);

@@ -205,7 +205,9 @@ pub fn run(args: CloneArgs) -> anyhow::Result<()> {
     report_clone_warnings(&stats);
 
     let reclone_ms = match &background {
-        Some(background) => time_reclone(&mut cloner, background, &placement, deformation.as_mut())?,
+        Some(background) => {
+            time_reclone(&mut cloner, background, &placement, deformation.as_mut())?
+        }
         None => 0.0,
     };
     write_output(&args, &canvas, target_format, &cloner, &handles, &placement)?;

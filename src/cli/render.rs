@@ -99,7 +99,12 @@ pub struct RenderArgs {
     /// Output: a folder for frame_NNNN.png (a name without an extension), or a file whose
     /// extension names the format (.gif, .apng, .png = animated PNG, .mp4, .webm, .mov,
     /// .y4m); `-` writes Y4M to standard output.
-    #[arg(short = 'o', long = "output", default_value = "frames", allow_hyphen_values = true)]
+    #[arg(
+        short = 'o',
+        long = "output",
+        default_value = "frames",
+        allow_hyphen_values = true
+    )]
     pub output: PathBuf,
     /// Inclusive frame numbers to render, e.g. 1..24 (default: all).
     #[arg(long, value_parser = frame_range, allow_hyphen_values = true)]
@@ -374,7 +379,14 @@ impl FrameSink {
         cancel: Arc<AtomicBool>,
     ) -> anyhow::Result<Self> {
         let settings = SinkSettings::default();
-        Self::open_kind(format.kind(), output, renderer, range, (jobs, cancel), settings)
+        Self::open_kind(
+            format.kind(),
+            output,
+            renderer,
+            range,
+            (jobs, cancel),
+            settings,
+        )
     }
 
     pub(crate) fn open_kind(
@@ -387,7 +399,10 @@ impl FrameSink {
     ) -> anyhow::Result<Self> {
         let canvas = &renderer.scene().canvas;
         if kind != OutputKind::PngFolder && output.is_dir() {
-            anyhow::bail!("{} is a folder; name a file for {kind:?} output", output.display());
+            anyhow::bail!(
+                "{} is a folder; name a file for {kind:?} output",
+                output.display()
+            );
         }
         let video = |kind| VideoOptions {
             kind,

@@ -69,7 +69,10 @@ impl VideoOptions {
         if self.keeps_alpha() {
             (self.width, self.height)
         } else {
-            (self.width.next_multiple_of(2), self.height.next_multiple_of(2))
+            (
+                self.width.next_multiple_of(2),
+                self.height.next_multiple_of(2),
+            )
         }
     }
 
@@ -80,18 +83,43 @@ impl VideoOptions {
         let (w, h) = self.encoded_size();
         if (w, h) != (self.width, self.height) {
             // Pad with the edge's own pixels, so no dark line appears at the border.
-            args.extend(["-vf".into(), format!("pad={w}:{h}:0:0,fillborders=right={}:bottom={}:mode=smear", w - self.width, h - self.height)]);
+            args.extend([
+                "-vf".into(),
+                format!(
+                    "pad={w}:{h}:0:0,fillborders=right={}:bottom={}:mode=smear",
+                    w - self.width,
+                    h - self.height
+                ),
+            ]);
         }
         let codec: &[&str] = if self.keeps_alpha() {
-            &["-c:v", "prores_ks", "-profile:v", "4444", "-pix_fmt", "yuva444p10le"]
+            &[
+                "-c:v",
+                "prores_ks",
+                "-profile:v",
+                "4444",
+                "-pix_fmt",
+                "yuva444p10le",
+            ]
         } else {
             match self.kind {
                 VideoKind::Mp4 | VideoKind::Mov => &[
                     "-c:v", "libx264", "-preset", "veryfast", "-pix_fmt", "yuv420p", "-crf",
                 ],
                 VideoKind::Webm => &[
-                    "-c:v", "libvpx-vp9", "-pix_fmt", "yuv420p", "-b:v", "0", "-row-mt", "1",
-                    "-deadline", "good", "-cpu-used", "4", "-crf",
+                    "-c:v",
+                    "libvpx-vp9",
+                    "-pix_fmt",
+                    "yuv420p",
+                    "-b:v",
+                    "0",
+                    "-row-mt",
+                    "1",
+                    "-deadline",
+                    "good",
+                    "-cpu-used",
+                    "4",
+                    "-crf",
                 ],
             }
         };
@@ -128,7 +156,9 @@ impl FfmpegWriter {
         let temp = TempOutput::new(path);
         let mut command = Command::new(ffmpeg);
         command
-            .args(["-v", "error", "-nostdin", "-y", "-f", "rawvideo", "-pix_fmt", "rgba"])
+            .args([
+                "-v", "error", "-nostdin", "-y", "-f", "rawvideo", "-pix_fmt", "rgba",
+            ])
             .args(["-s", &format!("{}x{}", options.width, options.height)])
             .args(["-framerate", &format!("{}", options.fps), "-i", "-"])
             .args(options.codec_args())
@@ -182,7 +212,9 @@ impl FfmpegWriter {
     /// Queues the next frame (8-bit RGBA of the video's size; 16-bit frames are rounded).
     pub fn add(&mut self, frame: &FrameRef<'_>) -> Result<(), OutputError> {
         if (frame.width(), frame.height()) != (self.options.width, self.options.height) {
-            return Err(OutputError::BadFrame("frame size differs from the video's".into()));
+            return Err(OutputError::BadFrame(
+                "frame size differs from the video's".into(),
+            ));
         }
         let mut buffer = self.spare.try_recv().unwrap_or_default();
         frame.write_rgba8(&mut buffer);

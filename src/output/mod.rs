@@ -22,12 +22,12 @@ pub use encode::{encode_png, PngCompression};
 pub use ffmpeg::{FfmpegWriter, VideoKind, VideoOptions};
 pub use format::OutputKind;
 pub use frame::{Frame, FrameData, FrameRef, Pixels};
-pub use y4m::{fps_fraction, rgb_to_ycbcr, Y4mWriter};
 pub use gif::{gif_delays_cs, GifOptions, GifWriter, PALETTE_FRAMES};
 pub use gif_palette::{Palette, PaletteMap};
 pub use png_sequence::{
     foreign_frames, frame_digits, frame_file_name, write_png_file, PngSequenceWriter,
 };
+pub use y4m::{fps_fraction, rgb_to_ycbcr, Y4mWriter};
 
 use std::path::{Path, PathBuf};
 

@@ -349,7 +349,14 @@ fn ffprobe() -> Result<PathBuf, FootageError> {
 
 fn ffprobe_entry(path: &Path, entry: &str) -> Result<String, FootageError> {
     let output = Command::new(ffprobe()?)
-        .args(["-v", "error", "-select_streams", "v:0", "-show_entries", entry])
+        .args([
+            "-v",
+            "error",
+            "-select_streams",
+            "v:0",
+            "-show_entries",
+            entry,
+        ])
         .args(["-of", "default=noprint_wrappers=1:nokey=1"])
         .arg(path)
         .stdin(Stdio::null())
@@ -587,8 +594,15 @@ impl VideoStream {
             self.next += 1;
             return Ok(true);
         }
-        let status = self.child.wait().map_err(|e| video_error(&self.path, e.to_string()))?;
-        let stderr = self.stderr.take().and_then(|h| h.join().ok()).unwrap_or_default();
+        let status = self
+            .child
+            .wait()
+            .map_err(|e| video_error(&self.path, e.to_string()))?;
+        let stderr = self
+            .stderr
+            .take()
+            .and_then(|h| h.join().ok())
+            .unwrap_or_default();
         if !status.success() || self.next == 0 {
             let message = last_lines(&stderr, 3);
             let message = if message.is_empty() {
@@ -615,7 +629,9 @@ mod tests {
 
     #[test]
     fn patterns_parse_and_format() {
-        let p = Pattern::parse(Path::new("dir/plate_%04d.png")).unwrap().unwrap();
+        let p = Pattern::parse(Path::new("dir/plate_%04d.png"))
+            .unwrap()
+            .unwrap();
         assert_eq!(p.path(7), Path::new("dir/plate_0007.png"));
         assert_eq!(p.path(12345), Path::new("dir/plate_12345.png"));
         assert_eq!(p.number_of("plate_0042.png"), Some(42));
@@ -631,7 +647,10 @@ mod tests {
     fn bad_patterns_are_refused() {
         for bad in ["a_%s.png", "a_%4d.png", "a_%d_%d.png", "a%"] {
             assert!(
-                matches!(Pattern::parse(Path::new(bad)), Err(FootageError::BadPattern(_))),
+                matches!(
+                    Pattern::parse(Path::new(bad)),
+                    Err(FootageError::BadPattern(_))
+                ),
                 "{bad}"
             );
         }

@@ -12,5 +12,6 @@ pub use to_rhai::rhai_string_literal;
 pub use track::{Easing, Interpolate, Key, KeyError, Track};
 pub use types::{
     check_polygons, Background, BoundaryData, BoundaryPlacement, Canvas, CloneMode, Footage,
-    FootageSource, Handle, LaplacianKind, ModelError, Patch, Pin, Placement, Polygon, Scene, Shape, MAX_CANVAS_SIDE,
+    FootageSource, Handle, LaplacianKind, ModelError, Patch, Pin, Placement, Polygon, Scene, Shape,
+    MAX_CANVAS_SIDE,
 };

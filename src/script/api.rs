@@ -131,7 +131,13 @@ fn parse_canvas(
     options: &Map,
 ) -> Result<Canvas, String> {
     let [start_key, hold_key] = footage_keys("background");
-    let keys = ["fps", "duration", "background", start_key.as_str(), hold_key.as_str()];
+    let keys = [
+        "fps",
+        "duration",
+        "background",
+        start_key.as_str(),
+        hold_key.as_str(),
+    ];
     values::check_keys(options, &keys, "canvas")?;
     let fps = match options.get("fps") {
         Some(v) => values::positive(v, "fps")?,
@@ -160,9 +166,7 @@ fn parse_canvas(
         ),
         (None, Background::Footage(f)) => (f.width, f.height),
         (None, _) => {
-            return Err(
-                "canvas needs a width and a height unless its background is footage".into(),
-            )
+            return Err("canvas needs a width and a height unless its background is footage".into())
         }
     };
     let canvas = Canvas {
