@@ -193,7 +193,8 @@ fn apng_decodes_back_to_the_same_frames() {
             writer.add(&f.as_ref().unwrap()).unwrap();
         }
         writer.finish().unwrap();
-        let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&path).unwrap()));
+        let decoder =
+            png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&path).unwrap()));
         let mut reader = decoder.read_info().unwrap();
         let control = reader.info().animation_control().copied().unwrap();
         assert_eq!((control.num_frames, control.num_plays), (4, 0));
