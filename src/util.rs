@@ -1,6 +1,7 @@
 //! Small helpers shared by every stage: atomic file output (write to a temporary file in the
-//! destination folder, then rename, so a failure never leaves a partial file), and the two
-//! pieces of thread hand-off the raster and the caches use.
+//! destination folder, then rename, so a failure never leaves a partial file), the two
+//! pieces of thread hand-off the raster and the caches use, and finding an external program
+//! (ffmpeg) on `PATH`.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};

@@ -4,8 +4,8 @@
 //!
 //! Boundary vertices outside the canvas, or hidden under the patch's own front layer, are
 //! switched off (rank-1 downdates of the kept factor) rather than clamped, and switched back
-//! on when they return. Source colours at the rest boundary never change, so they are sampled
-//! once per mesh; per frame only the canvas is sampled.
+//! on when they return. Source colours at the rest boundary are sampled once per mesh (again
+//! only when an animated source moves to its next frame); per frame only the canvas is sampled.
 //!
 //! The factor can be built eagerly ([`MembraneSolver::new`]) or by the first solve
 //! ([`MembraneSolver::deferred`]): a first clone then factors on the solving thread while the
