@@ -299,13 +299,16 @@ fn the_output_extension_names_the_format_and_old_frames_need_force() {
     let gif = dir.path().join("cat.gif");
     assert!(render(&scene, &gif, &[]).status.success());
     assert_eq!(&std::fs::read(&gif).unwrap()[..6], b"GIF89a");
+    let apng = dir.path().join("cat.apng");
+    assert!(render(&scene, &apng, &[]).status.success());
+    let bytes = std::fs::read(&apng).unwrap();
+    assert_eq!(&bytes[1..4], b"PNG");
+    assert!(bytes.windows(4).any(|w| w == b"acTL"), ".apng is animated");
     let png = dir.path().join("cat.png");
     assert!(render(&scene, &png, &[]).status.success());
-    let bytes = std::fs::read(&png).unwrap();
-    assert_eq!(&bytes[1..4], b"PNG");
     assert!(
-        bytes.windows(4).any(|w| w == b"acTL"),
-        ".png is an animated PNG"
+        png.join("frame_0004.png").is_file(),
+        ".png is a frame folder"
     );
     // A folder with all four frames, then a 2-frame slice into it: refused, then forced.
     let folder = dir.path().join("frames");

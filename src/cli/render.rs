@@ -96,9 +96,9 @@ pub fn frame_range(text: &str) -> Result<FrameRange, String> {
 pub struct RenderArgs {
     /// Scene file (.rhai).
     pub scene: PathBuf,
-    /// Output: a folder for frame_NNNN.png (a name without an extension), or a file whose
-    /// extension names the format (.gif, .apng, .png = animated PNG, .mp4, .webm, .mov,
-    /// .y4m); `-` writes Y4M to standard output.
+    /// Output: a folder for frame_NNNN.png (a name without an extension, or ending in .png),
+    /// or a file whose extension names the format (.gif, .apng, .mp4, .webm, .mov, .y4m);
+    /// `-` writes Y4M to standard output.
     #[arg(
         short = 'o',
         long = "output",
@@ -109,7 +109,7 @@ pub struct RenderArgs {
     /// Inclusive frame numbers to render, e.g. 1..24 (default: all).
     #[arg(long, value_parser = frame_range, allow_hyphen_values = true)]
     pub frames: Option<FrameRange>,
-    /// Output format (default: from the output's extension).
+    /// Output format (default: the one the output's extension names).
     #[arg(long, value_enum)]
     pub format: Option<OutputFormat>,
     /// PNG encoder threads (default: available cores).
@@ -129,23 +129,13 @@ pub struct RenderArgs {
 
 /// The output format: `--format`, else the one `-o`'s extension names.
 fn output_kind(args: &RenderArgs) -> anyhow::Result<OutputKind> {
-    let named = OutputKind::from_path(&args.output);
-    let kind = match (args.format, named) {
-        (Some(format), Ok(named)) if args.output.extension().is_some() || named == OutputKind::Y4m => {
-            if format.kind() != named {
-                return Err(UsageError(format!(
-                    "-o {} names {named:?} output, but --format is {format:?}",
-                    args.output.display()
-                ))
-                .into());
-            }
-            named
-        }
+    let kind = match (args.format, OutputKind::from_path(&args.output)) {
+        // An explicit format wins: the name is then just a name.
         (Some(format), _) => format.kind(),
         (None, Ok(named)) => named,
         (None, Err(extension)) => {
             return Err(UsageError(format!(
-                "-o {}: unknown output extension `.{extension}` (use .gif, .apng, .png, .mp4, .webm, .mov, .y4m, a folder name without an extension, or --format)",
+                "-o {}: unknown output extension `.{extension}` (use .gif, .apng, .mp4, .webm, .mov, .y4m, a folder name without an extension, or --format)",
                 args.output.display()
             ))
             .into())

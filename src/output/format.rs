@@ -1,10 +1,10 @@
 //! Output formats and how an output path names one: takes the `-o` path and gives the
-//! [`OutputKind`] its extension stands for (`.gif`, `.apng`, `.png`, `.mp4`, `.webm`, `.mov`,
+//! [`OutputKind`] its extension stands for (`.gif`, `.apng`, `.mp4`, `.webm`, `.mov`,
 //! `.y4m`; `-` is a Y4M stream on standard output; a name without an extension is a folder
 //! of PNG frames).
 //!
-//! `.png` is one animated PNG file: it is a valid PNG, so a viewer without APNG support shows
-//! its first frame, and a one-frame render is an ordinary PNG image.
+//! `.png` names a folder of PNG frames too (`out/shot.png/frame_0001.png …`), as it always
+//! has: a render is a sequence, and one animated file is asked for with `.apng`.
 
 use std::path::Path;
 
@@ -32,7 +32,8 @@ impl OutputKind {
         };
         Ok(match extension.to_ascii_lowercase().as_str() {
             "gif" => OutputKind::Gif,
-            "apng" | "png" => OutputKind::Apng,
+            "apng" => OutputKind::Apng,
+            "png" => OutputKind::PngFolder,
             "mp4" => OutputKind::Mp4,
             "webm" => OutputKind::Webm,
             "mov" => OutputKind::Mov,
@@ -56,7 +57,8 @@ mod tests {
         let kind = |p: &str| OutputKind::from_path(Path::new(p));
         assert_eq!(kind("out/cat.gif"), Ok(OutputKind::Gif));
         assert_eq!(kind("cat.MP4"), Ok(OutputKind::Mp4));
-        assert_eq!(kind("cat.png"), Ok(OutputKind::Apng));
+        assert_eq!(kind("cat.png"), Ok(OutputKind::PngFolder));
+        assert_eq!(kind("cat.apng"), Ok(OutputKind::Apng));
         assert_eq!(kind("frames"), Ok(OutputKind::PngFolder));
         assert_eq!(kind("-"), Ok(OutputKind::Y4m));
         assert_eq!(kind("cat.jpg"), Err("jpg".to_string()));
