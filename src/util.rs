@@ -1,6 +1,6 @@
 //! Small helpers shared by every stage: atomic file output (write to a temporary file in the
-//! destination folder, then rename, so a failure never leaves a partial file), and a lock that
-//! survives poisoning.
+//! destination folder, then rename, so a failure never leaves a partial file), a lock that
+//! survives poisoning, and finding an external program (ffmpeg) on `PATH`.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -12,6 +12,30 @@ pub(crate) fn lock<T>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {
     mutex
         .lock()
         .unwrap_or_else(|poisoned| poisoned.into_inner())
+}
+
+/// What to tell a user who asked for something that needs ffmpeg when it is not installed.
+pub const FFMPEG_MISSING: &str = "ffmpeg not found on PATH: install it (for example: apt-get install ffmpeg) or use --format png|gif|apng|y4m";
+
+/// The first executable file called `name` in a folder of `PATH`.
+pub fn find_program(name: &str) -> Option<PathBuf> {
+    let path = std::env::var_os("PATH")?;
+    std::env::split_paths(&path)
+        .map(|dir| dir.join(name))
+        .find(|candidate| is_executable(candidate))
+}
+
+fn is_executable(path: &Path) -> bool {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        path.metadata()
+            .is_ok_and(|m| m.is_file() && m.permissions().mode() & 0o111 != 0)
+    }
+    #[cfg(not(unix))]
+    {
+        path.is_file()
+    }
 }
 
 /// Writes `bytes` to `path` through a temporary sibling file and a rename.

@@ -10,15 +10,15 @@ type Rect = (u32, u32, u32, u32);
 
 /// Decodes an APNG and composites its records; also gives each record's rectangle.
 fn composite(path: &Path) -> (Vec<Vec<u8>>, Vec<Rect>) {
-    let decoder = png::Decoder::new(std::fs::File::open(path).unwrap());
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap()));
     let mut reader = decoder.read_info().unwrap();
     let (width, bytes_per_pixel) = {
         let info = reader.info();
         (info.width as usize, info.bytes_per_pixel())
     };
     let count = reader.info().animation_control().unwrap().num_frames;
-    let mut canvas = vec![0u8; reader.output_buffer_size()];
-    let mut buf = vec![0; reader.output_buffer_size()];
+    let mut canvas = vec![0u8; reader.output_buffer_size().unwrap()];
+    let mut buf = vec![0; reader.output_buffer_size().unwrap()];
     let (mut frames, mut rects) = (Vec::new(), Vec::new());
     for _ in 0..count {
         let info = reader.next_frame(&mut buf).unwrap();

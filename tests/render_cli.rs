@@ -158,7 +158,7 @@ fn gif_and_apng_hold_every_frame() {
         apng.as_os_str(),
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let reader = png::Decoder::new(std::fs::File::open(&apng).unwrap())
+    let reader = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&apng).unwrap()))
         .read_info()
         .unwrap();
     assert_eq!(

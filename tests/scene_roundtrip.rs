@@ -143,6 +143,7 @@ fn patch(index: usize) -> impl Strategy<Value = Patch> {
             )| Patch {
                 name: format!("{name}{index}"),
                 source: asset("astronaut.png"),
+                footage: None,
                 shape,
                 density,
                 laplacian: if cot {

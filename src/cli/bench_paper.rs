@@ -464,7 +464,16 @@ fn write_figure(args: &PaperBenchArgs, run_options: &RunOptions) -> anyhow::Resu
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
     let path = args.out.join("fig5_spiral.png");
-    let bytes = picture.encode_png().context("encoding the picture")?;
+    // The figure is opaque, so its premultiplied pixels are its straight RGBA ones.
+    let mut bytes = Vec::new();
+    image::ImageEncoder::write_image(
+        image::codecs::png::PngEncoder::new(&mut bytes),
+        picture.data(),
+        picture.width(),
+        picture.height(),
+        image::ExtendedColorType::Rgba8,
+    )
+    .context("encoding the picture")?;
     write_atomic(&path, &bytes).with_context(|| format!("writing {}", path.display()))?;
     if !args.json {
         for (wanted, run) in FIGURE_VERTICES.iter().zip(&runs) {

@@ -12,7 +12,7 @@ use lapclone::clone::{
 };
 use lapclone::deform::{DeformRig, Deformed, Handle, Pin};
 use lapclone::mesh::{BitMask, MeshOptions};
-use lapclone::pixels::{Canvas, FloatImage};
+use lapclone::pixels::{Canvas, FloatImage, PixelFormat};
 use lapclone::raster::overlay::{draw_mesh_overlay, HandleMarker, OverlayStyle};
 use lapclone::solve::LaplacianKind;
 
@@ -133,10 +133,23 @@ fn parse_drag(text: &str) -> Result<DragArg, String> {
 pub fn run(args: CloneArgs) -> anyhow::Result<()> {
     check_arguments(&args)?;
     let load_started = Instant::now();
-    let source = FloatImage::load(&args.source)?;
-    let target = FloatImage::load(&args.target)?;
-    let mask = BitMask::load(&args.mask, args.threshold as f32)?;
-    let mut canvas = Canvas::from_image(&target);
+    // The three inputs decode in parallel; the target goes straight to the canvas.
+    let (source, target, mask) = std::thread::scope(|scope| {
+        let source = scope.spawn(|| FloatImage::load(&args.source));
+        let mask = scope.spawn(|| BitMask::load(&args.mask, args.threshold as f32));
+        let target = load_target(&args.target);
+        (
+            source
+                .join()
+                .unwrap_or_else(|panic| std::panic::resume_unwind(panic)),
+            target,
+            mask.join()
+                .unwrap_or_else(|panic| std::panic::resume_unwind(panic)),
+        )
+    });
+    let (source, (mut canvas, target_format), mask) = (source?, target?, mask?);
+    // Kept only to time a re-clone for --stats.
+    let background = args.stats.then(|| canvas.clone());
     let load_ms = millis_since(load_started);
 
     // The first clone: mesh, factor, solve and raster (`total_ms`), inputs already decoded.
@@ -191,10 +204,9 @@ pub fn run(args: CloneArgs) -> anyhow::Result<()> {
     let total_ms = millis_since(mesh_started);
     report_clone_warnings(&stats);
 
-    write_output(&args, &canvas, &target, &cloner, &handles, &placement)?;
-    if args.stats {
-        let background = Canvas::from_image(&target);
-        let reclone_ms = time_reclone(&mut cloner, &background, &placement, deformation.as_mut())?;
+    write_output(&args, &canvas, target_format, &cloner, &handles, &placement)?;
+    if let Some(background) = &background {
+        let reclone_ms = time_reclone(&mut cloner, background, &placement, deformation.as_mut())?;
         let json = serde_json::json!({
             "vertices": cloner.mesh().vertex_count(),
             "boundary_vertices": cloner.membrane().boundary_vertices().len(),
@@ -315,14 +327,14 @@ fn report_clone_warnings(stats: &CloneStats) {
 fn write_output(
     args: &CloneArgs,
     canvas: &Canvas,
-    target: &FloatImage,
+    target_format: PixelFormat,
     cloner: &PatchCloner,
     handles: &[Handle],
     placement: &Placement,
 ) -> anyhow::Result<()> {
     if !args.show_mesh {
         canvas
-            .save_png(&args.output, target.format())
+            .save_png(&args.output, target_format)
             .with_context(|| format!("writing {}", args.output.display()))?;
         return Ok(());
     }
@@ -357,6 +369,18 @@ fn write_output(
         .context("encoding the overlay")?;
     lapclone::util::write_atomic(&args.output, &bytes)
         .with_context(|| format!("writing {}", args.output.display()))
+}
+
+/// The target as the canvas to clone onto (8-bit images without a float copy), and the
+/// format the output is written in.
+fn load_target(path: &Path) -> anyhow::Result<(Canvas, PixelFormat)> {
+    let decoded = FloatImage::decode(path)?;
+    let format = PixelFormat::of(&decoded);
+    let canvas = match Canvas::from_eight_bit(&decoded) {
+        Some(canvas) => canvas,
+        None => Canvas::from_image(&FloatImage::from_dynamic(&decoded)?),
+    };
+    Ok((canvas, format))
 }
 
 fn millis_since(start: Instant) -> f64 {

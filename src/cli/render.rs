@@ -12,7 +12,9 @@ use anyhow::Context;
 use clap::ValueEnum;
 use indicatif::{ProgressBar, ProgressStyle};
 use lapclone::output::{
-    ApngWriter, Frame, FrameData, FrameRef, GifWriter, Pixels, PngCompression, PngSequenceWriter,
+    foreign_frames, frame_digits, frame_file_name, ApngWriter, FfmpegWriter, Frame, FrameData,
+    FrameRef, GifWriter, OutputKind, Pixels, PngCompression, PngSequenceWriter, VideoKind,
+    VideoOptions, Y4mWriter,
 };
 use lapclone::pixels::{Canvas, CanvasPixels, Depth};
 use lapclone::render::{RenderError, Renderer};
@@ -22,9 +24,49 @@ use crate::cli::UsageError;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum OutputFormat {
+    /// A folder of frame_NNNN.png.
     Png,
     Gif,
     Apng,
+    /// H.264 (through ffmpeg).
+    Mp4,
+    /// VP9 (through ffmpeg).
+    Webm,
+    /// H.264, or ProRes 4444 with alpha for a transparent canvas (through ffmpeg).
+    Mov,
+    /// YUV4MPEG2, 4:4:4 (written without ffmpeg; `-o -` for standard output).
+    Y4m,
+}
+
+impl OutputFormat {
+    fn kind(self) -> OutputKind {
+        match self {
+            OutputFormat::Png => OutputKind::PngFolder,
+            OutputFormat::Gif => OutputKind::Gif,
+            OutputFormat::Apng => OutputKind::Apng,
+            OutputFormat::Mp4 => OutputKind::Mp4,
+            OutputFormat::Webm => OutputKind::Webm,
+            OutputFormat::Mov => OutputKind::Mov,
+            OutputFormat::Y4m => OutputKind::Y4m,
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum CompressionArg {
+    #[default]
+    Fast,
+    Default,
+    Best,
+}
+
+/// Output settings beyond the format and path.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct SinkSettings {
+    /// Remove frame files of another render from a PNG folder instead of refusing.
+    pub force: bool,
+    pub png_compression: PngCompression,
+    pub crf: Option<u32>,
 }
 
 /// An inclusive frame range `A..B` (frame numbers as in the file names, from 1).
@@ -54,17 +96,58 @@ pub fn frame_range(text: &str) -> Result<FrameRange, String> {
 pub struct RenderArgs {
     /// Scene file (.rhai).
     pub scene: PathBuf,
-    /// Output folder for frame_NNNN.png, or the output file for --format gif|apng.
-    #[arg(short = 'o', long = "output", default_value = "frames")]
+    /// Output: a folder for frame_NNNN.png (a name without an extension, or ending in .png),
+    /// or a file whose extension names the format (.gif, .apng, .mp4, .webm, .mov, .y4m);
+    /// `-` writes Y4M to standard output.
+    #[arg(
+        short = 'o',
+        long = "output",
+        default_value = "frames",
+        allow_hyphen_values = true
+    )]
     pub output: PathBuf,
     /// Inclusive frame numbers to render, e.g. 1..24 (default: all).
     #[arg(long, value_parser = frame_range, allow_hyphen_values = true)]
     pub frames: Option<FrameRange>,
-    #[arg(long, value_enum, default_value = "png")]
-    pub format: OutputFormat,
+    /// Output format (default: the one the output's extension names).
+    #[arg(long, value_enum)]
+    pub format: Option<OutputFormat>,
     /// PNG encoder threads (default: available cores).
     #[arg(long, allow_hyphen_values = true)]
     pub jobs: Option<usize>,
+    /// Remove frame files of an earlier render from the PNG output folder (without it,
+    /// such a folder is refused).
+    #[arg(long)]
+    pub force: bool,
+    /// PNG deflate effort for frame folders: fast (default), default, or best (smaller files).
+    #[arg(long, value_enum, default_value = "fast")]
+    pub png_compression: CompressionArg,
+    /// Constant quality for MP4/WebM/MOV (lower is better; H.264 default 20, VP9 default 32).
+    #[arg(long, visible_alias = "quality", value_parser = clap::value_parser!(u32).range(0..=63))]
+    pub crf: Option<u32>,
+}
+
+/// The output format: `--format`, else the one `-o`'s extension names.
+fn output_kind(args: &RenderArgs) -> anyhow::Result<OutputKind> {
+    let kind = match (args.format, OutputKind::from_path(&args.output)) {
+        // An explicit format wins: the name is then just a name.
+        (Some(format), _) => format.kind(),
+        (None, Ok(named)) => named,
+        (None, Err(extension)) => {
+            return Err(UsageError(format!(
+                "-o {}: unknown output extension `.{extension}` (use .gif, .apng, .mp4, .webm, .mov, .y4m, a folder name without an extension, or --format)",
+                args.output.display()
+            ))
+            .into())
+        }
+    };
+    if args.output.as_os_str() == "-" && kind != OutputKind::Y4m {
+        return Err(UsageError("-o - (standard output) needs --format y4m".into()).into());
+    }
+    if kind.needs_ffmpeg() && lapclone::util::find_program("ffmpeg").is_none() {
+        anyhow::bail!("{}", lapclone::util::FFMPEG_MISSING);
+    }
+    Ok(kind)
 }
 
 #[derive(clap::Args, Debug)]
@@ -91,6 +174,7 @@ pub fn run_render(args: RenderArgs) -> anyhow::Result<()> {
     if args.jobs == Some(0) {
         return Err(UsageError("--jobs must be at least 1".into()).into());
     }
+    let kind = output_kind(&args)?;
     let (loaded, mut renderer) = load_renderer(&args.scene)?;
     let total = renderer.frame_count();
     let range = match args.frames {
@@ -110,13 +194,22 @@ pub fn run_render(args: RenderArgs) -> anyhow::Result<()> {
     let cancel = install_cancel_handler();
     let jobs = args.jobs.unwrap_or_else(default_jobs);
     let started = Instant::now();
-    let mut sink = FrameSink::open(
-        args.format,
+    let settings = SinkSettings {
+        force: args.force,
+        png_compression: match args.png_compression {
+            CompressionArg::Fast => PngCompression::Fast,
+            CompressionArg::Default => PngCompression::Default,
+            CompressionArg::Best => PngCompression::Best,
+        },
+        crf: args.crf,
+    };
+    let mut sink = FrameSink::open_kind(
+        kind,
         &args.output,
         &renderer,
         range,
-        jobs,
-        cancel.clone(),
+        (jobs, cancel.clone()),
+        settings,
     )?;
     let progress = progress_bar(range.last - range.first + 1);
     let mut compute_ms = 0.0;
@@ -125,9 +218,10 @@ pub fn run_render(args: RenderArgs) -> anyhow::Result<()> {
             sink.abandon();
             anyhow::bail!("interrupted: stopped after frame {}", number - 1);
         }
-        renderer
-            .render_frame(number - 1)
-            .map_err(|e| positioned(&loaded, e))?;
+        if let Err(e) = renderer.render_frame(number - 1) {
+            sink.abandon();
+            return Err(positioned(&loaded, e));
+        }
         compute_ms += renderer.last_stats().total_ms;
         if let Err(error) = sink.push(number, renderer.frame()) {
             // The writers see Ctrl-C too: report the interruption, not their refusal.
@@ -135,6 +229,7 @@ pub fn run_render(args: RenderArgs) -> anyhow::Result<()> {
                 sink.abandon();
                 anyhow::bail!("interrupted: stopped after frame {}", number - 1);
             }
+            sink.abandon();
             return Err(error);
         }
         progress.inc(1);
@@ -148,12 +243,20 @@ pub fn run_render(args: RenderArgs) -> anyhow::Result<()> {
     };
     let frames = range.last - range.first + 1;
     let seconds = started.elapsed().as_secs_f64();
-    println!(
-        "rendered {frames} frames to {} in {seconds:.2} s ({:.1} fps; {:.2} ms/frame compute)",
+    let factorisations = renderer.factorisations();
+    let summary = format!(
+        "rendered {frames} frames to {} in {seconds:.2} s ({:.1} fps; {:.2} ms/frame compute; {factorisations} factorisation{})",
         written.display(),
         frames as f64 / seconds,
-        compute_ms / frames as f64
+        compute_ms / frames as f64,
+        if factorisations == 1 { "" } else { "s" }
     );
+    // Standard output may be the video stream itself.
+    if args.output.as_os_str() == "-" {
+        eprintln!("{summary}");
+    } else {
+        println!("{summary}");
+    }
     Ok(())
 }
 
@@ -249,11 +352,14 @@ fn progress_bar(frames: u64) -> ProgressBar {
     bar
 }
 
-/// Where rendered frames go: a PNG folder (encoded in parallel), a GIF or an APNG.
+/// Where rendered frames go: a PNG folder (encoded in parallel), a GIF, an APNG, a Y4M
+/// stream or a video through ffmpeg.
 pub(crate) enum FrameSink {
     Png(PngSequenceWriter, PathBuf),
     Gif(Box<GifWriter>),
     Apng(Box<ApngWriter>),
+    Y4m(Box<Y4mWriter>),
+    Video(Box<FfmpegWriter>),
 }
 
 impl FrameSink {
@@ -265,28 +371,74 @@ impl FrameSink {
         jobs: usize,
         cancel: Arc<AtomicBool>,
     ) -> anyhow::Result<Self> {
+        let settings = SinkSettings::default();
+        Self::open_kind(
+            format.kind(),
+            output,
+            renderer,
+            range,
+            (jobs, cancel),
+            settings,
+        )
+    }
+
+    pub(crate) fn open_kind(
+        kind: OutputKind,
+        output: &Path,
+        renderer: &Renderer,
+        range: FrameRange,
+        (jobs, cancel): (usize, Arc<AtomicBool>),
+        settings: SinkSettings,
+    ) -> anyhow::Result<Self> {
         let canvas = &renderer.scene().canvas;
-        Ok(match format {
-            OutputFormat::Png => {
-                if !output.is_dir() {
-                    super::clone::check_output_folder(output)?;
-                    std::fs::create_dir(output)
-                        .with_context(|| format!("creating {}", output.display()))?;
-                }
-                let writer = PngSequenceWriter::new(
-                    output,
-                    renderer.frame_count(),
-                    jobs,
-                    PngCompression::Fast,
-                    cancel,
-                )?;
+        if kind != OutputKind::PngFolder && output.is_dir() {
+            anyhow::bail!(
+                "{} is a folder; name a file for {kind:?} output",
+                output.display()
+            );
+        }
+        let video = |kind| VideoOptions {
+            kind,
+            width: canvas.width,
+            height: canvas.height,
+            fps: canvas.fps,
+            crf: settings.crf,
+            alpha: !renderer.frame().pixels_opaque(),
+        };
+        Ok(match kind {
+            OutputKind::PngFolder => {
+                let writer = open_png_folder(output, renderer, range, jobs, cancel, settings)?;
                 FrameSink::Png(writer, output.to_path_buf())
             }
-            OutputFormat::Gif => {
+            OutputKind::Gif => {
                 super::clone::check_output_folder(output)?;
                 FrameSink::Gif(Box::new(GifWriter::create(output, canvas.fps)?))
             }
-            OutputFormat::Apng => {
+            OutputKind::Y4m => {
+                let path = (output.as_os_str() != "-").then_some(output);
+                if let Some(path) = path {
+                    super::clone::check_output_folder(path)?;
+                }
+                let writer = Y4mWriter::create(path, canvas.width, canvas.height, canvas.fps)?;
+                FrameSink::Y4m(Box::new(writer))
+            }
+            OutputKind::Mp4 | OutputKind::Webm | OutputKind::Mov => {
+                super::clone::check_output_folder(output)?;
+                let kind = match kind {
+                    OutputKind::Mp4 => VideoKind::Mp4,
+                    OutputKind::Webm => VideoKind::Webm,
+                    _ => VideoKind::Mov,
+                };
+                let writer = FfmpegWriter::create(output, video(kind))?;
+                if let Some((w, h)) = writer.padded() {
+                    eprintln!(
+                        "note: {}×{} has an odd side; the video is padded to {w}×{h} (4:2:0 needs even sides; the edge pixels repeat)",
+                        canvas.width, canvas.height
+                    );
+                }
+                FrameSink::Video(Box::new(writer))
+            }
+            OutputKind::Apng => {
                 super::clone::check_output_folder(output)?;
                 let frames = u32::try_from(range.last - range.first + 1)
                     .context("too many frames for an APNG")?;
@@ -312,6 +464,8 @@ impl FrameSink {
             }
             FrameSink::Gif(writer) => writer.add(&frame_ref(canvas)?)?,
             FrameSink::Apng(writer) => writer.add(&frame_ref(canvas)?)?,
+            FrameSink::Y4m(writer) => writer.add(&frame_ref(canvas)?)?,
+            FrameSink::Video(writer) => writer.add(&frame_ref(canvas)?)?,
         }
         Ok(())
     }
@@ -324,6 +478,8 @@ impl FrameSink {
             }
             FrameSink::Gif(writer) => writer.finish()?,
             FrameSink::Apng(writer) => writer.finish()?,
+            FrameSink::Y4m(writer) => writer.finish()?,
+            FrameSink::Video(writer) => writer.finish()?,
         })
     }
 
@@ -333,6 +489,48 @@ impl FrameSink {
             let _ = writer.finish();
         }
     }
+}
+
+/// The PNG frame folder, created if missing; frame files of another render in it are
+/// refused, or removed with `--force`, so the folder never holds a mixed set.
+fn open_png_folder(
+    output: &Path,
+    renderer: &Renderer,
+    range: FrameRange,
+    jobs: usize,
+    cancel: Arc<AtomicBool>,
+    settings: SinkSettings,
+) -> anyhow::Result<PngSequenceWriter> {
+    if !output.is_dir() {
+        super::clone::check_output_folder(output)?;
+        std::fs::create_dir(output).with_context(|| format!("creating {}", output.display()))?;
+    }
+    let digits = frame_digits(renderer.frame_count());
+    let ours: std::collections::HashSet<String> = (range.first..=range.last)
+        .map(|n| frame_file_name(n, digits))
+        .collect();
+    let foreign = foreign_frames(output, |name| ours.contains(name))
+        .with_context(|| format!("reading {}", output.display()))?;
+    if let Some(first) = foreign.first() {
+        if !settings.force {
+            anyhow::bail!(
+                "{} holds {} frame files of another render (e.g. {}); use --force to remove them, or another folder",
+                output.display(),
+                foreign.len(),
+                first.file_name().unwrap_or_default().to_string_lossy()
+            );
+        }
+        for path in &foreign {
+            std::fs::remove_file(path).with_context(|| format!("removing {}", path.display()))?;
+        }
+    }
+    Ok(PngSequenceWriter::new(
+        output,
+        renderer.frame_count(),
+        jobs,
+        settings.png_compression,
+        cancel,
+    )?)
 }
 
 fn frame_ref(canvas: &Canvas) -> anyhow::Result<FrameRef<'_>> {

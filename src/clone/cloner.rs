@@ -87,6 +87,7 @@ pub struct CloneStats {
 /// Everything kept between clones of one patch. See the module doc.
 pub struct PatchCloner {
     source: FloatImage,
+    mode: CloneMode,
     mesh: Mesh,
     membrane: MembraneSolver,
     raster_options: RasterOptions,
@@ -116,6 +117,7 @@ impl PatchCloner {
         let glue = Glue::new(&mesh, membrane.boundary_vertices(), options.boundary_data);
         Ok(Self {
             source,
+            mode: options.mode,
             mesh,
             membrane,
             raster_options: RasterOptions {
@@ -135,6 +137,23 @@ impl PatchCloner {
 
     pub fn mesh(&self) -> &Mesh {
         &self.mesh
+    }
+
+    /// Replaces the source (the next frame of an animated source; the mesh, and so the
+    /// factor, stay): resamples it along the rest boundary.
+    pub fn set_source(&mut self, source: FloatImage) {
+        let source = match self.mode {
+            CloneMode::Normal => source,
+            CloneMode::Monochrome => source.to_grey(),
+        };
+        self.membrane.resample_source(&self.mesh, &source);
+        self.source = source;
+    }
+
+    /// Factorisations of the cloning Laplacian so far: the first, plus any rebuild a
+    /// guard of the rank-1 updates made.
+    pub fn factorisations(&self) -> usize {
+        self.membrane.factorisations()
     }
 
     pub fn source(&self) -> &FloatImage {

@@ -4,8 +4,8 @@
 //!
 //! Boundary vertices outside the canvas, or hidden under the patch's own front layer, are
 //! switched off (rank-1 downdates of the kept factor) rather than clamped, and switched back
-//! on when they return. Source colours at the rest boundary never change, so they are sampled
-//! once per mesh; per frame only the canvas is sampled.
+//! on when they return. Source colours at the rest boundary are sampled once per mesh (again
+//! only when an animated source moves to its next frame); per frame only the canvas is sampled.
 
 use glam::DVec2;
 
@@ -81,6 +81,20 @@ impl MembraneSolver {
             values: vec![0.0; n * MEMBRANE_CHANNELS],
             membrane: vec![[0.0; 3]; n],
         })
+    }
+
+    /// Samples a new source along the rest boundary (an animated source's next frame).
+    pub fn resample_source(&mut self, mesh: &Mesh, source: &FloatImage) {
+        self.sampler.sample(
+            &mesh.positions,
+            |p| rgb(source.sample_bilinear(p.x, p.y)),
+            &mut self.source_at_boundary,
+        );
+    }
+
+    /// Factorisations so far: the one at construction plus the guards' rebuilds.
+    pub fn factorisations(&self) -> usize {
+        1 + self.factor.refactor_count()
     }
 
     /// Solves the membrane for a patch whose vertices sit at `placed` on `canvas`.

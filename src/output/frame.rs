@@ -77,12 +77,38 @@ impl<'a> FrameRef<'a> {
         }
     }
 
+    /// Whether every pixel's alpha is full.
+    pub fn is_opaque(&self) -> bool {
+        match self.pixels {
+            // Folded without an early exit, so it vectorises.
+            Pixels::Rgba8(p) => p.chunks_exact(4).fold(u8::MAX, |a, px| a & px[3]) == u8::MAX,
+            Pixels::Rgba16(p) => p.chunks_exact(4).all(|px| px[3] == u16::MAX),
+        }
+    }
+
     /// Writes the samples as PNG wants them: bytes, 16-bit ones big-endian.
     pub fn write_png_bytes(&self, out: &mut Vec<u8>) {
+        self.write_png_samples(out, false);
+    }
+
+    /// [`write_png_bytes`](Self::write_png_bytes), RGB without the alpha samples if
+    /// `drop_alpha`.
+    pub fn write_png_samples(&self, out: &mut Vec<u8>, drop_alpha: bool) {
         out.clear();
+        let channels = if drop_alpha { 3 } else { 4 };
         match self.pixels {
-            Pixels::Rgba8(p) => out.extend_from_slice(p),
-            Pixels::Rgba16(p) => out.extend(p.iter().flat_map(|v| v.to_be_bytes())),
+            Pixels::Rgba8(p) if !drop_alpha => out.extend_from_slice(p),
+            Pixels::Rgba8(p) => {
+                out.resize(p.len() / 4 * 3, 0);
+                for (rgb, px) in out.chunks_exact_mut(3).zip(p.chunks_exact(4)) {
+                    rgb.copy_from_slice(&px[..3]);
+                }
+            }
+            Pixels::Rgba16(p) => {
+                for px in p.chunks_exact(4) {
+                    out.extend(px[..channels].iter().flat_map(|v| v.to_be_bytes()));
+                }
+            }
         }
     }
 }

@@ -1,23 +1,33 @@
 //! Frame writers: take rendered frames ([`FrameRef`], RGBA 8 or 16 bits) and give a PNG
-//! sequence (`DIR/frame_0001.png …`, encoded in parallel), an animated GIF or an animated
-//! PNG. Every file appears whole or not at all (temporary file + rename).
+//! sequence (`DIR/frame_0001.png …`, encoded in parallel), an animated GIF, an animated
+//! PNG, a YUV4MPEG2 stream, or an MP4/WebM/MOV through an ffmpeg process; plus the format an
+//! output path names ([`OutputKind::from_path`]). Every file appears whole or not at all
+//! (temporary file + rename).
 
 mod apng;
 mod atomic;
 mod encode;
+mod ffmpeg;
+mod format;
 mod frame;
 mod gif;
 mod gif_frame;
 mod gif_palette;
 mod png_sequence;
+mod y4m;
 
 pub use apng::{apng_delays, ApngWriter};
 pub use atomic::TempOutput;
 pub use encode::{encode_png, PngCompression};
+pub use ffmpeg::{FfmpegWriter, VideoKind, VideoOptions};
+pub use format::OutputKind;
 pub use frame::{Frame, FrameData, FrameRef, Pixels};
 pub use gif::{gif_delays_cs, GifOptions, GifWriter, PALETTE_FRAMES};
 pub use gif_palette::{Palette, PaletteMap};
-pub use png_sequence::{frame_digits, frame_file_name, write_png_file, PngSequenceWriter};
+pub use png_sequence::{
+    foreign_frames, frame_digits, frame_file_name, write_png_file, PngSequenceWriter,
+};
+pub use y4m::{fps_fraction, rgb_to_ycbcr, Y4mWriter};
 
 use std::path::{Path, PathBuf};
 
@@ -48,6 +58,10 @@ pub enum OutputError {
     NotAFolder(PathBuf),
     #[error("{0}")]
     Worker(String),
+    #[error("{}", crate::util::FFMPEG_MISSING)]
+    NoFfmpeg,
+    #[error("ffmpeg failed writing {}; it said:\n  {stderr}", path.display())]
+    Ffmpeg { path: PathBuf, stderr: String },
     #[error("cancelled")]
     Cancelled,
 }

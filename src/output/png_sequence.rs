@@ -26,6 +26,25 @@ pub fn frame_digits(last: u64) -> usize {
     last.to_string().len().max(4)
 }
 
+/// Files in `dir` named like frames (`frame_` + digits + `.png`) for which `ours` is false:
+/// the frames of another render, which a new render would leave beside its own.
+pub fn foreign_frames(dir: &Path, ours: impl Fn(&str) -> bool) -> std::io::Result<Vec<PathBuf>> {
+    let mut found = Vec::new();
+    for entry in std::fs::read_dir(dir)? {
+        let entry = entry?;
+        let name = entry.file_name().to_string_lossy().into_owned();
+        let is_frame = name
+            .strip_prefix("frame_")
+            .and_then(|rest| rest.strip_suffix(".png"))
+            .is_some_and(|n| !n.is_empty() && n.bytes().all(|b| b.is_ascii_digit()));
+        if is_frame && !ours(&name) {
+            found.push(entry.path());
+        }
+    }
+    found.sort();
+    Ok(found)
+}
+
 /// Writes one frame file atomically (also usable without the worker pool).
 pub fn write_png_file(
     path: &Path,

@@ -83,6 +83,40 @@ impl Canvas {
         })
     }
 
+    /// An 8-bit canvas holding `pixels` (straight RGBA, row-major).
+    pub fn from_rgba8(width: u32, height: u32, pixels: Vec<[u8; 4]>) -> Result<Canvas, PixelError> {
+        if width == 0 || height == 0 {
+            return Err(PixelError::EmptyImage { width, height });
+        }
+        if pixels.len() != width as usize * height as usize {
+            return Err(PixelError::BufferSize {
+                width,
+                height,
+                actual: pixels.len(),
+            });
+        }
+        Ok(Canvas {
+            width,
+            height,
+            pixels: CanvasPixels::Eight(pixels),
+        })
+    }
+
+    /// A decoded 8-bit image (grey, grey+alpha, RGB, RGBA) as a canvas, straight from its
+    /// bytes: the same canvas as [`from_image`](Self::from_image) of its [`FloatImage`],
+    /// without the float copy. `None` for other formats.
+    pub fn from_eight_bit(decoded: &image::DynamicImage) -> Option<Canvas> {
+        use image::DynamicImage as D;
+        let pixels: Vec<[u8; 4]> = match decoded {
+            D::ImageRgb8(img) => img.pixels().map(|p| [p[0], p[1], p[2], 255]).collect(),
+            D::ImageRgba8(img) => img.pixels().map(|p| p.0).collect(),
+            D::ImageLuma8(img) => img.pixels().map(|p| [p[0], p[0], p[0], 255]).collect(),
+            D::ImageLumaA8(img) => img.pixels().map(|p| [p[0], p[0], p[0], p[1]]).collect(),
+            _ => return None,
+        };
+        Canvas::from_rgba8(decoded.width(), decoded.height(), pixels).ok()
+    }
+
     /// The image quantised to its own bit depth.
     pub fn from_image(image: &FloatImage) -> Canvas {
         let pixels = match image.format().depth {
@@ -113,6 +147,14 @@ impl Canvas {
 
     pub fn pixels(&self) -> &CanvasPixels {
         &self.pixels
+    }
+
+    /// Whether every pixel's alpha is full.
+    pub fn pixels_opaque(&self) -> bool {
+        match &self.pixels {
+            CanvasPixels::Eight(p) => p.iter().all(|px| px[3] == u8::MAX),
+            CanvasPixels::Sixteen(p) => p.iter().all(|px| px[3] == u16::MAX),
+        }
     }
 
     pub fn pixels_mut(&mut self) -> &mut CanvasPixels {

@@ -48,6 +48,8 @@ pub enum PixelError {
         other_height: u32,
         other_depth: super::Depth,
     },
+    #[error(transparent)]
+    Footage(#[from] Box<super::FootageError>),
     #[error("pixel buffer of {actual} pixels does not match {width}×{height}")]
     BufferSize {
         width: u32,

@@ -122,9 +122,22 @@ impl FloatImage {
     /// Reads and decodes an image file (format guessed from its content); images over the
     /// size limits of [`crate::limits`] are refused from their header, before decoding.
     pub fn load(path: &Path) -> Result<FloatImage, PixelError> {
+        let decoded = Self::decode(path)?;
+        FloatImage::from_dynamic(&decoded).map_err(|err| match err {
+            PixelError::EmptyImage { width, height } => PixelError::Empty {
+                path: path.to_path_buf(),
+                width,
+                height,
+            },
+            other => other,
+        })
+    }
+
+    /// Reads and decodes an image file as [`load`](Self::load) does, without converting it.
+    pub fn decode(path: &Path) -> Result<image::DynamicImage, PixelError> {
         use crate::limits::{open_image, ImageOpenError};
         let path_buf = || path.to_path_buf();
-        let decoded = open_image(path).map_err(|error| match error {
+        open_image(path).map_err(|error| match error {
             ImageOpenError::Read(source) => PixelError::Read {
                 path: path_buf(),
                 source,
@@ -137,14 +150,6 @@ impl FloatImage {
                 path: path_buf(),
                 source,
             },
-        })?;
-        FloatImage::from_dynamic(&decoded).map_err(|err| match err {
-            PixelError::EmptyImage { width, height } => PixelError::Empty {
-                path: path.to_path_buf(),
-                width,
-                height,
-            },
-            other => other,
         })
     }
 

@@ -1,7 +1,8 @@
 //! Pixels shared by all stages: takes image files or `image::DynamicImage`s in and gives
 //! [`FloatImage`]s (straight RGBA `f32` in [0, 1], for sources and targets as loaded) and
 //! [`Canvas`]es (the frame being composited, in the target's output bit depth), plus PNG
-//! output in the target's original [`PixelFormat`].
+//! output in the target's original [`PixelFormat`], and [`footage`]: numbered image sequences
+//! and videos read one frame at a time.
 //!
 //! Coordinates follow the mesh convention: x right, y down, pixel (i, j) covers
 //! [i, i+1] × [j, j+1] and its centre is (i + 0.5, j + 0.5); bilinear sampling is exact at
@@ -15,6 +16,7 @@ mod bilinear;
 mod canvas;
 mod error;
 mod float_image;
+pub mod footage;
 mod format;
 mod png_encode;
 mod rect;
@@ -24,5 +26,6 @@ pub(crate) use canvas::composite_over_straight as canvas_composite_over;
 pub use canvas::{Canvas, CanvasPixels, Texel};
 pub use error::PixelError;
 pub use float_image::FloatImage;
+pub use footage::{Footage, FootageError, FootageReader, FootageSource};
 pub use format::{ColorKind, Depth, PixelFormat};
 pub use rect::PixelRect;

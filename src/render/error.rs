@@ -30,6 +30,13 @@ pub enum RenderError {
     },
     #[error(transparent)]
     Pixels(#[from] PixelError),
+    #[error("{}{source}", patch.as_ref().map(|p| format!("patch `{p}`: source footage: ")).unwrap_or_else(|| "background footage: ".into()))]
+    Footage {
+        /// The patch whose source this is; `None` for the background.
+        patch: Option<String>,
+        #[source]
+        source: Box<crate::pixels::FootageError>,
+    },
     #[error("scene is not valid: {0}")]
     Scene(#[from] crate::scene::ModelError),
 }
@@ -41,6 +48,7 @@ impl RenderError {
             RenderError::Clone { patch, .. }
             | RenderError::Deform { patch, .. }
             | RenderError::Mask { patch, .. } => Some(patch),
+            RenderError::Footage { patch, .. } => patch.as_deref(),
             RenderError::Pixels(_) | RenderError::Scene(_) => None,
         }
     }

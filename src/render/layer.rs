@@ -10,7 +10,7 @@ use crate::clone::{
 };
 use crate::deform::{DeformRig, DeformStats, Deformed, Handle, Pin};
 use crate::mesh::{BitMask, Mesh, MeshOptions};
-use crate::pixels::{Canvas, FloatImage};
+use crate::pixels::{Canvas, FloatImage, Footage, FootageReader};
 use crate::scene::{
     BoundaryData, BoundaryPlacement, CloneMode, LaplacianKind, Patch, PatchState, Shape,
 };
@@ -23,6 +23,7 @@ const MASK_THRESHOLD: f32 = 0.5;
 #[derive(Clone, Debug, PartialEq)]
 pub(super) struct LayerSettings {
     source: std::path::PathBuf,
+    footage: Option<Footage>,
     shape: Shape,
     density: Option<f64>,
     laplacian: LaplacianKind,
@@ -36,6 +37,7 @@ impl LayerSettings {
     pub fn of(patch: &Patch) -> Self {
         LayerSettings {
             source: patch.source.clone(),
+            footage: patch.footage.clone(),
             shape: patch.shape.clone(),
             density: patch.density,
             laplacian: patch.laplacian,
@@ -66,10 +68,14 @@ pub(super) struct Layer {
     deformed: Deformed,
     handles: Vec<Handle>,
     pins: Vec<Pin>,
+    /// An animated source's frames, and the frame index the cloner holds.
+    footage: Option<(FootageReader, u64)>,
 }
 
 impl Layer {
-    pub fn new(patch: &Patch, source: FloatImage) -> Result<Self, RenderError> {
+    /// `source` is the patch's source image (an animated source's first frame); `fps` the
+    /// scene's, which picks an animated source's frames.
+    pub fn new(patch: &Patch, source: FloatImage, fps: f64) -> Result<Self, RenderError> {
         let clone_error = |source| RenderError::Clone {
             patch: patch.name.clone(),
             source,
@@ -107,7 +113,33 @@ impl Layer {
             deformed: Deformed::default(),
             handles: Vec::new(),
             pins: Vec::new(),
+            footage: patch
+                .footage
+                .clone()
+                .map(|f| (FootageReader::new(f, fps), 0)),
         })
+    }
+
+    /// Moves an animated source to scene frame `index` (nothing for a still source).
+    pub fn seek_source(&mut self, index: u64) -> Result<(), RenderError> {
+        let Some((reader, held)) = self.footage.as_mut() else {
+            return Ok(());
+        };
+        if *held == index {
+            return Ok(());
+        }
+        let image = reader.frame(index).map_err(|e| RenderError::Footage {
+            patch: Some(self.name.clone()),
+            source: Box::new(e),
+        })?;
+        self.cloner.set_source(image.clone());
+        *held = index;
+        Ok(())
+    }
+
+    /// Factorisations of this layer's cloning Laplacian so far.
+    pub fn factorisations(&self) -> usize {
+        self.cloner.factorisations()
     }
 
     /// The canvas-independent part of cloning this patch, in its state at this frame:

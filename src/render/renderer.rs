@@ -11,8 +11,7 @@ use super::layer::{Layer, LayerSettings};
 use super::opacity::blend_over_below;
 use super::RenderError;
 use crate::mesh::Mesh;
-use crate::pixels::PixelRect;
-use crate::pixels::{Canvas, Depth, FloatImage, PixelFormat};
+use crate::pixels::{Canvas, Depth, FloatImage, FootageReader, PixelFormat, PixelRect};
 use crate::scene::{frame_time, Background, FrameState, Patch, Scene};
 use crate::util::lock;
 
@@ -75,19 +74,26 @@ pub struct Renderer {
     dirty_valid: bool,
     /// The frame before a translucent layer was drawn (allocated by the first one).
     below: Option<Canvas>,
+    /// Background footage, and the scene frame whose plate `background` holds.
+    plates: Option<(FootageReader, u64)>,
 }
 
 impl Renderer {
-    /// Loads images and meshes every patch; the cloning factors are built by the first frame
-    /// (see `PatchCloner::new`).
+    /// Loads images, meshes every patch and factors its Laplacian (see `PatchCloner::new`).
     pub fn new(scene: Scene) -> Result<Self, RenderError> {
         scene.sanity_check()?;
-        let background = background_canvas(&scene)?;
-        let mut sources: HashMap<PathBuf, FloatImage> = HashMap::new();
-        let mut layers = Vec::with_capacity(scene.patches.len());
-        for patch in &scene.patches {
-            layers.push(Layer::new(patch, source_image(&mut sources, patch)?)?);
-        }
+        check_footage(&scene)?;
+        // The background decodes on a thread of its own while the layers load and mesh.
+        let (background, layers) = std::thread::scope(|scope| {
+            let background = scope.spawn(|| background_canvas(&scene));
+            let layers = build_layers(&scene);
+            let background = background
+                .join()
+                .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+            (background, layers)
+        });
+        let (background, plates) = background?;
+        let layers = layers?;
         let frame = background.clone();
         Ok(Self {
             scene,
@@ -99,6 +105,7 @@ impl Renderer {
             dirty: Vec::new(),
             dirty_valid: true,
             below: None,
+            plates,
         })
     }
 
@@ -113,6 +120,7 @@ impl Renderer {
     /// On error the renderer is unchanged.
     pub fn set_scene(&mut self, scene: Scene) -> Result<SceneUpdate, RenderError> {
         scene.sanity_check()?;
+        check_footage(&scene)?;
         let mut update = SceneUpdate::default();
         let canvas_changed = scene.canvas.background != self.scene.canvas.background
             || (scene.canvas.width, scene.canvas.height)
@@ -145,9 +153,10 @@ impl Renderer {
             self.layers.push(layer);
         }
         update.dropped = old.iter().filter(|l| l.is_some()).count();
-        if let Some(background) = background {
+        if let Some((background, plates)) = background {
             self.frame = background.clone();
             self.background = background;
+            self.plates = plates;
             self.dirty.clear();
             self.dirty_valid = true;
         }
@@ -173,7 +182,8 @@ impl Renderer {
                 }
                 None => {
                     let source = source_image(&mut sources, patch)?;
-                    Planned::Build(Box::new(Layer::new(patch, source)?))
+                    let fps = self.scene.canvas.fps;
+                    Planned::Build(Box::new(Layer::new(patch, source, fps)?))
                 }
             });
         }
@@ -227,13 +237,25 @@ impl Renderer {
 
     /// Frame `index` (from 0) at t = index / fps.
     pub fn render_frame(&mut self, index: u64) -> Result<&Canvas, RenderError> {
-        self.render_time(frame_time(index, self.scene.canvas.fps))
+        self.render_at(frame_time(index, self.scene.canvas.fps), index)
     }
 
-    /// The frame at time `t` seconds.
+    /// The frame at time `t` seconds (footage shows its frame ⌊t · fps⌋).
     pub fn render_time(&mut self, t: f64) -> Result<&Canvas, RenderError> {
+        let index = (t * self.scene.canvas.fps + 1e-9).floor().max(0.0) as u64;
+        self.render_at(t, index)
+    }
+
+    /// Factorisations of the patches' cloning Laplacians so far (one per patch once each
+    /// has drawn, whatever the frame count, unless a guard had to rebuild one).
+    pub fn factorisations(&self) -> usize {
+        self.layers.iter().map(Layer::factorisations).sum()
+    }
+
+    fn render_at(&mut self, t: f64, index: u64) -> Result<&Canvas, RenderError> {
         let started = Instant::now();
         self.scene.evaluate_into(t, &mut self.state);
+        self.seek_footage(index)?;
         self.restore_background()?;
         let mut stats = FrameStats {
             time: t,
@@ -320,6 +342,24 @@ impl Renderer {
         Ok(switches)
     }
 
+    /// Puts footage at scene frame `index`: the background's plate and animated sources.
+    fn seek_footage(&mut self, index: u64) -> Result<(), RenderError> {
+        if let Some((reader, held)) = self.plates.as_mut().filter(|(_, held)| *held != index) {
+            let plate = reader.frame(index).map_err(|e| RenderError::Footage {
+                patch: None,
+                source: Box::new(e),
+            })?;
+            let (width, height) = (self.scene.canvas.width, self.scene.canvas.height);
+            self.background = canvas_over(plate, width, height)?;
+            *held = index;
+            self.dirty_valid = false;
+        }
+        for &layer in &self.state.draw_order {
+            self.layers[layer].seek_source(index)?;
+        }
+        Ok(())
+    }
+
     /// Resets the frame to the background: only the rectangles the last frame drew into when
     /// they are known (a frame is mostly background), else the whole canvas.
     fn restore_background(&mut self) -> Result<(), RenderError> {
@@ -367,11 +407,29 @@ enum Planned {
     Build(Box<Layer>),
 }
 
-/// The patch's source image, loaded once per path.
+fn build_layers(scene: &Scene) -> Result<Vec<Layer>, RenderError> {
+    let mut sources: HashMap<PathBuf, FloatImage> = HashMap::new();
+    let mut layers = Vec::with_capacity(scene.patches.len());
+    for patch in &scene.patches {
+        let source = source_image(&mut sources, patch)?;
+        layers.push(Layer::new(patch, source, scene.canvas.fps)?);
+    }
+    Ok(layers)
+}
+
+/// The patch's source image, loaded once per path (an animated source's first frame).
 fn source_image(
     sources: &mut HashMap<PathBuf, FloatImage>,
     patch: &Patch,
 ) -> Result<FloatImage, RenderError> {
+    if let Some(footage) = &patch.footage {
+        let mut reader = FootageReader::new(footage.clone(), 1.0);
+        let image = reader.frame(0).map_err(|e| RenderError::Footage {
+            patch: Some(patch.name.clone()),
+            source: Box::new(e),
+        })?;
+        return Ok(image.clone());
+    }
     if let Some(image) = sources.get(&patch.source) {
         return Ok(image.clone());
     }
@@ -380,27 +438,87 @@ fn source_image(
     Ok(image)
 }
 
-/// The canvas every frame starts from: the background image at the origin over opaque
-/// black (16-bit when the image is), or a plain colour.
-fn background_canvas(scene: &Scene) -> Result<Canvas, RenderError> {
+/// Refuses, before anything is drawn, footage that runs out before the scene does (unless
+/// it holds its last frame).
+fn check_footage(scene: &Scene) -> Result<(), RenderError> {
+    let (frames, fps) = (scene.canvas.frame_count(), scene.canvas.fps);
+    if let Background::Footage(footage) = &scene.canvas.background {
+        footage
+            .check_covers(frames, fps)
+            .map_err(|e| RenderError::Footage {
+                patch: None,
+                source: Box::new(e),
+            })?;
+    }
+    for patch in &scene.patches {
+        if let Some(footage) = &patch.footage {
+            footage
+                .check_covers(frames, fps)
+                .map_err(|e| RenderError::Footage {
+                    patch: Some(patch.name.clone()),
+                    source: Box::new(e),
+                })?;
+        }
+    }
+    Ok(())
+}
+
+/// The canvas every frame starts from: the background image (or footage's first plate, with
+/// its reader) at the origin over opaque black (16-bit when the image is), or a plain colour.
+fn background_canvas(scene: &Scene) -> Result<(Canvas, Option<(FootageReader, u64)>), RenderError> {
     let (width, height) = (scene.canvas.width, scene.canvas.height);
     match &scene.canvas.background {
         Background::Colour(rgba) => {
             let image = FloatImage::from_fn(width, height, PixelFormat::RGBA8, |_, _| *rgba)?;
-            Ok(Canvas::from_image(&image))
+            Ok((Canvas::from_image(&image), None))
         }
         Background::Image(path) => {
-            let picture = FloatImage::load(path)?;
-            let format = PixelFormat {
-                alpha: true,
-                ..picture.format()
-            };
-            let image = FloatImage::from_fn(width, height, format, |x, y| {
-                picture.pixel(x, y).unwrap_or([0.0, 0.0, 0.0, 1.0])
+            let decoded = FloatImage::decode(path)?;
+            if let Some(canvas) = eight_bit_canvas(&decoded, width, height)? {
+                return Ok((canvas, None));
+            }
+            let picture = FloatImage::from_dynamic(&decoded)?;
+            Ok((canvas_over(&picture, width, height)?, None))
+        }
+        Background::Footage(footage) => {
+            let mut reader = FootageReader::new(footage.clone(), scene.canvas.fps);
+            let plate = reader.frame(0).map_err(|e| RenderError::Footage {
+                patch: None,
+                source: Box::new(e),
             })?;
-            Ok(Canvas::from_image(&image))
+            let canvas = canvas_over(plate, width, height)?;
+            Ok((canvas, Some((reader, 0))))
         }
     }
+}
+
+/// A decoded 8-bit image of the canvas's size as the canvas, straight from its bytes (no
+/// float copy; the same bytes as the float path); `None` for other depths and sizes.
+fn eight_bit_canvas(
+    decoded: &image::DynamicImage,
+    width: u32,
+    height: u32,
+) -> Result<Option<Canvas>, RenderError> {
+    if (decoded.width(), decoded.height()) != (width, height) {
+        return Ok(None);
+    }
+    Ok(Canvas::from_eight_bit(decoded))
+}
+
+/// `picture` at the origin of a `width`×`height` canvas, opaque black where it does not
+/// reach, in the picture's bit depth.
+fn canvas_over(picture: &FloatImage, width: u32, height: u32) -> Result<Canvas, RenderError> {
+    if (picture.width(), picture.height()) == (width, height) {
+        return Ok(Canvas::from_image(picture));
+    }
+    let format = PixelFormat {
+        alpha: true,
+        ..picture.format()
+    };
+    let image = FloatImage::from_fn(width, height, format, |x, y| {
+        picture.pixel(x, y).unwrap_or([0.0, 0.0, 0.0, 1.0])
+    })?;
+    Ok(Canvas::from_image(&image))
 }
 
 fn millis(duration: std::time::Duration) -> f64 {

@@ -13,6 +13,7 @@ pub use evaluate::{frame_time, FrameState, HandleState, PatchState};
 pub use to_rhai::rhai_string_literal;
 pub use track::{Easing, Interpolate, Key, KeyError, Track};
 pub use types::{
-    check_polygons, Background, BoundaryData, BoundaryPlacement, Canvas, CloneMode, Handle,
-    LaplacianKind, ModelError, Patch, Pin, Placement, Polygon, Scene, Shape, MAX_CANVAS_SIDE,
+    check_polygons, Background, BoundaryData, BoundaryPlacement, Canvas, CloneMode, Footage,
+    FootageSource, Handle, LaplacianKind, ModelError, Patch, Pin, Placement, Polygon, Scene, Shape,
+    MAX_CANVAS_SIDE,
 };

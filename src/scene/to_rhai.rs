@@ -10,7 +10,9 @@ use std::path::{Component, Path, PathBuf};
 use glam::DVec2;
 
 use super::track::{Interpolate, Track};
-use super::types::{Background, Canvas, Handle, Patch, Pin, Polygon, Scene, Shape};
+use super::types::{
+    Background, Canvas, Footage, FootageSource, Handle, Patch, Pin, Polygon, Scene, Shape,
+};
 
 impl Scene {
     /// Rhai source that re-creates this scene (paths written as stored, i.e. resolved).
@@ -208,6 +210,7 @@ fn write_canvas(out: &mut String, canvas: &Canvas, paths: &Paths) {
             num_f32(c[2]),
             num_f32(c[3])
         ),
+        Background::Footage(footage) => footage_options(footage, "background", paths),
     };
     // invariant: writing to a String cannot fail.
     writeln!(
@@ -222,8 +225,30 @@ fn write_canvas(out: &mut String, canvas: &Canvas, paths: &Paths) {
     .expect("write to String"); // invariant: writing to a String cannot fail
 }
 
+/// `KEY: "pattern or video", KEY_start: N, KEY_hold: b`, with `background: ` left out of the
+/// background's own text (the caller writes the key).
+fn footage_options(footage: &Footage, key: &str, paths: &Paths) -> String {
+    let mut text = match &footage.source {
+        FootageSource::Sequence { pattern, start } => format!(
+            "{}, {key}_start: {start}",
+            rhai_string_literal(pattern.text())
+        ),
+        FootageSource::Video(path) => paths.literal(path),
+    };
+    if footage.hold {
+        text.push_str(&format!(", {key}_hold: true"));
+    }
+    if key == "source" {
+        text.insert_str(0, "source: ");
+    }
+    text
+}
+
 fn write_patch(out: &mut String, patch: &Patch, var: &str, paths: &Paths) {
-    let mut options = vec![format!("source: {}", paths.literal(&patch.source))];
+    let mut options = vec![match &patch.footage {
+        Some(footage) => footage_options(footage, "source", paths),
+        None => format!("source: {}", paths.literal(&patch.source)),
+    }];
     match &patch.shape {
         Shape::Mask(path) => options.push(format!("mask: {}", paths.literal(path))),
         Shape::Polygons(polygons) => {

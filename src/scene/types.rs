@@ -40,7 +40,12 @@ pub enum Background {
     Image(PathBuf),
     /// Straight (not premultiplied) RGBA, each channel in [0, 1].
     Colour([f32; 4]),
+    /// Numbered plates or a video: frame i of the scene is drawn over the footage's frame i,
+    /// at the canvas origin like an image.
+    Footage(Footage),
 }
+
+pub use crate::pixels::{Footage, FootageSource};
 
 /// A polygon with holes in source-pixel coordinates: the mesher's own type.
 pub use crate::mesh::Polygon;
@@ -108,7 +113,10 @@ impl Pin {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Patch {
     pub name: String,
+    /// The source image; for an animated source, its first frame (what the mask fits).
     pub source: PathBuf,
+    /// An animated source: frame i clones the footage's frame i (mask and mesh stay fixed).
+    pub footage: Option<Footage>,
     pub shape: Shape,
     /// Mesh density (mesher's default when `None`).
     pub density: Option<f64>,
@@ -131,6 +139,7 @@ impl Patch {
         Patch {
             name: name.into(),
             source,
+            footage: None,
             shape,
             density: None,
             laplacian: LaplacianKind::default(),

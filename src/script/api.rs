@@ -10,6 +10,7 @@ use glam::DVec2;
 use rhai::{CustomType, Dynamic, Engine, EvalAltResult, Map, NativeCallContext, TypeBuilder};
 
 use super::draft::{Origin, SharedDraft};
+use super::footage_options::{footage_keys, footage_option};
 use super::values::{self, number};
 use crate::scene::{
     Background, Canvas, CloneMode, Easing, Handle, LaplacianKind, Patch, Pin, Polygon, Shape, Track,
@@ -37,6 +38,11 @@ fn existing_file(base_dir: &Path, text: &str, what: &str) -> Result<PathBuf, Str
     let path = base_dir.join(text);
     if path.is_file() {
         Ok(path)
+    } else if path.is_dir() {
+        Err(format!(
+            "{what} `{text}` is a folder, not a file ({})",
+            path.display()
+        ))
     } else {
         Err(format!(
             "{what} file `{text}` not found (looked for {})",
@@ -67,14 +73,19 @@ pub fn register(engine: &mut Engine, draft: &SharedDraft) {
     engine.register_fn(
         "canvas",
         move |ctx: NativeCallContext, w: Dynamic, h: Dynamic| {
-            set_canvas(&ctx, &d, &w, &h, &Map::new())
+            set_canvas(&ctx, &d, Some((&w, &h)), &Map::new())
         },
     );
+    let d = draft.clone();
+    // The size comes from the background footage's plates.
+    engine.register_fn("canvas", move |ctx: NativeCallContext, options: Map| {
+        set_canvas(&ctx, &d, None, &options)
+    });
     let d = draft.clone();
     engine.register_fn(
         "canvas",
         move |ctx: NativeCallContext, w: Dynamic, h: Dynamic, options: Map| {
-            set_canvas(&ctx, &d, &w, &h, &options)
+            set_canvas(&ctx, &d, Some((&w, &h)), &options)
         },
     );
     let d = draft.clone();
@@ -107,12 +118,11 @@ pub fn register(engine: &mut Engine, draft: &SharedDraft) {
 fn set_canvas(
     ctx: &NativeCallContext,
     draft: &SharedDraft,
-    w: &Dynamic,
-    h: &Dynamic,
+    size: Option<(&Dynamic, &Dynamic)>,
     options: &Map,
 ) -> Fallible<()> {
     let mut d = draft.lock();
-    let canvas = parse_canvas(&d.base_dir, w, h, options).map_err(|m| fail(ctx, m))?;
+    let canvas = parse_canvas(&d.base_dir, size, options).map_err(|m| fail(ctx, m))?;
     d.origins.canvas = Some(origin(ctx, &d.base_dir));
     d.canvas = Some(canvas);
     Ok(())
@@ -120,13 +130,18 @@ fn set_canvas(
 
 fn parse_canvas(
     base_dir: &Path,
-    w: &Dynamic,
-    h: &Dynamic,
+    size: Option<(&Dynamic, &Dynamic)>,
     options: &Map,
 ) -> Result<Canvas, String> {
-    values::check_keys(options, &["fps", "duration", "background"], "canvas")?;
-    let width = values::size(w, "canvas width")?;
-    let height = values::size(h, "canvas height")?;
+    let [start_key, hold_key] = footage_keys("background");
+    let keys = [
+        "fps",
+        "duration",
+        "background",
+        start_key.as_str(),
+        hold_key.as_str(),
+    ];
+    values::check_keys(options, &keys, "canvas")?;
     let fps = match options.get("fps") {
         Some(v) => values::positive(v, "fps")?,
         None => 24.0,
@@ -139,10 +154,23 @@ fn parse_canvas(
         None => Background::Colour([0.0, 0.0, 0.0, 1.0]),
         Some(v) => match v.read_lock::<rhai::ImmutableString>() {
             Some(text) if !text.starts_with('#') => {
-                Background::Image(existing_file(base_dir, &text, "background")?)
+                match footage_option(base_dir, &text, options, "background")? {
+                    Some(footage) => Background::Footage(footage),
+                    None => Background::Image(existing_file(base_dir, &text, "background")?),
+                }
             }
             _ => Background::Colour(values::colour(v)?),
         },
+    };
+    let (width, height) = match (size, &background) {
+        (Some((w, h)), _) => (
+            values::size(w, "canvas width")?,
+            values::size(h, "canvas height")?,
+        ),
+        (None, Background::Footage(f)) => (f.width, f.height),
+        (None, _) => {
+            return Err("canvas needs a width and a height unless its background is footage".into())
+        }
     };
     let canvas = Canvas {
         width,
@@ -156,8 +184,10 @@ fn parse_canvas(
     Ok(canvas)
 }
 
-const PATCH_OPTIONS: [&str; 9] = [
+const PATCH_OPTIONS: [&str; 11] = [
     "source",
+    "source_start",
+    "source_hold",
     "mask",
     "polygons",
     "density",
@@ -201,7 +231,11 @@ fn parse_patch(base_dir: &Path, name: &Dynamic, options: &Dynamic) -> Result<Pat
         .get("source")
         .ok_or("patch needs a `source` image")
         .and_then(|v| values::string(v, "source").map_err(|_| "`source` must be a string path"))?;
-    let source = existing_file(base_dir, &source, "source")?;
+    let footage = footage_option(base_dir, &source, &options, "source")?;
+    let source = match &footage {
+        Some(footage) => footage.first_path(),
+        None => existing_file(base_dir, &source, "source")?,
+    };
     let shape = match (options.get("mask"), options.get("polygons")) {
         (Some(mask), None) => {
             let mask = values::string(mask, "mask")?;
@@ -212,6 +246,7 @@ fn parse_patch(base_dir: &Path, name: &Dynamic, options: &Dynamic) -> Result<Pat
         (None, None) => return Err("patch needs a `mask` image or `polygons`".into()),
     };
     let mut patch = Patch::new(name, source, shape);
+    patch.footage = footage;
     if let Some(v) = options.get("density") {
         patch.density = Some(values::positive(v, "density")?);
     }

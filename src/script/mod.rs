@@ -9,6 +9,7 @@ mod edit_api;
 mod engine;
 mod error;
 mod golden;
+mod footage_options;
 mod sandbox;
 mod validate;
 mod values;

@@ -48,17 +48,24 @@ pub fn validate_scene(loaded: &LoadedScene) -> Result<CheckSummary, SceneError> 
     for (i, patch) in scene.patches.iter().enumerate() {
         let origin = loaded.origins.patches.get(i);
         let named = |m: String| fail(origin, format!("patch `{}`: {m}", patch.name));
-        let source = decode(&patch.source).map_err(named)?;
+        // Footage was sized when the scene named it; a video is not an image file.
+        let source = match &patch.footage {
+            Some(f) => (f.width, f.height),
+            None => {
+                let image = decode(&patch.source).map_err(named)?;
+                (image.width(), image.height())
+            }
+        };
         let inside = match &patch.shape {
             Shape::Mask(path) => {
                 let mask = decode(path).map_err(named)?;
-                if (mask.width(), mask.height()) != (source.width(), source.height()) {
+                if (mask.width(), mask.height()) != source {
                     return Err(named(format!(
                         "mask is {}×{} but the source is {}×{}",
                         mask.width(),
                         mask.height(),
-                        source.width(),
-                        source.height()
+                        source.0,
+                        source.1
                     )));
                 }
                 let luma = mask.to_luma8();

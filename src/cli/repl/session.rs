@@ -533,6 +533,7 @@ impl Session {
                 let background = match &c.background {
                     Background::Image(path) => short(path),
                     Background::Colour(rgba) => format!("colour {rgba:?}"),
+                    Background::Footage(f) => format!("footage {}", f.describe()),
                 };
                 out.push_str(&format!(
                     "canvas {}×{}, {} fps, {} s ({} frames), background {background}\n",

@@ -1,0 +1,279 @@
+//! Video files through an `ffmpeg` process: takes frames in order and gives an MP4, WebM or
+//! MOV. Raw RGBA frames go down a pipe (written by a thread of their own, so encoding
+//! overlaps rendering) into `ffmpeg -f rawvideo`, which writes a temporary file; it is
+//! renamed onto the destination only when ffmpeg exits 0. On failure the last lines ffmpeg
+//! printed are in the error; an abandoned writer kills ffmpeg and leaves no file.
+//!
+//! Codecs: MP4 is H.264 in yuv420p at constant quality (CRF 20 by default); WebM is VP9 in
+//! yuv420p at constant quality (CRF 32); MOV is H.264 like MP4 for opaque frames and ProRes
+//! 4444 with alpha when the canvas has transparency (CRF does not apply to it). 4:2:0 needs
+//! even sides: an odd side is padded by one pixel (repeating the last row or column), which
+//! [`FfmpegWriter::padded`] reports.
+
+use std::io::{Read, Write};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::sync::mpsc::{sync_channel, Receiver, SyncSender};
+use std::thread::JoinHandle;
+
+use super::atomic::TempOutput;
+use super::{FrameRef, OutputError};
+
+/// The containers written through ffmpeg.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VideoKind {
+    Mp4,
+    Webm,
+    Mov,
+}
+
+impl VideoKind {
+    fn muxer(self) -> &'static str {
+        match self {
+            VideoKind::Mp4 => "mp4",
+            VideoKind::Webm => "webm",
+            VideoKind::Mov => "mov",
+        }
+    }
+
+    /// The default constant-quality value (lower is better) of its codec.
+    pub fn default_crf(self) -> u32 {
+        match self {
+            VideoKind::Mp4 | VideoKind::Mov => 20,
+            VideoKind::Webm => 32,
+        }
+    }
+}
+
+/// How a video is encoded.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VideoOptions {
+    pub kind: VideoKind,
+    pub width: u32,
+    pub height: u32,
+    pub fps: f64,
+    /// Constant-quality value; the codec's default when `None`.
+    pub crf: Option<u32>,
+    /// Whether frames have transparency worth keeping (MOV only).
+    pub alpha: bool,
+}
+
+impl VideoOptions {
+    /// Whether this encodes ProRes 4444 with alpha rather than 4:2:0.
+    fn keeps_alpha(&self) -> bool {
+        self.alpha && self.kind == VideoKind::Mov
+    }
+
+    /// The encoded size: sides padded to even for 4:2:0.
+    pub fn encoded_size(&self) -> (u32, u32) {
+        if self.keeps_alpha() {
+            (self.width, self.height)
+        } else {
+            (
+                self.width.next_multiple_of(2),
+                self.height.next_multiple_of(2),
+            )
+        }
+    }
+
+    /// The ffmpeg arguments after the raw input, up to (not including) the output path.
+    pub fn codec_args(&self) -> Vec<String> {
+        let crf = self.crf.unwrap_or(self.kind.default_crf()).to_string();
+        let mut args: Vec<String> = Vec::new();
+        let (w, h) = self.encoded_size();
+        if (w, h) != (self.width, self.height) {
+            // Pad with the edge's own pixels, so no dark line appears at the border.
+            args.extend([
+                "-vf".into(),
+                format!(
+                    "pad={w}:{h}:0:0,fillborders=right={}:bottom={}:mode=smear",
+                    w - self.width,
+                    h - self.height
+                ),
+            ]);
+        }
+        let codec: &[&str] = if self.keeps_alpha() {
+            &[
+                "-c:v",
+                "prores_ks",
+                "-profile:v",
+                "4444",
+                "-pix_fmt",
+                "yuva444p10le",
+            ]
+        } else {
+            match self.kind {
+                VideoKind::Mp4 | VideoKind::Mov => &[
+                    "-c:v", "libx264", "-preset", "veryfast", "-pix_fmt", "yuv420p", "-crf",
+                ],
+                VideoKind::Webm => &[
+                    "-c:v",
+                    "libvpx-vp9",
+                    "-pix_fmt",
+                    "yuv420p",
+                    "-b:v",
+                    "0",
+                    "-row-mt",
+                    "1",
+                    "-deadline",
+                    "good",
+                    "-cpu-used",
+                    "4",
+                    "-crf",
+                ],
+            }
+        };
+        args.extend(codec.iter().map(|s| s.to_string()));
+        if !self.keeps_alpha() {
+            args.push(crf);
+        }
+        if self.kind != VideoKind::Webm {
+            args.extend(["-movflags".into(), "+faststart".into()]);
+        }
+        args.extend(["-f".into(), self.kind.muxer().into()]);
+        args
+    }
+}
+
+/// An ffmpeg process encoding frames into a temporary file next to the destination.
+pub struct FfmpegWriter {
+    path: PathBuf,
+    /// Taken when committed.
+    temp: Option<TempOutput>,
+    child: Child,
+    sender: Option<SyncSender<Vec<u8>>>,
+    spare: Receiver<Vec<u8>>,
+    feeder: Option<JoinHandle<std::io::Result<()>>>,
+    stderr: Option<JoinHandle<String>>,
+    options: VideoOptions,
+}
+
+impl FfmpegWriter {
+    /// Starts ffmpeg for a video at `path`; fails with the install hint when ffmpeg is not
+    /// on `PATH`.
+    pub fn create(path: &Path, options: VideoOptions) -> Result<Self, OutputError> {
+        let ffmpeg = crate::util::find_program("ffmpeg").ok_or(OutputError::NoFfmpeg)?;
+        let temp = TempOutput::new(path);
+        let mut command = Command::new(ffmpeg);
+        command
+            .args([
+                "-v", "error", "-nostdin", "-y", "-f", "rawvideo", "-pix_fmt", "rgba",
+            ])
+            .args(["-s", &format!("{}x{}", options.width, options.height)])
+            .args(["-framerate", &format!("{}", options.fps), "-i", "-"])
+            .args(options.codec_args())
+            .arg(temp.temp_path())
+            .stdin(Stdio::piped())
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped());
+        #[cfg(unix)]
+        {
+            // Its own process group: Ctrl-C reaches lapclone, which then stops ffmpeg and
+            // removes the file, instead of ffmpeg finishing a partial video by itself.
+            use std::os::unix::process::CommandExt;
+            command.process_group(0);
+        }
+        let mut child = command.spawn().map_err(|e| OutputError::io(path, e))?;
+        // invariant: both were requested as pipes just above.
+        let mut stdin = child.stdin.take().expect("piped stdin");
+        let mut stderr_pipe = child.stderr.take().expect("piped stderr");
+        let stderr = std::thread::spawn(move || {
+            let mut text = String::new();
+            let _ = stderr_pipe.read_to_string(&mut text);
+            text
+        });
+        let (sender, frames) = sync_channel::<Vec<u8>>(2);
+        let (spare_sender, spare) = sync_channel::<Vec<u8>>(4);
+        let feeder = std::thread::spawn(move || {
+            for frame in frames {
+                stdin.write_all(&frame)?;
+                let _ = spare_sender.try_send(frame);
+            }
+            stdin.flush()
+        });
+        Ok(FfmpegWriter {
+            path: path.to_path_buf(),
+            temp: Some(temp),
+            child,
+            sender: Some(sender),
+            spare,
+            feeder: Some(feeder),
+            stderr: Some(stderr),
+            options,
+        })
+    }
+
+    /// The size the video was padded to, when a side was odd.
+    pub fn padded(&self) -> Option<(u32, u32)> {
+        let size = self.options.encoded_size();
+        (size != (self.options.width, self.options.height)).then_some(size)
+    }
+
+    /// Queues the next frame (8-bit RGBA of the video's size; 16-bit frames are rounded).
+    pub fn add(&mut self, frame: &FrameRef<'_>) -> Result<(), OutputError> {
+        if (frame.width(), frame.height()) != (self.options.width, self.options.height) {
+            return Err(OutputError::BadFrame(
+                "frame size differs from the video's".into(),
+            ));
+        }
+        let mut buffer = self.spare.try_recv().unwrap_or_default();
+        frame.write_rgba8(&mut buffer);
+        let sent = self.sender.as_ref().is_some_and(|s| s.send(buffer).is_ok());
+        if !sent {
+            // The feeder stopped: ffmpeg exited early. Its message says why.
+            return Err(self.failure());
+        }
+        Ok(())
+    }
+
+    /// Closes the pipe, waits for ffmpeg and renames the video into place.
+    pub fn finish(mut self) -> Result<PathBuf, OutputError> {
+        self.sender = None;
+        let fed = self.feeder.take().map(|f| f.join());
+        let status = self
+            .child
+            .wait()
+            .map_err(|e| OutputError::io(&self.path, e))?;
+        let fed_ok = matches!(fed, Some(Ok(Ok(()))));
+        if !status.success() || !fed_ok {
+            return Err(self.failure());
+        }
+        if let Some(temp) = self.temp.take() {
+            temp.commit().map_err(|e| OutputError::io(&self.path, e))?;
+        }
+        Ok(self.path.clone())
+    }
+
+    fn failure(&mut self) -> OutputError {
+        self.sender = None;
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+        let stderr = self
+            .stderr
+            .take()
+            .and_then(|h| h.join().ok())
+            .unwrap_or_default();
+        let lines: Vec<&str> = stderr.lines().filter(|l| !l.trim().is_empty()).collect();
+        let last = lines[lines.len().saturating_sub(5)..].join("\n  ");
+        OutputError::Ffmpeg {
+            path: self.path.clone(),
+            stderr: if last.is_empty() {
+                "(ffmpeg printed nothing)".into()
+            } else {
+                last
+            },
+        }
+    }
+}
+
+impl Drop for FfmpegWriter {
+    fn drop(&mut self) {
+        // Unless finished: stop ffmpeg before the temporary file is removed.
+        self.sender = None;
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+        if let Some(feeder) = self.feeder.take() {
+            let _ = feeder.join();
+        }
+    }
+}

@@ -1,0 +1,199 @@
+//! YUV4MPEG2 (`.y4m`) from frames, written by lapclone itself (no ffmpeg): takes frames in
+//! order and gives one uncompressed stream any encoder reads (`ffmpeg -i x.y4m`, `x264`,
+//! `aomenc`…), to a file (temporary file, renamed on [`Y4mWriter::finish`]) or to standard
+//! output.
+//!
+//! The stream is 8-bit 4:4:4 (`C444`, no chroma subsampling, so odd sizes need nothing
+//! special), progressive, square pixels, at the scene's fps as a fraction. Colours are
+//! converted with [`rgb_to_ycbcr`]: BT.709 coefficients, limited ("TV") range — what
+//! encoders assume for HD when a stream says nothing else. Y4M has no alpha: a transparent
+//! pixel is shown composited over black. 16-bit frames are rounded to 8 bits first.
+
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+use super::atomic::TempOutput;
+use super::{FrameRef, OutputError};
+
+/// BT.709 luma weights.
+const KR: f32 = 0.2126;
+const KB: f32 = 0.0722;
+const KG: f32 = 1.0 - KR - KB;
+
+/// One 8-bit straight-alpha RGBA pixel composited over black and converted to limited-range
+/// BT.709 Y′CbCr: Y = 16 + 219·E′y, Cb = 128 + 224·(E′b − E′y)/1.8556,
+/// Cr = 128 + 224·(E′r − E′y)/1.5748 (E′ in [0, 1]), each rounded to the nearest level.
+pub fn rgb_to_ycbcr(rgba: [u8; 4]) -> [u8; 3] {
+    let a = f32::from(rgba[3]) / 255.0;
+    let [r, g, b] = [rgba[0], rgba[1], rgba[2]].map(|v| f32::from(v) / 255.0 * a);
+    let y = KR * r + KG * g + KB * b;
+    let cb = (b - y) / (2.0 * (1.0 - KB));
+    let cr = (r - y) / (2.0 * (1.0 - KR));
+    let level = |v: f32| (v + 0.5).clamp(0.0, 255.0) as u8;
+    [
+        level(16.0 + 219.0 * y),
+        level(128.0 + 224.0 * cb),
+        level(128.0 + 224.0 * cr),
+    ]
+}
+
+/// `fps` as the fraction Y4M wants: whole rates exactly, NTSC-style rates over 1001, others
+/// to a thousandth.
+pub fn fps_fraction(fps: f64) -> (u64, u64) {
+    if (fps - fps.round()).abs() < 1e-9 {
+        return (fps.round() as u64, 1);
+    }
+    let ntsc = fps * 1001.0;
+    if (ntsc - ntsc.round()).abs() < 1e-6 {
+        return (ntsc.round() as u64, 1001);
+    }
+    let num = (fps * 1000.0).round() as u64;
+    let g = gcd(num, 1000);
+    (num / g, 1000 / g)
+}
+
+fn gcd(a: u64, b: u64) -> u64 {
+    if b == 0 {
+        a.max(1)
+    } else {
+        gcd(b, a % b)
+    }
+}
+
+/// Where a Y4M stream goes.
+enum Sink {
+    File {
+        temp: TempOutput,
+        path: PathBuf,
+        out: BufWriter<std::fs::File>,
+    },
+    Stdout(BufWriter<std::io::Stdout>),
+}
+
+pub struct Y4mWriter {
+    sink: Sink,
+    width: u32,
+    height: u32,
+    rgba: Vec<u8>,
+    planes: Vec<u8>,
+}
+
+impl Y4mWriter {
+    /// A stream of `width`×`height` frames at `fps` into `path`, or standard output if
+    /// `path` is `None`.
+    pub fn create(
+        path: Option<&Path>,
+        width: u32,
+        height: u32,
+        fps: f64,
+    ) -> Result<Self, OutputError> {
+        if !(fps.is_finite() && fps > 0.0) || width == 0 || height == 0 {
+            return Err(OutputError::BadFrame(format!(
+                "a Y4M stream needs fps > 0 and a size of at least 1×1, got {fps} and {width}×{height}"
+            )));
+        }
+        let mut sink = match path {
+            Some(path) => {
+                let temp = TempOutput::new(path);
+                let file = std::fs::File::create(temp.temp_path())
+                    .map_err(|e| OutputError::io(path, e))?;
+                Sink::File {
+                    temp,
+                    path: path.to_path_buf(),
+                    out: BufWriter::with_capacity(1 << 20, file),
+                }
+            }
+            None => Sink::Stdout(BufWriter::with_capacity(1 << 20, std::io::stdout())),
+        };
+        let (num, den) = fps_fraction(fps);
+        let header = format!("YUV4MPEG2 W{width} H{height} F{num}:{den} Ip A1:1 C444\n");
+        write_all(&mut sink, header.as_bytes())?;
+        Ok(Y4mWriter {
+            sink,
+            width,
+            height,
+            rgba: Vec::new(),
+            planes: Vec::new(),
+        })
+    }
+
+    /// Appends the next frame (of the stream's size).
+    pub fn add(&mut self, frame: &FrameRef<'_>) -> Result<(), OutputError> {
+        if (frame.width(), frame.height()) != (self.width, self.height) {
+            return Err(OutputError::BadFrame(format!(
+                "frame is {}×{}, the stream {}×{}",
+                frame.width(),
+                frame.height(),
+                self.width,
+                self.height
+            )));
+        }
+        frame.write_rgba8(&mut self.rgba);
+        let n = self.width as usize * self.height as usize;
+        self.planes.resize(3 * n, 0);
+        let (y, chroma) = self.planes.split_at_mut(n);
+        let (cb, cr) = chroma.split_at_mut(n);
+        for (i, px) in self.rgba.chunks_exact(4).enumerate() {
+            let [yy, u, v] = rgb_to_ycbcr([px[0], px[1], px[2], px[3]]);
+            y[i] = yy;
+            cb[i] = u;
+            cr[i] = v;
+        }
+        write_all(&mut self.sink, b"FRAME\n")?;
+        let planes = std::mem::take(&mut self.planes);
+        let result = write_all(&mut self.sink, &planes);
+        self.planes = planes;
+        result
+    }
+
+    /// Flushes and, for a file, renames it into place; gives its path (`-` for stdout).
+    pub fn finish(self) -> Result<PathBuf, OutputError> {
+        match self.sink {
+            Sink::File {
+                temp,
+                path,
+                mut out,
+            } => {
+                out.flush().map_err(|e| OutputError::io(&path, e))?;
+                drop(out);
+                temp.commit().map_err(|e| OutputError::io(&path, e))?;
+                Ok(path)
+            }
+            Sink::Stdout(mut out) => {
+                out.flush()
+                    .map_err(|e| OutputError::io(Path::new("standard output"), e))?;
+                Ok(PathBuf::from("-"))
+            }
+        }
+    }
+}
+
+fn write_all(sink: &mut Sink, bytes: &[u8]) -> Result<(), OutputError> {
+    match sink {
+        Sink::File { out, path, .. } => out.write_all(bytes).map_err(|e| OutputError::io(path, e)),
+        Sink::Stdout(out) => out
+            .write_all(bytes)
+            .map_err(|e| OutputError::io(Path::new("standard output"), e)),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reference_colours_convert_to_their_bt709_levels() {
+        assert_eq!(rgb_to_ycbcr([0, 0, 0, 255]), [16, 128, 128]);
+        assert_eq!(rgb_to_ycbcr([255, 255, 255, 255]), [235, 128, 128]);
+        // BT.709 100% red: Y 63, Cb 102, Cr 240.
+        assert_eq!(rgb_to_ycbcr([255, 0, 0, 255]), [63, 102, 240]);
+        assert_eq!(rgb_to_ycbcr([255, 255, 255, 0]), [16, 128, 128]);
+    }
+
+    #[test]
+    fn rates_become_fractions() {
+        assert_eq!(fps_fraction(24.0), (24, 1));
+        assert_eq!(fps_fraction(30000.0 / 1001.0), (30000, 1001));
+        assert_eq!(fps_fraction(12.5), (25, 2));
+    }
+}
