@@ -21,3 +21,29 @@ pub mod scene;
 pub mod script;
 pub mod solve;
 pub mod util;
+
+// The CLI's files name library items as `lapclone::…`, as any other user would.
+extern crate self as lapclone;
+
+#[cfg(feature = "cli")]
+mod cli;
+
+/// The `lapclone` program: parses `std::env::args`, runs the subcommand, reports an error on
+/// stderr and gives the exit code (0 ok, 1 failure, 2 usage). Only `src/main.rs` calls it.
+#[cfg(feature = "cli")]
+#[doc(hidden)]
+pub fn run_cli() -> i32 {
+    use clap::Parser as _;
+    let args = cli::Cli::parse();
+    match cli::run(args) {
+        Ok(()) => 0,
+        Err(err) => {
+            if let Some(usage) = err.downcast_ref::<cli::UsageError>() {
+                eprintln!("lapclone: {usage}");
+                return 2;
+            }
+            eprintln!("lapclone: error: {}", cli::describe(&err));
+            1
+        }
+    }
+}
