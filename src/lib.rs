@@ -8,24 +8,31 @@
 //! all stages; [`reference`](mod@reference) holds the pixel-grid and MVC baselines used by tests and benches;
 //! [`limits`] the documented resource limits every input is checked against.
 
-pub mod clone;
-pub mod deform;
-pub mod limits;
-pub mod mesh;
-pub mod output;
-pub mod pixels;
-pub mod raster;
-pub mod reference;
-pub mod render;
-pub mod scene;
-pub mod script;
-pub mod solve;
-pub mod util;
+/// Declares the pipeline's stage modules: private in the library, public (and undocumented)
+/// with the `internals` feature, which lapclone's own tests and `lapclone-bench` use.
+macro_rules! stage_modules {
+    ($($name:ident),* $(,)?) => {$(
+        #[cfg(feature = "internals")]
+        #[doc(hidden)]
+        pub mod $name;
+        // Without `internals`, what only the tests and benchmarks reach is unused here.
+        #[cfg(not(feature = "internals"))]
+        #[allow(dead_code, unused_imports)]
+        mod $name;
+    )*};
+}
+
+stage_modules!(
+    clone, deform, limits, mesh, output, pixels, raster, render, scene, script, solve, util,
+);
 
 // The CLI's files name library items as `lapclone::…`, as any other user would.
 extern crate self as lapclone;
 
-#[cfg(feature = "cli")]
+#[cfg(all(feature = "cli", feature = "internals"))]
+#[doc(hidden)]
+pub mod cli;
+#[cfg(all(feature = "cli", not(feature = "internals")))]
 mod cli;
 
 /// The `lapclone` program: parses `std::env::args`, runs the subcommand, reports an error on

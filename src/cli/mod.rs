@@ -4,13 +4,6 @@
 
 use clap::{Parser, Subcommand};
 
-pub mod bench;
-pub mod bench_clone;
-pub mod bench_deform;
-pub mod bench_mesh;
-pub mod bench_paper;
-pub mod bench_render;
-pub mod bench_solver;
 pub mod clone;
 pub mod mesh;
 pub mod mesh_args;
@@ -64,8 +57,6 @@ pub enum Command {
     Check(render::CheckArgs),
     /// Edit a scene interactively.
     Repl(repl::ReplArgs),
-    /// Benchmarks (release builds only give meaningful figures).
-    Bench(bench::BenchArgs),
 }
 
 pub fn run(cli: Cli) -> anyhow::Result<()> {
@@ -76,7 +67,6 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Preview(args) => render::run_preview(args),
         Command::Check(args) => render::run_check(args),
         Command::Repl(args) => repl::run(args),
-        Command::Bench(args) => bench::run(args),
     }
 }
 

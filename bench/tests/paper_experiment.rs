@@ -5,9 +5,9 @@
 use lapclone::clone::BoundaryData;
 use lapclone::mesh::{synth, BoundaryPlacement, MeshOptions};
 use lapclone::pixels::{FloatImage, PixelFormat};
-use lapclone::reference::experiment::{Experiment, MvcOutcome, RunOptions};
-use lapclone::reference::figure::comparison_figure;
-use lapclone::reference::GridMask;
+use lapclone_bench::reference::experiment::{Experiment, MvcOutcome, RunOptions};
+use lapclone_bench::reference::figure::comparison_figure;
+use lapclone_bench::reference::GridMask;
 
 const SIZE: usize = 64;
 
@@ -183,7 +183,7 @@ fn hat_averaged_boundary_data_beats_the_vertex_sample_on_texture() {
     };
     let (vertex, hat) = (run(BoundaryData::Vertex), run(BoundaryData::HatAverage));
     let gain =
-        |pick: fn(&lapclone::reference::experiment::MeshRun) -> f64| pick(&hat) - pick(&vertex);
+        |pick: fn(&lapclone_bench::reference::experiment::MeshRun) -> f64| pick(&hat) - pick(&vertex);
     let combinatorial = gain(|r| r.combinatorial.comparison.psnr_db);
     let cotangent = gain(|r| r.cotangent.comparison.psnr_db);
     // Measured: 1.24 / 1.47 dB.
@@ -313,7 +313,7 @@ fn boundary_on_the_dirichlet_centres_beats_the_moved_crack_boundary() {
         ..MeshOptions::default()
     };
     let centred = experiment.run(&centred_options, &run_options()).unwrap();
-    let psnr = |run: &lapclone::reference::experiment::MeshRun| {
+    let psnr = |run: &lapclone_bench::reference::experiment::MeshRun| {
         (
             run.combinatorial.comparison.psnr_db,
             run.cotangent.comparison.psnr_db,

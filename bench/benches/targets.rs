@@ -1,7 +1,7 @@
 //! `cargo bench`: every performance and quality target the issues set, in one table. Takes
-//! the release binary (`lapclone bench … --json`, the same measurements the closing notes
+//! the release binary (`lapclone-bench … --json`, the same measurements the closing notes
 //! quote) and gives, per target, the issue, the figure, what was measured, the target and
-//! whether it holds. The measuring code lives in the binary's `bench` commands; this file only
+//! whether it holds. The measuring code lives in `lapclone-bench`'s commands; this file only
 //! runs them and compares, so the two can never disagree.
 //!
 //! Arguments after `--`: `--quick` (fewer repeats, and no 495k-vertex factor), `--strict`
@@ -264,20 +264,20 @@ fn paper_checks(checks: &mut Vec<Check>) -> Result<(), String> {
     Ok(())
 }
 
-/// Runs `lapclone bench <arguments> --json` from the package root and parses its stdout.
+/// Runs `lapclone-bench <arguments> --json` from the repository root (where `assets/` is)
+/// and parses its stdout.
 fn run_bench(arguments: &[&str]) -> Result<Value, String> {
-    let binary = env!("CARGO_BIN_EXE_lapclone");
-    eprintln!("running lapclone bench {} --json", arguments.join(" "));
+    let binary = env!("CARGO_BIN_EXE_lapclone-bench");
+    eprintln!("running lapclone-bench {} --json", arguments.join(" "));
     let output = Command::new(binary)
-        .arg("bench")
         .args(arguments)
         .arg("--json")
-        .current_dir(Path::new(env!("CARGO_MANIFEST_DIR")))
+        .current_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
         .output()
         .map_err(|e| format!("cannot run {binary}: {e}"))?;
     if !output.status.success() {
         return Err(format!(
-            "`lapclone bench {}` failed ({}): {}",
+            "`lapclone-bench {}` failed ({}): {}",
             arguments.join(" "),
             output.status,
             String::from_utf8_lossy(&output.stderr).trim()
@@ -285,7 +285,7 @@ fn run_bench(arguments: &[&str]) -> Result<Value, String> {
     }
     serde_json::from_slice(&output.stdout).map_err(|e| {
         format!(
-            "`lapclone bench {}` gave bad JSON: {e}",
+            "`lapclone-bench {}` gave bad JSON: {e}",
             arguments.join(" ")
         )
     })

@@ -1,4 +1,4 @@
-//! `lapclone bench clone`: times the paper's spiral case end to end and one deformation
+//! `lapclone-bench clone`: times the paper's spiral case end to end and one deformation
 //! frame. Takes no input files beyond the bundled photos (synthetic stand-ins when they are
 //! missing) and gives a table (or JSON) with the target beside each figure. Use a release build.
 //!
@@ -140,7 +140,7 @@ pub fn run(args: CloneBenchArgs) -> anyhow::Result<()> {
 
 fn asset(name: &str) -> std::path::PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("assets")
+        .join("../assets")
         .join(name)
 }
 

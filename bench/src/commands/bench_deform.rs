@@ -1,4 +1,4 @@
-//! `lapclone bench deform`: times the deform stage on hexagonal-disc fixtures (4 px edges):
+//! `lapclone-bench deform`: times the deform stage on hexagonal-disc fixtures (4 px edges):
 //! rig build, a drag step with an unchanged constraint set (rotation + right-hand side + two
 //! solves), a step that toggles one pin (2 rank-1 switches per frame), and a step that changes
 //! the handle radius by 2% (a ring of far-field switches). Use a release build.

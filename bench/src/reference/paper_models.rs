@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use thiserror::Error;
 
 use super::synthetic::{self, SyntheticMask};
-use crate::pixels::{FloatImage, PixelError, PixelFormat};
+use lapclone::pixels::{FloatImage, PixelError, PixelFormat};
 
 /// Pixels of margin kept around the resized horse silhouette.
 const HORSE_MARGIN: u32 = 4;

@@ -1,13 +1,13 @@
-//! `lapclone bench paper --quick`: the table has every column, the JSON every documented key,
+//! `lapclone-bench paper --quick`: the table has every column, the JSON every documented key,
 //! and bad arguments exit with code 2.
 
 use std::path::Path;
 use std::process::Command;
 
 fn bench_paper(extra: &[&str]) -> std::process::Output {
-    let assets = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets");
-    Command::new(env!("CARGO_BIN_EXE_lapclone"))
-        .args(["bench", "paper", "--quick", "--assets"])
+    let assets = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets");
+    Command::new(env!("CARGO_BIN_EXE_lapclone-bench"))
+        .args(["paper", "--quick", "--assets"])
         .arg(&assets)
         .args(extra)
         .output()

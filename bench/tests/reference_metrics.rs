@@ -2,7 +2,7 @@
 //! MVC on a pixel-aligned square patch against the pixel-grid reference.
 
 use glam::DVec2;
-use lapclone::reference::{
+use lapclone_bench::reference::{
     composite, poisson_membrane, psnr, psnr_by_ring, ring_of_pixels, seam_step, uncovered_pixels,
     ComparisonInput, GridMask, MembraneComparison, MetricError, MvcWeights,
 };

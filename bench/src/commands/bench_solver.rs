@@ -1,4 +1,4 @@
-//! `lapclone bench solver` and `lapclone bench factor`: timings of the solve stage —
+//! `lapclone-bench solver` and `lapclone-bench factor`: timings of the solve stage —
 //! analyse, factor, 3-RHS solve and rank-1 switches — on a Matrix Market Laplacian or on the
 //! built-in disc meshes. Release builds only give meaningful figures.
 

@@ -31,12 +31,12 @@ use super::{
     GridMask, GridPoisson, MaskError, MembraneComparison, MetricError, MvcError, MvcWeights,
     PoissonError,
 };
-use crate::clone::{
+use lapclone::clone::{
     BoundaryData, BoundarySampler, CloneError, CloneOptions, MembraneSolver, PatchCloner, Placement,
 };
-use crate::mesh::{mesh_mask, BitMask, Mesh, MeshError, MeshOptions};
-use crate::pixels::{Canvas, FloatImage};
-use crate::solve::LaplacianKind;
+use lapclone::mesh::{mesh_mask, BitMask, Mesh, MeshError, MeshOptions};
+use lapclone::pixels::{Canvas, FloatImage};
+use lapclone::solve::LaplacianKind;
 
 /// Colour channels compared (alpha is never cloned).
 pub const CHANNELS: usize = 3;
@@ -267,7 +267,7 @@ impl Experiment {
         for _ in 0..run.repeats {
             let started = Instant::now();
             let mut fresh = mesh_mask(&bits, mesh_options)?;
-            crate::clone::finish_mask_mesh(&mut fresh, mesh_options);
+            lapclone::clone::finish_mask_mesh(&mut fresh, mesh_options);
             mesh_ms = mesh_ms.min(millis(started.elapsed()));
             result = Some(fresh);
         }

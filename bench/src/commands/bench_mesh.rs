@@ -1,4 +1,4 @@
-//! `lapclone bench mesh`: meshes synthetic masks from 128² to 2000² (the spiral family and
+//! `lapclone-bench mesh`: meshes synthetic masks from 128² to 2000² (the spiral family and
 //! the other shapes of `mesh::synth`) at default settings and prints a table of vertex
 //! counts and timings (median and best of `--repeat` runs), or JSON with `--json`.
 

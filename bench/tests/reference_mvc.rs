@@ -4,7 +4,7 @@
 
 use glam::DVec2;
 use lapclone::mesh::{BoundaryLoop, LoopKind, Mesh};
-use lapclone::reference::{mean_value_coordinates, MvcError, MvcWeights};
+use lapclone_bench::reference::{mean_value_coordinates, MvcError, MvcWeights};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed};
 use std::f64::consts::TAU;

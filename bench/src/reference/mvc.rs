@@ -20,7 +20,7 @@
 use glam::DVec2;
 use thiserror::Error;
 
-use crate::mesh::{BoundaryLoop, LoopKind, Mesh};
+use lapclone::mesh::{BoundaryLoop, LoopKind, Mesh};
 
 /// Relative size under which a point counts as lying on a polygon vertex or edge.
 const ON_BOUNDARY_TOLERANCE: f64 = 1e-14;

@@ -18,7 +18,7 @@
 use glam::DVec2;
 
 use super::GridMask;
-use crate::mesh::Mesh;
+use lapclone::mesh::Mesh;
 
 /// How far (px) from a triangle an uncovered centre may be and still extrapolate from it.
 pub const EXTRAPOLATION_REACH_PX: f64 = 2.0;
@@ -217,7 +217,7 @@ fn extrapolate_uncovered(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::{mesh_mask, BitMask, MeshOptions};
+    use lapclone::mesh::{mesh_mask, BitMask, MeshOptions};
 
     #[test]
     fn linear_function_is_reproduced_at_every_covered_centre() {

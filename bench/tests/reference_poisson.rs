@@ -1,7 +1,7 @@
 //! Pixel-grid reference membrane: exact reproduction of discrete-harmonic data, the discrete
 //! equation's residual on random masks, pieces, holes, image-border Neumann and errors.
 
-use lapclone::reference::{poisson_membrane, GridMask, GridPoisson, PoissonError};
+use lapclone_bench::reference::{poisson_membrane, GridMask, GridPoisson, PoissonError};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed};
 

@@ -1,4 +1,4 @@
-//! `lapclone bench render`: the issue-6 frame budget — a 1920×1080 scene with two deforming
+//! `lapclone-bench render`: the issue-6 frame budget — a 1920×1080 scene with two deforming
 //! patches of ≈2,500 vertices each, 120 frames: per-frame computation (timeline, deformation,
 //! switches, membrane, raster; no encoding), then PNG encoding of rendered frames with 1 and
 //! with N jobs. Use a release build.

@@ -1,7 +1,7 @@
 //! Synthetic Table-I masks: sizes, margins, one 4-connected piece each, solvable.
 
-use lapclone::reference::synthetic::{paper_masks, spiral};
-use lapclone::reference::{GridMask, GridPoisson};
+use lapclone_bench::reference::synthetic::{paper_masks, spiral};
+use lapclone_bench::reference::{GridMask, GridPoisson};
 
 fn piece_count(w: usize, h: usize, inside: &[bool]) -> usize {
     let grid = GridMask::new(w, h, inside).unwrap();
