@@ -96,14 +96,17 @@ impl Canvas {
         }
     }
 
+    /// Columns.
     pub fn width(&self) -> u32 {
         self.width
     }
 
+    /// Rows.
     pub fn height(&self) -> u32 {
         self.height
     }
 
+    /// Bits per channel of the frame and its output.
     pub fn depth(&self) -> Depth {
         match self.pixels {
             CanvasPixels::Eight(_) => Depth::Eight,
@@ -111,10 +114,12 @@ impl Canvas {
         }
     }
 
+    /// The premultiplied pixels, row-major.
     pub fn pixels(&self) -> &CanvasPixels {
         &self.pixels
     }
 
+    /// The premultiplied pixels, mutable.
     pub fn pixels_mut(&mut self) -> &mut CanvasPixels {
         &mut self.pixels
     }
@@ -137,7 +142,7 @@ impl Canvas {
 
     /// Copies the pixels of `rect` (clipped to the canvas) from `other`, which must have the
     /// same size and depth: the cheap per-frame reset that restores only the rectangles the
-    /// previous frame drew into (e.g. [`RasterStats::work`](crate::raster::RasterStats)).
+    /// previous frame drew into (e.g. `RasterStats::work`).
     pub fn copy_rect_from(&mut self, other: &Canvas, rect: PixelRect) -> Result<(), PixelError> {
         if (self.width, self.height, self.depth()) != (other.width, other.height, other.depth()) {
             return Err(PixelError::CanvasMismatch {

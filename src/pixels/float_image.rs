@@ -145,7 +145,7 @@ impl FloatImage {
     }
 
     /// Reads and decodes an image file (format guessed from its content); images over the
-    /// size limits of [`crate::limits`] are refused from their header, before decoding.
+    /// size limits of `limits` are refused from their header, before decoding.
     pub fn load(path: &Path) -> Result<FloatImage, PixelError> {
         use crate::limits::{open_image, ImageOpenError};
         let path_buf = || path.to_path_buf();
@@ -199,14 +199,17 @@ impl FloatImage {
         FloatImage::new(width, height, pixels, format)
     }
 
+    /// Columns.
     pub fn width(&self) -> u32 {
         self.width
     }
 
+    /// Rows.
     pub fn height(&self) -> u32 {
         self.height
     }
 
+    /// The format the image was stored in.
     pub fn format(&self) -> PixelFormat {
         self.format
     }

@@ -42,6 +42,7 @@ pub struct PlacedMesh<'a> {
 /// Timings and counts of the last frame.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct FrameStats {
+    /// Scene time of the frame, seconds.
     pub time: f64,
     /// Deformation constraint switches (all patches).
     pub deform_switches: usize,
@@ -51,9 +52,13 @@ pub struct FrameStats {
     pub hidden: usize,
     /// Boundary vertices outside the canvas.
     pub outside: usize,
+    /// Deformation (rigs) over all patches, ms.
     pub deform_ms: f64,
+    /// Membrane solves over all patches, ms.
     pub solve_ms: f64,
+    /// Rasterisation and compositing, ms.
     pub raster_ms: f64,
+    /// The whole frame, ms.
     pub total_ms: f64,
 }
 
@@ -95,6 +100,7 @@ impl Renderer {
         })
     }
 
+    /// The scene being rendered.
     pub fn scene(&self) -> &Scene {
         &self.scene
     }
@@ -304,6 +310,7 @@ impl Renderer {
         &self.frame
     }
 
+    /// Timings of the last frame rendered.
     pub fn last_stats(&self) -> FrameStats {
         self.stats
     }

@@ -4,8 +4,7 @@
 
 use lapclone::solve::symbolic::{SymbolicFactor, SUPERNODAL_MIN_VERTICES};
 
-#[path = "common/solve_checks.rs"]
-mod checks;
+use crate::checks;
 use checks::{dense_solve, rel_diff, Rng};
 use lapclone::solve::{
     fixtures, laplacian, FactorMethod, LaplacianKind, PenaltyFactor, PenaltyOptions, SymmetricCsc,

@@ -4,8 +4,7 @@
 use std::path::Path;
 use std::process::Command;
 
-#[path = "common/files.rs"]
-mod files;
+use crate::files;
 use files::asset;
 
 fn check(dir: &Path, text: &str) -> (i32, String, String) {

@@ -4,8 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-#[path = "common/files.rs"]
-mod files;
+use crate::files;
 use files::{asset, sorted_names};
 
 /// A 96×64 scene of 4 frames (fps 4, 1 s): a dragged, moving triangle patch.

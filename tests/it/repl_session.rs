@@ -6,8 +6,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 
-#[path = "common/files.rs"]
-mod files;
+use crate::files;
 use files::asset;
 
 /// A tiny scene (64×48, 3 frames) with one polygon patch of the cat photo.

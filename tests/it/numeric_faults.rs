@@ -17,8 +17,7 @@ use lapclone::render::Renderer;
 use lapclone::script::{parse_scene, ScriptOptions};
 use lapclone::solve::{FactorMethod, LaplacianKind, PenaltyOptions};
 
-#[path = "common/solve_checks.rs"]
-mod checks;
+use crate::checks;
 use checks::Rng;
 
 /// Two discs and a bar: three pieces, one with a hole.

@@ -2,8 +2,7 @@
 //! entirely outside the target, non-finite numbers, a missing output folder, a zero scale —
 //! each with its exit code (0 ok, 1 failure, 2 usage), a message, and never a partial file.
 
-#[path = "common/clone_fixtures.rs"]
-mod fixtures;
+use crate::fixtures;
 
 use std::path::Path;
 use std::process::{Command, Output};

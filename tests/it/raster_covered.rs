@@ -1,8 +1,7 @@
 //! The coverage query: boundary vertices under the patch's own front layer, compared with a
 //! brute-force check over all triangles on random folded meshes (fixed seed).
 
-#[path = "common/raster_meshes.rs"]
-mod raster_meshes;
+use crate::raster_meshes;
 
 use glam::DVec2;
 use lapclone::raster::{covered_boundary_vertices, CoverageGrid};

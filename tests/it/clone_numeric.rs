@@ -4,8 +4,7 @@
 //! fresh cloner at the new placement; boundary vertices outside the target switch off and
 //! come back; monochrome mode; the source's alpha.
 
-#[path = "common/clone_fixtures.rs"]
-mod fixtures;
+use crate::fixtures;
 
 use glam::DVec2;
 use lapclone::clone::{

@@ -2,8 +2,7 @@
 //! their union exactly once — fans meeting at pixel centres, diagonals through pixel centres,
 //! edges along pixel-centre rows, and randomly jittered grids (fixed seed).
 
-#[path = "common/raster_meshes.rs"]
-mod raster_meshes;
+use crate::raster_meshes;
 
 use glam::DVec2;
 use lapclone::raster::{triangle_pixels, PixelRect};

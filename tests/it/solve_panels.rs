@@ -13,8 +13,7 @@ use lapclone::solve::{
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed};
 
-#[path = "common/solve_checks.rs"]
-mod checks;
+use crate::checks;
 use checks::{mixed_mesh as mesh, rel_diff, simd_levels as levels, METHODS};
 
 fn factor(mesh: &Mesh, method: FactorMethod, constrained_every: usize) -> PenaltyFactor {

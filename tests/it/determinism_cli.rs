@@ -5,8 +5,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-#[path = "common/files.rs"]
-mod files;
+use crate::files;
 use files::asset;
 
 /// 80 × 60, 5 frames: a dragged and pinned triangle over a moving, rotating quad.

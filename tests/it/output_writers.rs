@@ -11,8 +11,7 @@ use lapclone::output::{
     FrameRef, GifWriter, OutputError, Pixels, PngCompression, PngSequenceWriter,
 };
 
-#[path = "common/files.rs"]
-mod files;
+use crate::files;
 use files::sorted_names;
 
 /// A deterministic, not-too-compressible test pattern.

@@ -5,10 +5,8 @@
 //! depth order), checked for determinism and for exactly which boundary constraints it
 //! switches off.
 
-#[path = "common/clone_fixtures.rs"]
-mod fixtures;
-#[path = "common/golden.rs"]
-mod golden;
+use crate::fixtures;
+use crate::golden;
 
 use std::process::Command;
 

@@ -9,8 +9,7 @@
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 
-#[path = "common/files.rs"]
-mod files;
+use crate::files;
 use files::sorted_names;
 
 /// A long scene (2 000 frames) so the render is still running when the signal comes.

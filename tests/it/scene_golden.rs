@@ -2,8 +2,7 @@
 //! middle), rendered at the scene's size and box-filtered down 4× to keep the references
 //! small. Also checks that rendering is deterministic: a fresh renderer gives the same bytes.
 
-#[path = "common/golden.rs"]
-mod golden;
+use crate::golden;
 
 use std::path::{Path, PathBuf};
 

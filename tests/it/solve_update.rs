@@ -6,8 +6,7 @@ use lapclone::solve::{
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed};
 
-#[path = "common/solve_checks.rs"]
-mod checks;
+use crate::checks;
 use checks::{rel_diff, Rng};
 
 /// Relative difference between the updated factor's solutions and a fresh factorisation's.

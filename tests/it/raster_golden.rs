@@ -1,10 +1,8 @@
 //! Golden frames of the raster alone: a rotated, scaled polygon patch with a membrane
 //! gradient, anti-aliased and feathered, and a folded strip with depth, over a pattern.
 
-#[path = "common/golden.rs"]
-mod golden;
-#[path = "common/raster_meshes.rs"]
-mod raster_meshes;
+use crate::golden;
+use crate::raster_meshes;
 
 use glam::{DAffine2, DVec2};
 use lapclone::mesh::{BoundaryLoop, LoopKind};

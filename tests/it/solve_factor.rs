@@ -5,8 +5,7 @@ use lapclone::solve::{
     fixtures, laplacian, LaplacianKind, PenaltyFactor, PenaltyOptions, SchedulePolicy, SymmetricCsc,
 };
 
-#[path = "common/solve_checks.rs"]
-mod checks;
+use crate::checks;
 use checks::{dense_solve, rel_diff, Rng};
 
 /// The penalised matrix `L + P + εI` as a dense matrix.

@@ -2,8 +2,7 @@
 //! membrane adds exactly, depth picks the front layer, anti-aliased coverage integrates to
 //! the polygon area, the feather ramp is monotone, folds keep their coverage.
 
-#[path = "common/raster_meshes.rs"]
-mod raster_meshes;
+use crate::raster_meshes;
 
 use glam::DVec2;
 use lapclone::mesh::BoundaryLoop;
