@@ -36,7 +36,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ..Placement::translate(centre, DVec2::new(320.0, 250.0))
     };
     let mut canvas = Canvas::from_image(&target);
-    cloner.clone_deformed(&mut canvas, &placement, &deformed.positions, Some(&deformed.depth))?;
+    cloner.clone_deformed(
+        &mut canvas,
+        &placement,
+        &deformed.positions,
+        Some(&deformed.depth),
+    )?;
     canvas.save_png(&out, target.format())?;
     let moved = deformed.positions.iter().zip(&cloner.mesh().positions);
     let furthest = moved.map(|(d, r)| d.distance(*r)).fold(0.0, f64::max);

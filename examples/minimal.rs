@@ -30,6 +30,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut canvas = Canvas::from_image(&target);
     cloner.clone_onto(&mut canvas, &placement)?;
     canvas.save_png(&out, target.format())?;
-    println!("cloned a {}-vertex patch into {}", cloner.mesh().vertex_count(), out.display());
+    println!(
+        "cloned a {}-vertex patch into {}",
+        cloner.mesh().vertex_count(),
+        out.display()
+    );
     Ok(())
 }

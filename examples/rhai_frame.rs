@@ -19,9 +19,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let frame: image::RgbaImage = renderer.render_time(t)?.to_rgba8_image();
 
     // FNV-1a over the pixels: a short, deterministic fingerprint of the frame.
-    let checksum = frame.as_raw().iter().fold(0xcbf2_9ce4_8422_2325_u64, |hash, &byte| {
-        (hash ^ u64::from(byte)).wrapping_mul(0x0100_0000_01b3)
-    });
+    let checksum = frame
+        .as_raw()
+        .iter()
+        .fold(0xcbf2_9ce4_8422_2325_u64, |hash, &byte| {
+            (hash ^ u64::from(byte)).wrapping_mul(0x0100_0000_01b3)
+        });
     println!(
         "{}: frame at t = {t} s is {}x{}, checksum {checksum:016x}",
         file.display(),

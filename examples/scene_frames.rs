@@ -21,8 +21,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     );
     // Keys: position slides right and scale grows, both easing in and out.
     face.placement.position = Track::new();
-    face.placement.position.push(0.0, DVec2::new(262.0, 150.0), Easing::Linear)?;
-    face.placement.position.push(1.0, DVec2::new(302.0, 140.0), Easing::Smooth)?;
+    face.placement
+        .position
+        .push(0.0, DVec2::new(262.0, 150.0), Easing::Linear)?;
+    face.placement
+        .position
+        .push(1.0, DVec2::new(302.0, 140.0), Easing::Smooth)?;
     face.placement.scale = Track::new();
     face.placement.scale.push(0.0, 0.32, Easing::Linear)?;
     face.placement.scale.push(1.0, 0.42, Easing::Smooth)?;
@@ -45,6 +49,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let path = folder.join(format!("frame_{:04}.png", index + 1));
         renderer.render_frame(index)?.save_png(&path, format)?;
     }
-    println!("wrote {} frames to {}", renderer.frame_count(), folder.display());
+    println!(
+        "wrote {} frames to {}",
+        renderer.frame_count(),
+        folder.display()
+    );
     Ok(())
 }

@@ -53,8 +53,8 @@ pub use glam;
 pub use image;
 
 pub use clone::{
-    mesh_from_mask, mesh_from_polygons, Anchor, BoundaryData, CloneError, CloneMode,
-    CloneOptions, CloneStats, PatchCloner, PatchMesh, Placement,
+    mesh_from_mask, mesh_from_polygons, Anchor, BoundaryData, CloneError, CloneMode, CloneOptions,
+    CloneStats, PatchCloner, PatchMesh, Placement,
 };
 pub use deform::{DeformError, DeformOptions, DeformRig, DeformStats, Deformed, Handle, Pin};
 pub use mesh::{

@@ -182,8 +182,9 @@ fn hat_averaged_boundary_data_beats_the_vertex_sample_on_texture() {
         experiment.run(&MeshOptions::default(), &options).unwrap()
     };
     let (vertex, hat) = (run(BoundaryData::Vertex), run(BoundaryData::HatAverage));
-    let gain =
-        |pick: fn(&lapclone_bench::reference::experiment::MeshRun) -> f64| pick(&hat) - pick(&vertex);
+    let gain = |pick: fn(&lapclone_bench::reference::experiment::MeshRun) -> f64| {
+        pick(&hat) - pick(&vertex)
+    };
     let combinatorial = gain(|r| r.combinatorial.comparison.psnr_db);
     let cotangent = gain(|r| r.cotangent.comparison.psnr_db);
     // Measured: 1.24 / 1.47 dB.

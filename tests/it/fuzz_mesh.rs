@@ -8,7 +8,7 @@
 //! expansion of the clone stage, and clones onto a canvas with a finite membrane.
 //!
 //! The small fixed-seed run is part of the normal suite. The long run is opt-in:
-//! `LAPCLONE_FUZZ_CASES=50000 cargo test --release --test fuzz_mesh -- --ignored`
+//! `LAPCLONE_FUZZ_CASES=50000 cargo test --release --test it fuzz_mesh:: -- --ignored`
 //! (default 20 000 cases). Crashing inputs found are kept as explicit regression cases below.
 
 use glam::DVec2;
@@ -288,7 +288,7 @@ fn random_masks_mesh_and_clone_small_fixed_seed() {
 }
 
 #[test]
-#[ignore = "long fuzz run: cargo test --release --test fuzz_mesh -- --ignored"]
+#[ignore = "long fuzz run: cargo test --release --test it fuzz_mesh:: -- --ignored"]
 fn random_masks_mesh_and_clone_long() {
     let cases: u32 = std::env::var("LAPCLONE_FUZZ_CASES")
         .ok()

@@ -7,7 +7,7 @@
 //! carry a line and column.
 //!
 //! The small fixed-seed run is part of the normal suite. The long run is opt-in:
-//! `LAPCLONE_FUZZ_CASES=20000 cargo test --release --test fuzz_scene -- --ignored`
+//! `LAPCLONE_FUZZ_CASES=20000 cargo test --release --test it fuzz_scene:: -- --ignored`
 //! (default 10 000 cases). Crashing inputs found are kept as explicit regression cases below.
 
 use std::path::{Path, PathBuf};
@@ -348,7 +348,7 @@ fn mutated_scenes_small_fixed_seed() {
 }
 
 #[test]
-#[ignore = "long fuzz run: cargo test --release --test fuzz_scene -- --ignored"]
+#[ignore = "long fuzz run: cargo test --release --test it fuzz_scene:: -- --ignored"]
 fn mutated_scenes_long() {
     let world = World::new();
     let cases: u32 = std::env::var("LAPCLONE_FUZZ_CASES")

@@ -20,15 +20,15 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use anyhow::Context;
-use glam::DVec2;
-use lapclone::mesh::{BoundaryPlacement, MeshOptions};
 use crate::reference::experiment::{
     reclone_ms, Experiment, MeshRun, MethodFigures, MvcOutcome, RunOptions,
 };
 use crate::reference::figure::comparison_figure;
 use crate::reference::paper_models::{paper_model, MODEL_NAMES};
 use crate::reference::{psnr_by_ring, GridMask};
+use anyhow::Context;
+use glam::DVec2;
+use lapclone::mesh::{BoundaryPlacement, MeshOptions};
 use lapclone::solve::LaplacianKind;
 use lapclone::util::write_atomic;
 
