@@ -23,7 +23,9 @@
 //!
 //! Points are [`glam`] vectors, re-exported so callers use the same version.
 //!
-//! ```no_run
+//! Clone the cat's face of the bundled photo into an espresso:
+//!
+//! ```
 //! use lapclone::glam::DVec2;
 //! use lapclone::{mesh_from_mask, BitMask, Canvas, CloneOptions, FloatImage, MeshOptions};
 //! use lapclone::{PatchCloner, Placement};
@@ -38,7 +40,23 @@
 //! let mut cloner = PatchCloner::new(source, patch.result.mesh, &CloneOptions::default())?;
 //! let mut canvas = Canvas::from_image(&target);
 //! cloner.clone_onto(&mut canvas, &Placement::translate(centre, DVec2::new(288.0, 143.0)))?;
-//! canvas.save_png(Path::new("clone.png"), target.format())?;
+//! let png = canvas.encode_png(target.format())?; // or canvas.save_png(path, format)
+//! assert!(png.starts_with(b"\x89PNG"));
+//! # Ok(())
+//! # }
+//! ```
+//!
+//! Load a scene file and render one frame for the `image` crate:
+//!
+//! ```
+//! use lapclone::{load_scene, Renderer};
+//! use std::path::Path;
+//!
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! let loaded = load_scene(Path::new("scenes/cat_in_coffee.rhai"))?;
+//! let mut renderer = Renderer::new(loaded.scene)?;
+//! let frame: lapclone::image::RgbaImage = renderer.render_time(1.5)?.to_rgba8_image();
+//! assert_eq!(frame.dimensions(), (600, 400));
 //! # Ok(())
 //! # }
 //! ```
@@ -65,13 +83,15 @@ pub use render::{FrameStats, RenderError, Renderer};
 pub use script::{load_scene, LoadedScene, SceneError};
 pub use solve::LaplacianKind;
 
-/// Scenes: the animated description a [`Renderer`] draws.
+/// Scenes: the animated description a [`Renderer`] draws, built in Rust or loaded from a
+/// `.rhai` file with [`load_scene`]. A [`Scene`](animation::Scene) is a
+/// [`Canvas`](animation::Canvas) (size, frame rate, duration,
+/// [`Background`](animation::Background)) and layered [`Patch`](animation::Patch)es, each
+/// with a [`Shape`](animation::Shape), an animated [`Placement`](animation::Placement), drag
+/// [`Handle`](animation::Handle)s and [`Pin`](animation::Pin)s; every animated value is a
+/// [`Track`](animation::Track) of [`Key`](animation::Key)s, each with an
+/// [`Easing`](animation::Easing).
 pub mod animation {
-    //! Built in Rust, or loaded from a `.rhai` file with [`load_scene`](crate::load_scene).
-    //! A [`Scene`] is a [`Canvas`] (size, frame rate, duration, [`Background`]) and layered
-    //! [`Patch`]es, each with a [`Shape`], an animated [`Placement`], drag [`Handle`]s and
-    //! [`Pin`]s; every animated value is a [`Track`] of [`Key`]s, each with an [`Easing`].
-
     pub use crate::scene::{
         Background, Canvas, Easing, Handle, Key, KeyError, ModelError, Patch, Pin, Placement,
         Scene, Shape, Track,
