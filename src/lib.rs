@@ -119,10 +119,13 @@ stage_modules!(
 // The CLI's files name library items as `lapclone::…`, as any other user would.
 extern crate self as lapclone;
 
+// The CLI's doc comments are clap's help texts, where `[…]` marks an optional part.
 #[cfg(all(feature = "cli", feature = "internals"))]
 #[doc(hidden)]
+#[allow(rustdoc::broken_intra_doc_links)]
 pub mod cli;
 #[cfg(all(feature = "cli", not(feature = "internals")))]
+#[allow(rustdoc::broken_intra_doc_links)]
 mod cli;
 
 /// The `lapclone` program: parses `std::env::args`, runs the subcommand, reports an error on
