@@ -1,26 +1,150 @@
 //! lapclone: seamless image cloning and deformation with the combinatorial Laplacian
-//! (Cuadros-Vargas, Nonato, Pascucci). The library takes masks, images and scene files in
-//! and gives meshes, factored Laplacians, membranes, deformed meshes and rendered frames
-//! out; the `lapclone` binary is a thin CLI over it.
+//! (Cuadros-Vargas, Nonato, Pascucci). The library takes masks or polygons, images and scenes
+//! in and gives patch meshes, seamless clones, deformed patches and rendered frames out; the
+//! `lapclone` binary (default feature `cli`) is a thin command line over it.
 //!
-//! The modules follow the pipeline: [`mesh`] → [`solve`] → [`clone`] / [`deform`] →
-//! [`raster`], driven per frame by [`scene`]. [`pixels`] holds the float image type shared by
-//! all stages; [`reference`](mod@reference) holds the pixel-grid and MVC baselines used by tests and benches;
-//! [`limits`] the documented resource limits every input is checked against; [`golden`]
-//! compares rendered frames with reference frames (`lapclone test` and the project's tests).
+//! The API follows the pipeline:
+//!
+//! 1. **Mesh** a patch: [`mesh_from_mask`] (a [`BitMask`]) or [`mesh_from_polygons`], tuned
+//!    by [`MeshOptions`], gives a [`PatchMesh`] (or [`MeshError`] / [`CloneError`]).
+//! 2. **Clone**: a [`PatchCloner`] factors the mesh's Laplacian once; every
+//!    [`PatchCloner::clone_onto`] at a new [`Placement`] only switches constraints and
+//!    back-substitutes. Its [`CloneOptions`] pick the [`LaplacianKind`], the [`CloneMode`] and
+//!    the [`BoundaryData`]. Errors: [`CloneError`].
+//! 3. **Deform**: a [`DeformRig`] moves the mesh by drag [`Handle`]s and [`Pin`]s into
+//!    [`Deformed`] positions, which [`PatchCloner::clone_deformed`] clones. Errors:
+//!    [`DeformError`].
+//! 4. **Animate**: an [`animation::Scene`] (built in Rust, or loaded from a `.rhai` file with
+//!    [`load_scene`]) is rendered frame by frame by a [`Renderer`]. Errors: [`SceneError`],
+//!    [`RenderError`].
+//! 5. **Images**: [`FloatImage`] (sources and targets, any 8/16-bit PNG or JPEG) and
+//!    [`Canvas`] (the premultiplied frame being composited) with their [`PixelFormat`];
+//!    [`Canvas::to_rgba8_image`] hands a frame to the `image` crate. Errors: [`PixelError`].
+//!
+//! Points are [`glam`] vectors, re-exported so callers use the same version.
+//!
+//! Clone the cat's face of the bundled photo into an espresso:
+//!
+//! ```
+//! use lapclone::glam::DVec2;
+//! use lapclone::{mesh_from_mask, BitMask, Canvas, CloneOptions, FloatImage, MeshOptions};
+//! use lapclone::{PatchCloner, Placement};
+//! use std::path::Path;
+//!
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! let source = FloatImage::load(Path::new("assets/chelsea.png"))?;
+//! let mask = BitMask::load(Path::new("assets/masks/chelsea_face.png"), 0.5)?;
+//! let target = FloatImage::load(Path::new("assets/coffee.png"))?;
+//! let patch = mesh_from_mask(&mask, None, (source.width(), source.height()), &MeshOptions::default())?;
+//! let centre = (patch.bbox_min + patch.bbox_max) / 2.0;
+//! let mut cloner = PatchCloner::new(source, patch.result.mesh, &CloneOptions::default())?;
+//! let mut canvas = Canvas::from_image(&target);
+//! cloner.clone_onto(&mut canvas, &Placement::translate(centre, DVec2::new(288.0, 143.0)))?;
+//! let png = canvas.encode_png(target.format())?; // or canvas.save_png(path, format)
+//! assert!(png.starts_with(b"\x89PNG"));
+//! # Ok(())
+//! # }
+//! ```
+//!
+//! Load a scene file and render one frame for the `image` crate:
+//!
+//! ```
+//! use lapclone::{load_scene, Renderer};
+//! use std::path::Path;
+//!
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! let loaded = load_scene(Path::new("scenes/cat_in_coffee.rhai"))?;
+//! let mut renderer = Renderer::new(loaded.scene)?;
+//! let frame: lapclone::image::RgbaImage = renderer.render_time(1.5)?.to_rgba8_image();
+//! assert_eq!(frame.dimensions(), (600, 400));
+//! # Ok(())
+//! # }
+//! ```
+//!
+//! Features: `cli` (default) builds the `lapclone` program and its terminal dependencies;
+//! library users turn it off with `default-features = false`. `gif`, `bmp`, `tiff` and `webp`
+//! add those input decoders (PNG and JPEG are always read).
 
-pub mod clone;
-pub mod deform;
-pub mod golden;
-pub mod limits;
-pub mod mesh;
-pub mod output;
-pub mod pixels;
-pub mod raster;
-pub mod reference;
-pub mod render;
-pub mod scene;
-pub mod script;
-pub mod simd;
-pub mod solve;
-pub mod util;
+#![warn(missing_docs)]
+
+pub use glam;
+pub use image;
+
+pub use clone::{
+    mesh_from_mask, mesh_from_polygons, Anchor, BoundaryData, CloneError, CloneMode, CloneOptions,
+    CloneStats, PatchCloner, PatchMesh, Placement,
+};
+pub use deform::{DeformError, DeformOptions, DeformRig, DeformStats, Deformed, Handle, Pin};
+pub use mesh::{
+    BitMask, BoundaryPlacement, Mesh, MeshError, MeshOptions, MeshResult, MeshStats, Polygon,
+};
+pub use pixels::{Canvas, ColorKind, Depth, FloatImage, PixelError, PixelFormat};
+pub use render::{FrameStats, RenderError, Renderer};
+pub use script::{load_scene, LoadedScene, SceneError};
+pub use solve::LaplacianKind;
+
+/// Scenes: the animated description a [`Renderer`] draws, built in Rust or loaded from a
+/// `.rhai` file with [`load_scene`]. A [`Scene`](animation::Scene) is a
+/// [`Canvas`](animation::Canvas) (size, frame rate, duration,
+/// [`Background`](animation::Background)) and layered [`Patch`](animation::Patch)es, each
+/// with a [`Shape`](animation::Shape), an animated [`Placement`](animation::Placement), drag
+/// [`Handle`](animation::Handle)s and [`Pin`](animation::Pin)s; every animated value is a
+/// [`Track`](animation::Track) of [`Key`](animation::Key)s, each with an
+/// [`Easing`](animation::Easing).
+pub mod animation {
+    pub use crate::scene::{
+        Background, Canvas, Easing, Handle, Key, KeyError, ModelError, Patch, Pin, Placement,
+        Scene, Shape, Track,
+    };
+}
+
+/// Declares the pipeline's stage modules: private in the library, public (and undocumented)
+/// with the `internals` feature, which lapclone's own tests and `lapclone-bench` use.
+macro_rules! stage_modules {
+    ($($name:ident),* $(,)?) => {$(
+        #[cfg(feature = "internals")]
+        #[doc(hidden)]
+        pub mod $name;
+        // Without `internals`, what only the tests and benchmarks reach is unused here.
+        #[cfg(not(feature = "internals"))]
+        #[allow(dead_code, unused_imports)]
+        mod $name;
+    )*};
+}
+
+stage_modules!(
+    clone, deform, golden, limits, mesh, output, pixels, raster, render, scene, script, simd,
+    solve, util,
+);
+
+// The CLI's files name library items as `lapclone::…`, as any other user would.
+extern crate self as lapclone;
+
+// The CLI's doc comments are clap's help texts, where `[…]` marks an optional part.
+#[cfg(all(feature = "cli", feature = "internals"))]
+#[doc(hidden)]
+#[allow(rustdoc::broken_intra_doc_links)]
+pub mod cli;
+#[cfg(all(feature = "cli", not(feature = "internals")))]
+#[allow(rustdoc::broken_intra_doc_links)]
+mod cli;
+
+/// The `lapclone` program: parses `std::env::args`, runs the subcommand, reports an error on
+/// stderr and gives the exit code (0 ok, 1 failure, 2 usage). Only `src/main.rs` calls it.
+#[cfg(feature = "cli")]
+#[doc(hidden)]
+pub fn run_cli() -> i32 {
+    use clap::Parser as _;
+    let args = cli::Cli::parse();
+    match cli::run(args) {
+        Ok(()) => 0,
+        Err(err) => {
+            if let Some(usage) = err.downcast_ref::<cli::UsageError>() {
+                eprintln!("lapclone: {usage}");
+                return 2;
+            }
+            eprintln!("lapclone: error: {}", cli::describe(&err));
+            1
+        }
+    }
+}

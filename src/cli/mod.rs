@@ -4,13 +4,6 @@
 
 use clap::{Parser, Subcommand};
 
-pub mod bench;
-pub mod bench_clone;
-pub mod bench_deform;
-pub mod bench_mesh;
-pub mod bench_paper;
-pub mod bench_render;
-pub mod bench_solver;
 pub mod clone;
 pub mod mesh;
 pub mod mesh_args;
@@ -59,7 +52,7 @@ pub enum Command {
     Mesh(mesh::MeshArgs),
     /// Clone a source patch seamlessly into a target image (optionally deformed).
     Clone(clone::CloneArgs),
-    /// Render a Rhai scene into frames (PNG sequence, GIF or APNG).
+    /// Render a Rhai scene into frames (PNG sequence, GIF, APNG, Y4M, or MP4/WebM/MOV through ffmpeg).
     Render(render::RenderArgs),
     /// Render one frame of a scene.
     Preview(render::PreviewArgs),
@@ -69,8 +62,6 @@ pub enum Command {
     Repl(repl::ReplArgs),
     /// Compare scenes' frames with their golden frames (accept, reject, review changes).
     Test(test::TestArgs),
-    /// Benchmarks (release builds only give meaningful figures).
-    Bench(bench::BenchArgs),
 }
 
 pub fn run(cli: Cli) -> anyhow::Result<()> {
@@ -82,7 +73,6 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Check(args) => render::run_check(args),
         Command::Repl(args) => repl::run(args),
         Command::Test(args) => test::run(args),
-        Command::Bench(args) => bench::run(args),
     }
 }
 

@@ -43,6 +43,7 @@ impl CloneMode {
         }
     }
 
+    /// The mode named `name` (`normal`, `monochrome`), as the CLI and scenes spell it.
     pub fn from_name(name: &str) -> Option<Self> {
         [CloneMode::Normal, CloneMode::Monochrome]
             .into_iter()
@@ -53,7 +54,9 @@ impl CloneMode {
 /// Settings fixed for the life of a [`PatchCloner`] (changing them means a new cloner).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CloneOptions {
+    /// Which Laplacian the membrane solves with.
     pub laplacian: LaplacianKind,
+    /// Whether the source keeps its colour or turns grey first.
     pub mode: CloneMode,
     /// Width in px of the soft outer edge (0: a crisp anti-aliased edge).
     pub feather: f32,
@@ -75,7 +78,9 @@ impl Default for CloneOptions {
 /// What one clone did and how long its parts took.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct CloneStats {
+    /// Membrane figures (constraints, switches, solve).
     pub membrane: MembraneStats,
+    /// Raster figures (triangles, pixels, timings).
     pub raster: RasterStats,
     /// Hidden-vertex query ([`clone_deformed`](PatchCloner::clone_deformed) only), constraint
     /// switches and back-substitution.
@@ -135,6 +140,7 @@ impl PatchCloner {
         })
     }
 
+    /// The patch mesh in rest (source) coordinates.
     pub fn mesh(&self) -> &Mesh {
         &self.mesh
     }
@@ -156,6 +162,7 @@ impl PatchCloner {
         self.membrane.factorisations()
     }
 
+    /// The source image the patch is cut from.
     pub fn source(&self) -> &FloatImage {
         &self.source
     }

@@ -13,16 +13,18 @@ use crate::mesh::{
 /// A patch mesh in source coordinates, with its mask's bounding box.
 #[derive(Clone, Debug)]
 pub struct PatchMesh {
+    /// The mesh (rest = source coordinates), the mesher's warnings and statistics.
     pub result: MeshResult,
     /// Bounding box of the inside pixels (pixel corners), in source coordinates.
     pub bbox_min: DVec2,
+    /// Bottom-right corner of that bounding box; with `bbox_min` it gives the patch centre.
     pub bbox_max: DVec2,
 }
 
 /// Meshes `mask`, whose pixel (0, 0) sits at `offset` in a source of `source_size`.
 /// Without an offset the mask must have the source's size. The boundary ends on the outside
 /// pixel centres: meshed there ([`BoundaryPlacement::OutsideCentres`]), or meshed on the
-/// cracks and moved half a pixel out ([`expand_boundary`]).
+/// cracks and moved half a pixel out (`expand_boundary`).
 pub fn mesh_from_mask(
     mask: &BitMask,
     offset: Option<DVec2>,

@@ -9,9 +9,13 @@ use glam::{DAffine2, DVec2};
 /// points down) around the pivot.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Placement {
+    /// Rest (source) point the placement is anchored at.
     pub pivot: DVec2,
+    /// Where `pivot` lands in the target, pixels.
     pub at: DVec2,
+    /// Uniform scale about the pivot (> 0).
     pub scale: f64,
+    /// Rotation about the pivot, degrees (clockwise on screen).
     pub rotation_deg: f64,
 }
 
@@ -71,6 +75,7 @@ impl Placement {
         );
     }
 
+    /// Whether every number is finite and the scale positive.
     pub fn is_finite(&self) -> bool {
         self.pivot.is_finite()
             && self.at.is_finite()

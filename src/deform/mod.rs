@@ -81,8 +81,11 @@ use glam::DVec2;
 /// A drag from `from` (p0, rest frame) to `to` (p1) with falloff radius `radius` (pixels).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Handle {
+    /// Rest point (source coordinates) that is dragged.
     pub from: DVec2,
+    /// Where `from` goes, in rest coordinates.
     pub to: DVec2,
+    /// Falloff radius in pixels (> 0).
     pub radius: f64,
     /// Rotation centre o; `None`: the rest centroid of the mesh.
     pub pivot: Option<DVec2>,
@@ -169,16 +172,30 @@ impl DeformStats {
 /// Everything that can go wrong in the deform stage.
 #[derive(Debug, thiserror::Error)]
 pub enum DeformError {
+    /// The mesh has no vertices.
     #[error("cannot deform an empty mesh")]
     EmptyMesh,
+    /// The mesh breaks an invariant the rig needs.
     #[error("mesh is not valid for deformation: {0}")]
     InvalidMesh(String),
+    /// A handle is unusable (not finite, radius not positive).
     #[error("handle {index}: {reason}")]
-    InvalidHandle { index: usize, reason: String },
+    InvalidHandle {
+        /// Position of the handle in the slice given.
+        index: usize,
+        /// What is wrong with it.
+        reason: String,
+    },
+    /// A pin has a non-finite coordinate.
     #[error("pin {index}: coordinates must be finite")]
-    InvalidPin { index: usize },
+    InvalidPin {
+        /// Position of the pin in the slice given.
+        index: usize,
+    },
+    /// The [`DeformOptions`] are out of range.
     #[error("invalid deform options: {0}")]
     InvalidOptions(String),
+    /// The deformation's solver failed.
     #[error(transparent)]
     Solve(#[from] SolveError),
 }

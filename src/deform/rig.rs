@@ -23,7 +23,7 @@ pub(crate) struct HandleFrame {
     pub depth: f32,
 }
 
-/// Once-per-mesh deformation state plus reusable per-frame scratch. See [`deform`](super).
+/// Once-per-mesh deformation state plus reusable per-frame scratch. See the `deform` module.
 pub struct DeformRig {
     pub(crate) options: DeformOptions,
     pub(crate) rest: Vec<DVec2>,
@@ -100,10 +100,12 @@ impl DeformRig {
         })
     }
 
+    /// Vertices of the rest mesh.
     pub fn vertex_count(&self) -> usize {
         self.rest.len()
     }
 
+    /// The rest positions the deformation starts from.
     pub fn rest_positions(&self) -> &[DVec2] {
         &self.rest
     }
@@ -113,6 +115,7 @@ impl DeformRig {
         self.rest_centroid
     }
 
+    /// The options the rig was built with.
     pub fn options(&self) -> &DeformOptions {
         &self.options
     }

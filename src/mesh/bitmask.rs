@@ -79,7 +79,9 @@ pub(crate) fn crack_edge_count(mask: &BitMask) -> usize {
 /// A width × height grid of inside/outside pixels. Pixel (x, y) covers [x, x+1] × [y, y+1].
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct BitMask {
+    /// Columns.
     pub width: usize,
+    /// Rows.
     pub height: usize,
     inside: Vec<bool>,
 }
@@ -128,7 +130,7 @@ impl BitMask {
     }
 
     /// Reads a mask image; the error names the path. Masks over the size limits of
-    /// [`crate::limits`] are refused from their header, before decoding.
+    /// `limits` are refused from their header, before decoding.
     pub fn load(path: &Path, threshold: f32) -> Result<Self, MeshError> {
         use crate::limits::{open_image, ImageOpenError};
         let image = open_image(path).map_err(|error| {
@@ -166,6 +168,7 @@ impl BitMask {
         }
     }
 
+    /// How many pixels are inside.
     pub fn count_inside(&self) -> usize {
         let bytes = self.as_bytes();
         let mut words = bytes.chunks_exact(8);

@@ -7,52 +7,92 @@ use std::path::PathBuf;
 /// Why meshing (or reading a mask, or writing a mesh file) failed.
 #[derive(Debug, thiserror::Error)]
 pub enum MeshError {
+    /// The mask image cannot be read or decoded.
     #[error("cannot read mask {path}")]
     MaskRead {
+        /// The mask file.
         path: PathBuf,
+        /// The decoder's error.
         #[source]
         source: image::ImageError,
     },
+    /// The mask exceeds a resource limit.
     #[error("mask {path}: {source}")]
     MaskTooLarge {
+        /// The mask file.
         path: PathBuf,
+        /// Which limit.
         #[source]
         source: crate::limits::LimitError,
     },
+    /// No pixel of the mask is inside.
     #[error("mask has no inside pixels")]
     EmptyMask,
+    /// Every piece of the mask is below `min_piece_area`.
     #[error(
         "every piece of the mask is smaller than the minimum piece area ({min_piece_area} px²); \
          lower min_piece_area to keep them"
     )]
-    AllPiecesTooSmall { min_piece_area: f64 },
+    AllPiecesTooSmall {
+        /// The option's value, px².
+        min_piece_area: f64,
+    },
+    /// A [`MeshOptions`](super::MeshOptions) value is out of range.
     #[error("invalid mesh option: {0}")]
     InvalidOption(String),
+    /// A polygon is unusable (too few points, not finite, out of range).
     #[error("polygon {polygon}: {reason}")]
-    InvalidPolygon { polygon: usize, reason: String },
+    InvalidPolygon {
+        /// Position of the polygon in the list.
+        polygon: usize,
+        /// What is wrong.
+        reason: String,
+    },
+    /// The polygon list is empty.
     #[error("no polygons to mesh")]
     NoPolygons,
+    /// Boundary loops (of polygons) cross each other.
     #[error(
         "boundary loops cross each other ({conflicts} conflicting edges); loops must not intersect"
     )]
-    IntersectingBoundary { conflicts: usize },
+    IntersectingBoundary {
+        /// Edges that cross another loop.
+        conflicts: usize,
+    },
+    /// `max_vertices` is below what the boundary alone needs.
     #[error(
         "vertex budget of {max_vertices} is below the {needed} boundary vertices this mask needs; \
          raise max_vertices or the density (max boundary edge length)"
     )]
-    VertexBudget { max_vertices: usize, needed: usize },
+    VertexBudget {
+        /// The budget.
+        max_vertices: usize,
+        /// Boundary vertices needed.
+        needed: usize,
+    },
+    /// The mask's boundary is too long for the vertex budget.
     #[error(
         "the mask's boundary has {edges} pixel edges, more than the {max_edges} the vertex \
          budget allows (16 per vertex, at least 2^20); use a smoother mask or raise max_vertices"
     )]
-    BoundaryTooLong { edges: usize, max_edges: usize },
+    BoundaryTooLong {
+        /// Pixel edges on the mask's boundary.
+        edges: usize,
+        /// The most the budget allows.
+        max_edges: usize,
+    },
+    /// The triangulator failed.
     #[error("triangulation failed: {0}")]
     Triangulation(String),
+    /// The mesh broke an invariant.
     #[error("the mesh failed its sanity check")]
     Sanity(#[from] SanityError),
+    /// A mesh or Laplacian file cannot be written.
     #[error("cannot write {path}")]
     Write {
+        /// The file.
         path: PathBuf,
+        /// The I/O error.
         #[source]
         source: std::io::Error,
     },

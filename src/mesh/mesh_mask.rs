@@ -20,7 +20,9 @@ use super::{BitMask, Mesh, MeshError, MeshOptions, MeshResult, MeshStats};
 /// A polygon with holes in pixel coordinates; orientation does not matter (it is fixed up).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Polygon {
+    /// The outer boundary, any orientation, source-pixel coordinates.
     pub outer: Vec<DVec2>,
+    /// Holes inside `outer`, each a closed ring.
     pub holes: Vec<Vec<DVec2>>,
 }
 

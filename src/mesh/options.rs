@@ -35,9 +35,11 @@ pub struct MeshOptions {
     pub relax_sweeps: usize,
 }
 
-/// Where [`mesh_mask`](fn@super::mesh_mask) puts the boundary of a mask mesh.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
-#[serde(rename_all = "kebab-case")]
+/// Where `mesh_mask` (and so [`mesh_from_mask`](crate::mesh_from_mask)) puts the boundary of a
+/// mask mesh.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "kebab-case"))]
 pub enum BoundaryPlacement {
     /// The pixel cracks, simplified by `simplify_tolerance` and subdivided to `density`.
     /// The clone stage then moves it half a pixel out (`clone::expand_boundary`).
@@ -145,6 +147,7 @@ impl MeshOptions {
         }
     }
 
+    /// Checks every option is in its documented range.
     pub fn validate(&self) -> Result<(), MeshError> {
         let bad = |what: String| Err(MeshError::InvalidOption(what));
         if !(self.density.is_finite() && self.density >= 0.05) {
@@ -195,12 +198,18 @@ impl MeshOptions {
 }
 
 /// Statistics of a meshing run (no timings, so they are deterministic).
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct MeshStats {
+    /// Vertices of the mesh.
     pub vertices: usize,
+    /// Triangles of the mesh.
     pub triangles: usize,
+    /// Vertices on a boundary loop.
     pub boundary_vertices: usize,
+    /// Connected pieces.
     pub pieces: usize,
+    /// Holes over all pieces.
     pub holes: usize,
     /// Smallest triangle angle in the mesh, degrees.
     pub min_angle_deg: f64,
@@ -210,7 +219,9 @@ pub struct MeshStats {
     pub simplified: bool,
     /// spade's `refinement_complete` (false: the vertex budget ran out).
     pub refinement_complete: bool,
+    /// Pieces dropped as smaller than `min_piece_area`.
     pub dropped_pieces: usize,
+    /// Mask pixels in the dropped pieces.
     pub dropped_pixels: usize,
     /// Where the boundary ended up (`OutsideCentres` falls back to `Cracks` when the centre
     /// loops cannot be meshed, with a warning).
@@ -223,8 +234,11 @@ pub struct MeshStats {
 /// A mesh with warnings (dropped pieces, budget exhausted, fallbacks) and statistics.
 #[derive(Clone, Debug)]
 pub struct MeshResult {
+    /// The triangle mesh.
     pub mesh: Mesh,
+    /// Non-fatal notes (e.g. dropped pieces), one sentence each.
     pub warnings: Vec<String>,
+    /// Sizes and what was dropped.
     pub stats: MeshStats,
 }
 

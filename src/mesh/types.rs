@@ -28,25 +28,32 @@ pub struct BoundaryLoop {
 /// (which, with y pointing down, looks clockwise on screen).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Mesh {
+    /// Vertex positions, rest (source-pixel) coordinates.
     pub positions: Vec<DVec2>,
+    /// Counter-clockwise vertex triples.
     pub triangles: Vec<[u32; 3]>,
+    /// Closed boundary loops: outer rings and holes.
     pub loops: Vec<BoundaryLoop>,
     /// `is_boundary[v]`: v lies on a boundary loop.
     pub is_boundary: Vec<bool>,
     /// `piece[v]`: the connected piece of v (pieces touching at a vertex are one piece).
     pub piece: Vec<u32>,
+    /// Number of connected pieces.
     pub piece_count: u32,
 }
 
 impl Mesh {
+    /// Number of vertices.
     pub fn vertex_count(&self) -> usize {
         self.positions.len()
     }
 
+    /// Indices of the vertices on a boundary loop.
     pub fn boundary_vertices(&self) -> impl Iterator<Item = u32> + '_ {
         (0..self.positions.len() as u32).filter(|&v| self.is_boundary[v as usize])
     }
 
+    /// Number of hole loops.
     pub fn hole_count(&self) -> usize {
         self.loops
             .iter()

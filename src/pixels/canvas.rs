@@ -130,14 +130,17 @@ impl Canvas {
         }
     }
 
+    /// Columns.
     pub fn width(&self) -> u32 {
         self.width
     }
 
+    /// Rows.
     pub fn height(&self) -> u32 {
         self.height
     }
 
+    /// Bits per channel of the frame and its output.
     pub fn depth(&self) -> Depth {
         match self.pixels {
             CanvasPixels::Eight(_) => Depth::Eight,
@@ -145,6 +148,7 @@ impl Canvas {
         }
     }
 
+    /// The premultiplied pixels, row-major.
     pub fn pixels(&self) -> &CanvasPixels {
         &self.pixels
     }
@@ -157,6 +161,7 @@ impl Canvas {
         }
     }
 
+    /// The premultiplied pixels, mutable.
     pub fn pixels_mut(&mut self) -> &mut CanvasPixels {
         &mut self.pixels
     }

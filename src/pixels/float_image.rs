@@ -120,7 +120,7 @@ impl FloatImage {
     }
 
     /// Reads and decodes an image file (format guessed from its content); images over the
-    /// size limits of [`crate::limits`] are refused from their header, before decoding.
+    /// size limits of `limits` are refused from their header, before decoding.
     pub fn load(path: &Path) -> Result<FloatImage, PixelError> {
         let decoded = Self::decode(path)?;
         FloatImage::from_dynamic(&decoded).map_err(|err| match err {
@@ -179,14 +179,17 @@ impl FloatImage {
         FloatImage::new(width, height, pixels, format)
     }
 
+    /// Columns.
     pub fn width(&self) -> u32 {
         self.width
     }
 
+    /// Rows.
     pub fn height(&self) -> u32 {
         self.height
     }
 
+    /// The format the image was stored in.
     pub fn format(&self) -> PixelFormat {
         self.format
     }

@@ -4,31 +4,40 @@
 /// Colour model of an image file.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum ColorKind {
+    /// One grey channel.
     Grey,
+    /// Red, green, blue.
     Rgb,
 }
 
 /// Bits per channel of an image file (32-bit float inputs count as 16-bit for output).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Depth {
+    /// 8 bits per channel.
     Eight,
+    /// 16 bits per channel.
     Sixteen,
 }
 
 /// The format an image was stored in, kept so the output matches the target's.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct PixelFormat {
+    /// Grey or RGB.
     pub color: ColorKind,
+    /// Whether there is an alpha channel.
     pub alpha: bool,
+    /// Bits per channel.
     pub depth: Depth,
 }
 
 impl PixelFormat {
+    /// 8-bit RGBA.
     pub const RGBA8: PixelFormat = PixelFormat {
         color: ColorKind::Rgb,
         alpha: true,
         depth: Depth::Eight,
     };
+    /// 16-bit RGBA.
     pub const RGBA16: PixelFormat = PixelFormat {
         color: ColorKind::Rgb,
         alpha: true,

@@ -6,37 +6,51 @@ use crate::clone::CloneError;
 use crate::deform::DeformError;
 use crate::pixels::PixelError;
 
+/// Why building a renderer or rendering a frame failed.
 #[derive(Debug, thiserror::Error)]
 pub enum RenderError {
+    /// Cloning a patch failed.
     #[error("patch `{patch}`: {source}")]
     Clone {
+        /// The patch's name.
         patch: String,
+        /// The cloner's error.
         #[source]
         source: CloneError,
     },
+    /// Deforming a patch failed.
     #[error("patch `{patch}`: {source}")]
     Deform {
+        /// The patch's name.
         patch: String,
+        /// The rig's error.
         #[source]
         source: DeformError,
     },
+    /// A patch's mask cannot be read or meshed.
     #[error("patch `{patch}`: mask {}: {source}", path.display())]
     Mask {
+        /// The patch's name.
         patch: String,
+        /// The mask file.
         path: PathBuf,
         /// Boxed: mesh errors are large and every render result carries this type.
         #[source]
         source: Box<crate::mesh::MeshError>,
     },
+    /// Reading an image or drawing the background failed.
     #[error(transparent)]
     Pixels(#[from] PixelError),
+    /// Reading footage (an image sequence or a video) failed.
     #[error("{}{source}", patch.as_ref().map(|p| format!("patch `{p}`: source footage: ")).unwrap_or_else(|| "background footage: ".into()))]
     Footage {
         /// The patch whose source this is; `None` for the background.
         patch: Option<String>,
+        /// Why.
         #[source]
         source: Box<crate::pixels::FootageError>,
     },
+    /// The scene is not valid.
     #[error("scene is not valid: {0}")]
     Scene(#[from] crate::scene::ModelError),
 }

@@ -43,6 +43,7 @@ pub struct PlacedMesh<'a> {
 /// Timings and counts of the last frame.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct FrameStats {
+    /// Scene time of the frame, seconds.
     pub time: f64,
     /// Deformation constraint switches (all patches).
     pub deform_switches: usize,
@@ -54,9 +55,13 @@ pub struct FrameStats {
     pub outside: usize,
     /// Front-layer boundary vertices glued to their own patch beneath them.
     pub glued: usize,
+    /// Deformation (rigs) over all patches, ms.
     pub deform_ms: f64,
+    /// Membrane solves over all patches, ms.
     pub solve_ms: f64,
+    /// Rasterisation and compositing, ms.
     pub raster_ms: f64,
+    /// The whole frame, ms.
     pub total_ms: f64,
 }
 
@@ -109,6 +114,7 @@ impl Renderer {
         })
     }
 
+    /// The scene being rendered.
     pub fn scene(&self) -> &Scene {
         &self.scene
     }
@@ -381,6 +387,7 @@ impl Renderer {
         &self.frame
     }
 
+    /// Timings of the last frame rendered.
     pub fn last_stats(&self) -> FrameStats {
         self.stats
     }

@@ -30,6 +30,7 @@ pub enum Easing {
 }
 
 impl Easing {
+    /// Every easing, in the order the scene language documents them.
     pub const ALL: [Easing; 6] = [
         Easing::Linear,
         Easing::Hold,
@@ -51,6 +52,7 @@ impl Easing {
         }
     }
 
+    /// The easing named `name` (as scenes spell it).
     pub fn from_name(name: &str) -> Option<Easing> {
         Easing::ALL.into_iter().find(|e| e.name() == name)
     }
@@ -108,22 +110,34 @@ impl Interpolate for DVec2 {
 /// One keyframe: at `time` the track has `value`; `easing` governs the segment ending here.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Key<T> {
+    /// Seconds from the start (≥ 0).
     pub time: f64,
+    /// The value at `time`.
     pub value: T,
+    /// How the segment ending at this key is interpolated.
     pub easing: Easing,
 }
 
 /// Why a key was refused.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum KeyError {
+    /// The time is NaN or infinite.
     #[error("key time {0} is not a finite number")]
     NonFiniteTime(f64),
+    /// The time is below zero.
     #[error("key time {0} is negative")]
     NegativeTime(f64),
+    /// The value has a NaN or infinite component.
     #[error("key value is not finite")]
     NonFiniteValue,
+    /// A key that must come after the track's last one does not.
     #[error("key at t = {time} is out of order: the previous key is at t = {previous}")]
-    OutOfOrder { time: f64, previous: f64 },
+    OutOfOrder {
+        /// The key's time.
+        time: f64,
+        /// The time of the key before it.
+        previous: f64,
+    },
 }
 
 /// Keys in strictly increasing time. Empty tracks have no value (the caller's default).
@@ -150,6 +164,7 @@ fn check_time(time: f64) -> Result<(), KeyError> {
 }
 
 impl<T: Interpolate> Track<T> {
+    /// An empty track (the property keeps its default).
     pub fn new() -> Self {
         Track::default()
     }
@@ -165,10 +180,12 @@ impl<T: Interpolate> Track<T> {
         }
     }
 
+    /// The keys, in time order.
     pub fn keys(&self) -> &[Key<T>] {
         &self.keys
     }
 
+    /// Whether the track has no key.
     pub fn is_empty(&self) -> bool {
         self.keys.is_empty()
     }

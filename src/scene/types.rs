@@ -13,10 +13,12 @@ use super::track::{KeyError, Track};
 pub const MAX_CANVAS_SIDE: u32 = 16384;
 
 /// A whole scene: one canvas and patches layered in order (each clones onto the composite of
-/// the patches before it; see [`FrameState::draw_order`](super::FrameState::draw_order)).
+/// the patches before it; see `FrameState::draw_order`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Scene {
+    /// Size, timing and background.
     pub canvas: Canvas,
+    /// Patches, back to front unless their depth says otherwise.
     pub patches: Vec<Patch>,
     /// What `lapclone test` checks and how strictly (`golden(#{ … })`); rendering ignores it.
     pub golden: Option<crate::golden::GoldenSettings>,
@@ -25,15 +27,19 @@ pub struct Scene {
 /// Output size, timing and what lies under every patch.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Canvas {
+    /// Pixels.
     pub width: u32,
+    /// Pixels.
     pub height: u32,
     /// Frames per second; frame i is shown at t = i / fps.
     pub fps: f64,
     /// Seconds; the scene has [`Canvas::frame_count`] frames.
     pub duration: f64,
+    /// What the first patch is cloned onto.
     pub background: Background,
 }
 
+/// What lies under every patch.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Background {
     /// An image, drawn at the canvas origin at its own size.
@@ -55,6 +61,7 @@ pub use crate::mesh::Polygon;
 pub enum Shape {
     /// A mask image of the source's size: non-zero pixels are inside.
     Mask(PathBuf),
+    /// Polygons with holes, source-pixel coordinates.
     Polygons(Vec<Polygon>),
 }
 
@@ -82,6 +89,7 @@ pub struct Placement {
 /// A drag of the patch's rest point `from` (source coordinates) to `to(t)`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Handle {
+    /// Rest point (source coordinates) that is dragged.
     pub from: DVec2,
     /// Target over time in source coordinates; an empty track means `to = from`.
     pub to: Track<DVec2>,
@@ -99,28 +107,37 @@ pub struct Handle {
 /// Holds a rest point of the patch still while it is active: `start ≤ t < end`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Pin {
+    /// Rest point held still.
     pub at: DVec2,
+    /// Seconds from which the pin holds.
     pub start: f64,
+    /// Seconds at which it lets go; `None`: never.
     pub end: Option<f64>,
 }
 
 impl Pin {
+    /// Whether the pin holds at time `t`.
     pub fn is_active(&self, t: f64) -> bool {
         t >= self.start && self.end.is_none_or(|end| t < end)
     }
 }
 
+/// One patch: where it comes from, how it is meshed and cloned, and how it moves.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Patch {
+    /// Name, unique in the scene (errors and the REPL use it).
     pub name: String,
     /// The source image; for an animated source, its first frame (what the mask fits).
     pub source: PathBuf,
     /// An animated source: frame i clones the footage's frame i (mask and mesh stay fixed).
     pub footage: Option<Footage>,
+    /// Which pixels of the source make up the patch.
     pub shape: Shape,
     /// Mesh density (mesher's default when `None`).
     pub density: Option<f64>,
+    /// Which Laplacian the membrane solves with.
     pub laplacian: LaplacianKind,
+    /// Normal or monochrome cloning.
     pub mode: CloneMode,
     /// Width in pixels of the softened outer edge (0: hard edge, anti-aliased).
     pub feather: f64,
@@ -128,8 +145,11 @@ pub struct Patch {
     pub boundary_data: BoundaryData,
     /// Where a mask patch's mesh boundary runs (polygon patches ignore it).
     pub boundary: BoundaryPlacement,
+    /// Animated position, scale, rotation and depth.
     pub placement: Placement,
+    /// Drags, applied every frame.
     pub handles: Vec<Handle>,
+    /// Points held still while active.
     pub pins: Vec<Pin>,
 }
 
@@ -157,22 +177,37 @@ impl Patch {
 /// A structural problem found by [`Scene::sanity_check`].
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ModelError {
+    /// The canvas size is zero.
     #[error("canvas size {0}×{1} must be between 1 and {MAX_CANVAS_SIDE} on each side")]
     CanvasSize(u32, u32),
+    /// The canvas exceeds a resource limit.
     #[error("canvas {0}×{1}: {2}")]
     CanvasLimit(u32, u32, crate::limits::LimitError),
+    /// The frame rate is not a positive finite number.
     #[error("fps {0} must be a finite number > 0")]
     Fps(f64),
+    /// The duration is not a positive finite number.
     #[error("duration {0} must be a finite number > 0")]
     Duration(f64),
+    /// The background colour has a channel outside [0, 1].
     #[error("background colour channels must be finite and in [0, 1]")]
     Colour,
+    /// A patch's setting is invalid.
     #[error("patch `{patch}`: {what}")]
-    Patch { patch: String, what: String },
+    Patch {
+        /// The patch's name.
+        patch: String,
+        /// What is wrong.
+        what: String,
+    },
+    /// A key of a patch's track is invalid.
     #[error("patch `{patch}`: {track}: {error}")]
     Key {
+        /// The patch's name.
         patch: String,
+        /// Which track (`position`, `scale`, …).
         track: String,
+        /// Why the key was refused.
         error: KeyError,
     },
 }
@@ -185,6 +220,7 @@ impl Canvas {
         (frames.max(1.0)) as u64
     }
 
+    /// Checks the whole scene: canvas, every patch and every key.
     pub fn sanity_check(&self) -> Result<(), ModelError> {
         let side_ok = |s: u32| (1..=MAX_CANVAS_SIDE).contains(&s);
         if !side_ok(self.width) || !side_ok(self.height) {
@@ -221,6 +257,7 @@ impl Scene {
 }
 
 impl Patch {
+    /// Checks the patch's settings and keys.
     pub fn sanity_check(&self) -> Result<(), ModelError> {
         let fail = |what: String| ModelError::Patch {
             patch: self.name.clone(),

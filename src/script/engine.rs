@@ -65,9 +65,13 @@ pub struct SceneEngine {
 /// A parsed scene with the source positions of its objects.
 #[derive(Clone, Debug)]
 pub struct LoadedScene {
+    /// The scene the file describes.
     pub scene: Scene,
+    /// Where in the file each patch and handle was made (for positioned errors).
     pub origins: Origins,
+    /// The scene file.
     pub file: PathBuf,
+    /// The file's text.
     pub text: String,
 }
 

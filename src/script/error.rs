@@ -22,12 +22,16 @@ pub enum ErrorKind {
     Io,
 }
 
+/// A scene file's error, positioned: `file:line:col: message`, with the source line and a caret when printed.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SceneError {
+    /// What kind of failure.
     pub kind: ErrorKind,
+    /// The scene file (or module) the error is in.
     pub file: PathBuf,
     /// Rhai position (1-based line and column); `Position::NONE` when there is none.
     pub position: Position,
+    /// The message, without position.
     pub message: String,
     /// The offending source line, when known.
     pub source_line: Option<String>,
@@ -36,6 +40,7 @@ pub struct SceneError {
 impl std::error::Error for SceneError {}
 
 impl SceneError {
+    /// An error of `kind` at `position` in `file`.
     pub fn new(
         kind: ErrorKind,
         file: &Path,
@@ -53,10 +58,12 @@ impl SceneError {
         error
     }
 
+    /// The 1-based line, if known.
     pub fn line(&self) -> Option<usize> {
         self.position.line()
     }
 
+    /// The 1-based column, if known.
     pub fn column(&self) -> Option<usize> {
         self.position.position()
     }

@@ -29,6 +29,7 @@ impl LaplacianKind {
         }
     }
 
+    /// The kind named `name` (`combinatorial`, `cotangent`).
     pub fn from_name(name: &str) -> Option<Self> {
         [LaplacianKind::Combinatorial, LaplacianKind::Cotangent]
             .into_iter()

@@ -144,14 +144,7 @@ pub fn show_picture(picture: &image::RgbaImage) -> bool {
     use std::io::IsTerminal as _;
     match Inline::detect(std::io::stdout().is_terminal()) {
         Inline::None => false,
-        Inline::Sixel => {
-            let text =
-                super::sixel::encode_sixel(picture.as_raw(), picture.width(), picture.height());
-            let mut out = std::io::stdout().lock();
-            let _ = writeln!(out, "{text}");
-            let _ = out.flush();
-            true
-        }
+        Inline::Sixel => write_sixel(picture),
         protocol => {
             let mut png = Vec::new();
             let encoded =
@@ -185,11 +178,19 @@ fn print_inline(protocol: Inline, png: &[u8]) {
 }
 
 fn print_sixel(renderer: &Renderer) {
-    let picture = renderer.frame().to_rgba8_image();
-    let text = super::sixel::encode_sixel(picture.as_raw(), picture.width(), picture.height());
+    // A preview that cannot be encoded is skipped; the text line still names the PNG.
+    write_sixel(&renderer.frame().to_rgba8_image());
+}
+
+/// Draws `picture` as sixel graphics; false (nothing printed) if it cannot be encoded.
+fn write_sixel(picture: &image::RgbaImage) -> bool {
+    let Ok(text) = super::sixel::encode_sixel(picture) else {
+        return false;
+    };
     let mut out = std::io::stdout().lock();
     let _ = writeln!(out, "{text}");
     let _ = out.flush();
+    true
 }
 
 /// Kitty's graphics protocol: the PNG in base64 chunks of at most 4096 bytes.
@@ -207,26 +208,10 @@ fn write_kitty(out: &mut impl std::io::Write, data: &str) -> std::io::Result<()>
     writeln!(out)
 }
 
-/// Standard base64 with padding.
+/// Standard base64 with padding (RFC 4648), as both protocols expect.
 pub fn base64(bytes: &[u8]) -> String {
-    const TABLE: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    let mut out = String::with_capacity(bytes.len().div_ceil(3) * 4);
-    for group in bytes.chunks(3) {
-        let b = [
-            group[0],
-            *group.get(1).unwrap_or(&0),
-            *group.get(2).unwrap_or(&0),
-        ];
-        let n = (u32::from(b[0]) << 16) | (u32::from(b[1]) << 8) | u32::from(b[2]);
-        for k in 0..4 {
-            if k <= group.len() {
-                out.push(TABLE[(n >> (18 - 6 * k)) as usize & 63] as char);
-            } else {
-                out.push('=');
-            }
-        }
-    }
-    out
+    use ::base64::Engine as _;
+    ::base64::engine::general_purpose::STANDARD.encode(bytes)
 }
 
 /// Whether `path` can hold a preview: its folder exists.

@@ -1,0 +1,11 @@
+//! lapclone's measurements, kept out of the library: takes lapclone's pipeline (through its
+//! internal stage modules) and gives the baselines it is measured against and the benchmark
+//! commands of the `lapclone-bench` binary.
+//!
+//! - [`reference`](mod@reference): the pixel-grid Poisson membrane, MVC cloning, the quality metrics and
+//!   the paper's experiments and figures;
+//! - [`commands`]: `lapclone-bench mesh | factor | solver | deform | render | clone | paper`,
+//!   each printing a table or, with `--json`, one JSON document.
+
+pub mod commands;
+pub mod reference;

@@ -1,0 +1,122 @@
+//! Interrupted renders (docs/robustness.md): SIGINT during `lapclone render` leaves only
+//! complete frames (each decodes fully) and no temporary file, and the render exits 1
+//! saying it was interrupted; an interrupted GIF/APNG leaves no file at all.
+//!
+//! No sleeps: the test polls for the first output with a bounded, yielding loop.
+
+#![cfg(unix)]
+
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+
+use crate::files;
+use files::sorted_names;
+
+/// A long scene (2 000 frames) so the render is still running when the signal comes.
+fn write_scene(dir: &Path) -> PathBuf {
+    let assets = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets");
+    let scene = dir.join("long.rhai");
+    let text = format!(
+        "canvas(64, 48, #{{ fps: 100, duration: 20, background: \"{}\" }});\n\
+         let p = patch(\"p\", #{{ source: \"{}\", polygons: [[[10, 10], [60, 14], [30, 50]]] }});\n\
+         p.at(0, [30, 24]).at(20, [40, 30]);\n\
+         p.drag([40, 16], 12).key(0, [40, 16]).key(20, [46, 20]);\n",
+        assets.join("coffee.png").display(),
+        assets.join("chelsea.png").display()
+    );
+    std::fs::write(&scene, text).unwrap();
+    scene
+}
+
+fn spawn_render(scene: &Path, out: &Path, extra: &[&str]) -> Child {
+    Command::new(env!("CARGO_BIN_EXE_lapclone"))
+        .arg("render")
+        .arg(scene)
+        .arg("-o")
+        .arg(out)
+        .args(extra)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
+/// Polls (yielding, bounded) until `ready` holds or the child has exited.
+fn wait_until(child: &mut Child, mut ready: impl FnMut() -> bool) -> bool {
+    for _ in 0..50_000_000u64 {
+        if ready() {
+            return true;
+        }
+        if child.try_wait().unwrap().is_some() {
+            return false;
+        }
+        std::thread::yield_now();
+    }
+    false
+}
+
+fn interrupt(child: &Child) {
+    let status = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+}
+
+#[test]
+fn sigint_leaves_only_complete_frames() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write_scene(dir.path());
+    let frames = dir.path().join("frames");
+    let mut child = spawn_render(&scene, &frames, &["--jobs", "2"]);
+    let first = frames.join("frame_0001.png");
+    assert!(
+        wait_until(&mut child, || first.exists()),
+        "the render ended before its first frame appeared"
+    );
+    interrupt(&child);
+    let output = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("interrupted"), "{stderr}");
+    let written = sorted_names(&frames);
+    assert!(!written.is_empty());
+    assert!(
+        written.len() < 2000,
+        "all frames were written: the signal came too late to test anything"
+    );
+    for name in &written {
+        assert!(
+            name.starts_with("frame_") && name.ends_with(".png"),
+            "stray file {name}"
+        );
+        let image = image::open(frames.join(name))
+            .unwrap_or_else(|e| panic!("{name} does not decode: {e}"));
+        assert_eq!((image.width(), image.height()), (64, 48), "{name}");
+    }
+}
+
+#[test]
+fn sigint_during_an_animation_file_leaves_no_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write_scene(dir.path());
+    for format in ["apng", "gif"] {
+        let out = dir.path().join(format!("movie.{format}"));
+        let mut child = spawn_render(&scene, &out, &["--format", format]);
+        // The writer's temporary file appears once the first frame is being written.
+        let started = wait_until(&mut child, || {
+            sorted_names(dir.path()).iter().any(|n| n.ends_with(".tmp"))
+        });
+        assert!(started, "{format}: the render ended before writing");
+        interrupt(&child);
+        let output = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(1), "{format}: {stderr}");
+        assert!(stderr.contains("interrupted"), "{format}: {stderr}");
+        assert_eq!(
+            sorted_names(dir.path()),
+            ["long.rhai"],
+            "{format}: the interrupted render left files"
+        );
+    }
+}

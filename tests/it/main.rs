@@ -1,0 +1,56 @@
+//! lapclone's integration tests, one binary with a module per area (linking one binary
+//! instead of one per file keeps a fresh `cargo test` short). Each module tests one stage
+//! or command through the library (with the `internals` feature) or the built `lapclone`
+//! binary; `tests/common/` holds the shared helpers, declared here once.
+
+#[path = "../common/solve_checks.rs"]
+mod checks;
+#[path = "../common/files.rs"]
+mod files;
+#[path = "../common/clone_fixtures.rs"]
+mod fixtures;
+#[path = "../common/golden.rs"]
+mod golden;
+#[path = "../common/raster_meshes.rs"]
+mod raster_meshes;
+
+mod bad_input;
+mod clone_cli;
+mod clone_glue;
+mod clone_golden;
+mod clone_numeric;
+mod deform_basic;
+mod deform_switching;
+mod determinism_cli;
+mod fuzz_mesh;
+mod fuzz_scene;
+mod interrupt_cli;
+mod mesh_cli;
+mod mesh_quality_options;
+mod mesh_shapes;
+mod numeric_faults;
+mod output_apng;
+mod output_gif;
+mod output_writers;
+mod pixels_formats;
+mod raster_covered;
+mod raster_draw;
+mod raster_fill_rule;
+mod raster_golden;
+mod render_cli;
+mod repl_pty;
+mod repl_session;
+mod repl_set_scene;
+mod scene_check_cli;
+mod scene_editing;
+mod scene_golden;
+mod scene_language;
+mod scene_roundtrip;
+mod simd_paths;
+mod solve_factor;
+mod solve_layout;
+mod solve_panels;
+mod solve_supernodal;
+mod solve_update;
+mod test_cli;
+mod video_cli;

@@ -1,0 +1,253 @@
+//! `lapclone repl` driven through its non-interactive mode (stdin piped into the binary):
+//! load, edit, error recovery, undo, multi-line input, `:list`, and `:save` → `lapclone
+//! render` giving byte-identical frames to the live scene's `:render`.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+
+use crate::files;
+use files::asset;
+
+/// A tiny scene (64×48, 3 frames) with one polygon patch of the cat photo.
+fn tiny_scene(dir: &Path) -> PathBuf {
+    let text = format!(
+        r#"canvas(64, 48, #{{ fps: 6, duration: 0.5, background: [0.2, 0.3, 0.4] }});
+let blob = patch("blob", #{{
+    source: "{}",
+    polygons: [[[150, 60], [185, 60], [190, 90], [160, 95]]],
+}});
+blob.at(0, [30, 24]);
+"#,
+        asset("chelsea.png")
+    );
+    let path = dir.join("tiny.rhai");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+fn repl(dir: &Path, args: &[&str], input: &str) -> Output {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_lapclone"))
+        .arg("repl")
+        .args(args)
+        .arg("--preview")
+        .arg(dir.join("preview.png"))
+        .current_dir(dir)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(input.as_bytes())
+        .unwrap();
+    child.wait_with_output().unwrap()
+}
+
+fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+#[test]
+fn edits_list_and_write_the_preview() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = tiny_scene(dir.path());
+    let out = repl(
+        dir.path(),
+        &[scene.to_str().unwrap()],
+        "blob.at(0.4, [36, 20]);\n:list\n40 + 2\n",
+    );
+    let (stdout, stderr) = (text(&out.stdout), text(&out.stderr));
+    assert!(out.status.success(), "{stdout}\n{stderr}");
+    assert!(
+        stdout.contains("canvas 64×48, 6 fps, 0.5 s (3 frames)"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("patch \"blob\""), "{stdout}");
+    assert!(stdout.contains("boundary data hat-average"), "{stdout}");
+    assert!(stdout.contains("boundary outside-centres"), "{stdout}");
+    assert!(stdout.contains("keys: position 2, scale 0"), "{stdout}");
+    assert!(stdout.contains("variables: blob"), "{stdout}");
+    assert!(stdout.lines().any(|l| l == "42"), "{stdout}");
+    assert!(
+        !stdout.contains('\x1b'),
+        "no escape sequences when not interactive"
+    );
+    assert_eq!(
+        stdout.matches("preview:").count(),
+        1,
+        "path shown once: {stdout}"
+    );
+    let preview = image::open(dir.path().join("preview.png")).unwrap();
+    assert_eq!((preview.width(), preview.height()), (64, 48));
+}
+
+#[test]
+fn a_failed_line_changes_nothing_and_the_session_goes_on() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = tiny_scene(dir.path());
+    let input = "\
+blob.at(0.2, [31, 24]); let extra = 1; nope(3);
+extra
+blob.at(0.1, [40, 30]);
+:list
+";
+    let out = repl(dir.path(), &[scene.to_str().unwrap()], input);
+    let (stdout, stderr) = (text(&out.stdout), text(&out.stderr));
+    assert_eq!(out.status.code(), Some(1), "a failed entry gives exit 1");
+    // The first entry failed at its third statement: position, source line and caret.
+    assert!(
+        stderr.contains("<entry 1>:1:40: unknown function or wrong argument types: nope"),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains(&format!("\n{}^", " ".repeat(39))),
+        "{stderr}"
+    );
+    // Its variable is gone and its key was not kept: `extra` fails, the third line works.
+    assert!(stderr.contains("<entry 2>"), "{stderr}");
+    assert!(stdout.contains("keys: position 2"), "{stdout}");
+    assert!(stdout.contains("variables: blob\n"), "{stdout}");
+}
+
+#[test]
+fn undo_goes_back_one_change() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = tiny_scene(dir.path());
+    let input = "\
+blob.at(0.2, [31, 24]);
+blob.scale(0, 1.2);
+:undo
+:list
+:undo
+:list
+:undo
+";
+    let out = repl(dir.path(), &[scene.to_str().unwrap()], input);
+    let (stdout, stderr) = (text(&out.stdout), text(&out.stderr));
+    let lists: Vec<&str> = stdout.lines().filter(|l| l.contains("keys:")).collect();
+    assert_eq!(
+        lists,
+        [
+            "  keys: position 2, scale 0, rotation 0, depth 0, opacity 0",
+            "  keys: position 1, scale 0, rotation 0, depth 0, opacity 0"
+        ],
+        "{stdout}"
+    );
+    assert!(stderr.contains("nothing to undo"), "{stderr}");
+    assert_eq!(out.status.code(), Some(1));
+}
+
+#[test]
+fn unfinished_input_continues_on_the_next_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = tiny_scene(dir.path());
+    let input = "\
+let k = [1,
+  2,
+  3];
+k.len()
+fn shift(x) {
+  x + 5
+}
+blob.key(0.3, #{
+  at: [shift(30), 24],
+});
+:list
+";
+    let out = repl(dir.path(), &[scene.to_str().unwrap()], input);
+    let (stdout, stderr) = (text(&out.stdout), text(&out.stderr));
+    assert!(out.status.success(), "{stdout}\n{stderr}");
+    assert!(stdout.lines().any(|l| l == "3"), "{stdout}");
+    assert!(stdout.contains("keys: position 2"), "{stdout}");
+}
+
+#[test]
+fn functions_and_imports_persist_across_entries() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = tiny_scene(dir.path());
+    std::fs::write(dir.path().join("helpers.rhai"), "fn twice(x) { 2 * x }\n").unwrap();
+    let input = "\
+import \"helpers\" as h;
+fn add1(x) { x + 1 }
+add1(h::twice(20))
+";
+    let out = repl(dir.path(), &[scene.to_str().unwrap()], input);
+    let (stdout, stderr) = (text(&out.stdout), text(&out.stderr));
+    assert!(out.status.success(), "{stdout}\n{stderr}");
+    assert!(stdout.lines().any(|l| l == "41"), "{stdout}");
+}
+
+fn frames_in(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut files: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    files.sort();
+    files
+        .into_iter()
+        .map(|p| {
+            (
+                p.file_name().unwrap().to_string_lossy().into_owned(),
+                std::fs::read(&p).unwrap(),
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn saved_scene_renders_the_live_frames_byte_for_byte() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = tiny_scene(dir.path());
+    let saved_dir = dir.path().join("elsewhere");
+    std::fs::create_dir(&saved_dir).unwrap();
+    let input = "\
+blob.at(0.3, [40, 26], \"ease_in_out\").rotate(0, 0).rotate(0.5, 25);
+blob.drag([170, 75], 12).key(0, [170, 75]).key(0.4, [176, 70], \"smooth\");
+:t 0.25
+:save elsewhere/saved.rhai
+:render -o live
+";
+    let out = repl(dir.path(), &[scene.to_str().unwrap()], input);
+    let (stdout, stderr) = (text(&out.stdout), text(&out.stderr));
+    assert!(out.status.success(), "{stdout}\n{stderr}");
+    let render = Command::new(env!("CARGO_BIN_EXE_lapclone"))
+        .args(["render", "saved.rhai", "-o"])
+        .arg(dir.path().join("from_file"))
+        .current_dir(&saved_dir)
+        .output()
+        .unwrap();
+    assert!(render.status.success(), "{}", text(&render.stderr));
+    let live = frames_in(&dir.path().join("live"));
+    let from_file = frames_in(&dir.path().join("from_file"));
+    assert_eq!(live.len(), 3);
+    assert!(live == from_file, "frames differ");
+}
+
+#[test]
+fn script_file_mode_and_bad_commands() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = tiny_scene(dir.path());
+    std::fs::write(
+        dir.path().join("edit.txt"),
+        ":frame 2\n:stats\n:frame 9\n:bogus\n",
+    )
+    .unwrap();
+    let out = repl(
+        dir.path(),
+        &[scene.to_str().unwrap(), "--script", "edit.txt"],
+        "",
+    );
+    let (stdout, stderr) = (text(&out.stdout), text(&out.stderr));
+    assert_eq!(out.status.code(), Some(1), "{stdout}\n{stderr}");
+    assert!(stdout.contains("ms total"), "{stdout}");
+    assert!(
+        stderr.contains("frame 9: the scene has 3 frames"),
+        "{stderr}"
+    );
+    assert!(stderr.contains("unknown command `:bogus`"), "{stderr}");
+    assert!(stderr.contains("2 failed entries"), "{stderr}");
+}

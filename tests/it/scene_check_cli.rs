@@ -1,0 +1,127 @@
+//! `lapclone check`: success summary, positioned errors with a caret, exit codes; and the
+//! `preview` flag group.
+
+use std::path::Path;
+use std::process::Command;
+
+use crate::files;
+use files::asset;
+
+fn check(dir: &Path, text: &str) -> (i32, String, String) {
+    let scene = dir.join("scene.rhai");
+    std::fs::write(&scene, text).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_lapclone"))
+        .arg("check")
+        .arg(&scene)
+        .output()
+        .unwrap();
+    (
+        out.status.code().unwrap(),
+        String::from_utf8(out.stdout).unwrap(),
+        String::from_utf8(out.stderr).unwrap(),
+    )
+}
+
+fn head() -> String {
+    format!(
+        "canvas(320, 240, #{{ fps: 12, duration: 2, background: \"{}\" }});\n\
+         let p = patch(\"tri\", #{{ source: \"{}\", polygons: [[[10, 10], [200, 20], [50, 180]]] }});\n",
+        asset("coffee.png"),
+        asset("astronaut.png")
+    )
+}
+
+#[test]
+fn a_valid_scene_passes_with_a_summary() {
+    let dir = tempfile::tempdir().unwrap();
+    let (code, stdout, _) = check(
+        dir.path(),
+        &format!(
+            "{}p.at(0, [100, 100]);\np.at(2, [200, 100], \"smooth\");\n",
+            head()
+        ),
+    );
+    assert_eq!(code, 0);
+    assert!(
+        stdout.contains("ok") && stdout.contains("24 frames") && stdout.contains("1 patches"),
+        "{stdout}"
+    );
+}
+
+#[test]
+fn a_missing_key_is_shown_with_a_caret() {
+    let dir = tempfile::tempdir().unwrap();
+    let (code, _, stderr) = check(
+        dir.path(),
+        &format!("{}p.at(1, [0, 0]);\n  p.remove_key(0.5, \"at\");\n", head()),
+    );
+    assert_eq!(code, 1);
+    let scene = dir.path().join("scene.rhai");
+    let expected = format!(
+        "{}:4:5: no \"at\" key at t = 0.5 on patch \"tri\"; its keys are at 1",
+        scene.display()
+    );
+    assert!(stderr.contains(&expected), "{stderr}");
+    assert!(
+        stderr.contains("\n  p.remove_key(0.5, \"at\");\n    ^"),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn a_mask_of_the_wrong_size_points_at_its_patch() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = format!(
+        "canvas(64, 64);\n\nlet m = patch(\"m\", #{{ source: \"{}\", mask: \"{}\" }});\n",
+        asset("astronaut.png"),
+        asset("horse_mask.png")
+    );
+    let (code, _, stderr) = check(dir.path(), &text);
+    assert_eq!(code, 1);
+    assert!(
+        stderr.contains("scene.rhai:3:9: ") && stderr.contains("mask is 400×328"),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn an_empty_polygon_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = format!(
+        "canvas(64, 64);\nlet z = patch(\"z\", #{{ source: \"{}\", polygons: [[[0, 0], [10, 0], [20, 0]]] }});\n",
+        asset("astronaut.png")
+    );
+    let (code, _, stderr) = check(dir.path(), &text);
+    assert_eq!(code, 1);
+    assert!(
+        stderr.contains("scene.rhai:2:9: ") && stderr.contains("empty"),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn missing_scene_and_syntax_errors_exit_1() {
+    let dir = tempfile::tempdir().unwrap();
+    let (code, _, stderr) = check(dir.path(), "canvas(8, 8;\n");
+    assert_eq!(code, 1);
+    assert!(
+        stderr.contains("scene.rhai:1:") && stderr.contains("syntax error"),
+        "{stderr}"
+    );
+    let out = Command::new(env!("CARGO_BIN_EXE_lapclone"))
+        .args(["check", "/no/such/scene.rhai"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+}
+
+#[test]
+fn preview_time_and_frame_are_exclusive() {
+    let out = Command::new(env!("CARGO_BIN_EXE_lapclone"))
+        .args([
+            "preview", "s.rhai", "--t", "1", "--frame", "3", "-o", "x.png",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+}
