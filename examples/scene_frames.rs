@@ -32,16 +32,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     face.placement.scale.push(1.0, 0.42, Easing::Smooth)?;
 
     let coffee = image::image_dimensions(assets.join("coffee.png"))?;
-    let scene = Scene {
-        canvas: Canvas {
-            width: coffee.0,
-            height: coffee.1,
-            fps: 8.0,
-            duration: 1.0,
-            background: Background::Image(assets.join("coffee.png")),
-        },
-        patches: vec![face],
+    let canvas = Canvas {
+        width: coffee.0,
+        height: coffee.1,
+        fps: 8.0,
+        duration: 1.0,
+        background: Background::Image(assets.join("coffee.png")),
     };
+    let scene = Scene::new(canvas, vec![face]);
 
     let mut renderer = Renderer::new(scene)?;
     let format = renderer.output_format();

@@ -66,6 +66,7 @@
 //! add those input decoders (PNG and JPEG are always read).
 
 #![warn(missing_docs)]
+#![forbid(unsafe_code)]
 
 pub use glam;
 pub use image;

@@ -20,6 +20,8 @@ mod centre_loops;
 mod contour;
 mod coverage;
 mod error;
+#[doc(hidden)]
+pub mod fixtures;
 mod laplacian_mtx;
 mod mesh_mask;
 mod options;

@@ -35,7 +35,7 @@ pub struct MeshOptions {
     pub relax_sweeps: usize,
 }
 
-/// Where `mesh_mask` (and so [`mesh_from_mask`](crate::mesh_from_mask)) puts the boundary of a
+/// Where `mesh_mask` (and so `mesh_from_mask`) puts the boundary of a
 /// mask mesh.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]

@@ -114,7 +114,7 @@ impl Mesh {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::solve::fixtures;
+    use crate::mesh::fixtures;
 
     /// The counting sort gives what sorting and deduplicating every triangle edge gives.
     #[test]

@@ -6,7 +6,7 @@
 //! seamless clone itself is unchanged; opacity only weighs its finished pixels.
 
 use crate::pixels::{Canvas, CanvasPixels};
-use crate::raster::PixelRect;
+use crate::pixels::PixelRect;
 
 /// Blends `frame` (cloned) towards `below` inside `rect` (clipped to the canvas). Both
 /// canvases have the same size and depth (the renderer keeps `below` as a copy of `frame`).

@@ -1,7 +1,7 @@
 //! The scene: a canvas and layered, keyframed patches as plain Rust values ([`Scene`]), their
 //! evaluation at a time ([`Scene::evaluate`] → [`FrameState`]) and their writing back as a
 //! Rhai scene file ([`Scene::to_rhai`]), and warnings about what no frame shows
-//! ([`Scene::warnings`]). Parsing scene files lives in [`crate::script`].
+//! ([`Scene::warnings`]). Parsing scene files lives in the script stage.
 
 mod evaluate;
 mod to_rhai;

@@ -246,6 +246,15 @@ impl Canvas {
 }
 
 impl Scene {
+    /// A scene of `patches` (back to front) on `canvas`, with no golden-frame settings.
+    pub fn new(canvas: Canvas, patches: Vec<Patch>) -> Self {
+        Self {
+            canvas,
+            patches,
+            golden: None,
+        }
+    }
+
     /// Every value finite and in range, every track ordered.
     pub fn sanity_check(&self) -> Result<(), ModelError> {
         self.canvas.sanity_check()?;

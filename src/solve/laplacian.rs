@@ -124,7 +124,7 @@ fn cotangent_edges(mesh: &Mesh) -> Vec<(u32, u32, f64)> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::solve::fixtures;
+    use crate::mesh::fixtures;
 
     /// The reference assembly the direct one replaced: every edge and diagonal as a triplet,
     /// sorted and summed by [`SymmetricCsc::from_triplets`].

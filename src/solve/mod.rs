@@ -33,8 +33,6 @@
 
 pub mod csc;
 pub mod faer_layout;
-#[doc(hidden)]
-pub mod fixtures;
 pub mod laplacian;
 pub mod matrix_market;
 pub mod numeric;

@@ -5,9 +5,9 @@
 //! `#[path = "common/solve_checks.rs"] mod checks;`.
 #![allow(dead_code)]
 
+use lapclone::mesh::fixtures;
 use lapclone::mesh::Mesh;
 use lapclone::simd::Path;
-use lapclone::solve::fixtures;
 use lapclone::solve::FactorMethod;
 
 /// Every numeric factorisation the solver offers.

@@ -2,8 +2,9 @@
 
 use glam::DVec2;
 use lapclone::deform::{DeformOptions, DeformRig, Deformed, Handle, Pin};
+use lapclone::mesh::fixtures;
 use lapclone::mesh::Mesh;
-use lapclone::solve::{fixtures, LaplacianKind};
+use lapclone::solve::LaplacianKind;
 
 const KINDS: [LaplacianKind; 2] = [LaplacianKind::Combinatorial, LaplacianKind::Cotangent];
 

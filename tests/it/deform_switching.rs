@@ -4,8 +4,9 @@
 
 use glam::DVec2;
 use lapclone::deform::{DeformRig, Deformed, Handle, Pin};
+use lapclone::mesh::fixtures;
 use lapclone::mesh::Mesh;
-use lapclone::solve::{fixtures, laplacian, LaplacianKind};
+use lapclone::solve::{laplacian, LaplacianKind};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed};
 

@@ -1,9 +1,8 @@
 //! Factorisation, solve and Laplacian tests for the solve stage, against dense references.
 
+use lapclone::mesh::fixtures;
 use lapclone::mesh::Mesh;
-use lapclone::solve::{
-    fixtures, laplacian, LaplacianKind, PenaltyFactor, PenaltyOptions, SymmetricCsc,
-};
+use lapclone::solve::{laplacian, LaplacianKind, PenaltyFactor, PenaltyOptions, SymmetricCsc};
 
 use crate::checks;
 use checks::{dense_solve, rel_diff, Rng};

@@ -3,9 +3,8 @@
 //! must rebuild `L·D·Lᵀ` = the permuted penalised matrix. Fails if a faer upgrade changes
 //! how it stores a simplicial or supernodal LDLᵀ factor.
 
-use lapclone::solve::{
-    fixtures, laplacian, FactorMethod, LaplacianKind, PenaltyFactor, PenaltyOptions,
-};
+use lapclone::mesh::fixtures;
+use lapclone::solve::{laplacian, FactorMethod, LaplacianKind, PenaltyFactor, PenaltyOptions};
 
 #[test]
 fn every_factor_kind_rebuilds_the_matrix_through_the_column_layout() {

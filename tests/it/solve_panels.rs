@@ -4,13 +4,12 @@
 //! bit for bit); random meshes
 //! and right-hand sides by proptest with a fixed seed.
 
+use lapclone::mesh::fixtures;
 use lapclone::mesh::Mesh;
 use lapclone::solve::solve::ldlt_solve_interleaved;
 use lapclone::solve::solve_supernodal::{inverse_diagonal, lanes_for, ldlt_solve_supernodal_at};
 use lapclone::solve::symbolic::SymbolicFactor;
-use lapclone::solve::{
-    fixtures, laplacian, FactorMethod, LaplacianKind, PenaltyFactor, PenaltyOptions,
-};
+use lapclone::solve::{laplacian, FactorMethod, LaplacianKind, PenaltyFactor, PenaltyOptions};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed};
 

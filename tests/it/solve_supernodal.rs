@@ -6,8 +6,9 @@ use lapclone::solve::symbolic::{SymbolicFactor, SUPERNODAL_MIN_VERTICES};
 
 use crate::checks;
 use checks::{dense_solve, rel_diff, Rng};
+use lapclone::mesh::fixtures;
 use lapclone::solve::{
-    fixtures, laplacian, FactorMethod, LaplacianKind, PenaltyFactor, PenaltyOptions, SymmetricCsc,
+    laplacian, FactorMethod, LaplacianKind, PenaltyFactor, PenaltyOptions, SymmetricCsc,
 };
 
 const SUPERNODAL: [FactorMethod; 2] = [FactorMethod::Supernodal, FactorMethod::SupernodalRelaxed];

@@ -1,7 +1,8 @@
 //! Rank-1 constraint switching: updated factors against fresh factorisations, and the guards.
 
+use lapclone::mesh::fixtures;
 use lapclone::solve::{
-    fixtures, laplacian, LaplacianKind, PenaltyFactor, PenaltyOptions, SolveError, SymmetricCsc,
+    laplacian, LaplacianKind, PenaltyFactor, PenaltyOptions, SolveError, SymmetricCsc,
 };
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed};

@@ -5,7 +5,8 @@
 
 use glam::DVec2;
 use lapclone::deform::{DeformRig, Deformed, Handle, Pin};
-use lapclone::solve::{fixtures, LaplacianKind};
+use lapclone::mesh::fixtures;
+use lapclone::solve::LaplacianKind;
 use std::time::Instant;
 
 #[derive(clap::Args, Debug)]

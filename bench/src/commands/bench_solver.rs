@@ -3,11 +3,12 @@
 //! built-in disc meshes. Release builds only give meaningful figures.
 
 use anyhow::Context;
+use lapclone::mesh::fixtures;
 use lapclone::simd::Path;
 use lapclone::solve::solve::ldlt_solve_interleaved;
 use lapclone::solve::solve_supernodal::{inverse_diagonal, ldlt_solve_supernodal_at};
 use lapclone::solve::{
-    fixtures, laplacian, read_constrained_list, read_matrix_market, FactorMethod, LaplacianKind,
+    laplacian, read_constrained_list, read_matrix_market, FactorMethod, LaplacianKind,
     PenaltyFactor, PenaltyOptions, SymmetricCsc,
 };
 use std::path::PathBuf;

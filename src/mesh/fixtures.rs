@@ -2,7 +2,7 @@
 //! triangulated grids, hexagonal-ring discs and disjoint unions as complete [`Mesh`] values
 //! (positions, positively oriented triangles, boundary loops, flags, pieces).
 
-use crate::mesh::{BoundaryLoop, LoopKind, Mesh};
+use super::{BoundaryLoop, LoopKind, Mesh};
 use glam::DVec2;
 
 /// A `cols × rows` cell grid of unit squares, each split into two triangles;
