@@ -61,7 +61,7 @@ pub struct TestArgs {
     /// Frames to check in every scene, e.g. 1,12,48 or 1..5 (numbered from 1).
     #[arg(long, value_parser = frame_list)]
     pub frames: Option<FrameList>,
-    /// Root of the goldens instead of `goldens/` beside each scene: DIR/<stem>/frame_NNNN.png.
+    /// Root of the goldens instead of `goldens/` beside each scene: `DIR/<stem>/frame_NNNN.png`.
     #[arg(long, value_name = "DIR")]
     pub goldens: Option<PathBuf>,
     /// A pixel fails when a channel differs by more than T (8-bit units) [default: 1].

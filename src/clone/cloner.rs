@@ -177,7 +177,9 @@ impl PatchCloner {
         &self.membrane
     }
 
-    /// The glued vertices of the last clone (see [`Glue`]).
+    /// The glued vertices of the last clone (the glue's internals, for lapclone's own tests).
+    #[cfg(feature = "internals")]
+    #[doc(hidden)]
     pub fn glue(&self) -> &Glue {
         &self.glue
     }

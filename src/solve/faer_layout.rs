@@ -2,7 +2,7 @@
 //! (and, after a numeric factorisation, supernodal) LDLᵀ factor and gives the one column
 //! layout that the rank-1 kernel ([`update`](super::update)) and the solves
 //! ([`solve_supernodal`](super::solve_supernodal), [`solve`](mod@super::solve)) read and
-//! write; [`check`] verifies it for every analysed pattern.
+//! write; `check` verifies it for every analysed pattern.
 //!
 //! Layout: column `j` of the factor occupies `col_ptr[j]..col_ptr[j+1]`; its first entry has
 //! row `j` and holds `D_jj`; the remaining rows are strictly increasing and hold `L_ij`, so
@@ -14,8 +14,8 @@
 //! supernode `s` covers columns `begin..end`; its values are one column-major
 //! `(ncols + |P|) × ncols` block whose top square holds `D` on the diagonal and unit-lower
 //! `L` below it, the bottom `|P|` rows — the supernode's pattern `P` — holding `L`. Column
-//! `j` then gets the rows `j..end` of the diagonal block followed by `P` ([`columns`]), and
-//! [`compact_supernodes`] moves the values there in place after each factorisation.
+//! `j` then gets the rows `j..end` of the diagonal block followed by `P` (`columns`), and
+//! `compact_supernodes` moves the values there in place after each factorisation.
 //! Relaxed supernodes store explicit zeros, which the kernels carry along harmlessly (they
 //! stay exactly zero). `tests/solve_layout.rs` rebuilds `L·D·Lᵀ` from the converted values
 //! and compares it with the matrix, so an upgrade that changes any of this fails there.
