@@ -39,8 +39,8 @@ golden(#{ frames: [1, 12, 48], fail: 2, fail_percent: 0.1 }); flags override it.
 
 A new frame (no golden) or a failing one writes frame_NNNN.new.png beside its golden, and its
 actual frame, difference image and expected | difference | actual triptych under --out, with
-an index.html. Nothing is written beside the goldens while CI is set, except by --update or
---accept.
+an index.html. While CI is set nothing is written unless asked for: no golden or pending file
+except by --update or --accept, and pictures only with an explicit --out.
 
 Exit codes: 0 all passed (warnings allowed), 1 a frame failed or had no golden, 2 usage error
 or a scene that does not load.
@@ -85,9 +85,10 @@ pub struct TestArgs {
     /// One JSON object per frame on stdout instead of text lines.
     #[arg(long)]
     pub json: bool,
-    /// Folder for failure pictures and index.html.
-    #[arg(long, value_name = "DIR", default_value = "lapclone-test-out")]
-    pub out: PathBuf,
+    /// Folder for failure pictures and index.html [default: lapclone-test-out; with CI set,
+    /// none unless given].
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
     /// Promote every pending frame_NNNN.new.png (under the paths given) to its golden.
     #[arg(long)]
     pub accept: bool,
@@ -154,6 +155,27 @@ fn unit_interval(text: &str) -> Result<f64, String> {
         return Err(format!("`{text}` must be in 0..=1"));
     }
     Ok(value)
+}
+
+/// The report folder when `--out` is not given.
+const DEFAULT_OUT: &str = "lapclone-test-out";
+
+impl TestArgs {
+    /// The `--out` folder, or its default; scene search skips it.
+    pub fn out_dir(&self) -> PathBuf {
+        self.out
+            .clone()
+            .unwrap_or_else(|| PathBuf::from(DEFAULT_OUT))
+    }
+
+    /// Where failure pictures and `index.html` go: none on CI unless `--out` was given, so a
+    /// CI run writes nothing it was not asked for.
+    pub fn report_dir(&self) -> Option<PathBuf> {
+        match &self.out {
+            Some(dir) => Some(dir.clone()),
+            None => (!is_ci()).then(|| PathBuf::from(DEFAULT_OUT)),
+        }
+    }
 }
 
 /// Whether the environment says this is a CI run (`CI` set, and not to `false` or `0`).
@@ -289,7 +311,7 @@ pub fn run(args: TestArgs) -> anyhow::Result<()> {
             .into());
         }
     }
-    let scenes = find_scenes(&paths, &args.out)?;
+    let scenes = find_scenes(&paths, &args.out_dir())?;
     if scenes.is_empty() {
         return Err(
             UsageError(format!("no scene files (*.rhai) found in {}", list(&paths))).into(),
@@ -535,16 +557,18 @@ fn check_frame(
             write_file(&result.paths.pending, &png)?;
             result.pending_written = Some(result.paths.pending.clone());
         }
-        let pictures = write_pictures(
-            job,
-            scene,
-            number,
-            &png,
-            expected.as_ref(),
-            &actual,
-            thresholds,
-        )?;
-        result.pictures = Some(pictures);
+        if let Some(root) = job.args.report_dir() {
+            let pictures = write_pictures(
+                &root,
+                scene,
+                number,
+                &png,
+                expected.as_ref(),
+                &actual,
+                thresholds,
+            )?;
+            result.pictures = Some(pictures);
+        }
         Ok(())
     })();
     if let Err(error) = written {
@@ -579,7 +603,7 @@ fn judge(
 
 /// Writes the actual frame, the difference image and the triptych under `--out`.
 fn write_pictures(
-    job: &Job,
+    root: &Path,
     scene: &Path,
     number: u64,
     png: &[u8],
@@ -587,7 +611,7 @@ fn write_pictures(
     actual: &GoldenFrame,
     thresholds: &Thresholds,
 ) -> anyhow::Result<Pictures> {
-    let dir = job.args.out.join(test_report::scene_slug(scene));
+    let dir = root.join(test_report::scene_slug(scene));
     let stem = format!("frame_{number:04}");
     let pictures = Pictures {
         actual: dir.join(format!("{stem}.actual.png")),

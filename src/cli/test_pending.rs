@@ -55,9 +55,9 @@ fn is_pending_name(name: &str) -> bool {
 fn find_pending(args: &TestArgs, paths: &[PathBuf]) -> anyhow::Result<Vec<PathBuf>> {
     let mut found = Vec::new();
     for path in paths.iter().filter(|p| p.is_dir()) {
-        walk(path, &args.out, &mut found)?;
+        walk(path, &args.out_dir(), &mut found)?;
     }
-    for scene in find_scenes(paths, &args.out)? {
+    for scene in find_scenes(paths, &args.out_dir())? {
         let dir = golden_dir(&scene, args.goldens.as_deref());
         if dir.is_dir() {
             collect_in(&dir, &mut found)?;
@@ -189,7 +189,7 @@ fn show(args: &TestArgs, file: &Path) -> anyhow::Result<()> {
     let sheet = triptych(expected.as_ref(), &actual, &thresholds);
     if !show_inline(&sheet) {
         let name = format!("{}.png", scene_slug(&file.with_extension("")));
-        let path = args.out.join("review").join(name);
+        let path = args.out_dir().join("review").join(name);
         write_file(&path, &lapclone::golden::encode_rgba_png(&sheet))?;
         println!("  expected | difference | actual: {}", path.display());
     }

@@ -91,8 +91,11 @@ pub fn finish(
         .flat_map(|r| r.frames.iter().map(move |f| (r, f)))
         .filter(|(_, f)| f.pictures.is_some())
         .collect();
-    if !shown.is_empty() || args.out.join("index.html").is_file() {
-        write_index(&args.out, &shown, &counts)?;
+    let report = args.report_dir();
+    if let Some(dir) = &report {
+        if !shown.is_empty() || dir.join("index.html").is_file() {
+            write_index(dir, &shown, &counts)?;
+        }
     }
     if let Some(path) = &args.junit {
         let xml = junit_xml(results, &counts, seconds);
@@ -105,8 +108,8 @@ pub fn finish(
         .filter(|f| f.pending_written.is_some())
         .count();
     let mut notes = Vec::new();
-    if !shown.is_empty() {
-        notes.push(format!("report: {}", args.out.join("index.html").display()));
+    if let Some(dir) = report.filter(|_| !shown.is_empty()) {
+        notes.push(format!("report: {}", dir.join("index.html").display()));
     }
     if pending > 0 {
         notes.push(format!(

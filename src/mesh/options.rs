@@ -90,13 +90,11 @@ pub const MIN_MAX_AREA: f64 = 0.25;
 
 impl Default for MeshOptions {
     /// - `density` 3 px: on the spiral, PSNR against the pixel-grid clone saturates with
-    ///   boundary density (`lapclone bench paper --sweep`, docs/quality.md; outside centres,
+    ///   boundary density (`lapclone-bench paper --sweep`, docs/quality.md; outside centres,
     ///   combinatorial / cotangent: 39.3 / 43.3 dB at 4 px, 38.6 / 43.8 at 3, 41.6 / 48.6
     ///   at 2, 42.0 / 49.5 at 1 with 2 × the vertices of 3 px), while
-    ///   vertices, meshing, factor and re-clone time grow as 1/density. Since large masks
-    ///   are meshed as two halves at once, the 770×743 spiral meshes in 6–7 ms at 3 px and
-    ///   9 ms at 2 px (its 20 ms budget no longer decides); 3 px keeps the first clone and
-    ///   the re-clone of issue #4 within reach. Seam-critical work can ask for `density` 1–2.
+    ///   vertices, meshing, factor and re-clone time grow as 1/density; 3 px keeps an
+    ///   interactive re-clone cheap. Seam-critical work can ask for `density` 1–2.
     /// - `simplify_tolerance` 0.9 px: keeps every mask pixel centre within 0.5 px of the
     ///   mesh (a centre is 0.5 px inside the crack boundary) and every mesh point within
     ///   0.9 px of the mask.
@@ -133,10 +131,10 @@ pub const SEAM_QUALITY_MIN_ANGLE_DEG: f64 = 29.0;
 pub const SEAM_QUALITY_RELAX_SWEEPS: usize = 5;
 
 impl MeshOptions {
-    /// Meets issue #8's quality bar on the 770×743 spiral (combinatorial ≥ 45 dB, cotangent
-    /// ≥ 52 dB against the pixel-grid clone; measured 45.8 / 54.3) at about three times the
-    /// default's vertices and re-clone time (docs/quality.md): boundary vertices on every
-    /// Dirichlet pixel centre, a 29° angle bound, 5 relaxation sweeps.
+    /// Reaches 45 dB (combinatorial) and 52 dB (cotangent) on the 770×743 spiral against the
+    /// pixel-grid clone (measured 45.8 / 54.3) at about three times the default's vertices and
+    /// re-clone time (docs/quality.md): boundary vertices on every Dirichlet pixel centre, a
+    /// 29° angle bound, 5 relaxation sweeps.
     pub fn seam_quality() -> Self {
         Self {
             density: 1.0,

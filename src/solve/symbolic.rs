@@ -31,7 +31,7 @@ pub enum FactorMethod {
     SupernodalRelaxed,
 }
 
-/// Crossover of [`FactorMethod::Auto`], measured with `lapclone bench factor` on disc meshes
+/// Crossover of [`FactorMethod::Auto`], measured with `lapclone-bench factor` on disc meshes
 /// (combinatorial Laplacian, AMD): below it faer's simplicial LDLᵀ is as fast or faster
 /// (≈1 ms either way at 2k vertices), above it the supernodal one wins by a growing factor
 /// (≈2× at 5e4, ≈5× at 5e5 vertices).
@@ -44,8 +44,8 @@ const RELAXED_SUPERNODES: &[(usize, f64)] = &[(4, 1.0), (16, 0.8), (48, 0.1), (u
 /// The supernodal factorisation [`FactorMethod::Auto`] picks above the crossover. Relaxed
 /// amalgamation factors ≈25 % faster than fundamental supernodes (callgrind at 52k vertices:
 /// 355 M vs 468 M instructions; `bench factor` best-of: 86 vs 151 ms under load) at the price
-/// of ≈13 % more stored entries, i.e. ≈11 % slower solves and switches; the factor target is
-/// the one the fundamental variant misses, so relaxed it is.
+/// of ≈13 % more stored entries, i.e. ≈11 % slower solves and switches; a large mesh is
+/// factored once and switched rarely, so the factor's time decides.
 pub const AUTO_SUPERNODAL: FactorMethod = FactorMethod::SupernodalRelaxed;
 use faer::sparse::SymbolicSparseColMatRef;
 use faer::Side;

@@ -281,17 +281,30 @@ fn review_accepts_rejects_and_skips_from_its_input() {
 }
 
 #[test]
-fn with_ci_set_nothing_is_written_beside_the_goldens() {
+fn with_ci_set_nothing_is_written() {
     let fixture = moved_fixture();
     let before = fixture.files();
     let check = fixture.run_env(&[], &[("CI", "1")]);
     assert_eq!(code(&check), 1);
-    let after: Vec<String> = fixture
+    assert_eq!(
+        fixture.files(),
+        before,
+        "no golden, pending file or picture under CI"
+    );
+    // An explicit --out asks for the failure pictures, CI or not; still no pending file.
+    let report = fixture.run_env(&["--out", "report"], &[("CI", "1")]);
+    assert_eq!(code(&report), 1);
+    let written: Vec<String> = fixture
         .files()
         .into_iter()
-        .filter(|f| !f.starts_with("lapclone-test-out"))
+        .filter(|f| !before.contains(f))
         .collect();
-    assert_eq!(after, before, "no golden or pending file under CI");
+    assert!(!written.is_empty(), "pictures under --out");
+    assert!(
+        written.iter().all(|f| f.starts_with("report")),
+        "{written:?}"
+    );
+    std::fs::remove_dir_all(fixture.root.join("report")).unwrap();
     // A new scene under CI: missing goldens fail, and none is created.
     std::fs::remove_dir_all(fixture.root.join("goldens")).unwrap();
     assert_eq!(code(&fixture.run_env(&[], &[("CI", "true")])), 1);

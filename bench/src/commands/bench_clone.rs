@@ -53,7 +53,7 @@ pub struct CloneBenchArgs {
     pub mesh: super::mesh_args::MeshQualityArgs,
 }
 
-/// OpenCV 5.0 `seamlessClone` (NORMAL) on the spiral masks, ms (issue #4).
+/// OpenCV 5.0 `seamlessClone` (NORMAL) on the spiral masks, ms.
 const OPENCV_MS: [(usize, f64); 2] = [(400, 40.0), (800, 184.0)];
 
 #[derive(serde::Serialize)]
