@@ -14,6 +14,8 @@
 
 use glam::DVec2;
 
+use crate::raster::PointGrid;
+
 /// A candidate over a lower layer: the triangle beneath it and its weights there.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Beneath {
@@ -28,74 +30,19 @@ pub struct Beneath {
 /// Reusable buffers of the candidates' grid and the best triangle found for each.
 #[derive(Default, Debug)]
 pub struct CandidateGrid {
-    /// Per cell (and one past the last): the first of its candidates in `cell_candidates`.
-    cell_start: Vec<u32>,
-    /// Indices into `candidates`, grouped by cell.
-    cell_candidates: Vec<u32>,
-    cell_of_candidate: Vec<u32>,
+    grid: PointGrid,
     candidates: Vec<(u32, u32)>,
     /// Per candidate: the topmost lower triangle so far and its depth there.
     best: Vec<Option<(f64, Beneath)>>,
-    min: DVec2,
-    max: DVec2,
-    inverse_cell: f64,
-    columns: usize,
-    rows: usize,
 }
 
 impl CandidateGrid {
     /// Buckets the candidates' placed positions (the grid covers their bounding box).
     fn build(&mut self, placed: &[DVec2]) {
-        let (mut min, mut max) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
-        for &(_, v) in &self.candidates {
-            let p = placed[v as usize];
-            (min, max) = (min.min(p), max.max(p));
-        }
-        (self.min, self.max) = (min, max);
-        let extent = (max - min).max(DVec2::splat(1e-9));
-        // The coverage query's sizing: about four cells per candidate, and a flat box kept
-        // at about 4n cells per side.
-        let slots = 4.0 * self.candidates.len() as f64;
-        let cell = ((extent.x * extent.y) / slots)
-            .sqrt()
-            .max(extent.max_element() / slots)
-            .max(1e-9);
-        self.columns = ((extent.x / cell).ceil() as usize).clamp(1, 4096);
-        self.rows = ((extent.y / cell).ceil() as usize).clamp(1, 4096);
-        self.inverse_cell = 1.0 / (extent.x / self.columns as f64).max(extent.y / self.rows as f64);
-        let cells = self.columns * self.rows;
-        self.cell_start.clear();
-        self.cell_start.resize(cells + 1, 0);
-        self.cell_of_candidate.clear();
-        for k in 0..self.candidates.len() {
-            let (c, r) = self.cell_of(placed[self.candidates[k].1 as usize]);
-            // At most 4096² cells, so the index fits u32.
-            let cell = (r * self.columns + c) as u32;
-            self.cell_of_candidate.push(cell);
-            self.cell_start[cell as usize + 1] += 1;
-        }
-        for i in 0..cells {
-            self.cell_start[i + 1] += self.cell_start[i];
-        }
-        // Counting sort: the start serves as the cursor, then shifting one cell restores it.
-        self.cell_candidates.clear();
-        self.cell_candidates.resize(self.candidates.len(), 0);
-        for (k, &cell) in self.cell_of_candidate.iter().enumerate() {
-            let cursor = &mut self.cell_start[cell as usize];
-            self.cell_candidates[*cursor as usize] = k as u32;
-            *cursor += 1;
-        }
-        self.cell_start.copy_within(0..cells, 1);
-        self.cell_start[0] = 0;
+        self.grid
+            .build(self.candidates.iter().map(|&(_, v)| placed[v as usize]));
         self.best.clear();
         self.best.resize(self.candidates.len(), None);
-    }
-
-    fn cell_of(&self, p: DVec2) -> (usize, usize) {
-        let q = (p - self.min) * self.inverse_cell;
-        let c = (q.x.max(0.0) as usize).min(self.columns - 1);
-        let r = (q.y.max(0.0) as usize).min(self.rows - 1);
-        (c, r)
     }
 
     /// Offers triangle `triangle` to the candidates strictly inside its box.
@@ -103,40 +50,32 @@ impl CandidateGrid {
         let corners = triangle.map(|i| placed[i as usize]);
         let [a, b, c] = corners;
         let (min, max) = (a.min(b).min(c), a.max(b).max(c));
-        if !(max.x > self.min.x && max.y > self.min.y && min.x < self.max.x && min.y < self.max.y) {
-            return;
-        }
-        let ((c0, r0), (c1, r1)) = (self.cell_of(min), self.cell_of(max));
-        for r in r0..=r1 {
-            let row = r * self.columns;
-            let range = self.cell_start[row + c0] as usize..self.cell_start[row + c1 + 1] as usize;
-            for i in range {
-                let k = self.cell_candidates[i] as usize;
-                let (slot, vertex) = self.candidates[k];
-                let p = placed[vertex as usize];
-                let in_box = p.x > min.x && p.y > min.y && p.x < max.x && p.y < max.y;
-                if !in_box || triangle.contains(&vertex) {
-                    continue;
-                }
-                let Some(weights) = weights_if_strictly_inside(corners, p) else {
-                    continue;
-                };
-                let d: f64 = (0..3)
-                    .map(|j| weights[j] * f64::from(depth[triangle[j] as usize]))
-                    .sum();
-                // Triangles come in index order, so `>=` keeps the later one on equal depth.
-                let lower = d < f64::from(depth[vertex as usize]);
-                if lower && self.best[k].is_none_or(|(top, _)| d >= top) {
-                    let hit = Beneath {
-                        vertex,
-                        slot,
-                        triangle,
-                        weights,
-                    };
-                    self.best[k] = Some((d, hit));
-                }
+        let (candidates, best) = (&self.candidates, &mut self.best);
+        self.grid.near_box(min, max, |k| {
+            let (slot, vertex) = candidates[k];
+            let p = placed[vertex as usize];
+            let in_box = p.x > min.x && p.y > min.y && p.x < max.x && p.y < max.y;
+            if !in_box || triangle.contains(&vertex) {
+                return;
             }
-        }
+            let Some(weights) = weights_if_strictly_inside(corners, p) else {
+                return;
+            };
+            let d: f64 = (0..3)
+                .map(|j| weights[j] * f64::from(depth[triangle[j] as usize]))
+                .sum();
+            // Triangles come in index order, so `>=` keeps the later one on equal depth.
+            let lower = d < f64::from(depth[vertex as usize]);
+            if lower && best[k].is_none_or(|(top, _)| d >= top) {
+                let hit = Beneath {
+                    vertex,
+                    slot,
+                    triangle,
+                    weights,
+                };
+                best[k] = Some((d, hit));
+            }
+        });
     }
 }
 

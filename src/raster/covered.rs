@@ -5,10 +5,8 @@
 //! strictly greater than the vertex's own. Independent of the pixel grid; candidates are
 //! reported in the order given, so the answer is deterministic.
 //!
-//! A uniform grid over the candidates, rebuilt per call into reusable buffers, lets each
-//! triangle look only at the candidates near it: per grid row that its bounding box spans,
-//! the candidates of its cells are one contiguous slice (cells are numbered row by row), so
-//! a triangle costs a few slice look-ups plus a box test per nearby candidate. The candidates
+//! A uniform grid over the candidates ([`PointGrid`]) lets each triangle look only at the
+//! candidates near it: a few slice look-ups plus a box test per nearby candidate. The candidates
 //! are about a fifth of the vertices and sit along the boundary, so this visits far fewer
 //! (candidate, triangle) pairs than a grid over the triangles queried per candidate, and a
 //! candidate found covered is not tested again. The predicate of each pair is unchanged, so
@@ -16,25 +14,15 @@
 
 use glam::DVec2;
 
+use super::point_grid::PointGrid;
 use super::RasterError;
 
 /// Reusable buffers of the candidates' grid.
 #[derive(Default, Debug)]
 pub struct CoverageGrid {
-    /// Per cell (and one past the last): the first of its candidates in `cell_candidates`.
-    cell_start: Vec<u32>,
-    /// Candidate slots (indices into the candidate list), grouped by cell.
-    cell_candidates: Vec<u32>,
-    /// Per slot: its cell.
-    cell_of_slot: Vec<u32>,
+    grid: PointGrid,
     /// Per slot: found covered.
     covered: Vec<bool>,
-    /// The candidates' bounding box.
-    min: DVec2,
-    max: DVec2,
-    inverse_cell: f64,
-    columns: usize,
-    rows: usize,
 }
 
 impl CoverageGrid {
@@ -44,60 +32,10 @@ impl CoverageGrid {
 
     /// Buckets the candidates' placed positions (the grid covers their bounding box).
     fn build(&mut self, placed: &[DVec2], candidates: &[u32]) {
-        self.min = DVec2::splat(f64::INFINITY);
-        self.max = DVec2::splat(f64::NEG_INFINITY);
-        for &v in candidates {
-            let p = placed[v as usize];
-            self.min = self.min.min(p);
-            self.max = self.max.max(p);
-        }
-        let extent = (self.max - self.min).max(DVec2::splat(1e-9));
-        // About four cells per candidate: boundary candidates line up along curves, so an
-        // occupied cell holds a few, and a small boundary triangle's box spans one or two
-        // cells. The second bound keeps a box that is flat (candidates on a line) at about
-        // 4n cells per side, so never more than about 12n cells.
-        let slots = 4.0 * candidates.len() as f64;
-        let cell = ((extent.x * extent.y) / slots)
-            .sqrt()
-            .max(extent.max_element() / slots)
-            .max(1e-9);
-        self.columns = ((extent.x / cell).ceil() as usize).clamp(1, 4096);
-        self.rows = ((extent.y / cell).ceil() as usize).clamp(1, 4096);
-        self.inverse_cell = 1.0 / (extent.x / self.columns as f64).max(extent.y / self.rows as f64);
-        let cells = self.columns * self.rows;
-        self.cell_start.clear();
-        self.cell_start.resize(cells + 1, 0);
-        self.cell_of_slot.clear();
-        for &v in candidates {
-            let (c, r) = self.cell_of(placed[v as usize]);
-            // Cells are at most 4096² < 2³², so the index fits u32.
-            let cell = (r * self.columns + c) as u32;
-            self.cell_of_slot.push(cell);
-            self.cell_start[cell as usize + 1] += 1;
-        }
-        for i in 0..cells {
-            self.cell_start[i + 1] += self.cell_start[i];
-        }
-        // Counting sort: `cell_start[cell]` serves as the cell's cursor, so afterwards each
-        // entry holds the next cell's start, and shifting by one cell restores the starts.
-        self.cell_candidates.clear();
-        self.cell_candidates.resize(candidates.len(), 0);
-        for (slot, &cell) in self.cell_of_slot.iter().enumerate() {
-            let cursor = &mut self.cell_start[cell as usize];
-            self.cell_candidates[*cursor as usize] = slot as u32;
-            *cursor += 1;
-        }
-        self.cell_start.copy_within(0..cells, 1);
-        self.cell_start[0] = 0;
+        self.grid
+            .build(candidates.iter().map(|&v| placed[v as usize]));
         self.covered.clear();
         self.covered.resize(candidates.len(), false);
-    }
-
-    fn cell_of(&self, p: DVec2) -> (usize, usize) {
-        let q = (p - self.min) * self.inverse_cell;
-        let c = (q.x.max(0.0) as usize).min(self.columns - 1);
-        let r = (q.y.max(0.0) as usize).min(self.rows - 1);
-        (c, r)
     }
 
     /// Marks the candidates that triangle `tri` covers (see the module doc).
@@ -105,30 +43,20 @@ impl CoverageGrid {
         let corners = tri.map(|i| query.placed[i as usize]);
         let [a, b, c] = corners;
         let (min, max) = (a.min(b).min(c), a.max(b).max(c));
-        if !(max.x > self.min.x && max.y > self.min.y && min.x < self.max.x && min.y < self.max.y) {
-            return; // no candidate strictly inside the box
-        }
-        // A point strictly inside the triangle is strictly inside its box, and the cell map
-        // is monotone, so the box's corner cells bound every cell such a point falls in.
-        let ((c0, r0), (c1, r1)) = (self.cell_of(min), self.cell_of(max));
         let depth = tri.map(|i| query.depth[i as usize]);
-        for r in r0..=r1 {
-            let row = r * self.columns;
-            let slots = self.cell_start[row + c0] as usize..self.cell_start[row + c1 + 1] as usize;
-            for k in slots {
-                let slot = self.cell_candidates[k] as usize;
-                if self.covered[slot] {
-                    continue;
-                }
-                let v = query.candidates[slot];
-                let p = query.placed[v as usize];
-                let in_box = p.x > min.x && p.y > min.y && p.x < max.x && p.y < max.y;
-                self.covered[slot] = in_box
-                    && !tri.contains(&v)
-                    && depth_if_strictly_inside(corners, depth, p)
-                        .is_some_and(|d| d > f64::from(query.depth[v as usize]));
+        let covered = &mut self.covered;
+        self.grid.near_box(min, max, |slot| {
+            if covered[slot] {
+                return;
             }
-        }
+            let v = query.candidates[slot];
+            let p = query.placed[v as usize];
+            let in_box = p.x > min.x && p.y > min.y && p.x < max.x && p.y < max.y;
+            covered[slot] = in_box
+                && !tri.contains(&v)
+                && depth_if_strictly_inside(corners, depth, p)
+                    .is_some_and(|d| d > f64::from(query.depth[v as usize]));
+        });
     }
 }
 

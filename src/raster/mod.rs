@@ -35,6 +35,7 @@ mod feather;
 mod folds;
 pub mod overlay;
 mod patch;
+mod point_grid;
 mod prepare;
 mod sampler;
 mod scratch;
@@ -44,6 +45,7 @@ mod triangles;
 
 pub use crate::pixels::PixelRect;
 pub use covered::{covered_boundary_vertices, CoverageGrid};
+pub use point_grid::PointGrid;
 pub use draw::{draw_patch, RasterOptions, RasterStats};
 pub use error::RasterError;
 pub use patch::Patch;
