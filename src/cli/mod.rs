@@ -10,6 +10,7 @@ pub mod mesh_args;
 pub mod render;
 pub mod repl;
 pub mod test;
+pub mod test_args;
 pub mod test_pending;
 pub mod test_report;
 
@@ -61,7 +62,7 @@ pub enum Command {
     /// Edit a scene interactively.
     Repl(repl::ReplArgs),
     /// Compare scenes' frames with their golden frames (accept, reject, review changes).
-    Test(test::TestArgs),
+    Test(test_args::TestArgs),
 }
 
 pub fn run(cli: Cli) -> anyhow::Result<()> {

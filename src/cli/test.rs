@@ -14,275 +14,18 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::mpsc;
 use std::time::Instant;
 
-use anyhow::Context as _;
-use lapclone::golden::{
-    compare, encode_rgba_png, triptych, Comparison, GoldenError, GoldenFrame, Mismatch, Thresholds,
-    Verdict,
-};
+use lapclone::golden::{compare, encode_rgba_png, triptych, GoldenError, GoldenFrame, Thresholds};
 use lapclone::output::{frame_digits, frame_file_name};
 use lapclone::pixels::Canvas;
 use lapclone::render::Renderer;
 
 use super::render::{default_jobs, positioned};
+use super::test_args::{
+    find_scenes, golden_dir, is_ci, overrides, pending_path, remove_if_present, write_file,
+    FramePaths, FrameResult, Outcome, Pictures, SceneFailure, SceneResult, Status, TestArgs,
+};
 use super::test_report::{self, Reporter};
 use super::UsageError;
-
-const AFTER_HELP: &str = "\
-Goldens live beside each scene in goldens/<scene stem>/frame_NNNN.png (numbered as
-`lapclone render` numbers frames, from 1), at the scene's bit depth.
-
-A pixel fails when any channel differs by more than --fail (8-bit units: one level of an
-8-bit channel is 1); a frame fails when more than --fail-percent of its pixels fail, when any
-channel differs by more than --hard-fail, or when its SSIM is below --min-ssim. --warn and
---warn-percent do the same for warnings. A scene sets its own frames and thresholds with
-golden(#{ frames: [1, 12, 48], fail: 2, fail_percent: 0.1 }); flags override it.
-
-A new frame (no golden) or a failing one writes frame_NNNN.new.png beside its golden, and its
-actual frame, difference image and expected | difference | actual triptych under --out, with
-an index.html. While CI is set nothing is written unless asked for: no golden or pending file
-except by --update or --accept, and pictures only with an explicit --out.
-
-Exit codes: 0 all passed (warnings allowed), 1 a frame failed or had no golden, 2 usage error
-or a scene that does not load.
-
-Examples:
-  lapclone test scenes/ --update        write every golden
-  lapclone test                         check every scene under the current folder
-  lapclone test --review                accept / reject / skip each pending frame
-  lapclone test --junit report.xml      also write JUnit XML for CI";
-
-#[derive(clap::Args, Debug)]
-#[command(after_help = AFTER_HELP)]
-#[command(group(clap::ArgGroup::new("mode").args(["accept", "reject", "review", "update"]).multiple(false)))]
-pub struct TestArgs {
-    /// Scene files or folders (searched recursively for *.rhai; folders named `scripts`,
-    /// `goldens` or `target` and hidden ones are skipped). Default: the current folder.
-    pub paths: Vec<PathBuf>,
-    /// Frames to check in every scene, e.g. 1,12,48 or 1..5 (numbered from 1).
-    #[arg(long, value_parser = frame_list)]
-    pub frames: Option<FrameList>,
-    /// Root of the goldens instead of `goldens/` beside each scene: `DIR/<stem>/frame_NNNN.png`.
-    #[arg(long, value_name = "DIR")]
-    pub goldens: Option<PathBuf>,
-    /// A pixel fails when a channel differs by more than T (8-bit units) [default: 1].
-    #[arg(long, value_name = "T", value_parser = non_negative)]
-    pub fail: Option<f64>,
-    /// Percentage of pixels allowed to fail [default: 0].
-    #[arg(long, value_name = "P", value_parser = percent)]
-    pub fail_percent: Option<f64>,
-    /// Any channel differing by more than T fails the frame, whatever the percentage.
-    #[arg(long, value_name = "T", value_parser = non_negative)]
-    pub hard_fail: Option<f64>,
-    /// A pixel warns when a channel differs by more than T [default: 0].
-    #[arg(long, value_name = "T", value_parser = non_negative)]
-    pub warn: Option<f64>,
-    /// Percentage of pixels allowed to warn [default: 0].
-    #[arg(long, value_name = "P", value_parser = percent)]
-    pub warn_percent: Option<f64>,
-    /// The frame fails when its SSIM (0–1) is below S.
-    #[arg(long, value_name = "S", value_parser = unit_interval)]
-    pub min_ssim: Option<f64>,
-    /// One JSON object per frame on stdout instead of text lines.
-    #[arg(long)]
-    pub json: bool,
-    /// Folder for failure pictures and index.html [default: lapclone-test-out; with CI set,
-    /// none unless given].
-    #[arg(long, value_name = "DIR")]
-    pub out: Option<PathBuf>,
-    /// Promote every pending frame_NNNN.new.png (under the paths given) to its golden.
-    #[arg(long)]
-    pub accept: bool,
-    /// Delete every pending frame_NNNN.new.png (under the paths given).
-    #[arg(long)]
-    pub reject: bool,
-    /// Go through pending frames one by one: accept, reject or skip.
-    #[arg(long)]
-    pub review: bool,
-    /// Render and overwrite every checked golden (also with CI set).
-    #[arg(long)]
-    pub update: bool,
-    /// Also write JUnit XML (one test case per scene and frame) to FILE.
-    #[arg(long, value_name = "FILE")]
-    pub junit: Option<PathBuf>,
-    /// Scenes checked at once (default: available cores).
-    #[arg(long, allow_hyphen_values = true)]
-    pub jobs: Option<usize>,
-}
-
-/// Frame numbers from 1, sorted, without repeats.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct FrameList(pub Vec<u64>);
-
-/// `1,12,48`, `1..5` or a mix.
-pub fn frame_list(text: &str) -> Result<FrameList, String> {
-    let mut frames = Vec::new();
-    for part in text.split(',') {
-        let part = part.trim();
-        if part.contains("..") {
-            let range = super::render::frame_range(part)?;
-            frames.extend(range.first..=range.last.min(range.first + 100_000));
-        } else {
-            match part.parse::<u64>() {
-                Ok(n) if n >= 1 => frames.push(n),
-                _ => return Err(format!("`{part}` is not a frame number (from 1)")),
-            }
-        }
-    }
-    frames.sort_unstable();
-    frames.dedup();
-    Ok(FrameList(frames))
-}
-
-fn non_negative(text: &str) -> Result<f64, String> {
-    let value = super::finite_f64(text)?;
-    if value < 0.0 {
-        return Err(format!("`{text}` must be ≥ 0"));
-    }
-    Ok(value)
-}
-
-fn percent(text: &str) -> Result<f64, String> {
-    let value = non_negative(text)?;
-    if value > 100.0 {
-        return Err(format!("`{text}` must be a percentage in 0..=100"));
-    }
-    Ok(value)
-}
-
-fn unit_interval(text: &str) -> Result<f64, String> {
-    let value = super::finite_f64(text)?;
-    if !(0.0..=1.0).contains(&value) {
-        return Err(format!("`{text}` must be in 0..=1"));
-    }
-    Ok(value)
-}
-
-/// The report folder when `--out` is not given.
-const DEFAULT_OUT: &str = "lapclone-test-out";
-
-impl TestArgs {
-    /// The `--out` folder, or its default; scene search skips it.
-    pub fn out_dir(&self) -> PathBuf {
-        self.out
-            .clone()
-            .unwrap_or_else(|| PathBuf::from(DEFAULT_OUT))
-    }
-
-    /// Where failure pictures and `index.html` go: none on CI unless `--out` was given, so a
-    /// CI run writes nothing it was not asked for.
-    pub fn report_dir(&self) -> Option<PathBuf> {
-        match &self.out {
-            Some(dir) => Some(dir.clone()),
-            None => (!is_ci()).then(|| PathBuf::from(DEFAULT_OUT)),
-        }
-    }
-}
-
-/// Whether the environment says this is a CI run (`CI` set, and not to `false` or `0`).
-pub fn is_ci() -> bool {
-    std::env::var("CI").is_ok_and(|v| !v.is_empty() && v != "false" && v != "0")
-}
-
-/// Where one frame's golden and pending files live.
-#[derive(Clone, Debug)]
-pub struct FramePaths {
-    pub golden: PathBuf,
-    pub pending: PathBuf,
-}
-
-/// The pending file of a golden: `frame_NNNN.png` → `frame_NNNN.new.png`.
-pub fn pending_path(golden: &Path) -> PathBuf {
-    golden.with_extension("new.png")
-}
-
-/// The folder holding a scene's goldens.
-pub fn golden_dir(scene: &Path, root: Option<&Path>) -> PathBuf {
-    let stem = scene.file_stem().unwrap_or_default();
-    match root {
-        Some(root) => root.join(stem),
-        None => scene
-            .parent()
-            .unwrap_or(Path::new(""))
-            .join("goldens")
-            .join(stem),
-    }
-}
-
-/// What happened to one frame.
-#[derive(Debug)]
-pub enum Outcome {
-    Compared(Comparison),
-    Mismatch(Mismatch),
-    /// No golden file; whether its folder existed.
-    Missing {
-        folder: bool,
-    },
-    /// The golden exists but cannot be read.
-    Unreadable(String),
-    /// `--update` wrote the golden.
-    Updated,
-}
-
-/// The status word and whether it counts as a failure.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Status {
-    Pass,
-    Warn,
-    Fail,
-    New,
-    Updated,
-}
-
-impl Outcome {
-    pub fn status(&self) -> Status {
-        match self {
-            Outcome::Compared(c) => match c.verdict {
-                Verdict::Pass => Status::Pass,
-                Verdict::Warn => Status::Warn,
-                Verdict::Fail => Status::Fail,
-            },
-            Outcome::Mismatch(_) | Outcome::Unreadable(_) => Status::Fail,
-            Outcome::Missing { .. } => Status::New,
-            Outcome::Updated => Status::Updated,
-        }
-    }
-}
-
-/// One checked frame and the files written for it.
-#[derive(Debug)]
-pub struct FrameResult {
-    pub frame: u64,
-    pub paths: FramePaths,
-    pub outcome: Outcome,
-    /// The pending file, if one was written.
-    pub pending_written: Option<PathBuf>,
-    /// Failure pictures under `--out`: actual, difference (if there is a golden), triptych.
-    pub pictures: Option<Pictures>,
-    pub seconds: f64,
-}
-
-#[derive(Debug, Clone)]
-pub struct Pictures {
-    pub actual: PathBuf,
-    pub difference: Option<PathBuf>,
-    pub triptych: PathBuf,
-}
-
-/// A scene that could not be loaded (exit 2) or rendered (a failure).
-#[derive(Debug)]
-pub struct SceneFailure {
-    pub message: String,
-    pub loads: bool,
-}
-
-#[derive(Debug)]
-pub struct SceneResult {
-    pub scene: PathBuf,
-    pub frames: Vec<FrameResult>,
-    pub failure: Option<SceneFailure>,
-    pub thresholds: Thresholds,
-    pub seconds: f64,
-}
 
 /// Everything a worker needs, shared by all scenes.
 struct Job<'a> {
@@ -362,52 +105,6 @@ fn check_all(args: &TestArgs, scenes: &[PathBuf]) -> anyhow::Result<()> {
     test_report::finish(args, &results, started.elapsed().as_secs_f64(), &reporter)
 }
 
-/// Scene files under `paths`, sorted, each once.
-pub fn find_scenes(paths: &[PathBuf], out: &Path) -> anyhow::Result<Vec<PathBuf>> {
-    let mut scenes = Vec::new();
-    for path in paths {
-        if path.is_dir() {
-            walk(path, out, &mut scenes)?;
-        } else if path.is_file() {
-            scenes.push(path.strip_prefix(".").unwrap_or(path).to_path_buf());
-        } else {
-            return Err(UsageError(format!("{}: no such file or folder", path.display())).into());
-        }
-    }
-    scenes.sort();
-    scenes.dedup();
-    Ok(scenes)
-}
-
-fn walk(dir: &Path, out: &Path, scenes: &mut Vec<PathBuf>) -> anyhow::Result<()> {
-    let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)
-        .with_context(|| format!("reading {}", dir.display()))?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .collect();
-    entries.sort();
-    for path in entries {
-        let name = path.file_name().unwrap_or_default().to_string_lossy();
-        if path.is_dir() {
-            let skipped = name.starts_with('.')
-                || ["scripts", "goldens", "target"].contains(&name.as_ref())
-                || same_path(&path, out);
-            if !skipped {
-                walk(&path, out, scenes)?;
-            }
-        } else if name.ends_with(".rhai") {
-            scenes.push(path.strip_prefix(".").unwrap_or(&path).to_path_buf());
-        }
-    }
-    Ok(())
-}
-
-fn same_path(a: &Path, b: &Path) -> bool {
-    match (a.canonicalize(), b.canonicalize()) {
-        (Ok(a), Ok(b)) => a == b,
-        _ => false,
-    }
-}
-
 /// Loads, renders and compares one scene; never panics on bad input.
 fn check_scene(job: &Job, scene: &Path) -> SceneResult {
     let started = Instant::now();
@@ -484,18 +181,6 @@ fn load(scene: &Path) -> anyhow::Result<(lapclone::script::LoadedScene, Renderer
     validate_scene(&loaded).map_err(|e| anyhow::anyhow!("{e}"))?;
     let renderer = Renderer::new(loaded.scene.clone()).map_err(|e| positioned(&loaded, e))?;
     Ok((loaded, renderer))
-}
-
-/// Flags win over the scene's settings.
-pub fn overrides(args: &TestArgs, base: Thresholds) -> Thresholds {
-    Thresholds {
-        fail: args.fail.unwrap_or(base.fail),
-        fail_percent: args.fail_percent.unwrap_or(base.fail_percent),
-        hard_fail: args.hard_fail.unwrap_or(base.hard_fail),
-        warn: args.warn.unwrap_or(base.warn),
-        warn_percent: args.warn_percent.unwrap_or(base.warn_percent),
-        min_ssim: args.min_ssim.or(base.min_ssim),
-    }
 }
 
 /// `--frames`, else the scene's own, else first, middle and last; all within the scene.
@@ -626,21 +311,4 @@ fn write_pictures(
     let sheet = triptych(expected, actual, thresholds);
     write_file(&pictures.triptych, &encode_rgba_png(&sheet))?;
     Ok(pictures)
-}
-
-/// Writes `bytes` atomically, creating the folder first.
-pub fn write_file(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    }
-    lapclone::util::write_atomic(path, bytes).with_context(|| format!("writing {}", path.display()))
-}
-
-pub fn remove_if_present(path: &Path) -> anyhow::Result<()> {
-    match std::fs::remove_file(path) {
-        Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-            Err(e).with_context(|| format!("removing {}", path.display()))
-        }
-        _ => Ok(()),
-    }
 }

@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use anyhow::Context as _;
 use lapclone::golden::{compare, triptych, GoldenFrame, Thresholds};
 
-use super::test::{find_scenes, golden_dir, remove_if_present, write_file, TestArgs};
+use super::test_args::{find_scenes, golden_dir, remove_if_present, write_file, TestArgs};
 use super::test_report::scene_slug;
 
 pub fn run(args: &TestArgs, paths: &[PathBuf]) -> anyhow::Result<()> {
@@ -166,7 +166,7 @@ fn show(args: &TestArgs, file: &Path) -> anyhow::Result<()> {
         println!("  new: no golden {}", golden_path.display());
         None
     };
-    let thresholds = super::test::overrides(args, Thresholds::default());
+    let thresholds = super::test_args::overrides(args, Thresholds::default());
     if let Some(expected) = &expected {
         match compare(expected, &actual, &thresholds) {
             Ok(c) => println!(

@@ -8,7 +8,7 @@ use std::path::Path;
 use lapclone::golden::Figures;
 use serde_json::json;
 
-use super::test::{FrameResult, Outcome, SceneResult, Status, TestArgs};
+use super::test_args::{FrameResult, Outcome, SceneResult, Status, TestArgs};
 use super::UsageError;
 
 /// Prints results as scenes finish.
@@ -99,7 +99,7 @@ pub fn finish(
     }
     if let Some(path) = &args.junit {
         let xml = junit_xml(results, &counts, seconds);
-        super::test::write_file(path, xml.as_bytes())?;
+        super::test_args::write_file(path, xml.as_bytes())?;
     }
     let summary = summary_line(&counts, seconds);
     let pending = results
@@ -345,7 +345,7 @@ fn write_index(
         );
     }
     html.push_str("</body></html>\n");
-    super::test::write_file(&out.join("index.html"), html.as_bytes())
+    super::test_args::write_file(&out.join("index.html"), html.as_bytes())
 }
 
 /// JUnit XML: a suite per scene, a case per frame; a scene that did not load or render is

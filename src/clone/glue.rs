@@ -23,7 +23,6 @@
 use glam::DVec2;
 
 use super::beneath::{find_beneath, Beneath, CandidateGrid};
-use super::membrane::MEMBRANE_CHANNELS;
 use super::{BoundaryData, HAT_SAMPLE_SPACING};
 use crate::mesh::Mesh;
 use crate::pixels::FloatImage;
@@ -32,6 +31,9 @@ use crate::solve::PenaltyFactor;
 /// The iteration stops once no glued Dirichlet value changes by more than this (colour units
 /// in [0, 1]: a 4000th of an 8-bit level, a 15th of a 16-bit one).
 pub const GLUE_TOLERANCE: f64 = 1e-6;
+
+/// Number of colour channels the membrane carries (alpha is never cloned).
+pub const MEMBRANE_CHANNELS: usize = 3;
 
 /// Back-substitutions one glue solve may add at most; a contraction as weak as 0.8 per step
 /// still reaches [`GLUE_TOLERANCE`] from a full-range start within this many.

@@ -15,8 +15,7 @@ use crate::mesh::Mesh;
 use crate::pixels::{Canvas, FloatImage};
 use crate::solve::{laplacian, LaplacianKind, PenaltyFactor, PenaltyOptions, SwitchStats};
 
-/// Number of colour channels the membrane carries (alpha is never cloned).
-pub const MEMBRANE_CHANNELS: usize = 3;
+pub use super::glue::MEMBRANE_CHANNELS;
 
 /// The factored Laplacian of one patch mesh and the scratch buffers of its per-frame solve.
 pub struct MembraneSolver {

@@ -7,21 +7,16 @@
 use std::path::{Path, PathBuf};
 
 use glam::DVec2;
-use rhai::{CustomType, Dynamic, Engine, EvalAltResult, Map, NativeCallContext, TypeBuilder};
+use rhai::{CustomType, Dynamic, Engine, Map, NativeCallContext, TypeBuilder};
 
 use super::draft::{Origin, SharedDraft};
+use super::refs::{fail, Fallible, HandleRef, PatchRef, Placed, PLACEMENT_KEYS};
 use super::footage_options::{footage_keys, footage_option};
 use super::values::{self, number};
 use crate::scene::{
     Background, Canvas, CloneMode, Easing, Handle, LaplacianKind, Patch, Pin, Polygon, Shape, Track,
 };
 
-pub(super) type Fallible<T> = Result<T, Box<EvalAltResult>>;
-
-/// A runtime error at the position of the current call.
-pub(super) fn fail(ctx: &NativeCallContext, message: impl Into<String>) -> Box<EvalAltResult> {
-    EvalAltResult::ErrorRuntime(message.into().into(), ctx.call_position()).into()
-}
 
 fn origin(ctx: &NativeCallContext, base_dir: &Path) -> Origin {
     Origin {
@@ -51,21 +46,6 @@ fn existing_file(base_dir: &Path, text: &str, what: &str) -> Result<PathBuf, Str
     }
 }
 
-/// A patch of the scene, as seen from a script. Cloning it in Rhai shares the patch; it
-/// names the patch by a stable id, so it survives renames, reordering and other removals.
-#[derive(Clone, Debug)]
-pub struct PatchRef {
-    pub(super) draft: SharedDraft,
-    pub(super) id: u64,
-}
-
-/// A handle (drag) of a patch, as seen from a script (stable ids, like [`PatchRef`]).
-#[derive(Clone, Debug)]
-pub struct HandleRef {
-    pub(super) draft: SharedDraft,
-    pub(super) patch: u64,
-    pub(super) handle: u64,
-}
 
 pub fn register(engine: &mut Engine, draft: &SharedDraft) {
     engine.build_type::<PatchRef>().build_type::<HandleRef>();
@@ -441,60 +421,6 @@ impl PatchRef {
     }
 }
 
-/// The keyframable placement properties, by their scene-language names.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum Placed {
-    At,
-    Scale,
-    Rotate,
-    Depth,
-    Opacity,
-}
-
-pub(super) const PLACEMENT_KEYS: [&str; 5] = ["at", "scale", "rotate", "depth", "opacity"];
-
-impl Placed {
-    pub(super) const ALL: [Placed; 5] = [
-        Placed::At,
-        Placed::Scale,
-        Placed::Rotate,
-        Placed::Depth,
-        Placed::Opacity,
-    ];
-
-    pub(super) fn from_name(name: &str) -> Option<Placed> {
-        Placed::ALL.into_iter().find(|p| p.name() == name)
-    }
-
-    /// The track's scene-language name.
-    pub(super) fn name(self) -> &'static str {
-        match self {
-            Placed::At => "at",
-            Placed::Scale => "scale",
-            Placed::Rotate => "rotate",
-            Placed::Depth => "depth",
-            Placed::Opacity => "opacity",
-        }
-    }
-
-    fn push(
-        self,
-        patch: &mut Patch,
-        t: f64,
-        value: &Dynamic,
-        easing: Easing,
-    ) -> Result<(), String> {
-        let p = &mut patch.placement;
-        let result = match self {
-            Placed::At => p.position.push(t, values::point(value, "`at`")?, easing),
-            Placed::Scale => p.scale.push(t, values::positive(value, "`scale`")?, easing),
-            Placed::Rotate => p.rotation.push(t, number(value, "`rotate`")?, easing),
-            Placed::Depth => p.depth.push(t, number(value, "`depth`")?, easing),
-            Placed::Opacity => p.opacity.push(t, values::unit(value, "`opacity`")?, easing),
-        };
-        result.map_err(|e| e.to_string())
-    }
-}
 
 fn add_placement_keys(patch: &mut Patch, t: f64, keys: &Map, easing: Easing) -> Result<(), String> {
     values::check_keys(keys, &PLACEMENT_KEYS, "key")?;

@@ -6,7 +6,7 @@
 
 use rhai::{Dynamic, Engine, NativeCallContext, TypeBuilder};
 
-use super::api::{fail, Fallible, HandleRef, PatchRef, Placed};
+use super::refs::{fail, Fallible, HandleRef, PatchRef, Placed};
 use super::draft::{Draft, SharedDraft};
 use super::values;
 use crate::scene::{Interpolate, Patch, Track};

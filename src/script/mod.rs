@@ -4,6 +4,7 @@
 //! documented in docs/scene-language.md.
 
 mod api;
+mod refs;
 mod draft;
 mod edit_api;
 mod engine;
@@ -14,7 +15,7 @@ mod sandbox;
 mod validate;
 mod values;
 
-pub use api::{HandleRef, PatchRef};
+pub use refs::{HandleRef, PatchRef};
 pub use draft::{Draft, Ids, Origin, Origins};
 pub use engine::{
     find_scripts_dir, load_scene, parse_scene, LoadedScene, SceneEngine, ScriptOptions,

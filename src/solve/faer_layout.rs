@@ -20,7 +20,7 @@
 //! stay exactly zero). `tests/solve_layout.rs` rebuilds `L·D·Lᵀ` from the converted values
 //! and compares it with the matrix, so an upgrade that changes any of this fails there.
 
-use super::symbolic::SymbolicFactor;
+use super::supernodes::SupernodePartition;
 use super::SolveError;
 use faer::sparse::linalg::cholesky::{
     supernodal::SymbolicSupernodalCholesky, SymbolicCholesky, SymbolicCholeskyRaw,
@@ -78,10 +78,22 @@ pub(super) fn compact_supernodes(
     }
 }
 
+/// What [`check`] reads of an analysed pattern: faer's symbolic factor, the columns in this
+/// module's layout, the ordering and the supernodes found in it.
+pub(super) struct Analysed<'a> {
+    pub faer: &'a SymbolicCholesky<u32>,
+    pub col_ptr: &'a [u32],
+    pub row_idx: &'a [u32],
+    pub perm_fwd: &'a [u32],
+    pub perm_inv: &'a [u32],
+    pub supernodes: &'a SupernodePartition,
+}
+
 /// Verifies the layout (module doc) of an analysed pattern; an error means the pinned faer
 /// version changed its representation.
-pub(super) fn check(symbolic: &SymbolicFactor) -> Result<(), SolveError> {
-    let (n, col_ptr, row_idx) = (symbolic.n(), symbolic.col_ptr(), symbolic.row_idx());
+pub(super) fn check(symbolic: Analysed) -> Result<(), SolveError> {
+    let (col_ptr, row_idx) = (symbolic.col_ptr, symbolic.row_idx);
+    let n = col_ptr.len().saturating_sub(1);
     let broken = |m: String| {
         Err(SolveError::Symbolic(format!(
             "unexpected faer factor layout: {m}"
@@ -106,7 +118,7 @@ pub(super) fn check(symbolic: &SymbolicFactor) -> Result<(), SolveError> {
             }
         }
     }
-    let (fwd, inv) = (&symbolic.perm_fwd, &symbolic.perm_inv);
+    let (fwd, inv) = (symbolic.perm_fwd, symbolic.perm_inv);
     if fwd.len() != n
         || inv.len() != n
         || fwd

@@ -229,7 +229,19 @@ impl SymbolicFactor {
     /// Verifies the layout contract of [`faer_layout`](super::faer_layout); an error here
     /// means the pinned faer version changed its representation.
     pub fn check_layout(&self) -> Result<(), SolveError> {
-        faer_layout::check(self)
+        if self.col_ptr.len() != self.n + 1 {
+            return Err(SolveError::Symbolic(
+                "unexpected faer factor layout: column pointers".into(),
+            ));
+        }
+        faer_layout::check(faer_layout::Analysed {
+            faer: &self.faer,
+            col_ptr: &self.col_ptr,
+            row_idx: &self.row_idx,
+            perm_fwd: &self.perm_fwd,
+            perm_inv: &self.perm_inv,
+            supernodes: &self.supernodes,
+        })
     }
 }
 
