@@ -18,7 +18,7 @@ mod y4m;
 
 pub use apng::{apng_delays, ApngWriter};
 pub use atomic::TempOutput;
-pub use encode::{encode_png, PngCompression};
+pub use encode::{encode_png, FrameEncoder, PngCompression};
 pub use ffmpeg::{FfmpegWriter, VideoKind, VideoOptions};
 pub use format::OutputKind;
 pub use frame::{Frame, FrameData, FrameRef, Pixels};

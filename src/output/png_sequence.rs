@@ -13,7 +13,7 @@ use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 
 use super::atomic::TempOutput;
-use super::encode::{encode_png, PngCompression};
+use super::encode::{FrameEncoder, PngCompression};
 use super::{Frame, OutputError};
 
 /// `frame_` + the number zero-padded to `digits`.
@@ -45,22 +45,22 @@ pub fn foreign_frames(dir: &Path, ours: impl Fn(&str) -> bool) -> std::io::Resul
     Ok(found)
 }
 
-/// Writes one frame file atomically (also usable without the worker pool).
+/// Writes one frame file atomically (also usable without the worker pool); gives back the
+/// frame `encoder` no longer needs.
 pub fn write_png_file(
     path: &Path,
-    frame: &Frame,
-    compression: PngCompression,
-    scratch: &mut Vec<u8>,
-) -> Result<(), OutputError> {
-    let frame_ref = frame.as_ref()?;
+    frame: Frame,
+    encoder: &mut FrameEncoder,
+) -> Result<Option<Frame>, OutputError> {
     let temp = TempOutput::new(path);
     let io = |e: std::io::Error| OutputError::io(path, e);
     let file = std::fs::File::create(temp.temp_path()).map_err(io)?;
     let mut out = BufWriter::with_capacity(1 << 16, file);
-    encode_png(&frame_ref, &mut out, compression, scratch)?;
+    let spare = encoder.encode(frame, &mut out)?;
     out.flush().map_err(io)?;
     drop(out);
-    temp.commit().map_err(io)
+    temp.commit().map_err(io)?;
+    Ok(spare)
 }
 
 struct Job {
@@ -207,7 +207,9 @@ fn worker(
     spare: &SyncSender<Frame>,
     compression: PngCompression,
 ) {
-    let mut scratch = Vec::new();
+    // Each worker compares a frame with the one it encoded before (a few frames earlier),
+    // reusing the bands of unchanged rows.
+    let mut encoder = FrameEncoder::new(compression);
     loop {
         let job = {
             let receiver = receiver.lock().unwrap_or_else(|p| p.into_inner());
@@ -217,10 +219,11 @@ fn worker(
         if shared.stop() {
             continue; // drain the queue without writing
         }
-        match write_png_file(&job.path, &job.frame, compression, &mut scratch) {
-            Ok(()) => {
-                let _ = spare.try_send(job.frame);
+        match write_png_file(&job.path, job.frame, &mut encoder) {
+            Ok(Some(frame)) => {
+                let _ = spare.try_send(frame);
             }
+            Ok(None) => {}
             Err(e) => shared.record(e),
         }
     }

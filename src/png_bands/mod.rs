@@ -1,0 +1,268 @@
+//! PNG images encoded in independent row bands: takes an image's header and a way to fill
+//! any row with its PNG samples, gives the PNG bytes. Rows are Up-filtered and each band of
+//! about 64 KiB is one self-contained deflate block ([`deflate_block`]), so a band's bytes
+//! depend only on its own rows and the row above. That buys two things: bands can be
+//! encoded on any threads in any order, and a band whose rows did not change since the last
+//! frame can be reused as it is ([`EncodedBand`]). The bytes are a pure function of the
+//! pixels, so they are identical however the work was split.
+
+mod container;
+mod deflate_block;
+mod huffman;
+
+use std::io::Write;
+
+pub use container::write_png;
+use deflate_block::BlockEncoder;
+
+/// A band aims at about this many bytes of filtered rows.
+const BAND_BYTES: usize = 64 * 1024;
+/// PNG's Up filter: each byte minus the one above it.
+const FILTER_UP: u8 = 2;
+
+/// The colour types lapclone writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PngColor {
+    Grey,
+    GreyAlpha,
+    Rgb,
+    Rgba,
+}
+
+impl PngColor {
+    fn channels(self) -> usize {
+        match self {
+            PngColor::Grey => 1,
+            PngColor::GreyAlpha => 2,
+            PngColor::Rgb => 3,
+            PngColor::Rgba => 4,
+        }
+    }
+
+    /// The IHDR colour type.
+    fn code(self) -> u8 {
+        match self {
+            PngColor::Grey => 0,
+            PngColor::GreyAlpha => 4,
+            PngColor::Rgb => 2,
+            PngColor::Rgba => 6,
+        }
+    }
+}
+
+/// What the IHDR chunk says, and the band layout that follows from it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PngHeader {
+    pub width: u32,
+    pub height: u32,
+    pub color: PngColor,
+    pub sixteen_bit: bool,
+}
+
+impl PngHeader {
+    /// Bytes of samples in one row (without the filter byte).
+    pub fn row_bytes(&self) -> usize {
+        self.width as usize * self.color.channels() * if self.sixteen_bit { 2 } else { 1 }
+    }
+
+    /// Rows per band: a function of the row size only, so bands line up across frames.
+    pub fn rows_per_band(&self) -> u32 {
+        let rows = BAND_BYTES / (self.row_bytes() + 1);
+        (rows.max(1) as u32).min(self.height)
+    }
+
+    pub fn band_count(&self) -> usize {
+        self.height.div_ceil(self.rows_per_band()) as usize
+    }
+
+    /// The rows of band `band`.
+    pub fn band_rows(&self, band: usize) -> std::ops::Range<u32> {
+        let per = self.rows_per_band();
+        let start = band as u32 * per;
+        start..(start + per).min(self.height)
+    }
+}
+
+/// One band's deflate block and the Adler-32 of the filtered bytes it holds.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct EncodedBand {
+    pub bytes: Vec<u8>,
+    pub adler: u32,
+    /// Filtered bytes the block inflates to.
+    pub filtered_len: usize,
+}
+
+/// Encodes bands; keeps its buffers between calls.
+#[derive(Default)]
+pub struct BandEncoder {
+    block: BlockEncoder,
+    filtered: Vec<u8>,
+    above: Vec<u8>,
+    row: Vec<u8>,
+}
+
+impl BandEncoder {
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Encodes band `band` of `header` into `into` (its buffer reused); `fill_row(y, buf)`
+    /// writes row `y`'s samples into `buf` (`header.row_bytes()` long).
+    pub fn encode_band(
+        &mut self,
+        header: &PngHeader,
+        band: usize,
+        mut fill_row: impl FnMut(u32, &mut [u8]),
+        into: &mut EncodedBand,
+    ) {
+        let rows = header.band_rows(band);
+        let row_bytes = header.row_bytes();
+        self.above.clear();
+        self.above.resize(row_bytes, 0);
+        self.row.resize(row_bytes, 0);
+        if rows.start > 0 {
+            fill_row(rows.start - 1, &mut self.above);
+        }
+        self.filtered.resize(rows.len() * (row_bytes + 1), 0);
+        for (y, filtered) in rows.zip(self.filtered.chunks_exact_mut(row_bytes + 1)) {
+            fill_row(y, &mut self.row);
+            filtered[0] = FILTER_UP;
+            for ((out, &b), &a) in filtered[1..].iter_mut().zip(&self.row).zip(&self.above) {
+                *out = b.wrapping_sub(a);
+            }
+            std::mem::swap(&mut self.row, &mut self.above);
+        }
+        into.bytes.clear();
+        self.block.encode(&self.filtered, &mut into.bytes);
+        into.adler = simd_adler32::adler32(&self.filtered.as_slice());
+        into.filtered_len = self.filtered.len();
+    }
+
+    /// The whole image on this thread.
+    pub fn encode_image(
+        &mut self,
+        header: &PngHeader,
+        mut fill_row: impl FnMut(u32, &mut [u8]),
+        out: impl Write,
+    ) -> std::io::Result<()> {
+        let mut bands = vec![EncodedBand::default(); header.band_count()];
+        for (index, band) in bands.iter_mut().enumerate() {
+            self.encode_band(header, index, &mut fill_row, band);
+        }
+        write_png(header, &bands, out)
+    }
+}
+
+/// The whole image with its bands spread over `threads` scoped threads (the same bytes as
+/// [`BandEncoder::encode_image`] for any thread count).
+pub fn encode_image_parallel(
+    header: &PngHeader,
+    fill_row: impl Fn(u32, &mut [u8]) + Sync,
+    threads: usize,
+    out: impl Write,
+) -> std::io::Result<()> {
+    let count = header.band_count();
+    let mut bands = vec![EncodedBand::default(); count];
+    let per_thread = count.div_ceil(threads.max(1)).max(1);
+    std::thread::scope(|scope| {
+        for (chunk_index, chunk) in bands.chunks_mut(per_thread).enumerate() {
+            let fill_row = &fill_row;
+            scope.spawn(move || {
+                let mut encoder = BandEncoder::new();
+                for (offset, band) in chunk.iter_mut().enumerate() {
+                    let index = chunk_index * per_thread + offset;
+                    encoder.encode_band(header, index, fill_row, band);
+                }
+            });
+        }
+    });
+    write_png(header, &bands, out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn decode(bytes: &[u8]) -> (png::OutputInfo, Vec<u8>) {
+        let mut reader = png::Decoder::new(std::io::Cursor::new(bytes))
+            .read_info()
+            .expect("a PNG header");
+        let mut pixels = vec![0; reader.output_buffer_size().expect("a size")];
+        let info = reader.next_frame(&mut pixels).expect("a valid PNG");
+        pixels.truncate(info.buffer_size());
+        (info, pixels)
+    }
+
+    fn image(header: &PngHeader, seed: u64) -> Vec<u8> {
+        // Smooth areas, flat runs and noise, as photos and graphics have.
+        let len = header.row_bytes() * header.height as usize;
+        let mut state = seed | 1;
+        (0..len)
+            .map(|i| {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                match (i / 997) % 3 {
+                    0 => (i / 3 % 256) as u8,
+                    1 => 40,
+                    _ => state as u8,
+                }
+            })
+            .collect()
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 24, rng_seed: proptest::test_runner::RngSeed::Fixed(5), ..ProptestConfig::default() })]
+
+        /// The png crate decodes exactly the samples given, for every colour type and depth,
+        /// and the bytes do not depend on the thread count.
+        #[test]
+        fn decodes_to_the_samples(
+            width in 1u32..300,
+            height in 1u32..200,
+            color in prop_oneof![Just(PngColor::Grey), Just(PngColor::GreyAlpha), Just(PngColor::Rgb), Just(PngColor::Rgba)],
+            sixteen_bit in any::<bool>(),
+            seed in any::<u64>(),
+        ) {
+            let header = PngHeader { width, height, color, sixteen_bit };
+            let samples = image(&header, seed);
+            let row_bytes = header.row_bytes();
+            let fill = |y: u32, buf: &mut [u8]| {
+                let start = y as usize * row_bytes;
+                buf.copy_from_slice(&samples[start..start + row_bytes]);
+            };
+            let mut serial = Vec::new();
+            BandEncoder::new().encode_image(&header, fill, &mut serial).expect("in memory");
+            let (info, decoded) = decode(&serial);
+            prop_assert_eq!((info.width, info.height), (width, height));
+            prop_assert_eq!(info.bit_depth == png::BitDepth::Sixteen, sixteen_bit);
+            prop_assert_eq!(&decoded, &samples);
+            for threads in [1, 2, 3, 7] {
+                let mut parallel = Vec::new();
+                encode_image_parallel(&header, fill, threads, &mut parallel).expect("in memory");
+                prop_assert_eq!(&parallel, &serial);
+            }
+        }
+    }
+
+    #[test]
+    fn bands_cover_every_row_once() {
+        for (width, height) in [(1, 1), (1920, 1080), (70_000, 3), (5, 100_000)] {
+            let header = PngHeader {
+                width,
+                height,
+                color: PngColor::Rgb,
+                sixteen_bit: false,
+            };
+            let mut next = 0;
+            for band in 0..header.band_count() {
+                let rows = header.band_rows(band);
+                assert_eq!(rows.start, next);
+                assert!(rows.end > rows.start);
+                next = rows.end;
+            }
+            assert_eq!(next, height);
+        }
+    }
+}
