@@ -95,25 +95,33 @@ impl BlockEncoder {
         out.extend_from_slice(&[0x00, 0x00, 0xff, 0xff]);
     }
 
-    /// Symbol frequencies for the code: every byte as a literal (zeros that end up in runs
-    /// included), and each length symbol and the end of block once. Any frequencies give a
-    /// valid code as long as every symbol used has one; these are cheap to count and close
-    /// enough to the token counts that the code is as short.
+    /// Symbol frequencies for the code: the bytes outside all-zero 8-byte words as literals,
+    /// the longest match once per 32 zero words (the runs they make), and every other
+    /// length symbol and the end of block once. Any frequencies give a valid code as long as
+    /// every symbol used has one; these are cheap to count and close enough to the token
+    /// counts that the code is as short.
     fn count_symbols(&mut self, data: &[u8]) {
         let mut counts = [[0u32; 256]; 4];
-        let mut quads = data.chunks_exact(4);
-        for quad in &mut quads {
-            for (lane, &b) in counts.iter_mut().zip(quad) {
-                lane[b as usize] += 1;
+        let mut zero_words = 0;
+        let mut words = data.chunks_exact(8);
+        for word in &mut words {
+            if word.iter().all(|&b| b == 0) {
+                zero_words += 1;
+                continue;
+            }
+            for (i, &b) in word.iter().enumerate() {
+                counts[i % 4][b as usize] += 1;
             }
         }
-        for &b in quads.remainder() {
+        for &b in words.remainder() {
             counts[0][b as usize] += 1;
         }
         for (symbol, freq) in self.freqs[..256].iter_mut().enumerate() {
             *freq = counts.iter().map(|lane| lane[symbol]).sum();
         }
         self.freqs[END_OF_BLOCK..].fill(1);
+        self.freqs[0] += zero_words / 32;
+        self.freqs[LITLEN_SYMBOLS - 1] += zero_words / 32;
     }
 
     fn write_header(&self, bits: &mut BitWriter<'_>) {
