@@ -429,7 +429,7 @@ impl FrameSink {
                     OutputKind::Webm => VideoKind::Webm,
                     _ => VideoKind::Mov,
                 };
-                let writer = FfmpegWriter::create(output, video(kind), jobs)?;
+                let writer = FfmpegWriter::create(output, video(kind), jobs)?.with_cancel(cancel);
                 if let Some((w, h)) = writer.padded() {
                     eprintln!(
                         "note: {}×{} has an odd side; the video is padded to {w}×{h} (4:2:0 needs even sides; the edge pixels repeat)",

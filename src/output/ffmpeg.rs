@@ -18,8 +18,11 @@
 
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
+use std::process::{Child, Command, ExitStatus, Stdio};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{sync_channel, Receiver, SyncSender};
+use std::sync::Arc;
+use std::time::Duration;
 use std::thread::JoinHandle;
 
 use super::atomic::TempOutput;
@@ -173,6 +176,8 @@ pub struct FfmpegWriter {
     options: VideoOptions,
     /// Threads converting a frame to 4:2:0.
     threads: usize,
+    /// Set by Ctrl-C: [`finish`](Self::finish) stops waiting for ffmpeg and fails.
+    cancel: Option<Arc<AtomicBool>>,
 }
 
 impl FfmpegWriter {
@@ -225,7 +230,15 @@ impl FfmpegWriter {
             stderr: Some(stderr),
             options,
             threads: threads.max(1),
+            cancel: None,
         })
+    }
+
+    /// Makes [`finish`](Self::finish) give up (stopping ffmpeg, leaving no file) once
+    /// `cancel` is set, instead of waiting for ffmpeg to complete the video.
+    pub fn with_cancel(mut self, cancel: Arc<AtomicBool>) -> Self {
+        self.cancel = Some(cancel);
+        self
     }
 
     /// The size the video was padded to, when a side was odd.
@@ -260,10 +273,7 @@ impl FfmpegWriter {
     pub fn finish(mut self) -> Result<PathBuf, OutputError> {
         self.sender = None;
         let fed = self.feeder.take().map(|f| f.join());
-        let status = self
-            .child
-            .wait()
-            .map_err(|e| OutputError::io(&self.path, e))?;
+        let status = self.wait_unless_cancelled()?;
         let fed_ok = matches!(fed, Some(Ok(Ok(()))));
         if !status.success() || !fed_ok {
             return Err(self.failure());
@@ -272,6 +282,24 @@ impl FfmpegWriter {
             temp.commit().map_err(|e| OutputError::io(&self.path, e))?;
         }
         Ok(self.path.clone())
+    }
+
+    /// ffmpeg's exit status; `Cancelled` as soon as the cancel flag is set (dropping the
+    /// writer then stops ffmpeg and removes the temporary file).
+    fn wait_unless_cancelled(&mut self) -> Result<ExitStatus, OutputError> {
+        let io = |e| OutputError::io(&self.path, e);
+        let Some(cancel) = self.cancel.clone() else {
+            return self.child.wait().map_err(io);
+        };
+        loop {
+            if let Some(status) = self.child.try_wait().map_err(io)? {
+                return Ok(status);
+            }
+            if cancel.load(Ordering::Relaxed) {
+                return Err(OutputError::Cancelled);
+            }
+            std::thread::sleep(Duration::from_millis(2));
+        }
     }
 
     fn failure(&mut self) -> OutputError {
