@@ -112,7 +112,8 @@ pub struct RenderArgs {
     /// Output format (default: the one the output's extension names).
     #[arg(long, value_enum)]
     pub format: Option<OutputFormat>,
-    /// PNG encoder threads (default: available cores).
+    /// Encoder threads: PNG frames, and the conversion of video frames (default: available
+    /// cores).
     #[arg(long, allow_hyphen_values = true)]
     pub jobs: Option<usize>,
     /// Remove frame files of an earlier render from the PNG output folder (without it,

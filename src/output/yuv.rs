@@ -81,7 +81,7 @@ pub fn frame_to_yuv420(frame: &FrameRef<'_>, out: &mut Vec<u8>, threads: usize) 
     let (cb_plane, cr_plane) = chroma.split_at_mut(pw / 2 * (ph / 2));
     let pairs = ph / 2;
     // Bands of whole row pairs; small frames are not worth a thread.
-    let bands = threads.clamp(1, (w * h >> 14).max(1)).min(pairs);
+    let bands = threads.clamp(1, ((w * h) >> 14).max(1)).min(pairs);
     let per_band = pairs.div_ceil(bands);
     let bands = pairs.div_ceil(per_band);
     let source = RgbaRows::new(frame);

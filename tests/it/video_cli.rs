@@ -504,5 +504,13 @@ fn without_ffmpeg_video_output_is_refused_and_nothing_is_written() {
         let o = render(&scene, &mp4, &[]);
         assert!(o.status.success(), "{}", stderr(&o));
         assert!(stderr(&o).contains("padded to 96×64"), "{}", stderr(&o));
+        let probe = Command::new("ffprobe")
+            .args(["-v", "error", "-show_entries", "stream=width,height"])
+            .args(["-of", "default=noprint_wrappers=1"])
+            .arg(&mp4)
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&probe.stdout);
+        assert!(text.contains("width=96\nheight=64"), "{text}");
     }
 }
