@@ -112,7 +112,8 @@ pub struct RenderArgs {
     /// Output format (default: the one the output's extension names).
     #[arg(long, value_enum)]
     pub format: Option<OutputFormat>,
-    /// PNG encoder threads (default: available cores).
+    /// Encoder threads: PNG frames, and the conversion of video frames (default: available
+    /// cores).
     #[arg(long, allow_hyphen_values = true)]
     pub jobs: Option<usize>,
     /// Remove frame files of an earlier render from the PNG output folder (without it,
@@ -429,7 +430,7 @@ impl FrameSink {
                     OutputKind::Webm => VideoKind::Webm,
                     _ => VideoKind::Mov,
                 };
-                let writer = FfmpegWriter::create(output, video(kind))?;
+                let writer = FfmpegWriter::create(output, video(kind), jobs)?.with_cancel(cancel);
                 if let Some((w, h)) = writer.padded() {
                     eprintln!(
                         "note: {}×{} has an odd side; the video is padded to {w}×{h} (4:2:0 needs even sides; the edge pixels repeat)",

@@ -1,23 +1,46 @@
 //! Video files through an `ffmpeg` process: takes frames in order and gives an MP4, WebM or
-//! MOV. Raw RGBA frames go down a pipe (written by a thread of their own, so encoding
-//! overlaps rendering) into `ffmpeg -f rawvideo`, which writes a temporary file; it is
-//! renamed onto the destination only when ffmpeg exits 0. On failure the last lines ffmpeg
-//! printed are in the error; an abandoned writer kills ffmpeg and leaves no file.
+//! MOV. Raw frames go down a pipe (written by a thread of their own, so encoding overlaps
+//! rendering) into `ffmpeg -f rawvideo`, which writes a temporary file; it is renamed onto
+//! the destination only when ffmpeg exits 0. On failure the last lines ffmpeg printed are in
+//! the error; an abandoned writer kills ffmpeg and leaves no file.
 //!
 //! Codecs: MP4 is H.264 in yuv420p at constant quality (CRF 20 by default); WebM is VP9 in
 //! yuv420p at constant quality (CRF 32); MOV is H.264 like MP4 for opaque frames and ProRes
-//! 4444 with alpha when the canvas has transparency (CRF does not apply to it). 4:2:0 needs
-//! even sides: an odd side is padded by one pixel (repeating the last row or column), which
-//! [`FfmpegWriter::padded`] reports.
+//! 4444 with alpha when the canvas has transparency (CRF does not apply to it).
+//!
+//! For the 4:2:0 codecs lapclone converts each frame itself (the `yuv` module: BT.709,
+//! limited range, integer maths, in row bands on the caller's threads) and feeds ffmpeg
+//! `yuv420p`, 1.5 bytes a pixel instead of RGBA's 4, sparing ffmpeg its serial conversion;
+//! input and output are tagged BT.709 / limited range so players decode the colours lapclone
+//! meant. 4:2:0 needs even sides: an odd side is padded by one pixel (repeating the last row
+//! or column), which [`FfmpegWriter::padded`] reports. ProRes 4444 is fed RGBA and converted
+//! by ffmpeg, which keeps the alpha.
 
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
+use std::process::{Child, Command, ExitStatus, Stdio};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{sync_channel, Receiver, SyncSender};
+use std::sync::Arc;
+use std::time::Duration;
 use std::thread::JoinHandle;
 
 use super::atomic::TempOutput;
-use super::{FrameRef, OutputError};
+use super::yuv::{frame_to_yuv420, yuv420_size};
+use super::{fps_fraction, FrameRef, OutputError};
+
+/// How lapclone's 4:2:0 frames are tagged, as ffmpeg options (before `-i` for the raw input,
+/// after it for the encoded stream): BT.709 matrix, primaries and transfer, limited range.
+const BT709_TAGS: [&str; 8] = [
+    "-color_range",
+    "tv",
+    "-colorspace",
+    "bt709",
+    "-color_primaries",
+    "bt709",
+    "-color_trc",
+    "bt709",
+];
 
 /// The containers written through ffmpeg.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -69,29 +92,31 @@ impl VideoOptions {
         if self.keeps_alpha() {
             (self.width, self.height)
         } else {
-            (
-                self.width.next_multiple_of(2),
-                self.height.next_multiple_of(2),
-            )
+            yuv420_size(self.width, self.height)
         }
+    }
+
+    /// The ffmpeg arguments describing the raw frames on standard input, `-i -` included.
+    pub fn input_args(&self) -> Vec<String> {
+        let (w, h) = self.encoded_size();
+        let (num, den) = fps_fraction(self.fps);
+        let mut args: Vec<String> = ["-f", "rawvideo", "-pix_fmt"].map(String::from).into();
+        if self.keeps_alpha() {
+            args.push("rgba".into());
+        } else {
+            args.push("yuv420p".into());
+            args.extend(BT709_TAGS.map(String::from));
+        }
+        args.extend(["-s".into(), format!("{w}x{h}")]);
+        args.extend(["-framerate".into(), format!("{num}/{den}")]);
+        args.extend(["-i", "-"].map(String::from));
+        args
     }
 
     /// The ffmpeg arguments after the raw input, up to (not including) the output path.
     pub fn codec_args(&self) -> Vec<String> {
         let crf = self.crf.unwrap_or(self.kind.default_crf()).to_string();
         let mut args: Vec<String> = Vec::new();
-        let (w, h) = self.encoded_size();
-        if (w, h) != (self.width, self.height) {
-            // Pad with the edge's own pixels, so no dark line appears at the border.
-            args.extend([
-                "-vf".into(),
-                format!(
-                    "pad={w}:{h}:0:0,fillborders=right={}:bottom={}:mode=smear",
-                    w - self.width,
-                    h - self.height
-                ),
-            ]);
-        }
         let codec: &[&str] = if self.keeps_alpha() {
             &[
                 "-c:v",
@@ -126,6 +151,9 @@ impl VideoOptions {
         args.extend(codec.iter().map(|s| s.to_string()));
         if !self.keeps_alpha() {
             args.push(crf);
+            args.extend(BT709_TAGS.map(String::from));
+            // Each chroma sample is its 2×2 block's mean.
+            args.extend(["-chroma_sample_location", "center"].map(String::from));
         }
         if self.kind != VideoKind::Webm {
             args.extend(["-movflags".into(), "+faststart".into()]);
@@ -146,21 +174,22 @@ pub struct FfmpegWriter {
     feeder: Option<JoinHandle<std::io::Result<()>>>,
     stderr: Option<JoinHandle<String>>,
     options: VideoOptions,
+    /// Threads converting a frame to 4:2:0.
+    threads: usize,
+    /// Set by Ctrl-C: [`finish`](Self::finish) stops waiting for ffmpeg and fails.
+    cancel: Option<Arc<AtomicBool>>,
 }
 
 impl FfmpegWriter {
-    /// Starts ffmpeg for a video at `path`; fails with the install hint when ffmpeg is not
-    /// on `PATH`.
-    pub fn create(path: &Path, options: VideoOptions) -> Result<Self, OutputError> {
+    /// Starts ffmpeg for a video at `path`, converting frames on up to `threads` threads;
+    /// fails with the install hint when ffmpeg is not on `PATH`.
+    pub fn create(path: &Path, options: VideoOptions, threads: usize) -> Result<Self, OutputError> {
         let ffmpeg = crate::util::find_program("ffmpeg").ok_or(OutputError::NoFfmpeg)?;
         let temp = TempOutput::new(path);
         let mut command = Command::new(ffmpeg);
         command
-            .args([
-                "-v", "error", "-nostdin", "-y", "-f", "rawvideo", "-pix_fmt", "rgba",
-            ])
-            .args(["-s", &format!("{}x{}", options.width, options.height)])
-            .args(["-framerate", &format!("{}", options.fps), "-i", "-"])
+            .args(["-v", "error", "-nostdin", "-y"])
+            .args(options.input_args())
             .args(options.codec_args())
             .arg(temp.temp_path())
             .stdin(Stdio::piped())
@@ -200,7 +229,16 @@ impl FfmpegWriter {
             feeder: Some(feeder),
             stderr: Some(stderr),
             options,
+            threads: threads.max(1),
+            cancel: None,
         })
+    }
+
+    /// Makes [`finish`](Self::finish) give up (stopping ffmpeg, leaving no file) once
+    /// `cancel` is set, instead of waiting for ffmpeg to complete the video.
+    pub fn with_cancel(mut self, cancel: Arc<AtomicBool>) -> Self {
+        self.cancel = Some(cancel);
+        self
     }
 
     /// The size the video was padded to, when a side was odd.
@@ -209,7 +247,8 @@ impl FfmpegWriter {
         (size != (self.options.width, self.options.height)).then_some(size)
     }
 
-    /// Queues the next frame (8-bit RGBA of the video's size; 16-bit frames are rounded).
+    /// Queues the next frame (of the video's size; 16-bit frames are rounded to 8 bits):
+    /// converted to 4:2:0 here, or copied as RGBA for ProRes 4444.
     pub fn add(&mut self, frame: &FrameRef<'_>) -> Result<(), OutputError> {
         if (frame.width(), frame.height()) != (self.options.width, self.options.height) {
             return Err(OutputError::BadFrame(
@@ -217,7 +256,11 @@ impl FfmpegWriter {
             ));
         }
         let mut buffer = self.spare.try_recv().unwrap_or_default();
-        frame.write_rgba8(&mut buffer);
+        if self.options.keeps_alpha() {
+            frame.write_rgba8(&mut buffer);
+        } else {
+            frame_to_yuv420(frame, &mut buffer, self.threads);
+        }
         let sent = self.sender.as_ref().is_some_and(|s| s.send(buffer).is_ok());
         if !sent {
             // The feeder stopped: ffmpeg exited early. Its message says why.
@@ -230,10 +273,7 @@ impl FfmpegWriter {
     pub fn finish(mut self) -> Result<PathBuf, OutputError> {
         self.sender = None;
         let fed = self.feeder.take().map(|f| f.join());
-        let status = self
-            .child
-            .wait()
-            .map_err(|e| OutputError::io(&self.path, e))?;
+        let status = self.wait_unless_cancelled()?;
         let fed_ok = matches!(fed, Some(Ok(Ok(()))));
         if !status.success() || !fed_ok {
             return Err(self.failure());
@@ -242,6 +282,24 @@ impl FfmpegWriter {
             temp.commit().map_err(|e| OutputError::io(&self.path, e))?;
         }
         Ok(self.path.clone())
+    }
+
+    /// ffmpeg's exit status; `Cancelled` as soon as the cancel flag is set (dropping the
+    /// writer then stops ffmpeg and removes the temporary file).
+    fn wait_unless_cancelled(&mut self) -> Result<ExitStatus, OutputError> {
+        let io = |e| OutputError::io(&self.path, e);
+        let Some(cancel) = self.cancel.clone() else {
+            return self.child.wait().map_err(io);
+        };
+        loop {
+            if let Some(status) = self.child.try_wait().map_err(io)? {
+                return Ok(status);
+            }
+            if cancel.load(Ordering::Relaxed) {
+                return Err(OutputError::Cancelled);
+            }
+            std::thread::sleep(Duration::from_millis(2));
+        }
     }
 
     fn failure(&mut self) -> OutputError {

@@ -15,6 +15,7 @@ mod gif_frame;
 mod gif_palette;
 mod png_sequence;
 mod y4m;
+mod yuv;
 
 pub use apng::{apng_delays, ApngWriter};
 pub use atomic::TempOutput;
@@ -27,7 +28,8 @@ pub use gif_palette::{Palette, PaletteMap};
 pub use png_sequence::{
     foreign_frames, frame_digits, frame_file_name, write_png_file, PngSequenceWriter,
 };
-pub use y4m::{fps_fraction, rgb_to_ycbcr, Y4mWriter};
+pub use y4m::{fps_fraction, Y4mWriter};
+pub use yuv::{frame_to_yuv420, rgb_to_ycbcr, yuv420_len, yuv420_size};
 
 use std::path::{Path, PathBuf};
 

@@ -5,37 +5,17 @@
 //!
 //! The stream is 8-bit 4:4:4 (`C444`, no chroma subsampling, so odd sizes need nothing
 //! special), progressive, square pixels, at the scene's fps as a fraction. Colours are
-//! converted with [`rgb_to_ycbcr`]: BT.709 coefficients, limited ("TV") range — what
-//! encoders assume for HD when a stream says nothing else. Y4M has no alpha: a transparent
-//! pixel is shown composited over black. 16-bit frames are rounded to 8 bits first.
+//! converted with [`rgb_to_ycbcr`] (the `yuv` module, shared with the ffmpeg pipe): BT.709
+//! coefficients, limited ("TV") range — what encoders assume for HD when a stream says
+//! nothing else. Y4M has no alpha: a transparent pixel is shown composited over black.
+//! 16-bit frames are rounded to 8 bits first.
 
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use super::atomic::TempOutput;
+use super::yuv::rgb_to_ycbcr;
 use super::{FrameRef, OutputError};
-
-/// BT.709 luma weights.
-const KR: f32 = 0.2126;
-const KB: f32 = 0.0722;
-const KG: f32 = 1.0 - KR - KB;
-
-/// One 8-bit straight-alpha RGBA pixel composited over black and converted to limited-range
-/// BT.709 Y′CbCr: Y = 16 + 219·E′y, Cb = 128 + 224·(E′b − E′y)/1.8556,
-/// Cr = 128 + 224·(E′r − E′y)/1.5748 (E′ in [0, 1]), each rounded to the nearest level.
-pub fn rgb_to_ycbcr(rgba: [u8; 4]) -> [u8; 3] {
-    let a = f32::from(rgba[3]) / 255.0;
-    let [r, g, b] = [rgba[0], rgba[1], rgba[2]].map(|v| f32::from(v) / 255.0 * a);
-    let y = KR * r + KG * g + KB * b;
-    let cb = (b - y) / (2.0 * (1.0 - KB));
-    let cr = (r - y) / (2.0 * (1.0 - KR));
-    let level = |v: f32| (v + 0.5).clamp(0.0, 255.0) as u8;
-    [
-        level(16.0 + 219.0 * y),
-        level(128.0 + 224.0 * cb),
-        level(128.0 + 224.0 * cr),
-    ]
-}
 
 /// `fps` as the fraction Y4M wants: whole rates exactly, NTSC-style rates over 1001, others
 /// to a thousandth.
@@ -180,15 +160,6 @@ fn write_all(sink: &mut Sink, bytes: &[u8]) -> Result<(), OutputError> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn reference_colours_convert_to_their_bt709_levels() {
-        assert_eq!(rgb_to_ycbcr([0, 0, 0, 255]), [16, 128, 128]);
-        assert_eq!(rgb_to_ycbcr([255, 255, 255, 255]), [235, 128, 128]);
-        // BT.709 100% red: Y 63, Cb 102, Cr 240.
-        assert_eq!(rgb_to_ycbcr([255, 0, 0, 255]), [63, 102, 240]);
-        assert_eq!(rgb_to_ycbcr([255, 255, 255, 0]), [16, 128, 128]);
-    }
 
     #[test]
     fn rates_become_fractions() {

@@ -1,6 +1,7 @@
 //! Interrupted renders (docs/robustness.md): SIGINT during `lapclone render` leaves only
 //! complete frames (each decodes fully) and no temporary file, and the render exits 1
-//! saying it was interrupted; an interrupted GIF/APNG leaves no file at all.
+//! saying it was interrupted; an interrupted GIF/APNG leaves no file at all, and an
+//! interrupted MP4 neither a file nor an ffmpeg process (skipped without ffmpeg).
 //!
 //! No sleeps: the test polls for the first output with a bounded, yielding loop.
 
@@ -119,4 +120,73 @@ fn sigint_during_an_animation_file_leaves_no_file() {
             "{format}: the interrupted render left files"
         );
     }
+}
+
+/// The ids of the processes whose parent is `parent` and whose command is `name` (/proc).
+fn children_named(parent: u32, name: &str) -> Vec<u32> {
+    let mut found = Vec::new();
+    for entry in std::fs::read_dir("/proc").unwrap().flatten() {
+        let Ok(pid) = entry.file_name().to_string_lossy().parse::<u32>() else {
+            continue;
+        };
+        // "pid (comm) state ppid …"; comm may hold spaces, so split at its last ')'.
+        let Ok(stat) = std::fs::read_to_string(entry.path().join("stat")) else {
+            continue;
+        };
+        let Some((head, tail)) = stat.rsplit_once(')') else {
+            continue;
+        };
+        let comm = head.split_once('(').map_or("", |(_, c)| c);
+        let ppid = tail.split_whitespace().nth(1).and_then(|p| p.parse().ok());
+        if comm == name && ppid == Some(parent) {
+            found.push(pid);
+        }
+    }
+    found
+}
+
+/// Whether any process is left in process group `group`.
+fn group_alive(group: u32) -> bool {
+    Command::new("kill")
+        .args(["-0", "--", &format!("-{group}")])
+        .stderr(Stdio::null())
+        .status()
+        .unwrap()
+        .success()
+}
+
+#[test]
+fn sigint_during_a_video_stops_ffmpeg_and_leaves_no_file() {
+    if lapclone::util::find_program("ffmpeg").is_none() {
+        eprintln!("skipped: ffmpeg not on PATH (apt-get install ffmpeg to run this test)");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write_scene(dir.path());
+    let out = dir.path().join("movie.mp4");
+    let mut child = spawn_render(&scene, &out, &[]);
+    // ffmpeg creates its temporary file once it is encoding.
+    let started = wait_until(&mut child, || {
+        sorted_names(dir.path()).iter().any(|n| n.ends_with(".tmp"))
+    });
+    assert!(started, "the render ended before ffmpeg wrote anything");
+    let ffmpeg = children_named(child.id(), "ffmpeg");
+    assert_eq!(ffmpeg.len(), 1, "ffmpeg processes: {ffmpeg:?}");
+    // ffmpeg leads a process group of its own, so the signal reaches only lapclone.
+    assert!(group_alive(ffmpeg[0]));
+    interrupt(&child);
+    let output = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("interrupted"), "{stderr}");
+    assert_eq!(
+        sorted_names(dir.path()),
+        ["long.rhai"],
+        "the interrupted video render left files"
+    );
+    assert!(
+        !group_alive(ffmpeg[0]),
+        "ffmpeg (process group {}) still runs",
+        ffmpeg[0]
+    );
 }

@@ -54,3 +54,4 @@ mod solve_supernodal;
 mod solve_update;
 mod test_cli;
 mod video_cli;
+mod video_encode;

@@ -13,22 +13,22 @@ use files::{asset, sorted_names};
 const W: u32 = 96;
 const H: u32 = 64;
 
-fn lapclone(args: &[&OsStr]) -> Output {
+pub(crate) fn lapclone(args: &[&OsStr]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_lapclone"))
         .args(args)
         .output()
         .unwrap()
 }
 
-fn os(s: &str) -> &OsStr {
+pub(crate) fn os(s: &str) -> &OsStr {
     OsStr::new(s)
 }
 
-fn stderr(o: &Output) -> String {
+pub(crate) fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
-fn has_ffmpeg() -> bool {
+pub(crate) fn has_ffmpeg() -> bool {
     let found = lapclone::util::find_program("ffmpeg").is_some()
         && lapclone::util::find_program("ffprobe").is_some();
     if !found {
@@ -38,7 +38,7 @@ fn has_ffmpeg() -> bool {
 }
 
 /// A plate whose every pixel differs from the other plates' (seeded by `k`).
-fn plate(k: u32, width: u32, height: u32) -> image::RgbImage {
+pub(crate) fn plate(k: u32, width: u32, height: u32) -> image::RgbImage {
     image::RgbImage::from_fn(width, height, |x, y| {
         let v = x * 7 + y * 13 + k * 50;
         image::Rgb([
@@ -58,9 +58,9 @@ fn write_plates(dir: &Path, count: u32, first: u32) {
 }
 
 /// A small still patch at [70, 20]: a triangle of chelsea.png.
-const PATCH: &str = "patch(\"p\", #{ source: SOURCE, polygons: [[[10, 10], [40, 12], [20, 36]]] }).at(0, [70, 20]);";
+pub(crate) const PATCH: &str = "patch(\"p\", #{ source: SOURCE, polygons: [[[10, 10], [40, 12], [20, 36]]] }).at(0, [70, 20]);";
 
-fn write_scene(dir: &Path, canvas: &str, patch: &str) -> PathBuf {
+pub(crate) fn write_scene(dir: &Path, canvas: &str, patch: &str) -> PathBuf {
     let scene = dir.join("scene.rhai");
     let source = format!("\"{}\"", asset("chelsea.png"));
     std::fs::write(
@@ -71,13 +71,13 @@ fn write_scene(dir: &Path, canvas: &str, patch: &str) -> PathBuf {
     scene
 }
 
-fn render(scene: &Path, out: &Path, extra: &[&str]) -> Output {
+pub(crate) fn render(scene: &Path, out: &Path, extra: &[&str]) -> Output {
     let mut args = vec![os("render"), scene.as_os_str(), os("-o"), out.as_os_str()];
     args.extend(extra.iter().map(|s| os(s)));
     lapclone(&args)
 }
 
-fn rgba(path: &Path) -> image::RgbaImage {
+pub(crate) fn rgba(path: &Path) -> image::RgbaImage {
     image::open(path).unwrap().to_rgba8()
 }
 
@@ -335,7 +335,7 @@ fn the_output_extension_names_the_format_and_old_frames_need_force() {
 }
 
 /// Each bad input: a clear message, exit 1, nothing written.
-fn assert_refused(dir: &Path, canvas: &str, patch: &str, message: &str) {
+pub(crate) fn assert_refused(dir: &Path, canvas: &str, patch: &str, message: &str) {
     let scene = write_scene(dir, canvas, patch);
     let out = dir.join("refused");
     let o = render(&scene, &out, &[]);
@@ -504,5 +504,13 @@ fn without_ffmpeg_video_output_is_refused_and_nothing_is_written() {
         let o = render(&scene, &mp4, &[]);
         assert!(o.status.success(), "{}", stderr(&o));
         assert!(stderr(&o).contains("padded to 96×64"), "{}", stderr(&o));
+        let probe = Command::new("ffprobe")
+            .args(["-v", "error", "-show_entries", "stream=width,height"])
+            .args(["-of", "default=noprint_wrappers=1"])
+            .arg(&mp4)
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&probe.stdout);
+        assert!(text.contains("width=96\nheight=64"), "{text}");
     }
 }
