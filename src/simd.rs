@@ -1,5 +1,6 @@
-//! Vector code in one place: takes a kernel written on plain `f64` arrays (a [`Row`] of `S`
-//! channels and the few operations kernels need on it) and runs it on a [`Path`]: compiled for
+//! Vector code in one place: takes a kernel written as plain loops (the solve's on `f64`
+//! arrays, a [`Row`] of `S` channels with the few operations it needs; the video writer's
+//! RGB→YUV conversion on integers) and runs it on a [`Path`]: compiled for
 //! the best instruction set this CPU has (pulp's run-time dispatch, e.g. AVX2 on x86_64), or
 //! the portable path at the baseline instruction set. Safe throughout: pulp checks the CPU
 //! before it enters code compiled for it.

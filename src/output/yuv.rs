@@ -95,7 +95,7 @@ pub fn frame_to_yuv420(frame: &FrameRef<'_>, out: &mut Vec<u8>, threads: usize) 
             // Compiled for the best instruction set this CPU has (integer maths: the same
             // bytes on every path).
             let mut work = move || {
-                pulp::Arch::new().dispatch(Band {
+                crate::simd::Path::current().run(Band {
                     source,
                     first_pair: band * per_band,
                     planes: [y, cb, cr],
@@ -145,18 +145,18 @@ impl<'a> RgbaRows<'a> {
     }
 }
 
-/// One band's work, as pulp's dispatch wants it.
+/// One band's work, as a kernel for [`crate::simd`].
 struct Band<'a, 'f> {
     source: &'a RgbaRows<'f>,
     first_pair: usize,
     planes: [&'a mut [u8]; 3],
 }
 
-impl pulp::WithSimd for Band<'_, '_> {
+impl crate::simd::Kernel for Band<'_, '_> {
     type Output = ();
 
     #[inline(always)]
-    fn with_simd<S: pulp::Simd>(self, _simd: S) {
+    fn call(self) {
         convert_band(self.source, self.first_pair, self.planes);
     }
 }
