@@ -120,7 +120,7 @@ pub struct RenderArgs {
     /// such a folder is refused).
     #[arg(long)]
     pub force: bool,
-    /// PNG deflate effort for frame folders: fast (default), default, or best (smaller files).
+    /// PNG deflate effort for frame folders: fast (default; unchanged rows reuse the frame before's bands), default, or best (smaller files).
     #[arg(long, value_enum, default_value = "fast")]
     pub png_compression: CompressionArg,
     /// Constant quality for MP4/WebM/MOV (lower is better; H.264 default 20, VP9 default 32).
