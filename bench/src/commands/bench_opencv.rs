@@ -65,17 +65,17 @@ pub struct OpencvBenchArgs {
 }
 
 /// Issue 32's budgets: (figure, unit, at most).
-const TARGETS: [(&str, &str, f64); 4] = [
+pub const TARGETS: [(&str, &str, f64); 4] = [
     (PNG_VS_OPENCV, "×", 0.10),
     (MP4_VS_PNG, "×", 1.5),
     (CLONE_VS_SEAMLESS, "×", 0.08),
     (CLONE_PEAK, "MB", 1000.0),
 ];
-const PNG_VS_OPENCV: &str = "png_vs_opencv";
-const MP4_VS_PNG: &str = "mp4_vs_png";
-const CLONE_VS_SEAMLESS: &str = "clone_vs_seamless_clone";
+pub const PNG_VS_OPENCV: &str = "png_vs_opencv";
+pub const MP4_VS_PNG: &str = "mp4_vs_png";
+pub const CLONE_VS_SEAMLESS: &str = "clone_vs_seamless_clone";
 /// The clone's peak resident set in MB of 10⁶ bytes, so 1000 is the issue's "1.0 GB".
-const CLONE_PEAK: &str = "clone_peak_rss_mb";
+pub const CLONE_PEAK: &str = "clone_peak_rss_mb";
 
 const SCENE: &str = "benches/scenes/hd_move.rhai";
 /// The centre of the 6000×5000 target, where clone_big.py puts the patch too.
@@ -269,17 +269,41 @@ fn load_average() -> Option<[f64; 3]> {
     Some([fields.next()??, fields.next()??, fields.next()??])
 }
 
-fn invocation(setup: &Setup, name: &'static str, program: &Path, args: &[&OsString]) -> Invocation {
+fn invocation(
+    setup: &Setup,
+    name: &'static str,
+    program: &Path,
+    args: impl IntoIterator<Item = OsString>,
+) -> Invocation {
     Invocation {
         name,
         program: program.to_path_buf(),
-        args: args.iter().map(|&a| a.clone()).collect(),
+        args: args.into_iter().collect(),
         cwd: setup.root.clone(),
     }
 }
 
-fn os(text: &str) -> OsString {
-    OsString::from(text)
+/// hd_move to PNG files, to MP4, and the OpenCV loop, each writing into the work folder.
+fn hd_move_commands(setup: &Setup) -> [Invocation; 3] {
+    let work = |name: &str| setup.work.join(name).into_os_string();
+    let render = |output: OsString| ["render".into(), SCENE.into(), "-o".into(), output];
+    let mut png_args = render(work("hd_move_png")).to_vec();
+    png_args.push("--force".into());
+    [
+        invocation(setup, "lapclone_png", &setup.lapclone, png_args),
+        invocation(
+            setup,
+            "lapclone_mp4",
+            &setup.lapclone,
+            render(work("hd_move.mp4")),
+        ),
+        invocation(
+            setup,
+            "opencv_loop",
+            &setup.python,
+            ["benches/opencv/hd_move.py".into(), work("hd_move_opencv")],
+        ),
+    ]
 }
 
 /// The PNG and MP4 figures of hd_move: one set of rounds over the commands they need.
@@ -296,32 +320,12 @@ fn hd_move_figures(
     }
     let ffmpeg = child_run::probe(Path::new("ffmpeg"), &["-hide_banner", "-version"])
         .map_err(|why| format!("ffmpeg not found on PATH ({why}); install it"));
-    let png_dir = setup.work.join("hd_move_png").into_os_string();
-    let mp4 = setup.work.join("hd_move.mp4").into_os_string();
-    let cv_dir = setup.work.join("hd_move_opencv").into_os_string();
-    let (render, scene, o, force) = (os("render"), os(SCENE), os("-o"), os("--force"));
-    let png = invocation(
-        setup,
-        "lapclone_png",
-        &setup.lapclone,
-        &[&render, &scene, &o, &png_dir, &force],
-    );
-    let video = invocation(
-        setup,
-        "lapclone_mp4",
-        &setup.lapclone,
-        &[&render, &scene, &o, &mp4],
-    );
-    let script = os("benches/opencv/hd_move.py");
-    let loop_cv = invocation(setup, "opencv_loop", &setup.python, &[&script, &cv_dir]);
-
-    let use_cv = want_png && cv.is_ok();
-    let use_mp4 = want_mp4 && ffmpeg.is_ok();
+    let [png, video, loop_cv] = hd_move_commands(setup);
     let mut order = vec![png];
-    if use_cv {
+    if want_png && cv.is_ok() {
         order.push(loop_cv);
     }
-    if use_mp4 {
+    if want_mp4 && ffmpeg.is_ok() {
         order.push(video);
     }
     // The PNG render alone compares with nothing: no rounds then.
@@ -330,25 +334,58 @@ fn hd_move_figures(
     } else {
         BTreeMap::new()
     };
-    let wall = |name: &str| runs.get(name).map(|r| walls(r));
     if want_png {
-        let figure = match (cv, wall("lapclone_png"), wall("opencv_loop")) {
-            (Ok(()), Some(a), Some(b)) => measured(PNG_VS_OPENCV, ratios(&a, &b), median),
-            (Err(why), ..) => skipped(PNG_VS_OPENCV, why),
-            _ => skipped(PNG_VS_OPENCV, "not run"),
-        };
+        let figure = ratio_figure(PNG_VS_OPENCV, cv, &runs, "lapclone_png", "opencv_loop");
         report.figures.insert(PNG_VS_OPENCV, figure);
     }
     if want_mp4 {
-        let figure = match (&ffmpeg, wall("lapclone_mp4"), wall("lapclone_png")) {
-            (Ok(()), Some(a), Some(b)) => measured(MP4_VS_PNG, ratios(&a, &b), median),
-            (Err(why), ..) => skipped(MP4_VS_PNG, why),
-            _ => skipped(MP4_VS_PNG, "not run"),
-        };
+        let figure = ratio_figure(MP4_VS_PNG, &ffmpeg, &runs, "lapclone_mp4", "lapclone_png");
         report.figures.insert(MP4_VS_PNG, figure);
     }
     record_commands(&order, &runs, report);
     Ok(())
+}
+
+/// Figure `name`: the median of round-by-round wall time `a ÷ b`, or skipped for `tool`'s
+/// reason.
+fn ratio_figure(
+    name: &str,
+    tool: &Result<(), String>,
+    runs: &BTreeMap<&'static str, Vec<Measured>>,
+    a: &str,
+    b: &str,
+) -> Figure {
+    match (tool, runs.get(a), runs.get(b)) {
+        (Err(why), ..) => skipped(name, why),
+        (Ok(()), Some(a), Some(b)) => measured(name, ratios(&walls(a), &walls(b)), median),
+        _ => skipped(name, "not run"),
+    }
+}
+
+/// `lapclone clone` of the large images, and clone_big.py on the same folder.
+fn clone_commands(setup: &Setup, big: &Path) -> [Invocation; 2] {
+    let file = |name: &str| big.join(name).into_os_string();
+    let args = [
+        "clone".into(),
+        "--source".into(),
+        file("source.png"),
+        "--mask".into(),
+        file("mask.png"),
+        "--target".into(),
+        file("target.png"),
+        "--at".into(),
+        BIG_AT.into(),
+        "-o".into(),
+        file("lapclone_out.png"),
+    ];
+    let script = [
+        "benches/opencv/clone_big.py".into(),
+        big.as_os_str().to_owned(),
+    ];
+    [
+        invocation(setup, "lapclone_clone", &setup.lapclone, args),
+        invocation(setup, "opencv_clone", &setup.python, script),
+    ]
 }
 
 /// The large clone against seamlessClone, and its peak memory.
@@ -358,67 +395,42 @@ fn clone_figures(
     report: &mut Report,
 ) -> anyhow::Result<()> {
     if let Err(why) = cv {
-        report
-            .figures
-            .insert(CLONE_VS_SEAMLESS, skipped(CLONE_VS_SEAMLESS, why));
-        report.figures.insert(CLONE_PEAK, skipped(CLONE_PEAK, why));
+        for name in [CLONE_VS_SEAMLESS, CLONE_PEAK] {
+            report.figures.insert(name, skipped(name, why));
+        }
         return Ok(());
     }
-    let big = big_images(setup)?;
-    let file = |name: &str| big.join(name).into_os_string();
-    let (source, mask, target, out) = (
-        file("source.png"),
-        file("mask.png"),
-        file("target.png"),
-        file("lapclone_out.png"),
-    );
-    let (clone, at, o) = (os("clone"), os("--at"), os("-o"));
-    let (s, m, t, a) = (os("--source"), os("--mask"), os("--target"), os(BIG_AT));
-    let lapclone = invocation(
-        setup,
-        "lapclone_clone",
-        &setup.lapclone,
-        &[
-            &clone, &s, &source, &m, &mask, &t, &target, &at, &a, &o, &out,
-        ],
-    );
-    let script = os("benches/opencv/clone_big.py");
-    let big_dir = big.clone().into_os_string();
-    let opencv = invocation(setup, "opencv_clone", &setup.python, &[&script, &big_dir]);
-    let order = [lapclone, opencv];
+    let order = clone_commands(setup, &big_images(setup)?);
     let runs = rounds(setup, &order)?;
-    let a = walls(&runs["lapclone_clone"]);
+    let clones = &runs["lapclone_clone"];
     let call = runs["opencv_clone"]
         .iter()
         .map(|m| seamless_clone_seconds(&m.stdout))
         .collect::<anyhow::Result<Vec<f64>>>()?;
-    report.figures.insert(
-        CLONE_VS_SEAMLESS,
-        measured(CLONE_VS_SEAMLESS, ratios(&a, &call), median),
-    );
-    let peaks: Vec<f64> = runs["lapclone_clone"]
+    let ratio = measured(CLONE_VS_SEAMLESS, ratios(&walls(clones), &call), median);
+    report.figures.insert(CLONE_VS_SEAMLESS, ratio);
+    report.figures.insert(CLONE_PEAK, peak_figure(clones));
+    record_commands(&order, &runs, report);
+    let what = "cv2.seamlessClone(…) alone, as clone_big.py prints it";
+    report
+        .commands
+        .insert("seamless_clone_call", times(what.into(), call, None));
+    Ok(())
+}
+
+/// The largest peak resident set of `runs`, MB.
+fn peak_figure(runs: &[Measured]) -> Figure {
+    let peaks: Vec<f64> = runs
         .iter()
         .filter_map(|m| m.peak_rss_bytes)
         .map(|bytes| bytes as f64 / 1e6)
         .collect();
-    let peak = if peaks.is_empty() {
-        skipped(CLONE_PEAK, "this platform reports no peak memory")
-    } else {
-        measured(CLONE_PEAK, peaks, |v| {
-            v.iter().copied().fold(f64::MIN, f64::max)
-        })
-    };
-    report.figures.insert(CLONE_PEAK, peak);
-    record_commands(&order, &runs, report);
-    report.commands.insert(
-        "seamless_clone_call",
-        times(
-            "cv2.seamlessClone(…) alone, as clone_big.py prints it".into(),
-            call,
-            None,
-        ),
-    );
-    Ok(())
+    if peaks.is_empty() {
+        return skipped(CLONE_PEAK, "this platform reports no peak memory");
+    }
+    measured(CLONE_PEAK, peaks, |v| {
+        v.iter().copied().fold(f64::MIN, f64::max)
+    })
 }
 
 /// The 6000×5000 target, its source and mask in `work/big`, made by make_big_images.py
@@ -435,15 +447,11 @@ fn big_images(setup: &Setup) -> anyhow::Result<PathBuf> {
         "lapclone-bench opencv: writing the 6000×5000 test images into {}",
         big.display()
     );
-    let make = invocation(
-        setup,
-        "make_big_images",
-        &setup.python,
-        &[
-            &os("benches/make_big_images.py"),
-            &big.clone().into_os_string(),
-        ],
-    );
+    let script = [
+        "benches/make_big_images.py".into(),
+        big.clone().into_os_string(),
+    ];
+    let make = invocation(setup, "make_big_images", &setup.python, script);
     child_run::run(&make, &setup.work.join("logs"))?;
     Ok(big)
 }
@@ -505,6 +513,14 @@ pub fn seamless_clone_seconds(stdout: &str) -> anyhow::Result<f64> {
         .with_context(|| {
             format!("clone_big.py printed no `seamlessClone: <seconds> s` line: {stdout:?}")
         })
+}
+
+/// The most figure `name` (a key of the JSON's `figures`) may measure, if it is one.
+pub fn budget(name: &str) -> Option<f64> {
+    TARGETS
+        .iter()
+        .find(|(n, ..)| *n == name)
+        .map(|&(.., limit)| limit)
 }
 
 fn target_of(name: &str) -> (&'static str, f64) {
@@ -606,13 +622,17 @@ fn print_table(report: &Report) {
     }
     println!("{:<24} {:>10} {:>10}  ok", "figure", "measured", "target");
     for (name, f) in &report.figures {
+        let with_unit = |value: f64| match f.unit {
+            "MB" => format!("{value:.0} MB"),
+            unit => format!("{value:.3}{unit}"),
+        };
         match (f.measured, &f.skipped) {
             (Some(value), _) => println!(
-                "{name:<24} {:>10} {:>10}  {}   ({} per round: {})",
-                format!("{value:.3}{}", f.unit),
-                format!("≤ {}{}", f.target, f.unit),
+                "{name:<24} {:>10} {:>10}  {}   ({} of rounds: {})",
+                with_unit(value),
+                format!("≤ {}", with_unit(f.target)),
                 if value <= f.target { "✓" } else { "✗" },
-                if f.unit == "MB" { "max" } else { "median" },
+                if f.unit == "MB" { "largest" } else { "median" },
                 list(&f.per_round)
             ),
             (None, why) => println!("{name:<24} skipped: {}", why.as_deref().unwrap_or("")),
