@@ -8,12 +8,21 @@
 //! (exit 1 when a target is missed; by default a miss is reported, not failed, since wall-clock
 //! figures on a shared machine move with its load) and `--json` (one JSON array on stdout
 //! instead of the table: `issue`, `figure`, `measured`, `bound` ("at_most" or "at_least"),
-//! `target`, `holds`). Exit 2 on a bad argument, 1 when a bench command fails. Run as a test
+//! `target`, `holds`, and `skipped`: why a figure was not measured, with `measured` and `holds`
+//! null). Exit 2 on a bad argument, 1 when a bench command fails. Run as a test
 //! (`cargo test --benches`, without cargo bench's `--bench` flag) it checks nothing.
+//!
+//! The whole-process figures (`lapclone-bench opencv`) time the `lapclone` binary beside
+//! `lapclone-bench`, which `cargo bench -p lapclone-bench` does not build: run `cargo build
+//! --release` first. They are skipped, with the reason, where python3 cannot import cv2 or
+//! ffmpeg is missing.
 
 use std::path::Path;
 use std::process::{Command, ExitCode};
 
+use lapclone_bench::commands::bench_opencv::{
+    budget, CLONE_PEAK, CLONE_VS_SEAMLESS, MP4_VS_PNG, PNG_VS_OPENCV,
+};
 use serde_json::Value;
 
 /// Which side of the target a figure must stay on.
@@ -45,6 +54,14 @@ struct Check {
     what: String,
     measured: f64,
     bound: Bound,
+}
+
+/// A figure that could not be measured here (a missing tool), and why.
+struct Skipped {
+    issue: u32,
+    what: String,
+    bound: Bound,
+    reason: String,
 }
 
 /// The run's settings, from the command line.
@@ -87,8 +104,8 @@ fn main() -> ExitCode {
         println!("targets: run by `cargo bench` (release build); nothing to check in a test run");
         return ExitCode::SUCCESS;
     }
-    let checks = match measure(&settings) {
-        Ok(checks) => checks,
+    let (checks, skipped) = match measure(&settings) {
+        Ok(measured) => measured,
         Err(message) => {
             eprintln!("targets: {message}");
             return ExitCode::from(1);
@@ -96,13 +113,18 @@ fn main() -> ExitCode {
     };
     let missed = checks.iter().filter(|c| !c.bound.holds(c.measured)).count();
     if settings.json {
-        println!("{}", checks_json(&checks));
+        println!("{}", checks_json(&checks, &skipped));
     } else {
-        print_table(&checks);
+        print_table(&checks, &skipped);
         println!(
-            "\n{} of {} targets hold{}",
+            "\n{} of {} targets hold{}{}",
             checks.len() - missed,
             checks.len(),
+            if skipped.is_empty() {
+                String::new()
+            } else {
+                format!(", {} skipped", skipped.len())
+            },
             if settings.quick { " (--quick)" } else { "" }
         );
     }
@@ -132,14 +154,16 @@ fn parse_arguments(arguments: impl Iterator<Item = String>) -> Result<Settings, 
     Ok(settings)
 }
 
-fn measure(settings: &Settings) -> Result<Vec<Check>, String> {
+fn measure(settings: &Settings) -> Result<(Vec<Check>, Vec<Skipped>), String> {
     let mut checks = Vec::new();
+    let mut skipped = Vec::new();
     mesh_checks(settings, &mut checks)?;
     factor_checks(settings, &mut checks)?;
     clone_checks(settings, &mut checks)?;
     render_checks(settings, &mut checks)?;
     paper_checks(&mut checks)?;
-    Ok(checks)
+    whole_process_checks(settings, &mut checks, &mut skipped)?;
+    Ok((checks, skipped))
 }
 
 /// Issue #2: the 770×743 spiral meshes in ≤ 20 ms at the defaults.
@@ -264,6 +288,87 @@ fn paper_checks(checks: &mut Vec<Check>) -> Result<(), String> {
     Ok(())
 }
 
+/// Issue #32: whole processes of the release `lapclone` binary against OpenCV and ffmpeg.
+/// The budgets are the command's own ([`budget`]), so the two cannot disagree.
+fn whole_process_checks(
+    settings: &Settings,
+    checks: &mut Vec<Check>,
+    skipped: &mut Vec<Skipped>,
+) -> Result<(), String> {
+    let runs = settings.pick("3", "5");
+    let lapclone = Path::new(env!("CARGO_BIN_EXE_lapclone-bench"))
+        .with_file_name(format!("lapclone{}", std::env::consts::EXE_SUFFIX));
+    let report = if lapclone.is_file() {
+        run_bench(&["opencv", "--runs", runs])?
+    } else {
+        let reason = format!(
+            "no {}: run `cargo build --release` first",
+            lapclone.display()
+        );
+        serde_json::json!({ "missing": reason })
+    };
+    for warning in report
+        .pointer("/warnings")
+        .and_then(Value::as_array)
+        .into_iter()
+        .flatten()
+        .filter_map(Value::as_str)
+    {
+        eprintln!("targets: warning: {warning}");
+    }
+    for (key, what) in [
+        (
+            PNG_VS_OPENCV,
+            format!("hd_move 1920×1080×48 to PNG ÷ OpenCV loop, median of {runs} (×)"),
+        ),
+        (
+            MP4_VS_PNG,
+            format!("hd_move to MP4 ÷ to PNG files, median of {runs} (×)"),
+        ),
+        (
+            CLONE_VS_SEAMLESS,
+            format!("6000×5000 clone ÷ seamlessClone call, median of {runs} (×)"),
+        ),
+        (
+            CLONE_PEAK,
+            format!("6000×5000 clone peak memory, max of {runs} (MB, 10⁶ B)"),
+        ),
+    ] {
+        let bound =
+            Bound::AtMost(budget(key).ok_or_else(|| format!("bench opencv has no budget {key}"))?);
+        match whole_process_figure(&report, key)? {
+            Ok(measured) => checks.push(Check {
+                issue: 32,
+                what,
+                measured,
+                bound,
+            }),
+            Err(reason) => skipped.push(Skipped {
+                issue: 32,
+                what,
+                bound,
+                reason,
+            }),
+        }
+    }
+    Ok(())
+}
+
+/// Figure `key` of `lapclone-bench opencv`'s report: measured, or why it was skipped (the
+/// report's own reason, or its `missing` when the command could not run).
+fn whole_process_figure(report: &Value, key: &str) -> Result<Result<f64, String>, String> {
+    if let Some(reason) = report.pointer("/missing").and_then(Value::as_str) {
+        return Ok(Err(reason.to_string()));
+    }
+    let figure = report
+        .pointer(&format!("/figures/{key}"))
+        .ok_or_else(|| format!("bench opencv gave no figure {key}"))?;
+    match figure.pointer("/skipped").and_then(Value::as_str) {
+        Some(reason) => Ok(Err(reason.to_string())),
+        None => number(figure, "/measured").map(Ok),
+    }
+}
+
 /// Runs `lapclone-bench <arguments> --json` from the repository root (where `assets/` is)
 /// and parses its stdout.
 fn run_bench(arguments: &[&str]) -> Result<Value, String> {
@@ -298,12 +403,9 @@ fn number(value: &Value, pointer: &str) -> Result<f64, String> {
         .ok_or_else(|| format!("no number at {pointer} in {value}"))
 }
 
-fn checks_json(checks: &[Check]) -> Value {
+fn checks_json(checks: &[Check], skipped: &[Skipped]) -> Value {
     let rows = checks.iter().map(|check| {
-        let (bound, target) = match check.bound {
-            Bound::AtMost(limit) => ("at_most", limit),
-            Bound::AtLeast(limit) => ("at_least", limit),
-        };
+        let (bound, target) = bound_json(check.bound);
         serde_json::json!({
             "issue": check.issue,
             "figure": check.what,
@@ -311,12 +413,32 @@ fn checks_json(checks: &[Check]) -> Value {
             "bound": bound,
             "target": target,
             "holds": check.bound.holds(check.measured),
+            "skipped": null,
         })
     });
-    Value::Array(rows.collect())
+    let skipped_rows = skipped.iter().map(|skip| {
+        let (bound, target) = bound_json(skip.bound);
+        serde_json::json!({
+            "issue": skip.issue,
+            "figure": skip.what,
+            "measured": null,
+            "bound": bound,
+            "target": target,
+            "holds": null,
+            "skipped": skip.reason,
+        })
+    });
+    Value::Array(rows.chain(skipped_rows).collect())
 }
 
-fn print_table(checks: &[Check]) {
+fn bound_json(bound: Bound) -> (&'static str, f64) {
+    match bound {
+        Bound::AtMost(limit) => ("at_most", limit),
+        Bound::AtLeast(limit) => ("at_least", limit),
+    }
+}
+
+fn print_table(checks: &[Check], skipped: &[Skipped]) {
     println!(
         "{:<6} {:<62} {:>10} {:>10}  ok",
         "issue", "figure", "measured", "target"
@@ -333,6 +455,16 @@ fn print_table(checks: &[Check]) {
             } else {
                 "✗"
             }
+        );
+    }
+    for skip in skipped {
+        println!(
+            "#{:<5} {:<62} {:>10} {:>10}  skipped: {}",
+            skip.issue,
+            skip.what,
+            "—",
+            skip.bound.describe(),
+            skip.reason
         );
     }
 }

@@ -4,8 +4,8 @@
 //!
 //! - [`reference`](mod@reference): the pixel-grid Poisson membrane, MVC cloning, the quality metrics and
 //!   the paper's experiments and figures;
-//! - [`commands`]: `lapclone-bench mesh | factor | solver | deform | render | clone | paper`,
-//!   each printing a table or, with `--json`, one JSON document.
+//! - [`commands`]: `lapclone-bench mesh | factor | solver | deform | render | clone | paper |
+//!   opencv`, each printing a table or, with `--json`, one JSON document.
 
 pub mod commands;
 pub mod reference;

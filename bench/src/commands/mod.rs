@@ -5,9 +5,11 @@
 pub mod bench_clone;
 pub mod bench_deform;
 pub mod bench_mesh;
+pub mod bench_opencv;
 pub mod bench_paper;
 pub mod bench_render;
 pub mod bench_solver;
+pub mod child_run;
 
 pub use lapclone::cli::{describe, finite_f64, mesh_args, UsageError};
 
@@ -31,6 +33,10 @@ pub enum BenchCommand {
     /// The paper's Table I and Fig. 5: MVC vs combinatorial vs cotangent against the
     /// pixel-grid reference; `--sweep` writes the density table.
     Paper(bench_paper::PaperBenchArgs),
+    /// Whole processes of the release `lapclone` binary against OpenCV and ffmpeg: a 1920×1080
+    /// scene to PNG files against an OpenCV loop and to MP4 against PNG, and a 6000×5000
+    /// clone against seamlessClone, with its peak memory.
+    Opencv(bench_opencv::OpencvBenchArgs),
 }
 
 /// Runs one benchmark.
@@ -43,5 +49,6 @@ pub fn run(which: BenchCommand) -> anyhow::Result<()> {
         BenchCommand::Render(args) => bench_render::run(args),
         BenchCommand::Clone(args) => bench_clone::run(args),
         BenchCommand::Paper(args) => bench_paper::run(args),
+        BenchCommand::Opencv(args) => bench_opencv::run(args),
     }
 }
