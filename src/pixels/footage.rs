@@ -519,13 +519,13 @@ const OPAQUE_RGB8: PixelFormat = PixelFormat {
     ..PixelFormat::RGBA8
 };
 
-/// An 8-bit RGBA buffer as an opaque-format float image.
+/// An 8-bit RGBA buffer as an opaque-format image of its levels.
 fn rgba8_image(width: u32, height: u32, bytes: &[u8]) -> Result<FloatImage, FootageError> {
-    let pixels = bytes
+    let levels = bytes
         .chunks_exact(4)
-        .map(|p| [p[0], p[1], p[2], p[3]].map(|v| f32::from(v) / 255.0))
+        .map(|p| [p[0], p[1], p[2], p[3]])
         .collect();
-    FloatImage::new(width, height, pixels, OPAQUE_RGB8)
+    FloatImage::from_levels(width, height, levels, OPAQUE_RGB8)
         .map_err(|e| FootageError::Image(Box::new(e)))
 }
 
