@@ -452,9 +452,16 @@ fn write_output(
         .with_context(|| format!("writing {}", args.output.display()))
 }
 
-/// The target as the canvas to clone onto (8-bit images without a float copy), and the
-/// format the output is written in.
+/// The target as the canvas to clone onto (8-bit images without a float copy; 8-bit PNGs
+/// decoded row by row straight into it), and the format the output is written in.
 fn load_target(path: &Path) -> anyhow::Result<(Canvas, PixelFormat)> {
+    use lapclone::pixels::{decode_png_levels, open_error};
+    if let Some(png) = decode_png_levels(path).map_err(|error| open_error(path, error))? {
+        return Ok((
+            Canvas::from_rgba8(png.width, png.height, png.levels)?,
+            png.format,
+        ));
+    }
     let decoded = FloatImage::decode(path)?;
     let format = PixelFormat::of(&decoded);
     let canvas = match Canvas::from_eight_bit(&decoded) {

@@ -10,6 +10,7 @@ use std::sync::OnceLock;
 use glam::Vec4;
 
 use super::bilinear::sample_bilinear_by;
+use super::png_decode::decode_png_levels;
 use super::{format::rgba8_levels, ColorKind, Depth, PixelError, PixelFormat};
 
 /// Rec. 709 luma weights (sum exactly 1 in real numbers).
@@ -169,37 +170,27 @@ impl FloatImage {
     }
 
     /// Reads and decodes an image file (format guessed from its content); images over the
-    /// size limits of `limits` are refused from their header, before decoding.
+    /// size limits of `limits` are refused from their header, before decoding. An 8-bit PNG
+    /// is decoded row by row straight into its levels.
     pub fn load(path: &Path) -> Result<FloatImage, PixelError> {
-        let decoded = Self::decode(path)?;
-        FloatImage::from_dynamic(&decoded).map_err(|err| match err {
+        let empty = |err| match err {
             PixelError::EmptyImage { width, height } => PixelError::Empty {
                 path: path.to_path_buf(),
                 width,
                 height,
             },
             other => other,
-        })
+        };
+        match decode_png_levels(path).map_err(|error| open_error(path, error))? {
+            Some(png) => FloatImage::from_levels(png.width, png.height, png.levels, png.format)
+                .map_err(empty),
+            None => FloatImage::from_dynamic(&Self::decode(path)?).map_err(empty),
+        }
     }
 
     /// Reads and decodes an image file as [`load`](Self::load) does, without converting it.
     pub fn decode(path: &Path) -> Result<image::DynamicImage, PixelError> {
-        use crate::limits::{open_image, ImageOpenError};
-        let path_buf = || path.to_path_buf();
-        open_image(path).map_err(|error| match error {
-            ImageOpenError::Read(source) => PixelError::Read {
-                path: path_buf(),
-                source,
-            },
-            ImageOpenError::Decode(source) => PixelError::Decode {
-                path: path_buf(),
-                source,
-            },
-            ImageOpenError::TooLarge(source) => PixelError::TooLarge {
-                path: path_buf(),
-                source,
-            },
-        })
+        crate::limits::open_image(path).map_err(|error| open_error(path, error))
     }
 
     /// Converts a decoded image, keeping its format for output (8-bit images keep their
@@ -351,6 +342,17 @@ impl FloatImage {
             ..self.format
         };
         FloatImage::with_eight_bit_view(self.width, self.height, pixels, format)
+    }
+}
+
+/// The pixel error of a failed [`open_image`](crate::limits::open_image) of `path`.
+pub(crate) fn open_error(path: &Path, error: crate::limits::ImageOpenError) -> PixelError {
+    use crate::limits::ImageOpenError;
+    let path = path.to_path_buf();
+    match error {
+        ImageOpenError::Read(source) => PixelError::Read { path, source },
+        ImageOpenError::Decode(source) => PixelError::Decode { path, source },
+        ImageOpenError::TooLarge(source) => PixelError::TooLarge { path, source },
     }
 }
 

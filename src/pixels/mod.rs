@@ -18,6 +18,7 @@ mod error;
 mod float_image;
 pub mod footage;
 mod format;
+mod png_decode;
 mod png_encode;
 mod rect;
 
@@ -26,6 +27,8 @@ pub(crate) use canvas::composite_over_straight as canvas_composite_over;
 pub use canvas::{Canvas, CanvasPixels, Texel};
 pub use error::PixelError;
 pub use float_image::FloatImage;
+pub(crate) use float_image::open_error;
+pub(crate) use png_decode::decode_png_levels;
 pub use footage::{Footage, FootageError, FootageReader, FootageSource};
 pub use format::{ColorKind, Depth, PixelFormat};
 pub use rect::PixelRect;
