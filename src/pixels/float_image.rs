@@ -534,7 +534,8 @@ mod tests {
             }
             proptest::prop_assert_eq!(levels.eight_bit_view(), floats.eight_bit_view());
             proptest::prop_assert_eq!(levels.pixels(), floats.pixels());
-            proptest::prop_assert!(levels == floats && floats == levels);
+            proptest::prop_assert!(levels == floats);
+            proptest::prop_assert!(floats == levels);
             proptest::prop_assert!(levels.to_grey() == floats.to_grey());
         }
     }
