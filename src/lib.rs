@@ -15,8 +15,9 @@
 //!    [`Deformed`] positions, which [`PatchCloner::clone_deformed`] clones. Errors:
 //!    [`DeformError`].
 //! 4. **Animate**: an [`animation::Scene`] (built in Rust, or loaded from a `.rhai` file with
-//!    [`load_scene`]) is rendered frame by frame by a [`Renderer`]. Errors: [`SceneError`],
-//!    [`RenderError`].
+//!    [`load_scene`]) is rendered frame by frame by a [`Renderer`]. Its background, and any
+//!    patch's source, may be [`animation::Footage`]: numbered plates or a video, one frame
+//!    per scene frame. Errors: [`SceneError`], [`RenderError`], [`FootageError`].
 //! 5. **Images**: [`FloatImage`] (sources and targets, any 8/16-bit PNG or JPEG) and
 //!    [`Canvas`] (the premultiplied frame being composited) with their [`PixelFormat`];
 //!    [`Canvas::to_rgba8_image`] hands a frame to the `image` crate. Errors: [`PixelError`].
@@ -79,7 +80,7 @@ pub use deform::{DeformError, DeformOptions, DeformRig, DeformStats, Deformed, H
 pub use mesh::{
     BitMask, BoundaryPlacement, Mesh, MeshError, MeshOptions, MeshResult, MeshStats, Polygon,
 };
-pub use pixels::{Canvas, ColorKind, Depth, FloatImage, PixelError, PixelFormat};
+pub use pixels::{Canvas, ColorKind, Depth, FloatImage, FootageError, PixelError, PixelFormat};
 pub use render::{FrameStats, RenderError, Renderer};
 pub use script::{load_scene, LoadedScene, SceneError};
 pub use solve::LaplacianKind;
@@ -91,11 +92,14 @@ pub use solve::LaplacianKind;
 /// with a [`Shape`](animation::Shape), an animated [`Placement`](animation::Placement), drag
 /// [`Handle`](animation::Handle)s and [`Pin`](animation::Pin)s; every animated value is a
 /// [`Track`](animation::Track) of [`Key`](animation::Key)s, each with an
-/// [`Easing`](animation::Easing).
+/// [`Easing`](animation::Easing). [`Footage`](animation::Footage) (numbered plates through a
+/// [`Pattern`](animation::Pattern), or a video) is a background or a patch's animated source;
+/// [`Footage::open`](animation::Footage::open) reads its size. Errors: [`FootageError`].
 pub mod animation {
+    pub use crate::pixels::footage::Pattern;
     pub use crate::scene::{
-        Background, Canvas, Easing, Handle, Key, KeyError, ModelError, Patch, Pin, Placement,
-        Scene, Shape, Track,
+        Background, Canvas, Easing, Footage, FootageSource, Handle, Key, KeyError, ModelError,
+        Patch, Pin, Placement, Scene, Shape, Track,
     };
 }
 

@@ -23,7 +23,7 @@ pub const MAX_MESH_VERTICES: usize = 2_000_000;
 pub const MAX_FRAMES: u64 = 1_000_000;
 /// Heap the image decoder may allocate for one image: an RGBA 16-bit image at the pixel
 /// limit (8 bytes per pixel) plus slack for the decoder's own buffers.
-const MAX_DECODER_ALLOC: u64 = MAX_IMAGE_PIXELS * 8 + (64 << 20);
+pub(crate) const MAX_DECODER_ALLOC: u64 = MAX_IMAGE_PIXELS * 8 + (64 << 20);
 
 /// An input larger than the documented limits.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]

@@ -8,7 +8,7 @@ use anyhow::Context;
 use glam::DVec2;
 use lapclone::clone::{
     mesh_from_mask, Anchor, BoundaryData, CloneMode, CloneOptions, CloneStats, PatchCloner,
-    Placement,
+    PatchMesh, Placement,
 };
 use lapclone::deform::{DeformRig, Deformed, Handle, Pin};
 use lapclone::mesh::{BitMask, MeshOptions};
@@ -132,76 +132,37 @@ fn parse_drag(text: &str) -> Result<DragArg, String> {
 
 pub fn run(args: CloneArgs) -> anyhow::Result<()> {
     check_arguments(&args)?;
+    let mesh_options = args.mesh.options(args.density)?;
     let load_started = Instant::now();
-    // The three inputs decode in parallel; the target goes straight to the canvas.
-    let (source, target, mask) = std::thread::scope(|scope| {
+    // The source and the mask (then the mesh and the factor) load on two threads while the
+    // target decodes here, straight to the canvas.
+    let (prepared, target) = std::thread::scope(|scope| {
         let source = scope.spawn(|| FloatImage::load(&args.source));
-        let mask = scope.spawn(|| BitMask::load(&args.mask, args.threshold as f32));
+        let prepared = scope.spawn(|| prepare(&args, &mesh_options, source));
         let target = load_target(&args.target);
-        (
-            source
-                .join()
-                .unwrap_or_else(|panic| std::panic::resume_unwind(panic)),
-            target,
-            mask.join()
-                .unwrap_or_else(|panic| std::panic::resume_unwind(panic)),
-        )
+        (join(prepared), target)
     });
-    let (source, (mut canvas, target_format), mask) = (source?, target?, mask?);
+    // Errors in the order source, target, mask and the rest.
+    let prepared = match prepared {
+        Err(PrepareError::Source(error)) => return Err(error.into()),
+        Err(PrepareError::Other(error)) => Err(error),
+        Ok(prepared) => Ok(prepared),
+    };
+    let (mut canvas, target_format) = target?;
+    let Prepared {
+        mut cloner,
+        mut deformation,
+        placement,
+        handles,
+        mesh_ms,
+        factor_ms,
+    } = prepared?;
     // Kept only to time a re-clone for --stats.
     let background = args.stats.then(|| canvas.clone());
     let load_ms = millis_since(load_started);
 
-    // The first clone: mesh, factor, solve and raster (`total_ms`), inputs already decoded.
-    let mesh_started = Instant::now();
-    let mesh_options = args.mesh.options(args.density)?;
-    let patch = mesh_from_mask(
-        &mask,
-        args.mask_offset.map(DVec2::from),
-        (source.width(), source.height()),
-        &mesh_options,
-    )?;
-    let mesh_ms = millis_since(mesh_started);
-    for warning in &patch.result.warnings {
-        eprintln!("lapclone: warning: {warning}");
-    }
-    let anchor = match args.anchor {
-        AnchorArg::Centre => Anchor::Centre,
-        AnchorArg::Topleft => Anchor::TopLeft,
-    };
-    let placement = Placement {
-        pivot: anchor.point(patch.bbox_min, patch.bbox_max),
-        at: DVec2::from(args.at),
-        scale: args.scale,
-        rotation_deg: args.rotate,
-    };
-    let handles = handles_from(&args.drag, patch.bbox_min, patch.bbox_max);
-    let pins: Vec<Pin> = args.pin.iter().map(|&p| Pin(DVec2::from(p))).collect();
-    let mesh = patch.result.mesh;
-
-    let factor_started = Instant::now();
-    let options = CloneOptions {
-        laplacian: laplacian_kind(args.laplacian),
-        mode: match args.mode {
-            ModeArg::Normal => CloneMode::Normal,
-            ModeArg::Monochrome => CloneMode::Monochrome,
-        },
-        feather: args.feather as f32,
-        boundary_data: args.boundary_data,
-    };
-    let mut cloner = PatchCloner::new(source, mesh, &options)?;
-    let mut deformation = if handles.is_empty() && pins.is_empty() {
-        None
-    } else {
-        let mut rig = DeformRig::new(cloner.mesh(), options.laplacian)?;
-        let mut deformed = Deformed::default();
-        rig.deform(&handles, &pins, &mut deformed)?;
-        Some(deformed)
-    };
-    let factor_ms = millis_since(factor_started);
-
     let stats = clone_once(&mut cloner, &mut canvas, &placement, deformation.as_mut())?;
-    let total_ms = millis_since(mesh_started);
+    let total_ms = mesh_ms + factor_ms + stats.solve_ms + stats.raster_ms;
     report_clone_warnings(&stats);
 
     write_output(&args, &canvas, target_format, &cloner, &handles, &placement)?;
@@ -227,6 +188,126 @@ pub fn run(args: CloneArgs) -> anyhow::Result<()> {
         println!("{json}");
     }
     Ok(())
+}
+
+/// The patch ready to clone: its cloner (mesh factored, source sampled), deformation and
+/// placement, with the meshing and factoring times.
+struct Prepared {
+    cloner: PatchCloner,
+    deformation: Option<Deformed>,
+    placement: Placement,
+    handles: Vec<Handle>,
+    mesh_ms: f64,
+    factor_ms: f64,
+}
+
+/// Why [`prepare`] failed: the source's error is told before the target's, the rest after.
+enum PrepareError {
+    Source(lapclone::pixels::PixelError),
+    Other(anyhow::Error),
+}
+
+/// Loads the mask and meshes it (the source's size read from its header, so meshing
+/// overlaps the source's decoding), then waits for the source and builds the cloner.
+fn prepare(
+    args: &CloneArgs,
+    mesh_options: &MeshOptions,
+    source: std::thread::ScopedJoinHandle<'_, Result<FloatImage, lapclone::pixels::PixelError>>,
+) -> Result<Prepared, PrepareError> {
+    let header_size = lapclone::limits::image_dimensions(&args.source).ok();
+    let mut mesh_ms = 0.0;
+    let meshed = BitMask::load(&args.mask, args.threshold as f32)
+        .map_err(anyhow::Error::from)
+        .map(|mask| {
+            let started = Instant::now();
+            let patch = mesh_patch(args, &mask, header_size.unwrap_or_default(), mesh_options);
+            mesh_ms = millis_since(started);
+            (patch, mask)
+        });
+    let source = join(source).map_err(PrepareError::Source)?;
+    let (mut patch, mask) = meshed.map_err(PrepareError::Other)?;
+    let size = (source.width(), source.height());
+    if header_size != Some(size) {
+        // Only if the header disagrees with the decoder: mesh again with the decoded size.
+        let started = Instant::now();
+        patch = mesh_patch(args, &mask, size, mesh_options);
+        mesh_ms += millis_since(started);
+    }
+    build_cloner(args, source, patch.map_err(PrepareError::Other)?, mesh_ms)
+        .map_err(PrepareError::Other)
+}
+
+fn mesh_patch(
+    args: &CloneArgs,
+    mask: &BitMask,
+    source_size: (u32, u32),
+    options: &MeshOptions,
+) -> anyhow::Result<PatchMesh> {
+    Ok(mesh_from_mask(
+        mask,
+        args.mask_offset.map(DVec2::from),
+        source_size,
+        options,
+    )?)
+}
+
+/// The cloner on the patch's mesh (the factor), and the deformation of the drags and pins.
+fn build_cloner(
+    args: &CloneArgs,
+    source: FloatImage,
+    patch: PatchMesh,
+    mesh_ms: f64,
+) -> anyhow::Result<Prepared> {
+    for warning in &patch.result.warnings {
+        eprintln!("lapclone: warning: {warning}");
+    }
+    let anchor = match args.anchor {
+        AnchorArg::Centre => Anchor::Centre,
+        AnchorArg::Topleft => Anchor::TopLeft,
+    };
+    let placement = Placement {
+        pivot: anchor.point(patch.bbox_min, patch.bbox_max),
+        at: DVec2::from(args.at),
+        scale: args.scale,
+        rotation_deg: args.rotate,
+    };
+    let handles = handles_from(&args.drag, patch.bbox_min, patch.bbox_max);
+    let pins: Vec<Pin> = args.pin.iter().map(|&p| Pin(DVec2::from(p))).collect();
+
+    let factor_started = Instant::now();
+    let options = CloneOptions {
+        laplacian: laplacian_kind(args.laplacian),
+        mode: match args.mode {
+            ModeArg::Normal => CloneMode::Normal,
+            ModeArg::Monochrome => CloneMode::Monochrome,
+        },
+        feather: args.feather as f32,
+        boundary_data: args.boundary_data,
+    };
+    let cloner = PatchCloner::new(source, patch.result.mesh, &options)?;
+    let deformation = if handles.is_empty() && pins.is_empty() {
+        None
+    } else {
+        let mut rig = DeformRig::new(cloner.mesh(), options.laplacian)?;
+        let mut deformed = Deformed::default();
+        rig.deform(&handles, &pins, &mut deformed)?;
+        Some(deformed)
+    };
+    Ok(Prepared {
+        cloner,
+        deformation,
+        placement,
+        handles,
+        mesh_ms,
+        factor_ms: millis_since(factor_started),
+    })
+}
+
+/// A scoped thread's result; a panic on it continues on this thread.
+fn join<T>(handle: std::thread::ScopedJoinHandle<'_, T>) -> T {
+    handle
+        .join()
+        .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
 }
 
 fn check_arguments(args: &CloneArgs) -> anyhow::Result<()> {
@@ -371,9 +452,16 @@ fn write_output(
         .with_context(|| format!("writing {}", args.output.display()))
 }
 
-/// The target as the canvas to clone onto (8-bit images without a float copy), and the
-/// format the output is written in.
+/// The target as the canvas to clone onto (8-bit images without a float copy; 8-bit PNGs
+/// decoded row by row straight into it), and the format the output is written in.
 fn load_target(path: &Path) -> anyhow::Result<(Canvas, PixelFormat)> {
+    use lapclone::pixels::{decode_png_levels, open_error};
+    if let Some(png) = decode_png_levels(path).map_err(|error| open_error(path, error))? {
+        return Ok((
+            Canvas::from_rgba8(png.width, png.height, png.levels)?,
+            png.format,
+        ));
+    }
     let decoded = FloatImage::decode(path)?;
     let format = PixelFormat::of(&decoded);
     let canvas = match Canvas::from_eight_bit(&decoded) {

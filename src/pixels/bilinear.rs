@@ -1,4 +1,5 @@
-//! Bilinear sampling: takes a row-major RGBA buffer (any [`Texel`] type) and a point in pixel
+//! Bilinear sampling: takes a row-major RGBA buffer (any [`Texel`] type, or any pixel type
+//! with a function giving its channels) and a point in pixel
 //! coordinates and gives the interpolated straight RGBA colour in [0, 1].
 //!
 //! Pixel-centre convention: pixel (i, j) is exact at (i + 0.5, j + 0.5); outside the centres'
@@ -20,15 +21,29 @@ pub fn sample_bilinear_rgba<T: Texel>(
     x: f64,
     y: f64,
 ) -> [f32; 4] {
+    sample_bilinear_by(pixels, width, height, x, y, |p| {
+        Vec4::from_array(p.map(Texel::to_unit))
+    })
+}
+
+/// [`sample_bilinear_rgba`] over any pixel type, `value` giving a pixel's channels in [0, 1].
+#[inline(always)]
+pub(crate) fn sample_bilinear_by<P>(
+    pixels: &[P],
+    width: u32,
+    height: u32,
+    x: f64,
+    y: f64,
+    value: impl Fn(&P) -> Vec4,
+) -> [f32; 4] {
     let (x0, x1, tx) = axis_taps(x, width);
     let (y0, y1, ty) = axis_taps(y, height);
     let w = width as usize;
     let row0 = &pixels[y0 * w..y0 * w + w];
     let row1 = &pixels[y1 * w..y1 * w + w];
     // glam's Vec4 is SIMD (SSE2 / NEON): one lerp handles all four channels.
-    let texel = |p: [T; 4]| Vec4::from_array(p.map(Texel::to_unit));
-    let top = texel(row0[x0]).lerp(texel(row0[x1]), tx);
-    let bottom = texel(row1[x0]).lerp(texel(row1[x1]), tx);
+    let top = value(&row0[x0]).lerp(value(&row0[x1]), tx);
+    let bottom = value(&row1[x0]).lerp(value(&row1[x1]), tx);
     top.lerp(bottom, ty).to_array()
 }
 

@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use super::png_encode::encode_png_rgba;
+use super::png_encode::write_png_rgba;
 use super::PixelRect;
 use super::{sample_bilinear_rgba, Depth, FloatImage, PixelError, PixelFormat};
 
@@ -106,22 +106,17 @@ impl Canvas {
     /// bytes: the same canvas as [`from_image`](Self::from_image) of its [`FloatImage`],
     /// without the float copy. `None` for other formats.
     pub fn from_eight_bit(decoded: &image::DynamicImage) -> Option<Canvas> {
-        use image::DynamicImage as D;
-        let pixels: Vec<[u8; 4]> = match decoded {
-            D::ImageRgb8(img) => img.pixels().map(|p| [p[0], p[1], p[2], 255]).collect(),
-            D::ImageRgba8(img) => img.pixels().map(|p| p.0).collect(),
-            D::ImageLuma8(img) => img.pixels().map(|p| [p[0], p[0], p[0], 255]).collect(),
-            D::ImageLumaA8(img) => img.pixels().map(|p| [p[0], p[0], p[0], p[1]]).collect(),
-            _ => return None,
-        };
+        let pixels = super::format::rgba8_levels(decoded)?;
         Canvas::from_rgba8(decoded.width(), decoded.height(), pixels).ok()
     }
 
     /// The image quantised to its own bit depth.
     pub fn from_image(image: &FloatImage) -> Canvas {
-        let pixels = match image.format().depth {
-            Depth::Eight => CanvasPixels::Eight(quantise(image.pixels())),
-            Depth::Sixteen => CanvasPixels::Sixteen(quantise(image.pixels())),
+        let pixels = match (image.format().depth, image.eight_bit_texels()) {
+            // Quantising k / 255 gives k back (tested), so the levels are the canvas.
+            (Depth::Eight, Some(levels)) => CanvasPixels::Eight(levels.to_vec()),
+            (Depth::Eight, None) => CanvasPixels::Eight(quantise(image.pixels())),
+            (Depth::Sixteen, _) => CanvasPixels::Sixteen(quantise(image.pixels())),
         };
         Canvas {
             width: image.width(),
@@ -252,19 +247,41 @@ impl Canvas {
     /// PNG bytes in `format` (grey formats store Rec. 709 luma; without alpha the alpha
     /// channel is dropped, not composited).
     pub fn encode_png(&self, format: PixelFormat) -> Result<Vec<u8>, PixelError> {
+        let mut bytes = Vec::new();
+        self.write_png(format, &mut bytes)?;
+        Ok(bytes)
+    }
+
+    /// Writes PNG bytes in `format` to `out` (as [`encode_png`](Self::encode_png), streamed).
+    pub fn write_png(&self, format: PixelFormat, out: impl std::io::Write) -> Result<(), PixelError> {
+        let (w, h) = (self.width, self.height);
         match &self.pixels {
-            CanvasPixels::Eight(p) => encode_png_rgba(p, self.width, self.height, format),
-            CanvasPixels::Sixteen(p) => encode_png_rgba(p, self.width, self.height, format),
+            CanvasPixels::Eight(p) => write_png_rgba(p, w, h, format, out),
+            CanvasPixels::Sixteen(p) => write_png_rgba(p, w, h, format, out),
         }
     }
 
-    /// Writes a PNG in `format` atomically (temporary file, then rename).
+    /// Writes a PNG in `format` atomically (temporary file, then rename), streamed into the
+    /// file.
     pub fn save_png(&self, path: &Path, format: PixelFormat) -> Result<(), PixelError> {
-        let bytes = self.encode_png(format)?;
-        crate::util::write_atomic(path, &bytes).map_err(|source| PixelError::Write {
+        let write_error = |source| PixelError::Write {
             path: path.to_path_buf(),
             source,
+        };
+        let mut failure = None;
+        crate::util::write_atomic_with(path, |file| {
+            let mut out = std::io::BufWriter::with_capacity(1 << 20, file);
+            match self.write_png(format, &mut out) {
+                Ok(()) => std::io::Write::flush(&mut out),
+                Err(PixelError::Encode(png::EncodingError::IoError(error))) => Err(error),
+                // Kept whole; the atomic write only needs to know that it failed.
+                Err(error) => {
+                    failure = Some(error);
+                    Err(std::io::Error::other("encoding failed"))
+                }
+            }
         })
+        .map_err(|error| failure.take().unwrap_or_else(|| write_error(error)))
     }
 
     /// A straight-alpha 8-bit RGBA copy (16-bit values are rounded), e.g. for overlays.
@@ -391,7 +408,7 @@ mod tests {
         for v in 0..=255u8 {
             assert_eq!(u8::from_unit(v.to_unit()), v);
         }
-        for v in (0..=65535u16).step_by(7) {
+        for v in 0..=65535u16 {
             assert_eq!(u16::from_unit(v.to_unit()), v);
         }
         assert_eq!(u8::from_unit(f32::NAN), 0);

@@ -20,46 +20,82 @@ pub fn is_video_path(path: &Path) -> bool {
         .is_some_and(|e| VIDEO_EXTENSIONS.contains(&e.to_ascii_lowercase().as_str()))
 }
 
+/// Why footage cannot be opened or read.
 #[derive(Debug, thiserror::Error)]
 pub enum FootageError {
+    /// The pattern (the text as given) has no `%d` / `%0Nd`.
     #[error("pattern `{0}` has no frame number: use %d or %0Nd (e.g. frame_%04d.png)")]
     NoNumber(String),
+    /// A `%` that starts neither `%d`, `%0Nd` nor `%%`, or a second number.
     #[error("pattern `{0}`: `%` must start %d, %0Nd or %% (one number per pattern)")]
     BadPattern(String),
+    /// The number is in a folder name rather than the file name.
     #[error("pattern `{0}`: the number must be in the file name, not a folder")]
     NumberInFolder(String),
+    /// No file in the folder matches the pattern (no start number can be found).
     #[error("pattern `{pattern}` matches no files in {}", folder.display())]
-    NoFiles { pattern: String, folder: PathBuf },
+    NoFiles {
+        /// The pattern as given.
+        pattern: String,
+        /// The folder searched.
+        folder: PathBuf,
+    },
+    /// The path (or a frame's file) is a folder.
     #[error("{} is a folder, not an image or video", .0.display())]
     IsFolder(PathBuf),
+    /// The video file does not exist.
     #[error("{} not found", .0.display())]
     NotFound(PathBuf),
+    /// A frame's file is missing and the footage does not hold its last frame.
     #[error("frame {frame} needs {}, which does not exist (add `{hold_key}: true` to hold the last one)", file.display())]
     MissingFrame {
+        /// The frame, counted from 1.
         frame: u64,
+        /// The file it needs.
         file: PathBuf,
+        /// The setting that would hold the last frame ([`Footage::hold_key`]).
         hold_key: String,
     },
+    /// A frame's size differs from the first frame's.
     #[error("{}: frame {frame} is {width}×{height}, but the footage is {expected_width}×{expected_height}", file.display())]
     SizeChanged {
+        /// The frame's file.
         file: PathBuf,
+        /// The frame, counted from 1.
         frame: u64,
+        /// Its width.
         width: u32,
+        /// Its height.
         height: u32,
+        /// The footage's width.
         expected_width: u32,
+        /// The footage's height.
         expected_height: u32,
     },
+    /// A video needs `ffmpeg` / `ffprobe`, and neither is on `PATH`.
     #[error("{}", crate::util::FFMPEG_MISSING)]
     NoFfmpeg,
+    /// ffmpeg or ffprobe cannot read the video.
     #[error("cannot read video {}: {message}", path.display())]
-    Video { path: PathBuf, message: String },
+    Video {
+        /// The video file.
+        path: PathBuf,
+        /// What ffmpeg or ffprobe said (its last lines).
+        message: String,
+    },
+    /// The video ends before the scene does and the footage does not hold its last frame.
     #[error("video {}: has {available} frames at the scene's fps, frame {frame} is needed (add `{hold_key}: true` to hold the last one)", path.display())]
     VideoTooShort {
+        /// The video file.
         path: PathBuf,
+        /// The first frame it lacks, counted from 1.
         frame: u64,
+        /// Frames it has at the scene's frame rate.
         available: u64,
+        /// The setting that would hold the last frame ([`Footage::hold_key`]).
         hold_key: String,
     },
+    /// A frame's file cannot be read or decoded.
     #[error(transparent)]
     Image(#[from] Box<PixelError>),
 }
@@ -110,6 +146,7 @@ impl Pattern {
         self.folder.join(name)
     }
 
+    /// The pattern as given.
     pub fn text(&self) -> &str {
         &self.text
     }
@@ -200,26 +237,42 @@ fn split_name(name: &str) -> Result<(String, usize, String), PatternProblem> {
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum FootageSource {
     /// Numbered image files: scene frame i is file `start + i`.
-    Sequence { pattern: Pattern, start: u64 },
+    Sequence {
+        /// The files' names.
+        pattern: Pattern,
+        /// The number of the file frame 0 shows.
+        start: u64,
+    },
     /// A video file, decoded by ffmpeg.
     Video(PathBuf),
 }
 
 /// Footage as a scene names it: where its frames come from, their size (all the same), and
-/// whether the last frame holds once the footage runs out.
+/// whether the last frame holds once the footage runs out. [`Footage::open`] fills it in from
+/// a pattern or a video path; a scene uses it as a background
+/// ([`Background::Footage`](crate::animation::Background::Footage)) or as a patch's animated
+/// source ([`Patch::footage`](crate::animation::Patch::footage)).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Footage {
+    /// The numbered files or the video.
     pub source: FootageSource,
+    /// Frame width in pixels.
     pub width: u32,
+    /// Frame height in pixels.
     pub height: u32,
+    /// Whether the last frame is shown once the footage runs out (else that is an error).
     pub hold: bool,
-    /// The scene option that sets `hold`, named in errors (`background_hold`, `source_hold`).
+    /// The setting that sets `hold`, named in errors: `background_hold` or `source_hold` in a
+    /// scene file; whatever name an embedding program shows its users.
     pub hold_key: String,
 }
 
 impl Footage {
-    /// Opens footage at `path` (a pattern or a video): finds the start number if not given
-    /// and reads the first frame's size (a video's through ffprobe).
+    /// Opens footage at `path`: a printf-style pattern of numbered images
+    /// (`plates/frame_%04d.png`) or a video file (`.mp4`, `.mov`, `.webm`, `.mkv`, read
+    /// through ffmpeg). Finds the start number if not given (the lowest number with a file)
+    /// and reads the first frame's size (a video's through ffprobe). `hold` and `hold_key`
+    /// become the fields of the same names.
     pub fn open(
         path: &Path,
         start: Option<u64>,
@@ -519,13 +572,13 @@ const OPAQUE_RGB8: PixelFormat = PixelFormat {
     ..PixelFormat::RGBA8
 };
 
-/// An 8-bit RGBA buffer as an opaque-format float image.
+/// An 8-bit RGBA buffer as an opaque-format image of its levels.
 fn rgba8_image(width: u32, height: u32, bytes: &[u8]) -> Result<FloatImage, FootageError> {
-    let pixels = bytes
+    let levels = bytes
         .chunks_exact(4)
-        .map(|p| [p[0], p[1], p[2], p[3]].map(|v| f32::from(v) / 255.0))
+        .map(|p| [p[0], p[1], p[2], p[3]])
         .collect();
-    FloatImage::new(width, height, pixels, OPAQUE_RGB8)
+    FloatImage::from_levels(width, height, levels, OPAQUE_RGB8)
         .map_err(|e| FootageError::Image(Box::new(e)))
 }
 

@@ -1,5 +1,6 @@
 //! Pixel formats: takes an `image::DynamicImage` and gives the [`PixelFormat`] (grey or RGB,
-//! alpha or not, 8 or 16 bit) that output PNGs reproduce.
+//! alpha or not, 8 or 16 bit) that output PNGs reproduce, and an 8-bit image's pixels as
+//! RGBA levels.
 
 /// Colour model of an image file.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -72,4 +73,31 @@ impl PixelFormat {
         };
         colour + usize::from(self.alpha)
     }
+}
+
+/// A decoded 8-bit image's pixels as straight RGBA levels, row-major (grey expanded to
+/// R = G = B, a missing alpha 255): the levels `to_rgba8` gives, without its colour-space
+/// path. `None` for other depths.
+pub(crate) fn rgba8_levels(decoded: &image::DynamicImage) -> Option<Vec<[u8; 4]>> {
+    use image::DynamicImage as D;
+    let levels = match decoded {
+        D::ImageRgb8(img) => img
+            .as_raw()
+            .chunks_exact(3)
+            .map(|p| [p[0], p[1], p[2], 255])
+            .collect(),
+        D::ImageRgba8(img) => img
+            .as_raw()
+            .chunks_exact(4)
+            .map(|p| [p[0], p[1], p[2], p[3]])
+            .collect(),
+        D::ImageLuma8(img) => img.as_raw().iter().map(|&l| [l, l, l, 255]).collect(),
+        D::ImageLumaA8(img) => img
+            .as_raw()
+            .chunks_exact(2)
+            .map(|p| [p[0], p[0], p[0], p[1]])
+            .collect(),
+        _ => return None,
+    };
+    Some(levels)
 }

@@ -1,16 +1,18 @@
 //! Pixels shared by all stages: takes image files or `image::DynamicImage`s in and gives
-//! [`FloatImage`]s (straight RGBA `f32` in [0, 1], for sources and targets as loaded) and
-//! [`Canvas`]es (the frame being composited, in the target's output bit depth), plus PNG
-//! output in the target's original [`PixelFormat`], and [`footage`]: numbered image sequences
-//! and videos read one frame at a time.
+//! [`FloatImage`]s (straight RGBA values in [0, 1], for sources and targets as loaded; 8-bit
+//! images keep their levels, 8-bit PNGs decoded straight into them) and [`Canvas`]es (the
+//! frame being composited, in the target's output bit depth), plus PNG output in the
+//! target's original [`PixelFormat`], and [`footage`]: numbered image sequences and videos
+//! read one frame at a time.
 //!
 //! Coordinates follow the mesh convention: x right, y down, pixel (i, j) covers
 //! [i, i+1] × [j, j+1] and its centre is (i + 0.5, j + 0.5); bilinear sampling is exact at
 //! pixel centres and clamps to the edge outside the image.
 //!
 //! 16-bit output: tiny-skia only holds 8-bit premultiplied pixmaps, so 16-bit canvases are
-//! stored as `u16` here and encoded with the `png` crate directly; [`Canvas::to_tiny_skia_pixmap`]
-//! exists for 8-bit overlays (a 16-bit canvas is rounded down to 8 bits for it).
+//! stored as `u16` here and encoded here (Up filter, fdeflate, the `png` crate's chunks);
+//! [`Canvas::to_tiny_skia_pixmap`] exists for 8-bit overlays (a 16-bit canvas is rounded
+//! down to 8 bits for it).
 
 mod bilinear;
 mod canvas;
@@ -18,6 +20,7 @@ mod error;
 mod float_image;
 pub mod footage;
 mod format;
+mod png_decode;
 mod png_encode;
 mod rect;
 
@@ -26,6 +29,8 @@ pub(crate) use canvas::composite_over_straight as canvas_composite_over;
 pub use canvas::{Canvas, CanvasPixels, Texel};
 pub use error::PixelError;
 pub use float_image::FloatImage;
+pub(crate) use float_image::open_error;
+pub(crate) use png_decode::decode_png_levels;
 pub use footage::{Footage, FootageError, FootageReader, FootageSource};
 pub use format::{ColorKind, Depth, PixelFormat};
 pub use rect::PixelRect;

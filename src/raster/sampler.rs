@@ -80,7 +80,11 @@ impl<'a> Sampler<'a> {
 impl<'a, S: SourceTexel> Sampler<'a, S> {
     /// A sampler of `source` reading `texels` (its pixels in one of the texel kinds).
     pub fn with_texels(source: &FloatImage, texels: &'a [S]) -> Sampler<'a, S> {
-        assert_eq!(texels.len(), source.pixels().len(), "one texel per pixel");
+        assert_eq!(
+            texels.len(),
+            source.width() as usize * source.height() as usize,
+            "one texel per pixel"
+        );
         Sampler {
             pixels: texels,
             width: source.width() as usize,

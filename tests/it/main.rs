@@ -22,6 +22,7 @@ mod clone_numeric;
 mod deform_basic;
 mod deform_switching;
 mod determinism_cli;
+mod footage_api;
 mod fuzz_mesh;
 mod fuzz_scene;
 mod interrupt_cli;

@@ -21,12 +21,17 @@ fn formats() -> Vec<PixelFormat> {
 
 /// Distinct, exactly representable values in the given format.
 fn test_image(format: PixelFormat) -> FloatImage {
+    test_image_of_size(format, 7, 5)
+}
+
+/// [`test_image`] of any size.
+fn test_image_of_size(format: PixelFormat, width: u32, height: u32) -> FloatImage {
     let max = match format.depth {
         Depth::Eight => 255.0,
         Depth::Sixteen => 65535.0,
     };
     let q = |v: u32| (v % (max as u32 + 1)) as f32 / max;
-    FloatImage::from_fn(7, 5, format, |i, j| {
+    FloatImage::from_fn(width, height, format, |i, j| {
         let grey = q(i * 9973 + j * 31 + 5);
         let (r, g, b) = match format.color {
             ColorKind::Grey => (grey, grey, grey),
@@ -70,6 +75,53 @@ fn save_and_load_through_files() {
         assert_eq!(loaded.format(), format);
         assert_eq!(Canvas::from_image(&loaded), Canvas::from_image(&image));
     }
+}
+
+/// Images taller than one band of streamed rows, with a width whose rows end mid-band, in
+/// every format and through both the in-memory and the file path: the decoded samples are
+/// the canvas's values quantised in the format (Rec. 709 luma for grey), band seams included.
+#[test]
+fn images_of_many_row_bands_write_every_sample() {
+    let dir = tempfile::tempdir().unwrap();
+    for format in formats() {
+        for depth in [Depth::Eight, Depth::Sixteen] {
+            let canvas =
+                Canvas::from_image(&test_image_of_size(PixelFormat { depth, ..format }, 13, 71));
+            let path = dir.path().join("tall.png");
+            canvas.save_png(&path, format).unwrap();
+            let bytes = canvas.encode_png(format).unwrap();
+            for decoded in [
+                image::open(&path).unwrap(),
+                image::load_from_memory(&bytes).unwrap(),
+            ] {
+                assert_eq!(PixelFormat::of(&decoded), format);
+                let samples = decoded.to_rgba16();
+                for j in 0..canvas.height() {
+                    for i in 0..canvas.width() {
+                        let expected = expected_samples(canvas.pixel_f32(i, j).unwrap(), format);
+                        let actual = samples.get_pixel(i, j).0;
+                        assert_eq!(actual, expected, "{format:?} from {depth:?} at ({i}, {j})");
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// A canvas value as a PNG of `format` stores it, widened to 16 bits as `to_rgba16` does.
+fn expected_samples(value: [f32; 4], format: PixelFormat) -> [u16; 4] {
+    let quantise = |v: f32| match format.depth {
+        Depth::Eight => u16::from((v * 255.0 + 0.5) as u8) * 257,
+        Depth::Sixteen => (v * 65535.0 + 0.5) as u16,
+    };
+    let [r, g, b, a] = value;
+    let colour = match format.color {
+        ColorKind::Grey => [0.2126 * r + 0.7152 * g + 0.0722 * b; 3],
+        ColorKind::Rgb => [r, g, b],
+    }
+    .map(quantise);
+    let alpha = if format.alpha { quantise(a) } else { u16::MAX };
+    [colour[0], colour[1], colour[2], alpha]
 }
 
 #[test]
