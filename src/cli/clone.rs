@@ -415,7 +415,7 @@ fn write_output(
 ) -> anyhow::Result<()> {
     if !args.show_mesh {
         canvas
-            .save_png(&args.output, target_format)
+            .save_png_threaded(&args.output, target_format, super::render::default_jobs())
             .with_context(|| format!("writing {}", args.output.display()))?;
         return Ok(());
     }

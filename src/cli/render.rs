@@ -275,7 +275,7 @@ pub fn run_preview(args: PreviewArgs) -> anyhow::Result<()> {
     }
     .map_err(|e| positioned(&loaded, e))?;
     canvas
-        .save_png(&args.output, format)
+        .save_png_threaded(&args.output, format, default_jobs())
         .with_context(|| format!("writing {}", args.output.display()))?;
     Ok(())
 }

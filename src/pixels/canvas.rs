@@ -248,22 +248,39 @@ impl Canvas {
     /// channel is dropped, not composited).
     pub fn encode_png(&self, format: PixelFormat) -> Result<Vec<u8>, PixelError> {
         let mut bytes = Vec::new();
-        self.write_png(format, &mut bytes)?;
+        self.write_png(format, 1, &mut bytes)?;
         Ok(bytes)
     }
 
-    /// Writes PNG bytes in `format` to `out` (as [`encode_png`](Self::encode_png), streamed).
-    pub fn write_png(&self, format: PixelFormat, out: impl std::io::Write) -> Result<(), PixelError> {
+    /// Writes PNG bytes in `format` to `out` (as [`encode_png`](Self::encode_png), streamed),
+    /// compressing bands of rows on `threads` scoped threads; the bytes are the same for any
+    /// count.
+    pub fn write_png(
+        &self,
+        format: PixelFormat,
+        threads: usize,
+        out: impl std::io::Write,
+    ) -> Result<(), PixelError> {
         let (w, h) = (self.width, self.height);
         match &self.pixels {
-            CanvasPixels::Eight(p) => write_png_rgba(p, w, h, format, out),
-            CanvasPixels::Sixteen(p) => write_png_rgba(p, w, h, format, out),
+            CanvasPixels::Eight(p) => write_png_rgba(p, w, h, format, threads, out),
+            CanvasPixels::Sixteen(p) => write_png_rgba(p, w, h, format, threads, out),
         }
     }
 
     /// Writes a PNG in `format` atomically (temporary file, then rename), streamed into the
-    /// file.
+    /// file, on this thread.
     pub fn save_png(&self, path: &Path, format: PixelFormat) -> Result<(), PixelError> {
+        self.save_png_threaded(path, format, 1)
+    }
+
+    /// [`save_png`](Self::save_png), compressing on `threads` scoped threads (the same bytes).
+    pub fn save_png_threaded(
+        &self,
+        path: &Path,
+        format: PixelFormat,
+        threads: usize,
+    ) -> Result<(), PixelError> {
         let write_error = |source| PixelError::Write {
             path: path.to_path_buf(),
             source,
@@ -271,7 +288,7 @@ impl Canvas {
         let mut failure = None;
         crate::util::write_atomic_with(path, |file| {
             let mut out = std::io::BufWriter::with_capacity(1 << 20, file);
-            match self.write_png(format, &mut out) {
+            match self.write_png(format, threads, &mut out) {
                 Ok(()) => std::io::Write::flush(&mut out),
                 Err(PixelError::Encode(png::EncodingError::IoError(error))) => Err(error),
                 // Kept whole; the atomic write only needs to know that it failed.

@@ -32,6 +32,8 @@ pub struct BlockEncoder {
     codes: [u16; LITLEN_SYMBOLS],
     /// Each literal's code (low 16 bits) and length (high bits), looked up once per byte.
     literal: [u32; 256],
+    /// Where a block is written before it is copied out at its exact length.
+    scratch: Vec<u8>,
     /// Length symbol (257..=285) and extra-bit count for each match length.
     length_symbol: [(u16, u8); MAX_MATCH as usize + 1],
 }
@@ -64,6 +66,7 @@ impl BlockEncoder {
             lengths: [0; LITLEN_SYMBOLS],
             codes: [0; LITLEN_SYMBOLS],
             literal: [0; 256],
+            scratch: Vec::new(),
             length_symbol,
         }
     }
@@ -76,7 +79,14 @@ impl BlockEncoder {
         for (packed, (&code, &len)) in self.literal.iter_mut().zip(self.codes.iter().zip(&self.lengths)) {
             *packed = u32::from(code) | u32::from(len) << 16;
         }
-        let mut bits = BitWriter::new(out, data.len());
+        // Written into a scratch buffer kept at its largest size (no zeroing per block), then
+        // copied out at its exact length.
+        let mut scratch = std::mem::take(&mut self.scratch);
+        let bound = data.len() * usize::from(MAX_CODE_LENGTH) / 8 + 512;
+        if scratch.len() < bound {
+            scratch.resize(bound, 0);
+        }
+        let mut bits = BitWriter::new(&mut scratch);
         self.write_header(&mut bits);
         // The writer moves into the emitter and back, so its state can stay in registers.
         let mut emitter = Emitter {
@@ -91,8 +101,10 @@ impl BlockEncoder {
         );
         // An empty stored block: BFINAL 0, BTYPE 00, pad to the byte, LEN 0, NLEN !0.
         bits.put(0, 3);
-        bits.finish();
+        let len = bits.finish();
+        out.extend_from_slice(&scratch[..len]);
         out.extend_from_slice(&[0x00, 0x00, 0xff, 0xff]);
+        self.scratch = scratch;
     }
 
     /// Symbol frequencies for the code: the bytes outside all-zero 8-byte words as literals,
@@ -338,7 +350,7 @@ fn first_length(symbol: u16) -> u32 {
 
 /// Bits packed LSB first into whole bytes, written eight bytes at a time.
 struct BitWriter<'a> {
-    out: &'a mut Vec<u8>,
+    out: &'a mut [u8],
     /// Where the next eight bytes go.
     at: usize,
     buffer: u64,
@@ -346,13 +358,12 @@ struct BitWriter<'a> {
 }
 
 impl<'a> BitWriter<'a> {
-    fn new(out: &'a mut Vec<u8>, input_len: usize) -> Self {
-        // A byte costs at most 12 bits as a literal; a header is under 300 bytes.
-        let at = out.len();
-        out.resize(at + input_len * 12 / 8 + 512, 0);
+    /// Writes from the start of `out`, which must be long enough for everything put plus
+    /// eight bytes.
+    fn new(out: &'a mut [u8]) -> Self {
         BitWriter {
             out,
-            at,
+            at: 0,
             buffer: 0,
             count: 0,
         }
@@ -375,11 +386,11 @@ impl<'a> BitWriter<'a> {
         }
     }
 
-    /// Writes the bits held, padded with zeros to a whole byte, and trims the output.
-    fn finish(self) {
+    /// Writes the bits held, padded with zeros to a whole byte; gives the bytes written.
+    fn finish(self) -> usize {
         let bytes = usize::from(self.count).div_ceil(8);
         self.out[self.at..self.at + bytes].copy_from_slice(&self.buffer.to_le_bytes()[..bytes]);
-        self.out.truncate(self.at + bytes);
+        self.at + bytes
     }
 }
 

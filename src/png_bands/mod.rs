@@ -1,6 +1,6 @@
 //! PNG images encoded in independent row bands: takes an image's header and a way to fill
 //! any row with its PNG samples, gives the PNG bytes. Rows are Up-filtered and each band of
-//! about 64 KiB is one self-contained deflate block ([`deflate_block`]), so a band's bytes
+//! about 64 KiB is one self-contained deflate block (`deflate_block`), so a band's bytes
 //! depend only on its own rows and the row above. That buys two things: bands can be
 //! encoded on any threads in any order, and a band whose rows did not change since the last
 //! frame can be reused as it is ([`EncodedBand`]). The bytes are a pure function of the
@@ -153,7 +153,8 @@ impl BandEncoder {
     }
 }
 
-/// The whole image with its bands spread over `threads` scoped threads (the same bytes as
+/// The whole image with its bands spread over `threads` threads, the caller's and scoped
+/// ones (the same bytes as
 /// [`BandEncoder::encode_image`] for any thread count).
 pub fn encode_image_parallel(
     header: &PngHeader,
@@ -164,16 +165,23 @@ pub fn encode_image_parallel(
     let count = header.band_count();
     let mut bands = vec![EncodedBand::default(); count];
     let per_thread = count.div_ceil(threads.max(1)).max(1);
+    let chunks = count.div_ceil(per_thread);
     std::thread::scope(|scope| {
         for (chunk_index, chunk) in bands.chunks_mut(per_thread).enumerate() {
             let fill_row = &fill_row;
-            scope.spawn(move || {
+            let mut work = move || {
                 let mut encoder = BandEncoder::new();
                 for (offset, band) in chunk.iter_mut().enumerate() {
                     let index = chunk_index * per_thread + offset;
                     encoder.encode_band(header, index, fill_row, band);
                 }
-            });
+            };
+            // The last share runs on the caller's thread.
+            if chunk_index + 1 == chunks {
+                work();
+            } else {
+                scope.spawn(work);
+            }
         }
     });
     write_png(header, &bands, out)
