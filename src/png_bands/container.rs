@@ -1,6 +1,7 @@
 //! The PNG file around encoded bands: takes a header and the bands in row order, gives the
 //! signature, IHDR, the zlib stream (header, the bands' blocks, an empty final block, the
-//! Adler-32 combined from the bands') in IDAT chunks, and IEND.
+//! Adler-32 combined from the bands') with one IDAT chunk per band, and IEND. Bands can be
+//! written as they come, so a file streams out while later bands are still being encoded.
 
 use std::io::Write;
 
@@ -10,66 +11,71 @@ use super::{EncodedBand, PngHeader};
 const SIGNATURE: [u8; 8] = [0x89, b'P', b'N', b'G', 0x0d, 0x0a, 0x1a, 0x0a];
 /// Deflate with a 32 KiB window, "fastest" flag, check bits making it a multiple of 31.
 const ZLIB_HEADER: [u8; 2] = [0x78, 0x01];
-/// IDAT chunks stay well under PNG's 2³¹ − 1 byte limit.
-const MAX_IDAT: usize = 1 << 30;
 const ADLER_MODULUS: u32 = 65_521;
 
-/// Writes the PNG of `bands` (all of `header`'s bands, in order) to `out`.
-pub fn write_png(
-    header: &PngHeader,
-    bands: &[EncodedBand],
-    mut out: impl Write,
-) -> std::io::Result<()> {
-    debug_assert_eq!(bands.len(), header.band_count());
-    out.write_all(&SIGNATURE)?;
-    let mut ihdr = Vec::with_capacity(13);
-    ihdr.extend_from_slice(&header.width.to_be_bytes());
-    ihdr.extend_from_slice(&header.height.to_be_bytes());
-    ihdr.extend_from_slice(&[
-        if header.sixteen_bit { 16 } else { 8 },
-        header.color.code(),
-        0, // deflate
-        0, // adaptive filtering (each row says its filter)
-        0, // not interlaced
-    ]);
-    write_chunk(&mut out, b"IHDR", &[&ihdr])?;
-    let adler = bands.iter().fold(1u32, |sum, band| {
-        adler32_combine(sum, band.adler, band.filtered_len)
-    });
-    let adler = adler.to_be_bytes();
-    let mut pieces: Vec<&[u8]> = vec![&ZLIB_HEADER];
-    pieces.extend(bands.iter().map(|band| band.bytes.as_slice()));
-    pieces.push(&FINAL_BLOCK);
-    pieces.push(&adler);
-    for chunk in idat_chunks(&pieces, MAX_IDAT) {
-        write_chunk(&mut out, b"IDAT", &chunk)?;
-    }
-    write_chunk(&mut out, b"IEND", &[])?;
-    out.flush()
+/// A PNG being written band by band: the signature and IHDR first, then one IDAT chunk per
+/// band as it comes (in row order), then the end of the zlib stream and IEND.
+pub struct PngStream<W: Write> {
+    out: W,
+    adler: u32,
+    started: bool,
 }
 
-/// Groups consecutive pieces into chunks of at most `max` bytes, splitting a piece only if
-/// it alone is larger.
-fn idat_chunks<'a>(pieces: &[&'a [u8]], max: usize) -> Vec<Vec<&'a [u8]>> {
-    let mut chunks = vec![Vec::new()];
-    let mut size = 0;
-    for &piece in pieces {
-        for part in piece.chunks(max) {
-            if size + part.len() > max {
-                chunks.push(Vec::new());
-                size = 0;
-            }
-            size += part.len();
-            // invariant: `chunks` starts non-empty and only grows.
-            chunks.last_mut().expect("a chunk").push(part);
-        }
+impl<W: Write> PngStream<W> {
+    /// Writes the signature and IHDR of `header`.
+    pub fn start(header: &PngHeader, mut out: W) -> std::io::Result<Self> {
+        out.write_all(&SIGNATURE)?;
+        let mut ihdr = Vec::with_capacity(13);
+        ihdr.extend_from_slice(&header.width.to_be_bytes());
+        ihdr.extend_from_slice(&header.height.to_be_bytes());
+        ihdr.extend_from_slice(&[
+            if header.sixteen_bit { 16 } else { 8 },
+            header.color.code(),
+            0, // deflate
+            0, // adaptive filtering (each row says its filter)
+            0, // not interlaced
+        ]);
+        write_chunk(&mut out, b"IHDR", &[&ihdr])?;
+        Ok(PngStream {
+            out,
+            adler: 1,
+            started: false,
+        })
     }
-    chunks
+
+    /// Writes the next band (bands are small, so each chunk is far under PNG's limit).
+    pub fn band(&mut self, band: &EncodedBand) -> std::io::Result<()> {
+        let header: &[u8] = if self.started { &[] } else { &ZLIB_HEADER };
+        self.started = true;
+        self.adler = adler32_combine(self.adler, band.adler, band.filtered_len);
+        write_chunk(&mut self.out, b"IDAT", &[header, &band.bytes])
+    }
+
+    /// Closes the zlib stream and the file; gives the writer back, flushed.
+    pub fn finish(mut self) -> std::io::Result<W> {
+        let header: &[u8] = if self.started { &[] } else { &ZLIB_HEADER };
+        let adler = self.adler.to_be_bytes();
+        write_chunk(&mut self.out, b"IDAT", &[header, &FINAL_BLOCK, &adler])?;
+        write_chunk(&mut self.out, b"IEND", &[])?;
+        self.out.flush()?;
+        Ok(self.out)
+    }
+}
+
+/// Writes the PNG of `bands` (all of `header`'s bands, in order) to `out`.
+pub fn write_png(header: &PngHeader, bands: &[EncodedBand], out: impl Write) -> std::io::Result<()> {
+    debug_assert_eq!(bands.len(), header.band_count());
+    let mut stream = PngStream::start(header, out)?;
+    for band in bands {
+        stream.band(band)?;
+    }
+    stream.finish().map(drop)
 }
 
 fn write_chunk(out: &mut impl Write, kind: &[u8; 4], pieces: &[&[u8]]) -> std::io::Result<()> {
     let len: usize = pieces.iter().map(|p| p.len()).sum();
-    // invariant: idat_chunks keeps every chunk under 2^30 bytes; IHDR and IEND are tiny.
+    // invariant: a band is at most a few rows (`BAND_BYTES` of samples unless one row is
+    // longer, and `limits` bounds a row far below 2^31 bytes); IHDR and IEND are tiny.
     let len = u32::try_from(len).expect("chunk under 2^31 bytes");
     out.write_all(&len.to_be_bytes())?;
     out.write_all(kind)?;
@@ -115,19 +121,5 @@ mod tests {
             );
             prop_assert_eq!(combined, whole);
         }
-    }
-
-    #[test]
-    fn idat_chunks_keep_order_and_size() {
-        let max = 16;
-        let big = vec![1u8; max + 10];
-        let small = [2u8; 5];
-        let chunks = idat_chunks(&[&small, &big, &small], max);
-        let sizes: Vec<usize> = chunks.iter().map(|c| c.iter().map(|p| p.len()).sum()).collect();
-        assert!(sizes.iter().all(|&s| s <= max));
-        assert_eq!(sizes.iter().sum::<usize>(), max + 20);
-        let flat: Vec<u8> = chunks.iter().flatten().flat_map(|p| p.iter().copied()).collect();
-        assert_eq!(flat[..5], small);
-        assert_eq!(flat[flat.len() - 5..], small);
     }
 }

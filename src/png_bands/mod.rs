@@ -11,8 +11,9 @@ mod deflate_block;
 mod huffman;
 
 use std::io::Write;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
-pub use container::write_png;
+pub use container::{write_png, PngStream};
 use deflate_block::BlockEncoder;
 
 /// A band aims at about this many bytes of filtered rows.
@@ -138,53 +139,71 @@ impl BandEncoder {
         into.filtered_len = self.filtered.len();
     }
 
-    /// The whole image on this thread.
+    /// The whole image on this thread, each band written as soon as it is encoded.
     pub fn encode_image(
         &mut self,
         header: &PngHeader,
         mut fill_row: impl FnMut(u32, &mut [u8]),
         out: impl Write,
     ) -> std::io::Result<()> {
-        let mut bands = vec![EncodedBand::default(); header.band_count()];
-        for (index, band) in bands.iter_mut().enumerate() {
-            self.encode_band(header, index, &mut fill_row, band);
+        let mut stream = PngStream::start(header, out)?;
+        let mut band = EncodedBand::default();
+        for index in 0..header.band_count() {
+            self.encode_band(header, index, &mut fill_row, &mut band);
+            stream.band(&band)?;
         }
-        write_png(header, &bands, out)
+        stream.finish().map(drop)
     }
 }
 
-/// The whole image with its bands spread over `threads` threads, the caller's and scoped
-/// ones (the same bytes as
-/// [`BandEncoder::encode_image`] for any thread count).
+/// The whole image with its bands encoded on `threads` scoped threads while the caller's
+/// thread writes them out in order (on the caller's thread alone for one); the bytes are the
+/// same for any thread count.
 pub fn encode_image_parallel(
     header: &PngHeader,
     fill_row: impl Fn(u32, &mut [u8]) + Sync,
     threads: usize,
     out: impl Write,
 ) -> std::io::Result<()> {
+    if threads <= 1 {
+        return BandEncoder::new().encode_image(header, fill_row, out);
+    }
     let count = header.band_count();
-    let mut bands = vec![EncodedBand::default(); count];
-    let per_thread = count.div_ceil(threads.max(1)).max(1);
-    let chunks = count.div_ceil(per_thread);
+    let next = AtomicUsize::new(0);
+    let mut stream = PngStream::start(header, out)?;
     std::thread::scope(|scope| {
-        for (chunk_index, chunk) in bands.chunks_mut(per_thread).enumerate() {
-            let fill_row = &fill_row;
-            let mut work = move || {
+        let (sender, bands) = std::sync::mpsc::sync_channel(2 * threads);
+        for _ in 0..threads {
+            let (sender, next, fill_row) = (sender.clone(), &next, &fill_row);
+            scope.spawn(move || {
                 let mut encoder = BandEncoder::new();
-                for (offset, band) in chunk.iter_mut().enumerate() {
-                    let index = chunk_index * per_thread + offset;
-                    encoder.encode_band(header, index, fill_row, band);
+                loop {
+                    let index = next.fetch_add(1, Ordering::Relaxed);
+                    let mut band = EncodedBand::default();
+                    if index >= count {
+                        return;
+                    }
+                    encoder.encode_band(header, index, fill_row, &mut band);
+                    if sender.send((index, band)).is_err() {
+                        return; // the writer failed and is gone
+                    }
                 }
-            };
-            // The last share runs on the caller's thread.
-            if chunk_index + 1 == chunks {
-                work();
-            } else {
-                scope.spawn(work);
+            });
+        }
+        drop(sender);
+        // Bands arrive in any order; each is written once the ones above it are.
+        let mut waiting = std::collections::BTreeMap::new();
+        let mut wanted = 0;
+        for (index, band) in bands {
+            waiting.insert(index, band);
+            while let Some(band) = waiting.remove(&wanted) {
+                stream.band(&band)?;
+                wanted += 1;
             }
         }
-    });
-    write_png(header, &bands, out)
+        Ok::<_, std::io::Error>(())
+    })?;
+    stream.finish().map(drop)
 }
 
 #[cfg(test)]
