@@ -284,7 +284,9 @@ fn build_cloner(
         feather: args.feather as f32,
         boundary_data: args.boundary_data,
     };
-    let cloner = PatchCloner::new(source, patch.result.mesh, &options)?;
+    let mut cloner = PatchCloner::new(source, patch.result.mesh, &options)?;
+    // One clone, nothing to overlap it with: shade on every core.
+    cloner.set_raster_threads(super::render::default_jobs());
     let deformation = if handles.is_empty() && pins.is_empty() {
         None
     } else {

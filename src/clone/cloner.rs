@@ -140,6 +140,12 @@ impl PatchCloner {
         })
     }
 
+    /// Shades each draw on `threads` threads (the caller's and scoped ones; 1 by default):
+    /// for a one-shot clone of a large patch. The pixels are the same for any count.
+    pub fn set_raster_threads(&mut self, threads: usize) {
+        self.raster_options.threads = threads.max(1);
+    }
+
     /// The patch mesh in rest (source) coordinates.
     pub fn mesh(&self) -> &Mesh {
         &self.mesh

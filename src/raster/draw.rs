@@ -18,6 +18,9 @@ pub struct RasterOptions {
     pub feather: f32,
     /// Anti-alias the silhouette (tiny-skia coverage); off: pixel-centre coverage only.
     pub anti_alias: bool,
+    /// Threads that shade (row ranges, the caller's thread and scoped ones); the pixels are
+    /// the same for any count. 1 by default: a scene render's other cores encode frames.
+    pub threads: usize,
 }
 
 impl Default for RasterOptions {
@@ -25,6 +28,7 @@ impl Default for RasterOptions {
         RasterOptions {
             feather: 0.0,
             anti_alias: true,
+            threads: 1,
         }
     }
 }
@@ -69,6 +73,7 @@ pub fn draw_patch(
         work,
         target: work.intersect(&canvas_rect(canvas)),
         width: canvas.width() as usize,
+        threads: options.threads,
     };
     let (centre_hits, written) = match canvas.pixels_mut() {
         CanvasPixels::Eight(p) => frame.shade(options, scratch, p),
@@ -81,6 +86,9 @@ pub fn draw_patch(
     })
 }
 
+/// Fewer rows than this per thread are shaded on the caller's thread alone.
+const MIN_ROWS_PER_THREAD: usize = 64;
+
 /// One draw's rectangles and canvas width.
 struct Frame<'a> {
     patch: &'a Patch<'a>,
@@ -89,12 +97,14 @@ struct Frame<'a> {
     target: PixelRect,
     /// The canvas width in pixels.
     width: usize,
+    /// Threads to shade on.
+    threads: usize,
 }
 
 impl Frame<'_> {
     /// Shades the target rectangle with the coverage the options ask for; gives (centre
     /// hits, pixels written).
-    fn shade<T: Texel>(
+    fn shade<T: Texel + Send>(
         &self,
         options: &RasterOptions,
         scratch: &mut RasterScratch,
@@ -162,7 +172,7 @@ impl Frame<'_> {
 
     /// Shades `rows` (inside the target) with `coverage` (texels, row stride, the canvas
     /// pixel of texel 0).
-    fn shade_rows<T: Texel, C: CoverageTexel>(
+    fn shade_rows<T: Texel + Send, C: CoverageTexel + Sync>(
         &self,
         scratch: &RasterScratch,
         (coverage, coverage_stride, coverage_origin): (&[C], usize, (i32, i32)),
@@ -178,8 +188,42 @@ impl Frame<'_> {
             coverage_origin,
             source: self.patch.source,
         };
-        let canvas_rows = &mut canvas[rows.y0 as usize * self.width..];
-        shade_and_composite(&input, rows, canvas_rows, self.width)
+        let mut canvas_rows = &mut canvas[rows.y0 as usize * self.width..];
+        let height = rows.height();
+        let parts = self.threads.min(height / MIN_ROWS_PER_THREAD).max(1);
+        if parts == 1 {
+            return shade_and_composite(&input, rows, canvas_rows, self.width);
+        }
+        // Rows shade independently: each part takes its own rows of the canvas.
+        let per_part = height.div_ceil(parts) as i32;
+        std::thread::scope(|scope| {
+            let mut parts = Vec::new();
+            let mut y0 = rows.y0;
+            while y0 < rows.y1 {
+                let y1 = (y0 + per_part).min(rows.y1);
+                let len = ((y1 - y0) as usize * self.width).min(canvas_rows.len());
+                let (part, rest) = std::mem::take(&mut canvas_rows).split_at_mut(len);
+                canvas_rows = rest;
+                parts.push((PixelRect { y0, y1, ..rows }, part));
+                y0 = y1;
+            }
+            // invariant: `rows` is not empty (parts ≥ 1), so there is a last part.
+            let (last_rows, last) = parts.pop().expect("a part");
+            let (input, width) = (&input, self.width);
+            let spawned: Vec<_> = parts
+                .into_iter()
+                .map(|(part_rows, part)| {
+                    scope.spawn(move || shade_and_composite(input, part_rows, part, width))
+                })
+                .collect();
+            let mine = shade_and_composite(input, last_rows, last, width);
+            spawned.into_iter().fold(mine, |(h, w), handle| {
+                // invariant: shading does not panic on validated input; a panic is a bug
+                // to surface, not to hide.
+                let (h2, w2) = handle.join().expect("a shading thread");
+                (h + h2, w + w2)
+            })
+        })
     }
 }
 

@@ -55,6 +55,7 @@ fn identity_reproduces_the_source_inside() {
     let options = RasterOptions {
         anti_alias: false,
         feather: 0.0,
+        ..RasterOptions::default()
     };
     draw(
         &mut canvas,
@@ -98,6 +99,7 @@ fn integer_translation_shifts_the_source_and_membrane_adds_exactly() {
     let options = RasterOptions {
         anti_alias: false,
         feather: 0.0,
+        ..RasterOptions::default()
     };
     draw(
         &mut canvas,
@@ -144,6 +146,7 @@ fn depth_picks_the_front_layer_and_ties_go_to_the_later_triangle() {
     let options = RasterOptions {
         anti_alias: false,
         feather: 0.0,
+        ..RasterOptions::default()
     };
     let red = Some([1.0, 0.0, 0.0, 1.0]);
     let blue = Some([0.0, 0.0, 1.0, 1.0]);
@@ -403,6 +406,7 @@ fn feather_is_monotone_inward_and_softer_than_none() {
         let options = RasterOptions {
             anti_alias: true,
             feather,
+            ..RasterOptions::default()
         };
         draw(
             &mut canvas,
@@ -492,6 +496,7 @@ fn patch_outside_the_canvas_draws_nothing_and_bad_input_is_an_error() {
     let bad_feather = RasterOptions {
         feather: -1.0,
         anti_alias: true,
+        ..RasterOptions::default()
     };
     assert!(draw_patch(&mut canvas, &patch, &bad_feather, &mut RasterScratch::new()).is_err());
     assert_eq!(canvas, before);
@@ -583,5 +588,57 @@ fn a_wrong_membrane_is_an_error_and_leaves_the_canvas_as_it_was() {
             assert!(result.is_err(), "depth {with_depth}: {result:?}");
         }
         assert!(canvas == before, "depth {with_depth}: the canvas changed");
+    }
+}
+
+/// Shading on several threads (row ranges) gives exactly the one-thread pixels, with
+/// anti-aliasing, pixel-centre coverage and a feather, and over a canvas edge.
+#[test]
+fn threads_shade_the_same_pixels() {
+    let source = raster_meshes::pattern_image(300, 300);
+    let mesh = raster_meshes::grid(DVec2::new(2.0, 3.5), 2.9, 100, 99);
+    let membrane: Vec<[f32; 3]> = (0..mesh.positions.len())
+        .map(|i| [(i % 7) as f32 * 0.01, -0.02, 0.03])
+        .collect();
+    let placed: Vec<DVec2> = mesh
+        .positions
+        .iter()
+        .map(|p| DVec2::new(p.x * 0.97 + 0.3 * p.y.sin(), p.y + 0.2))
+        .collect();
+    for (anti_alias, feather) in [(true, 0.0), (false, 0.0), (true, 3.5), (false, 2.0)] {
+        let canvases: Vec<Canvas> = [1, 2, 3]
+            .into_iter()
+            .map(|threads| {
+                let mut canvas = opaque_canvas(280, 300, 0.4);
+                let options = RasterOptions {
+                    anti_alias,
+                    feather,
+                    threads,
+                };
+                draw(
+                    &mut canvas,
+                    &mesh.positions,
+                    &placed,
+                    &mesh.triangles,
+                    &membrane,
+                    None,
+                    &mesh.loops,
+                    &source,
+                    options,
+                );
+                canvas
+            })
+            .collect();
+        let background = opaque_canvas(280, 300, 0.4);
+        assert!(
+            canvases[0].pixels() != background.pixels(),
+            "the patch drew"
+        );
+        for canvas in &canvases[1..] {
+            assert!(
+                canvas.pixels() == canvases[0].pixels(),
+                "AA {anti_alias}, feather {feather}"
+            );
+        }
     }
 }

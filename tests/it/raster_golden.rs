@@ -81,6 +81,7 @@ fn rotated_feathered_polygon() {
     let options = RasterOptions {
         feather: 2.5,
         anti_alias: true,
+        ..RasterOptions::default()
     };
     draw_patch(&mut canvas, &patch, &options, &mut RasterScratch::new()).unwrap();
     golden::assert_golden(
