@@ -73,6 +73,11 @@ pub fn yuv420_len(width: u32, height: u32) -> usize {
 /// Converts `frame` into `out` as 4:2:0 planes ([`yuv420_len`] bytes) on up to `threads`
 /// threads (row bands; the bytes do not depend on the count).
 pub fn frame_to_yuv420(frame: &FrameRef<'_>, out: &mut Vec<u8>, threads: usize) {
+    convert_frame(frame, out, threads, crate::simd::Path::current());
+}
+
+/// [`frame_to_yuv420`] with the rows compiled for `path`.
+fn convert_frame(frame: &FrameRef<'_>, out: &mut Vec<u8>, threads: usize, path: crate::simd::Path) {
     let (w, h) = (frame.width() as usize, frame.height() as usize);
     let (pw, ph) = yuv420_size(frame.width(), frame.height());
     let (pw, ph) = (pw as usize, ph as usize);
@@ -95,7 +100,7 @@ pub fn frame_to_yuv420(frame: &FrameRef<'_>, out: &mut Vec<u8>, threads: usize) 
             // Compiled for the best instruction set this CPU has (integer maths: the same
             // bytes on every path).
             let mut work = move || {
-                crate::simd::Path::current().run(Band {
+                path.run(Band {
                     source,
                     first_pair: band * per_band,
                     planes: [y, cb, cr],
@@ -320,6 +325,19 @@ mod tests {
                 assert!((cr - mean[2]).abs() <= 0.5 + 1e-3, "block {bx},{by}");
             }
         }
+    }
+
+    /// The vector and portable builds of the rows give the same bytes (integer maths).
+    #[test]
+    fn both_simd_paths_give_the_same_bytes() {
+        use crate::simd::Path;
+        let (w, h) = (333u32, 190u32);
+        let bytes = frame_bytes(w, h);
+        let frame = FrameRef::new(w, h, Pixels::Rgba8(&bytes)).unwrap();
+        let (mut vector, mut portable) = (Vec::new(), Vec::new());
+        convert_frame(&frame, &mut vector, 2, Path::Vector);
+        convert_frame(&frame, &mut portable, 2, Path::Portable);
+        assert_eq!(vector, portable);
     }
 
     #[test]
