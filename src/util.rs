@@ -1,6 +1,7 @@
 //! Small helpers shared by every stage: atomic file output (write to a temporary file in the
 //! destination folder, then rename, so a failure never leaves a partial file), a lock that
-//! survives poisoning, and finding an external program (ffmpeg) on `PATH`.
+//! survives poisoning, finding an external program (ffmpeg) on `PATH`, and the number of
+//! cores this process may use.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -16,6 +17,12 @@ pub(crate) fn lock<T>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {
 
 /// What to tell a user who asked for something that needs ffmpeg when it is not installed.
 pub const FFMPEG_MISSING: &str = "ffmpeg not found on PATH: install it (for example: apt-get install ffmpeg) or use --format png|gif|apng|y4m";
+
+/// Cores available to this process (1 if unknown), looked up once.
+pub fn available_cores() -> usize {
+    static CORES: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
+    *CORES.get_or_init(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
+}
 
 /// The first executable file called `name` in a folder of `PATH`.
 pub fn find_program(name: &str) -> Option<PathBuf> {

@@ -286,7 +286,7 @@ fn build_cloner(
     };
     let mut cloner = PatchCloner::new(source, patch.result.mesh, &options)?;
     // One clone, nothing to overlap it with: shade on every core.
-    cloner.set_raster_threads(super::render::default_jobs());
+    cloner.set_raster_threads(lapclone::util::available_cores());
     let deformation = if handles.is_empty() && pins.is_empty() {
         None
     } else {
@@ -417,7 +417,11 @@ fn write_output(
 ) -> anyhow::Result<()> {
     if !args.show_mesh {
         canvas
-            .save_png_threaded(&args.output, target_format, super::render::default_jobs())
+            .save_png_threaded(
+                &args.output,
+                target_format,
+                lapclone::util::available_cores(),
+            )
             .with_context(|| format!("writing {}", args.output.display()))?;
         return Ok(());
     }

@@ -337,7 +337,7 @@ fn install_cancel_handler() -> Arc<AtomicBool> {
 }
 
 pub(crate) fn default_jobs() -> usize {
-    std::thread::available_parallelism().map_or(1, |n| n.get())
+    lapclone::util::available_cores()
 }
 
 fn progress_bar(frames: u64) -> ProgressBar {

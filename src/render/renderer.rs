@@ -310,7 +310,7 @@ impl Renderer {
         let order = &self.state.draw_order;
         let patches = &self.state.patches;
         let deforming = order.iter().filter(|&&i| self.layers[i].deforms()).count();
-        if deforming < 2 || available_cores() < 2 {
+        if deforming < 2 || crate::util::available_cores() < 2 {
             let mut switches = 0;
             for &index in order {
                 switches += self.layers[index].prepare(&patches[index])?.switches();
@@ -329,7 +329,7 @@ impl Renderer {
             .collect();
         let queue = std::sync::Mutex::new(jobs.iter_mut());
         std::thread::scope(|scope| {
-            for _ in 0..available_cores().min(deforming) {
+            for _ in 0..crate::util::available_cores().min(deforming) {
                 scope.spawn(|| loop {
                     let job = lock(&queue).next();
                     let Some((index, layer, result)) = job else {
@@ -530,10 +530,4 @@ fn canvas_over(picture: &FloatImage, width: u32, height: u32) -> Result<Canvas, 
 
 fn millis(duration: std::time::Duration) -> f64 {
     duration.as_secs_f64() * 1e3
-}
-
-/// Cores available to this process (1 if unknown), looked up once.
-fn available_cores() -> usize {
-    static CORES: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
-    *CORES.get_or_init(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
 }
