@@ -52,16 +52,16 @@ impl FrameEncoder {
             return Ok(Some(frame));
         }
         let header = png_header(&frame_ref);
-        let mut previous = self.previous.take().filter(|p| p.header == header);
+        let (old_frame, mut old_bands) = match self.previous.take() {
+            Some(p) if p.header == header => (Some(p.frame), p.bands),
+            _ => (None, Vec::new()),
+        };
+        let before = old_frame.as_ref().map(Frame::as_ref).transpose()?;
+        let (before, now) = (before.map(|f| f.pixels()), frame_ref.pixels());
         let mut bands = Vec::with_capacity(header.band_count());
         for index in 0..header.band_count() {
-            let mut band = previous
-                .as_mut()
-                .map(|p| std::mem::take(&mut p.bands[index]))
-                .unwrap_or_default();
-            let unchanged = previous
-                .as_ref()
-                .is_some_and(|p| same_rows(&p.frame, &frame, &header, index));
+            let mut band = old_bands.get_mut(index).map(std::mem::take).unwrap_or_default();
+            let unchanged = before.is_some_and(|before| same_rows(before, now, &header, index));
             if !unchanged {
                 let fill = |y, row: &mut [u8]| fill_row(&frame_ref, header.color, y, row);
                 self.bands.encode_band(&header, index, fill, &mut band);
@@ -69,30 +69,13 @@ impl FrameEncoder {
             bands.push(band);
         }
         crate::png_bands::write_png(&header, &bands, out).map_err(png_io)?;
-        let spare = previous.map(|p| p.frame);
         self.previous = Some(Encoded {
             frame,
             header,
             bands,
         });
-        Ok(spare)
+        Ok(old_frame)
     }
-}
-
-/// Encodes one frame on its own into `out`.
-pub fn encode_png(
-    frame: &FrameRef<'_>,
-    mut out: impl Write,
-    compression: PngCompression,
-) -> Result<(), OutputError> {
-    if compression != PngCompression::Fast {
-        return encode_with_png_crate(frame, out, compression, &mut Vec::new());
-    }
-    let header = png_header(frame);
-    let fill = |y, row: &mut [u8]| fill_row(frame, header.color, y, row);
-    BandEncoder::new()
-        .encode_image(&header, fill, &mut out)
-        .map_err(png_io)
 }
 
 fn png_io(e: std::io::Error) -> OutputError {
@@ -112,15 +95,15 @@ fn png_header(frame: &FrameRef<'_>) -> PngHeader {
     }
 }
 
-/// Whether the rows band `index` is made from (its own and the one above) are equal in both
-/// frames, which have the same header.
-fn same_rows(a: &Frame, b: &Frame, header: &PngHeader, index: usize) -> bool {
+/// Whether the rows band `index` is made from (its own and the one above) are equal in the
+/// pixels of two frames with the same header.
+fn same_rows(a: Pixels<'_>, b: Pixels<'_>, header: &PngHeader, index: usize) -> bool {
     let rows = header.band_rows(index);
     let per_row = header.width as usize * 4;
     let samples = rows.start.saturating_sub(1) as usize * per_row..rows.end as usize * per_row;
-    match (a.as_ref().map(|f| f.pixels()), b.as_ref().map(|f| f.pixels())) {
-        (Ok(Pixels::Rgba8(a)), Ok(Pixels::Rgba8(b))) => a[samples.clone()] == b[samples],
-        (Ok(Pixels::Rgba16(a)), Ok(Pixels::Rgba16(b))) => a[samples.clone()] == b[samples],
+    match (a, b) {
+        (Pixels::Rgba8(a), Pixels::Rgba8(b)) => a[samples.clone()] == b[samples],
+        (Pixels::Rgba16(a), Pixels::Rgba16(b)) => a[samples.clone()] == b[samples],
         _ => false,
     }
 }
@@ -224,8 +207,9 @@ mod tests {
 
     fn alone(frame: &Frame) -> Vec<u8> {
         let mut bytes = Vec::new();
-        let frame_ref = frame.as_ref().expect("a well-formed frame");
-        encode_png(&frame_ref, &mut bytes, PngCompression::Fast).expect("in memory");
+        FrameEncoder::new(PngCompression::Fast)
+            .encode(frame.clone(), &mut bytes)
+            .expect("in memory");
         bytes
     }
 

@@ -19,7 +19,7 @@ mod yuv;
 
 pub use apng::{apng_delays, ApngWriter};
 pub use atomic::TempOutput;
-pub use encode::{encode_png, FrameEncoder, PngCompression};
+pub use encode::{FrameEncoder, PngCompression};
 pub use ffmpeg::{FfmpegWriter, VideoKind, VideoOptions};
 pub use format::OutputKind;
 pub use frame::{Frame, FrameData, FrameRef, Pixels};

@@ -134,13 +134,7 @@ impl Frame<'_> {
                 row,
                 &mut coverage,
             );
-            let origin = (self.work.x0, self.work.y0);
-            let totals = self.shade_rows(
-                scratch,
-                (&coverage, self.work.width(), origin),
-                self.target,
-                canvas,
-            );
+            let totals = self.shade_target(scratch, &coverage, canvas);
             scratch.feathered = coverage;
             return totals;
         }
@@ -148,13 +142,7 @@ impl Frame<'_> {
             let mut coverage = std::mem::take(&mut scratch.centres);
             coverage.clear();
             coverage.extend(scratch.ids.iter().map(|id| u8::from(hit(id)) * u8::MAX));
-            let origin = (self.work.x0, self.work.y0);
-            let totals = self.shade_rows(
-                scratch,
-                (&coverage, self.work.width(), origin),
-                self.target,
-                canvas,
-            );
+            let totals = self.shade_target(scratch, &coverage, canvas);
             scratch.centres = coverage;
             return totals;
         }
@@ -168,6 +156,18 @@ impl Frame<'_> {
             }
         }
         totals
+    }
+
+    /// Shades the whole target with `coverage` laid out like the work rectangle.
+    fn shade_target<T: Texel + Send, C: CoverageTexel + Sync>(
+        &self,
+        scratch: &RasterScratch,
+        coverage: &[C],
+        canvas: &mut [[T; 4]],
+    ) -> (usize, usize) {
+        let origin = (self.work.x0, self.work.y0);
+        let layout = (coverage, self.work.width(), origin);
+        self.shade_rows(scratch, layout, self.target, canvas)
     }
 
     /// Shades `rows` (inside the target) with `coverage` (texels, row stride, the canvas
