@@ -13,8 +13,8 @@ use clap::ValueEnum;
 use indicatif::{ProgressBar, ProgressStyle};
 use lapclone::output::{
     foreign_frames, frame_digits, frame_file_name, ApngWriter, FfmpegWriter, Frame, FrameData,
-    FrameRef, GifWriter, OutputKind, Pixels, PngCompression, PngSequenceWriter, VideoKind,
-    VideoOptions, Y4mWriter,
+    FrameRef, GifWriter, OutputKind, PendingVideo, Pixels, PngCompression, PngSequenceWriter,
+    VideoFrames, VideoKind, Y4mWriter,
 };
 use lapclone::pixels::{Canvas, CanvasPixels, Depth};
 use lapclone::render::{RenderError, Renderer};
@@ -39,7 +39,7 @@ pub enum OutputFormat {
 }
 
 impl OutputFormat {
-    fn kind(self) -> OutputKind {
+    pub(crate) fn kind(self) -> OutputKind {
         match self {
             OutputFormat::Png => OutputKind::PngFolder,
             OutputFormat::Gif => OutputKind::Gif,
@@ -176,6 +176,17 @@ pub fn run_render(args: RenderArgs) -> anyhow::Result<()> {
         return Err(UsageError("--jobs must be at least 1".into()).into());
     }
     let kind = output_kind(&args)?;
+    let settings = SinkSettings {
+        force: args.force,
+        png_compression: match args.png_compression {
+            CompressionArg::Fast => PngCompression::Fast,
+            CompressionArg::Default => PngCompression::Default,
+            CompressionArg::Best => PngCompression::Best,
+        },
+        crf: args.crf,
+    };
+    // Before the scene: a video's ffmpeg starts up while the scene loads.
+    let plan = SinkPlan::new(kind, &args.output, settings)?;
     let (loaded, mut renderer) = load_renderer(&args.scene)?;
     let total = renderer.frame_count();
     let range = match args.frames {
@@ -195,23 +206,7 @@ pub fn run_render(args: RenderArgs) -> anyhow::Result<()> {
     let cancel = install_cancel_handler();
     let jobs = args.jobs.unwrap_or_else(default_jobs);
     let started = Instant::now();
-    let settings = SinkSettings {
-        force: args.force,
-        png_compression: match args.png_compression {
-            CompressionArg::Fast => PngCompression::Fast,
-            CompressionArg::Default => PngCompression::Default,
-            CompressionArg::Best => PngCompression::Best,
-        },
-        crf: args.crf,
-    };
-    let mut sink = FrameSink::open_kind(
-        kind,
-        &args.output,
-        &renderer,
-        range,
-        (jobs, cancel.clone()),
-        settings,
-    )?;
+    let mut sink = plan.open(&renderer, range, jobs, cancel.clone())?;
     let progress = progress_bar(range.last - range.first + 1);
     let mut compute_ms = 0.0;
     for number in range.first..=range.last {
@@ -363,53 +358,62 @@ pub(crate) enum FrameSink {
     Video(Box<FfmpegWriter>),
 }
 
-impl FrameSink {
-    pub(crate) fn open(
-        format: OutputFormat,
-        output: &Path,
-        renderer: &Renderer,
-        range: FrameRange,
-        jobs: usize,
-        cancel: Arc<AtomicBool>,
-    ) -> anyhow::Result<Self> {
-        let settings = SinkSettings::default();
-        Self::open_kind(
-            format.kind(),
-            output,
-            renderer,
-            range,
-            (jobs, cancel),
-            settings,
-        )
-    }
+/// An output chosen before the scene is loaded; a video's ffmpeg is already starting.
+pub(crate) struct SinkPlan {
+    kind: OutputKind,
+    output: PathBuf,
+    settings: SinkSettings,
+    video: Option<PendingVideo>,
+}
 
-    pub(crate) fn open_kind(
+impl SinkPlan {
+    /// Checks the output path and, for a video, starts ffmpeg.
+    pub(crate) fn new(
         kind: OutputKind,
         output: &Path,
-        renderer: &Renderer,
-        range: FrameRange,
-        (jobs, cancel): (usize, Arc<AtomicBool>),
         settings: SinkSettings,
     ) -> anyhow::Result<Self> {
-        let canvas = &renderer.scene().canvas;
         if kind != OutputKind::PngFolder && output.is_dir() {
             anyhow::bail!(
                 "{} is a folder; name a file for {kind:?} output",
                 output.display()
             );
         }
-        let video = |kind| VideoOptions {
-            kind,
-            width: canvas.width,
-            height: canvas.height,
-            fps: canvas.fps,
-            crf: settings.crf,
-            alpha: !renderer.frame().pixels_opaque(),
+        let video_kind = match kind {
+            OutputKind::Mp4 => Some(VideoKind::Mp4),
+            OutputKind::Webm => Some(VideoKind::Webm),
+            OutputKind::Mov => Some(VideoKind::Mov),
+            _ => None,
         };
-        Ok(match kind {
+        let video = match video_kind {
+            Some(video_kind) => {
+                super::clone::check_output_folder(output)?;
+                Some(FfmpegWriter::start(output, video_kind, settings.crf)?)
+            }
+            None => None,
+        };
+        Ok(SinkPlan {
+            kind,
+            output: output.to_path_buf(),
+            settings,
+            video,
+        })
+    }
+
+    /// Opens the sink for `renderer`'s frames in `range`, encoding on `jobs` threads.
+    pub(crate) fn open(
+        self,
+        renderer: &Renderer,
+        range: FrameRange,
+        jobs: usize,
+        cancel: Arc<AtomicBool>,
+    ) -> anyhow::Result<FrameSink> {
+        let canvas = &renderer.scene().canvas;
+        let output = self.output.as_path();
+        Ok(match self.kind {
             OutputKind::PngFolder => {
-                let writer = open_png_folder(output, renderer, range, jobs, cancel, settings)?;
-                FrameSink::Png(writer, output.to_path_buf())
+                let writer = open_png_folder(output, renderer, range, jobs, cancel, self.settings)?;
+                FrameSink::Png(writer, self.output)
             }
             OutputKind::Gif => {
                 super::clone::check_output_folder(output)?;
@@ -424,13 +428,15 @@ impl FrameSink {
                 FrameSink::Y4m(Box::new(writer))
             }
             OutputKind::Mp4 | OutputKind::Webm | OutputKind::Mov => {
-                super::clone::check_output_folder(output)?;
-                let kind = match kind {
-                    OutputKind::Mp4 => VideoKind::Mp4,
-                    OutputKind::Webm => VideoKind::Webm,
-                    _ => VideoKind::Mov,
+                // invariant: `new` starts a video for exactly these kinds.
+                let pending = self.video.expect("a started video");
+                let frames = VideoFrames {
+                    width: canvas.width,
+                    height: canvas.height,
+                    fps: canvas.fps,
+                    alpha: !renderer.frame().pixels_opaque(),
                 };
-                let writer = FfmpegWriter::create(output, video(kind), jobs)?.with_cancel(cancel);
+                let writer = pending.begin(frames, jobs)?.with_cancel(cancel);
                 if let Some((w, h)) = writer.padded() {
                     eprintln!(
                         "note: {}×{} has an odd side; the video is padded to {w}×{h} (4:2:0 needs even sides; the edge pixels repeat)",
@@ -455,7 +461,9 @@ impl FrameSink {
             }
         })
     }
+}
 
+impl FrameSink {
     pub(crate) fn push(&mut self, number: u64, canvas: &Canvas) -> anyhow::Result<()> {
         match self {
             FrameSink::Png(writer, _) => {

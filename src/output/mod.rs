@@ -20,7 +20,7 @@ mod yuv;
 pub use apng::{apng_delays, ApngWriter};
 pub use atomic::TempOutput;
 pub use encode::{FrameEncoder, PngCompression};
-pub use ffmpeg::{FfmpegWriter, VideoKind, VideoOptions};
+pub use ffmpeg::{FfmpegWriter, PendingVideo, VideoFrames, VideoKind};
 pub use format::OutputKind;
 pub use frame::{Frame, FrameData, FrameRef, Pixels};
 pub use gif::{gif_delays_cs, GifOptions, GifWriter, PALETTE_FRAMES};

@@ -32,6 +32,13 @@ pub fn fps_fraction(fps: f64) -> (u64, u64) {
     (num / g, 1000 / g)
 }
 
+/// A Y4M stream header: `width`×`height` progressive square pixels at `fps`, sampled as
+/// `colour` (`C444`, `C420jpeg`…) in limited range.
+pub fn stream_header(width: u32, height: u32, fps: f64, colour: &str) -> String {
+    let (num, den) = fps_fraction(fps);
+    format!("YUV4MPEG2 W{width} H{height} F{num}:{den} Ip A1:1 {colour} XCOLORRANGE=LIMITED\n")
+}
+
 fn gcd(a: u64, b: u64) -> u64 {
     if b == 0 {
         a.max(1)
@@ -85,8 +92,7 @@ impl Y4mWriter {
             }
             None => Sink::Stdout(BufWriter::with_capacity(1 << 20, std::io::stdout())),
         };
-        let (num, den) = fps_fraction(fps);
-        let header = format!("YUV4MPEG2 W{width} H{height} F{num}:{den} Ip A1:1 C444\n");
+        let header = stream_header(width, height, fps, "C444");
         write_all(&mut sink, header.as_bytes())?;
         Ok(Y4mWriter {
             sink,

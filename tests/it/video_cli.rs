@@ -514,3 +514,59 @@ fn without_ffmpeg_video_output_is_refused_and_nothing_is_written() {
         assert!(text.contains("width=96\nheight=64"), "{text}");
     }
 }
+
+/// Processes whose command line names `needle` (Linux: `/proc/*/cmdline`).
+#[cfg(target_os = "linux")]
+fn processes_naming(needle: &str) -> Vec<String> {
+    let Ok(entries) = std::fs::read_dir("/proc") else {
+        return Vec::new();
+    };
+    entries
+        .filter_map(|e| std::fs::read(e.ok()?.path().join("cmdline")).ok())
+        .map(|bytes| String::from_utf8_lossy(&bytes).replace('\0', " "))
+        .filter(|line| line.contains(needle))
+        .collect()
+}
+
+/// ffmpeg starts before the scene is read; a scene that then fails must still leave no
+/// video, no temporary file and no ffmpeg behind.
+#[test]
+fn a_scene_failing_after_ffmpeg_started_leaves_nothing() {
+    if !has_ffmpeg() {
+        eprintln!("skipped: ffmpeg is not installed");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let broken = [
+        // A script error (reading), then a missing image (building the renderer).
+        ("canvas(96, 64, #{ fps: 4 });\npatch(\"p\", #{ source: 12 });", "scene.rhai:2"),
+        (
+            "canvas(96, 64, #{ fps: 4 });\npatch(\"p\", #{ source: \"gone.png\", polygons: [[[1, 1], [9, 1], [1, 9]]] });",
+            "gone.png",
+        ),
+    ];
+    for (text, message) in broken {
+        let scene = d.join("scene.rhai");
+        std::fs::write(&scene, text).unwrap();
+        let mp4 = d.join("out.mp4");
+        let o = render(&scene, &mp4, &[]);
+        assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+        assert!(
+            stderr(&o).contains(message),
+            "wanted `{message}` in: {}",
+            stderr(&o)
+        );
+        let left: Vec<_> = std::fs::read_dir(d)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .filter(|name| name.contains("mp4"))
+            .collect();
+        assert!(left.is_empty(), "left behind: {left:?}");
+        #[cfg(target_os = "linux")]
+        {
+            let running = processes_naming(&d.to_string_lossy());
+            assert!(running.is_empty(), "still running: {running:?}");
+        }
+    }
+}

@@ -135,7 +135,7 @@ fn mp4_colours_decode_to_the_png_frames() {
     assert!(o.status.success(), "{}", stderr(&o));
     let tags = probe(
         &mp4,
-        "stream=pix_fmt,color_range,color_space,color_primaries,color_transfer",
+        "stream=pix_fmt,color_range,color_space,color_primaries,color_transfer,chroma_location",
     );
     for tag in [
         "pix_fmt=yuv420p",
@@ -143,6 +143,7 @@ fn mp4_colours_decode_to_the_png_frames() {
         "color_space=bt709",
         "color_primaries=bt709",
         "color_transfer=bt709",
+        "chroma_location=center",
     ] {
         assert!(tags.contains(tag), "{tag} not in {tags}");
     }

@@ -21,7 +21,7 @@ use super::completion::{function_names, SharedWords, Words};
 use super::keys::key_table;
 use super::preview::Preview;
 use super::save::{saved_text, SaveForm};
-use crate::cli::render::{default_jobs, positioned, FrameRange, FrameSink, OutputFormat};
+use crate::cli::render::{default_jobs, positioned, FrameRange, OutputFormat, SinkPlan};
 
 /// What an entry did.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -454,6 +454,7 @@ impl Session {
     ) -> anyhow::Result<()> {
         let scene = self.current_scene()?;
         let started = Instant::now();
+        let plan = SinkPlan::new(format.kind(), output, Default::default())?;
         let mut renderer = Renderer::new(scene).map_err(|e| anyhow::anyhow!("{e}"))?;
         let total = renderer.frame_count();
         let range = range.unwrap_or(FrameRange {
@@ -467,14 +468,7 @@ impl Session {
                 range.last
             );
         }
-        let mut sink = FrameSink::open(
-            format,
-            output,
-            &renderer,
-            range,
-            default_jobs(),
-            self.cancel.clone(),
-        )?;
+        let mut sink = plan.open(&renderer, range, default_jobs(), self.cancel.clone())?;
         for number in range.first..=range.last {
             if self.cancel.load(Ordering::Relaxed) {
                 sink.abandon();
