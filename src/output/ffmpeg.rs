@@ -32,7 +32,7 @@ use std::thread::JoinHandle;
 
 use super::atomic::TempOutput;
 use super::yuv::{frame_to_yuv420, yuv420_size};
-use super::y4m::{fps_fraction, stream_header};
+use super::y4m::{check_stream, fps_fraction, stream_header};
 use super::{FrameRef, OutputError};
 
 /// How lapclone's 4:2:0 frames are tagged, as ffmpeg options (before `-i` for the raw input,
@@ -288,13 +288,7 @@ impl PendingVideo {
             crf: self.crf,
             frames,
         };
-        if frames.width == 0 || frames.height == 0 || !(frames.fps.is_finite() && frames.fps > 0.0)
-        {
-            return Err(OutputError::BadFrame(format!(
-                "a video needs fps > 0 and a size of at least 1×1, got {} and {}×{}",
-                frames.fps, frames.width, frames.height
-            )));
-        }
+        check_stream("a video", frames.width, frames.height, frames.fps)?;
         let spawned = match self.spawned {
             Some(spawned) => spawned,
             None => {

@@ -32,6 +32,16 @@ pub fn fps_fraction(fps: f64) -> (u64, u64) {
     (num / g, 1000 / g)
 }
 
+/// Refuses a stream (`what`) without a positive finite rate or with an empty side.
+pub(super) fn check_stream(what: &str, width: u32, height: u32, fps: f64) -> Result<(), OutputError> {
+    if !(fps.is_finite() && fps > 0.0) || width == 0 || height == 0 {
+        return Err(OutputError::BadFrame(format!(
+            "{what} needs fps > 0 and a size of at least 1×1, got {fps} and {width}×{height}"
+        )));
+    }
+    Ok(())
+}
+
 /// A Y4M stream header: `width`×`height` progressive square pixels at `fps`, sampled as
 /// `colour` (`C444`, `C420jpeg`…) in limited range.
 pub fn stream_header(width: u32, height: u32, fps: f64, colour: &str) -> String {
@@ -74,11 +84,7 @@ impl Y4mWriter {
         height: u32,
         fps: f64,
     ) -> Result<Self, OutputError> {
-        if !(fps.is_finite() && fps > 0.0) || width == 0 || height == 0 {
-            return Err(OutputError::BadFrame(format!(
-                "a Y4M stream needs fps > 0 and a size of at least 1×1, got {fps} and {width}×{height}"
-            )));
-        }
+        check_stream("a Y4M stream", width, height, fps)?;
         let mut sink = match path {
             Some(path) => {
                 let temp = TempOutput::new(path);
