@@ -340,6 +340,34 @@ mod tests {
         assert_eq!(vector, portable);
     }
 
+    /// A frame with translucent pixels gives the planes of the same frame composited over
+    /// black beforehand: the compositing is each pixel's, before any averaging.
+    #[test]
+    fn translucent_rows_give_the_planes_of_the_frame_over_black() {
+        let (w, h) = (97u32, 64u32);
+        let mut bytes = frame_bytes(w, h);
+        // Translucent pixels in every fourth row pair, mixed with opaque ones.
+        for (i, px) in bytes.chunks_exact_mut(4).enumerate() {
+            let (x, y) = (i % w as usize, i / w as usize);
+            if (y / 2) % 4 == 1 && x % 3 != 0 {
+                px[3] = (x * 37 + y * 11) as u8;
+            }
+        }
+        let flattened: Vec<u8> = bytes
+            .chunks_exact(4)
+            .flat_map(|px| {
+                let [r, g, b] = over_black([px[0], px[1], px[2], px[3]]).map(|v| v as u8);
+                [r, g, b, 255]
+            })
+            .collect();
+        let (mut got, mut want) = (Vec::new(), Vec::new());
+        frame_to_yuv420(&FrameRef::new(w, h, Pixels::Rgba8(&bytes)).unwrap(), &mut got, 2);
+        let opaque = FrameRef::new(w, h, Pixels::Rgba8(&flattened)).unwrap();
+        frame_to_yuv420(&opaque, &mut want, 2);
+        assert_eq!(got, want);
+        assert!(bytes.chunks_exact(4).any(|px| px[3] != 255));
+    }
+
     #[test]
     fn threads_and_sample_depth_do_not_change_the_bytes() {
         let (w, h) = (301u32, 257u32);
