@@ -19,7 +19,8 @@
 //! the encoded stream is tagged BT.709 / limited range so players decode the colours
 //! lapclone meant. 4:2:0 needs even sides: an odd side is padded by one pixel (repeating the
 //! last row or column), which [`FfmpegWriter::padded`] reports. ProRes 4444 is fed raw RGBA
-//! and converted by ffmpeg, which keeps the alpha.
+//! and converted by ffmpeg (to 10-bit 4:4:4 with alpha), with the same BT.709 matrix,
+//! limited range and tags.
 
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
@@ -35,7 +36,7 @@ use super::yuv::{frame_to_yuv420, yuv420_size};
 use super::y4m::{check_stream, fps_fraction, stream_header};
 use super::{FrameRef, OutputError};
 
-/// How lapclone's 4:2:0 frames are tagged, as ffmpeg options (before `-i` for the raw input,
+/// How lapclone's videos are tagged, as ffmpeg options (before `-i` for the 4:2:0 input,
 /// after it for the encoded stream): BT.709 matrix, primaries and transfer, limited range.
 const BT709_TAGS: [&str; 8] = [
     "-color_range",
@@ -149,12 +150,20 @@ fn codec_args(kind: VideoKind, crf: Option<u32>, keeps_alpha: bool) -> Vec<Strin
     let mut args: Vec<String> = Vec::new();
     let codec: &[&str] = if keeps_alpha {
         &[
+            // ffmpeg's own RGB→YUV defaults to the BT.601 matrix, while players take HD
+            // video as BT.709: convert with BT.709 and say so in the stream.
+            "-vf",
+            "scale=out_color_matrix=bt709:out_range=tv",
             "-c:v",
             "prores_ks",
             "-profile:v",
             "4444",
             "-pix_fmt",
             "yuva444p10le",
+            // The ProRes encoder leaves the colour fields of its frame headers unset; this
+            // filter writes them (and ffprobe and players read them from there).
+            "-bsf:v",
+            "prores_metadata=color_primaries=bt709:color_trc=bt709:colorspace=bt709",
         ]
     } else {
         match kind {
@@ -181,9 +190,9 @@ fn codec_args(kind: VideoKind, crf: Option<u32>, keeps_alpha: bool) -> Vec<Strin
     args.extend(codec.iter().map(|s| s.to_string()));
     if !keeps_alpha {
         args.push(crf);
-        args.extend(BT709_TAGS.map(String::from));
         args.extend(["-chroma_sample_location", "center"].map(String::from));
     }
+    args.extend(BT709_TAGS.map(String::from));
     if kind != VideoKind::Webm {
         args.extend(["-movflags".into(), "+faststart".into()]);
     }
@@ -516,6 +525,10 @@ mod tests {
         assert!(args.contains("-pix_fmt rgba -s 95x63 -framerate 30000/1001"), "{args}");
         let codec = codec_args(VideoKind::Mov, None, mov.keeps_alpha()).join(" ");
         assert!(codec.contains("prores_ks"), "{codec}");
+        // ffmpeg converts it with the matrix and range the stream is tagged with.
+        assert!(codec.contains("out_color_matrix=bt709:out_range=tv"), "{codec}");
+        assert!(codec.contains("prores_metadata=color_primaries=bt709"), "{codec}");
+        assert!(codec.contains(&BT709_TAGS.join(" ")), "{codec}");
         // Opaque MOV frames are H.264 over the same Y4M input as MP4.
         let opaque = options(VideoKind::Mov, 95, 63, false);
         assert_eq!(opaque.input_args(), y4m_input_args());

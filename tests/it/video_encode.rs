@@ -189,6 +189,61 @@ fn mp4_colours_decode_to_the_png_frames() {
     }
 }
 
+#[test]
+fn prores_with_alpha_is_bt709_and_its_colours_decode_to_the_png_frames() {
+    if !has_ffmpeg() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    // The bars above, clear below: a transparent canvas, so MOV is ProRes 4444.
+    let bars = colour_bars();
+    let clear_below = image::RgbaImage::from_fn(bars.width(), BARS_H, |x, y| {
+        let [r, g, b] = bars.get_pixel(x, y).0;
+        image::Rgba([r, g, b, if y < BARS_H / 2 { 255 } else { 0 }])
+    });
+    clear_below.save(dir.path().join("bars.png")).unwrap();
+    let canvas = "canvas(192, 96, #{ fps: 8, duration: 0.5, background: \"bars.png\" });";
+    let patch = "let p = patch(\"p\", #{ source: SOURCE, polygons: [[[10, 10], [60, 14], [30, 40]]] }); p.at(0, [40, 70]).at(0.5, [150, 74]);";
+    let scene = write_scene(dir.path(), canvas, patch);
+    let (pngs, mov) = (dir.path().join("pngs"), dir.path().join("out.mov"));
+    assert!(render(&scene, &pngs, &[]).status.success());
+    let o = render(&scene, &mov, &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let tags = probe(
+        &mov,
+        "stream=codec_name,color_range,color_space,color_primaries,color_transfer",
+    );
+    for tag in [
+        "codec_name=prores",
+        "color_range=tv",
+        "color_space=bt709",
+        "color_primaries=bt709",
+        "color_transfer=bt709",
+    ] {
+        assert!(tags.contains(tag), "{tag} not in {tags}");
+    }
+    let frames: Vec<_> = (1..=4)
+        .map(|n| rgba(&pngs.join(format!("frame_{n:04}.png"))))
+        .collect();
+    for (bar, error) in bar_errors(&decode(&mov, "rgb24"), &frames)
+        .iter()
+        .enumerate()
+    {
+        for (c, e) in error.iter().enumerate() {
+            // 10-bit 4:4:4 is nearly exact; the BT.601 matrix read as BT.709 moves these
+            // bars by up to 20 levels.
+            assert!(
+                e.abs() <= 1.5,
+                "bar {bar} {:?} channel {c}: off by {e:.2} levels",
+                BARS[bar]
+            );
+        }
+    }
+    // The clear half stays clear.
+    let alpha = decode(&mov, "rgba");
+    assert_eq!(alpha[(90 * 192 + 5) * 4 + 3], 0);
+}
+
 /// A small moving-patch scene over the coffee picture, or over `background`.
 fn small_scene(dir: &Path, background: &str) -> std::path::PathBuf {
     let canvas =
