@@ -8,8 +8,8 @@ use lapclone::simd::Path;
 use lapclone::solve::solve::ldlt_solve_interleaved;
 use lapclone::solve::solve_supernodal::{inverse_diagonal, ldlt_solve_supernodal_at};
 use lapclone::solve::{
-    laplacian, read_constrained_list, read_matrix_market, FactorMethod, LaplacianKind,
-    PenaltyFactor, PenaltyOptions, SymmetricCsc,
+    laplacian, read_constrained_list, read_matrix_market, write_matrix_market, FactorMethod,
+    LaplacianKind, PenaltyFactor, PenaltyOptions, SymmetricCsc,
 };
 use std::path::PathBuf;
 use std::time::Instant;
@@ -66,6 +66,10 @@ pub struct FactorBenchArgs {
     /// Numeric factorisation.
     #[arg(long, value_enum, default_value_t = MethodArg::Auto)]
     pub method: MethodArg,
+    /// Also write each Laplacian as `disc_<n>.mtx` and its constrained (boundary) vertices as
+    /// `disc_<n>.constrained` into this folder, for `benches/cholmod/reference.py`.
+    #[arg(long)]
+    pub matrix_out: Option<PathBuf>,
 }
 
 /// Timings of one matrix, milliseconds (best of several runs).
@@ -318,7 +322,24 @@ pub fn run_factor(args: FactorBenchArgs) -> anyhow::Result<()> {
         let mesh = fixtures::disc_with_vertices(size);
         let l = laplacian(&mesh, kind);
         let boundary: Vec<usize> = (0..l.n).filter(|&v| mesh.is_boundary[v]).collect();
+        if let Some(folder) = &args.matrix_out {
+            write_disc(folder, &l, &boundary)?;
+        }
         rows.push(measure(&l, &boundary, None, args.method.into())?);
     }
     print(&rows, args.json)
+}
+
+/// `disc_<n>.mtx` and `disc_<n>.constrained` (one 0-based index per line) in `folder`.
+fn write_disc(
+    folder: &std::path::Path,
+    l: &SymmetricCsc,
+    constrained: &[usize],
+) -> anyhow::Result<()> {
+    std::fs::create_dir_all(folder).with_context(|| format!("creating {}", folder.display()))?;
+    let stem = folder.join(format!("disc_{}", l.n));
+    write_matrix_market(&stem.with_extension("mtx"), l)?;
+    let list: String = constrained.iter().map(|v| format!("{v}\n")).collect();
+    let path = stem.with_extension("constrained");
+    std::fs::write(&path, list).with_context(|| format!("writing {}", path.display()))
 }
