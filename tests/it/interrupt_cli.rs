@@ -1,7 +1,9 @@
 //! Interrupted renders (docs/robustness.md): SIGINT during `lapclone render` leaves only
 //! complete frames (each decodes fully) and no temporary file, and the render exits 1
 //! saying it was interrupted; an interrupted GIF/APNG leaves no file at all, and an
-//! interrupted MP4 neither a file nor an ffmpeg process (skipped without ffmpeg).
+//! interrupted MP4 neither a file nor an ffmpeg process, whether it comes while frames are
+//! still going in (skipped without ffmpeg) or while ffmpeg finishes the file (a stand-in
+//! ffmpeg that takes its time).
 //!
 //! No sleeps: the test polls for the first output with a bounded, yielding loop.
 
@@ -188,5 +190,70 @@ fn sigint_during_a_video_stops_ffmpeg_and_leaves_no_file() {
         !group_alive(ffmpeg[0]),
         "ffmpeg (process group {}) still runs",
         ffmpeg[0]
+    );
+}
+
+/// A stand-in for ffmpeg that takes the whole stream, starts the file, says that its input
+/// has ended (writing its process id into `$FAKE_FFMPEG_FLUSHING`), then takes its time
+/// finishing, as x264 does draining its lookahead. `exec` keeps it one process, as ffmpeg is.
+const SLOW_FINISHING_FFMPEG: &str = "#!/bin/sh
+for output; do :; done
+printf 'not a video yet' > \"$output\"
+cat > /dev/null
+echo $$ > \"$FAKE_FFMPEG_FLUSHING.part\"
+mv \"$FAKE_FFMPEG_FLUSHING.part\" \"$FAKE_FFMPEG_FLUSHING\"
+exec sleep 60
+";
+
+#[test]
+fn sigint_while_ffmpeg_finishes_the_video_stops_it_and_leaves_no_file() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write_scene(dir.path());
+    let tools = tempfile::tempdir().unwrap();
+    let fake = tools.path().join("ffmpeg");
+    std::fs::write(&fake, SLOW_FINISHING_FFMPEG).unwrap();
+    std::fs::set_permissions(&fake, std::fs::Permissions::from_mode(0o755)).unwrap();
+    let flushing = tools.path().join("flushing");
+    let path = std::env::var_os("PATH").unwrap_or_default();
+    let mut search = vec![tools.path().to_path_buf()];
+    search.extend(std::env::split_paths(&path));
+    let out = dir.path().join("movie.mp4");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_lapclone"))
+        .args([
+            "render".as_ref(),
+            scene.as_os_str(),
+            "-o".as_ref(),
+            out.as_os_str(),
+        ])
+        .args(["--frames", "1..3"])
+        .env("PATH", std::env::join_paths(search).unwrap())
+        .env("FAKE_FFMPEG_FLUSHING", &flushing)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Every frame is in and the pipe closed: lapclone now waits for ffmpeg to finish.
+    assert!(
+        wait_until(&mut child, || flushing.exists()),
+        "the render ended before its encoder read the whole stream"
+    );
+    let pid = std::fs::read_to_string(&flushing).unwrap();
+    // It leads a process group of its own, as ffmpeg does.
+    let ffmpeg: u32 = pid.trim().parse().unwrap();
+    assert!(group_alive(ffmpeg));
+    interrupt(&child);
+    let output = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("interrupted"), "{stderr}");
+    assert_eq!(
+        sorted_names(dir.path()),
+        ["long.rhai"],
+        "the interrupted video render left files"
+    );
+    assert!(
+        !group_alive(ffmpeg),
+        "ffmpeg (process group {ffmpeg}) still runs"
     );
 }
