@@ -174,22 +174,27 @@ fn sigint_during_a_video_stops_ffmpeg_and_leaves_no_file() {
     assert!(started, "the render ended before ffmpeg wrote anything");
     let ffmpeg = children_named(child.id(), "ffmpeg");
     assert_eq!(ffmpeg.len(), 1, "ffmpeg processes: {ffmpeg:?}");
-    // ffmpeg leads a process group of its own, so the signal reaches only lapclone.
-    assert!(group_alive(ffmpeg[0]));
+    interrupt_video(child, dir.path(), ffmpeg[0]);
+}
+
+/// Interrupts a video render whose encoder leads process group `ffmpeg` and checks that it
+/// exits 1 saying so, leaving nothing in `dir` but the scene and no encoder process.
+fn interrupt_video(child: Child, dir: &Path, ffmpeg: u32) {
+    // The encoder leads a process group of its own, so the signal reaches only lapclone.
+    assert!(group_alive(ffmpeg));
     interrupt(&child);
     let output = child.wait_with_output().unwrap();
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert_eq!(output.status.code(), Some(1), "{stderr}");
     assert!(stderr.contains("interrupted"), "{stderr}");
     assert_eq!(
-        sorted_names(dir.path()),
+        sorted_names(dir),
         ["long.rhai"],
         "the interrupted video render left files"
     );
     assert!(
-        !group_alive(ffmpeg[0]),
-        "ffmpeg (process group {}) still runs",
-        ffmpeg[0]
+        !group_alive(ffmpeg),
+        "ffmpeg (process group {ffmpeg}) still runs"
     );
 }
 
@@ -239,21 +244,5 @@ fn sigint_while_ffmpeg_finishes_the_video_stops_it_and_leaves_no_file() {
         "the render ended before its encoder read the whole stream"
     );
     let pid = std::fs::read_to_string(&flushing).unwrap();
-    // It leads a process group of its own, as ffmpeg does.
-    let ffmpeg: u32 = pid.trim().parse().unwrap();
-    assert!(group_alive(ffmpeg));
-    interrupt(&child);
-    let output = child.wait_with_output().unwrap();
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    assert_eq!(output.status.code(), Some(1), "{stderr}");
-    assert!(stderr.contains("interrupted"), "{stderr}");
-    assert_eq!(
-        sorted_names(dir.path()),
-        ["long.rhai"],
-        "the interrupted video render left files"
-    );
-    assert!(
-        !group_alive(ffmpeg),
-        "ffmpeg (process group {ffmpeg}) still runs"
-    );
+    interrupt_video(child, dir.path(), pid.trim().parse().unwrap());
 }
