@@ -29,6 +29,14 @@ fn probe(video: &Path, entries: &str) -> String {
     String::from_utf8_lossy(&out.stdout).into_owned()
 }
 
+/// Asserts that ffprobe's `entries` of `video` include every `key=value` of `wanted`.
+fn assert_probed(video: &Path, entries: &str, wanted: &[&str]) {
+    let text = probe(video, entries);
+    for want in wanted {
+        assert!(text.contains(want), "{want} not in {text}");
+    }
+}
+
 /// Every frame of `video` decoded by ffmpeg to raw 8-bit pixels (`rgb24` or `rgba`).
 fn decode(video: &Path, pix_fmt: &str) -> Vec<u8> {
     let out = Command::new("ffmpeg")
@@ -133,20 +141,18 @@ fn mp4_colours_decode_to_the_png_frames() {
     assert!(o.status.success(), "{}", stderr(&o));
     let o = render(&scene, &mp4, &[]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let tags = probe(
+    assert_probed(
         &mp4,
         "stream=pix_fmt,color_range,color_space,color_primaries,color_transfer,chroma_location",
+        &[
+            "pix_fmt=yuv420p",
+            "color_range=tv",
+            "color_space=bt709",
+            "color_primaries=bt709",
+            "color_transfer=bt709",
+            "chroma_location=center",
+        ],
     );
-    for tag in [
-        "pix_fmt=yuv420p",
-        "color_range=tv",
-        "color_space=bt709",
-        "color_primaries=bt709",
-        "color_transfer=bt709",
-        "chroma_location=center",
-    ] {
-        assert!(tags.contains(tag), "{tag} not in {tags}");
-    }
     let frames: Vec<_> = (1..=4)
         .map(|n| rgba(&pngs.join(format!("frame_{n:04}.png"))))
         .collect();
@@ -209,19 +215,17 @@ fn prores_with_alpha_is_bt709_and_its_colours_decode_to_the_png_frames() {
     assert!(render(&scene, &pngs, &[]).status.success());
     let o = render(&scene, &mov, &[]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let tags = probe(
+    assert_probed(
         &mov,
         "stream=codec_name,color_range,color_space,color_primaries,color_transfer",
+        &[
+            "codec_name=prores",
+            "color_range=tv",
+            "color_space=bt709",
+            "color_primaries=bt709",
+            "color_transfer=bt709",
+        ],
     );
-    for tag in [
-        "codec_name=prores",
-        "color_range=tv",
-        "color_space=bt709",
-        "color_primaries=bt709",
-        "color_transfer=bt709",
-    ] {
-        assert!(tags.contains(tag), "{tag} not in {tags}");
-    }
     let frames: Vec<_> = (1..=4)
         .map(|n| rgba(&pngs.join(format!("frame_{n:04}.png"))))
         .collect();
@@ -262,19 +266,17 @@ fn webm_is_vp9_with_the_frames_size_and_rate() {
     let webm = dir.path().join("out.webm");
     let o = render(&scene, &webm, &[]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let text = probe(
+    assert_probed(
         &webm,
         "stream=codec_name,width,height,r_frame_rate,nb_read_frames",
+        &[
+            "codec_name=vp9",
+            "width=96",
+            "height=64",
+            "r_frame_rate=8/1",
+            "nb_read_frames=4",
+        ],
     );
-    for want in [
-        "codec_name=vp9",
-        "width=96",
-        "height=64",
-        "r_frame_rate=8/1",
-        "nb_read_frames=4",
-    ] {
-        assert!(text.contains(want), "{want} not in {text}");
-    }
 }
 
 #[test]
@@ -287,10 +289,11 @@ fn mov_keeps_alpha_of_a_transparent_canvas_and_is_h264_when_opaque() {
     let mov = dir.path().join("clear.mov");
     let o = render(&clear, &mov, &[]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let text = probe(&mov, "stream=codec_name,pix_fmt,nb_read_frames");
-    assert!(text.contains("codec_name=prores"), "{text}");
-    assert!(text.contains("pix_fmt=yuva444p"), "{text}");
-    assert!(text.contains("nb_read_frames=4"), "{text}");
+    assert_probed(
+        &mov,
+        "stream=codec_name,pix_fmt,nb_read_frames",
+        &["codec_name=prores", "pix_fmt=yuva444p", "nb_read_frames=4"],
+    );
     // The alpha survives: the canvas corner is clear, the patch's middle is not.
     let first = &decode(&mov, "rgba")[..96 * 64 * 4];
     let alpha = |x: usize, y: usize| first[(y * 96 + x) * 4 + 3];
@@ -300,9 +303,11 @@ fn mov_keeps_alpha_of_a_transparent_canvas_and_is_h264_when_opaque() {
     let mov = dir.path().join("opaque.mov");
     let o = render(&opaque, &mov, &[]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let text = probe(&mov, "stream=codec_name,pix_fmt");
-    assert!(text.contains("codec_name=h264"), "{text}");
-    assert!(text.contains("pix_fmt=yuv420p"), "{text}");
+    assert_probed(
+        &mov,
+        "stream=codec_name,pix_fmt",
+        &["codec_name=h264", "pix_fmt=yuv420p"],
+    );
 }
 
 /// `plates.mkv`: three plates at 3 fps, and `source.mkv`: chelsea then chelsea inverted,
