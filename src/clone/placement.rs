@@ -40,6 +40,15 @@ impl Placement {
         }
     }
 
+    /// OpenCV's `seamlessClone` placement of a patch whose mask's inside pixels span
+    /// `bbox_min`..`bbox_max` (pixel corners, whole numbers): the box's centre goes to the
+    /// target pixel `p` as OpenCV puts it, its top-left pixel landing on
+    /// `p − (⌊w / 2⌋, ⌊h / 2⌋)`. The patch moves by whole pixels, so it is never resampled.
+    pub fn centred_on_pixel(bbox_min: DVec2, bbox_max: DVec2, p: [i64; 2]) -> Self {
+        let half = ((bbox_max - bbox_min) / 2.0).floor();
+        Self::translate(bbox_min, DVec2::new(p[0] as f64, p[1] as f64) - half)
+    }
+
     /// The rest → target map.
     pub fn to_affine(&self) -> DAffine2 {
         DAffine2::from_translation(self.at)

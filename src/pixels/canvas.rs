@@ -3,9 +3,10 @@
 //! `u16` for 16-bit ones — with float reads, bilinear sampling, an allocation-free reset
 //! ([`Canvas::copy_from`]) and PNG output in any [`PixelFormat`].
 
+use std::ops::Range;
 use std::path::Path;
 
-use super::png_encode::write_png_rgba;
+use super::png_encode::{interleave, write_png_rgba};
 use super::PixelRect;
 use super::{sample_bilinear_rgba, Depth, FloatImage, PixelError, PixelFormat};
 
@@ -53,7 +54,9 @@ impl Texel for u16 {
 /// Canvas storage in the output bit depth (straight, non-premultiplied RGBA, row-major).
 #[derive(Clone, Debug, PartialEq)]
 pub enum CanvasPixels {
+    /// 8 bits per channel (an 8-bit target or background).
     Eight(Vec<[u8; 4]>),
+    /// 16 bits per channel.
     Sixteen(Vec<[u16; 4]>),
 }
 
@@ -265,6 +268,50 @@ impl Canvas {
         match &self.pixels {
             CanvasPixels::Eight(p) => write_png_rgba(p, w, h, format, threads, out),
             CanvasPixels::Sixteen(p) => write_png_rgba(p, w, h, format, threads, out),
+        }
+    }
+
+    /// The frame's channel samples as a PNG in `format` stores them, row-major and
+    /// interleaved (grey formats hold Rec. 709 luma; without alpha the alpha channel is
+    /// dropped, not composited; 16-bit samples big-endian): for callers that hand frames to
+    /// other software as arrays rather than files, with the values a saved PNG decodes to.
+    pub fn samples(&self, format: PixelFormat) -> Vec<u8> {
+        self.samples_in(format, 0..self.width, 0..self.height)
+    }
+
+    /// [`samples`](Self::samples) of the columns `x` and rows `y` only (clipped to the
+    /// canvas): the part of a frame a clone changed.
+    pub fn samples_in(&self, format: PixelFormat, x: Range<u32>, y: Range<u32>) -> Vec<u8> {
+        let sample_bytes = match format.depth {
+            Depth::Eight => 1,
+            Depth::Sixteen => 2,
+        };
+        let (x0, x1) = (x.start.min(self.width) as usize, x.end.min(self.width) as usize);
+        let (y0, y1) = (y.start.min(self.height), y.end.min(self.height));
+        let columns = x1.saturating_sub(x0);
+        let row_bytes = columns * format.channel_count() * sample_bytes;
+        let mut out = vec![0; row_bytes * y1.saturating_sub(y0) as usize];
+        if row_bytes == 0 {
+            return out;
+        }
+        let width = self.width as usize;
+        for (row, y) in out.chunks_exact_mut(row_bytes).zip(y0..y1) {
+            let start = y as usize * width + x0;
+            match &self.pixels {
+                CanvasPixels::Eight(p) => interleave(&p[start..start + columns], format, row),
+                CanvasPixels::Sixteen(p) => interleave(&p[start..start + columns], format, row),
+            }
+        }
+        out
+    }
+
+    /// A decoded image as a canvas in its own bit depth: 8-bit images straight from their
+    /// bytes ([`from_eight_bit`](Self::from_eight_bit)), others through their
+    /// [`FloatImage`] ([`from_image`](Self::from_image)).
+    pub fn from_dynamic(decoded: &image::DynamicImage) -> Result<Canvas, PixelError> {
+        match Canvas::from_eight_bit(decoded) {
+            Some(canvas) => Ok(canvas),
+            None => Ok(Canvas::from_image(&FloatImage::from_dynamic(decoded)?)),
         }
     }
 
