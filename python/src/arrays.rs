@@ -257,10 +257,10 @@ fn load_rect_typed<T: Element + Copy + CanvasTexel>(
     let (red, blue) = if bgr && channels >= 3 { (2, 0) } else { (0, 2) };
     for y in rect.y0 as usize..rect.y1 as usize {
         let row = view.index_axis(Axis(0), y);
-        let out = &mut pixels[y * width..(y + 1) * width];
-        for x in rect.x0 as usize..rect.x1 as usize {
+        let out = &mut pixels[y * width + rect.x0 as usize..y * width + rect.x1 as usize];
+        for (texel, x) in out.iter_mut().zip(rect.x0 as usize..) {
             let px = row.index_axis(Axis(0), x);
-            out[x] = match channels {
+            *texel = match channels {
                 1 => [px[0], px[0], px[0], opaque],
                 3 => [px[red], px[1], px[blue], opaque],
                 _ => [px[red], px[1], px[blue], px[3]],
@@ -453,12 +453,15 @@ fn copy_typed<T: Element + Copy>(
     Ok(())
 }
 
+/// A mesh's vertices (N×2 float64) and triangles (M×3 uint32).
+pub type MeshArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<u32>>);
+
 /// An N×2 float64 and an M×3 uint32 array: a mesh's vertices and triangles.
 pub fn mesh_arrays<'py>(
     py: Python<'py>,
     vertices: &[[f64; 2]],
     triangles: &[[u32; 3]],
-) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<u32>>)> {
+) -> PyResult<MeshArrays<'py>> {
     let v: Vec<f64> = vertices.iter().flatten().copied().collect();
     let t: Vec<u32> = triangles.iter().flatten().copied().collect();
     let v = numpy::PyArray1::from_vec(py, v).reshape([vertices.len(), 2])?;

@@ -7,7 +7,6 @@ use lapclone::{
     mesh_from_mask, Anchor, BitMask, BoundaryData, CloneMode, CloneOptions, Handle, LaplacianKind,
     MeshOptions, Pin, Placement,
 };
-use numpy::PyArray2;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
@@ -22,7 +21,13 @@ pub const MIXED_CLONE: i64 = 2;
 /// `cv2.MONOCHROME_TRANSFER`.
 pub const MONOCHROME_TRANSFER: i64 = 3;
 
-/// A patch meshed and factored once, cloned onto any number of targets.
+/// Cloner(source, mask, *, density=3.0, laplacian="combinatorial", mode="normal",
+/// feather=0.0, boundary_data="hat-average", bgr=False)
+///
+/// A patch meshed and factored once, cloned onto any number of targets: a loop over video
+/// frames pays only the per-frame solve. Arrays are RGB(A) (BGR(A) with `bgr=True`), grey
+/// or colour, uint8 or uint16; the mask is inside where its luma (or alpha) is at least half
+/// scale.
 #[pyclass(module = "lapclone", frozen)]
 pub struct Cloner {
     patch: Patch,
@@ -71,7 +76,12 @@ impl Cloner {
         build(py, source, mask, density, &options, bgr)
     }
 
-    /// Clones the patch onto `target`; see the stub for the arguments.
+    /// Clones the patch onto `target` (any uint8/uint16 grey, RGB or RGBA array) with its
+    /// anchor at `at`, scaled, rotated (degrees, clockwise on screen), deformed by `drags`
+    /// ((x0, y0), (x1, y1)[, radius]) and `pins` (source pixels); returns the result, or
+    /// writes it into `out` (which may be `target`) and returns that. The same pixels as
+    /// `lapclone clone` with the same images and flags. The GIL is released while it
+    /// computes.
     #[pyo3(signature = (target, at, *, scale=1.0, rotate=0.0, drags=Vec::new(), pins=Vec::new(), anchor="centre", out=None))]
     #[allow(clippy::too_many_arguments)]
     fn clone<'py>(
@@ -267,7 +277,12 @@ fn pixel(value: &Bound<'_, PyAny>) -> PyResult<[i64; 2]> {
     Ok([p.x as i64, p.y as i64])
 }
 
-/// `cv2.seamlessClone` with lapclone; see the stub.
+/// `cv2.seamlessClone` with lapclone: the same arguments, BGR arrays and placement (the
+/// centre of the mask's bounding box goes to the pixel `p` of `dst`); `flags` is
+/// NORMAL_CLONE or MONOCHROME_TRANSFER (MIXED_CLONE raises ValueError). Deliberate
+/// differences: no assert at the borders (the patch is clipped), holes and several pieces
+/// are allowed, and the mask is not eroded (the blend's boundary runs through the centres of
+/// the first outside pixels). Returns a new array like `dst`.
 #[pyfunction]
 #[pyo3(signature = (src, dst, mask, p, flags=NORMAL_CLONE))]
 pub fn seamless_clone<'py>(
@@ -334,7 +349,7 @@ pub fn mesh<'py>(
     py: Python<'py>,
     mask: &Bound<'py, PyAny>,
     density: f64,
-) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<u32>>)> {
+) -> PyResult<arrays::MeshArrays<'py>> {
     let options = mesh_options(density)?;
     let mask = arrays::read_mask(mask, "mask")?;
     let size = (mask.image.width(), mask.image.height());

@@ -13,7 +13,12 @@ use pyo3::prelude::*;
 use crate::arrays::{self, Dtype, Layout};
 use crate::errors::{scene_error, to_py};
 
-/// A scene file, loaded, validated and with every patch meshed and factored.
+/// Scene(path, *, bgr=False)
+///
+/// A `.rhai` scene file, opened as `lapclone render` opens it: `len()`, `.fps`, `.size`,
+/// `.frame(i)` (an H×W×4 RGBA array, BGRA with `bgr=True`), indexing and iteration.
+/// FileNotFoundError for a missing file, lapclone.SceneError (file, line, column) for an
+/// error in it.
 #[pyclass(module = "lapclone", frozen)]
 pub struct Scene {
     renderer: Mutex<Renderer>,
@@ -73,8 +78,8 @@ impl Scene {
 
     /// The scene file.
     #[getter]
-    fn path(&self) -> PathBuf {
-        self.path.clone()
+    fn path(&self) -> String {
+        self.path.display().to_string()
     }
 
     /// Frame `index` (from 0; negative counts from the end) as an H×W×4 array.
