@@ -85,6 +85,7 @@ class Cloner:
         feather: float = 0.0,
         boundary_data: str = "hat-average",
         bgr: bool = False,
+        threads: Optional[int] = None,
     ) -> None:
         """Meshes ``mask`` (the source's size) and factors the patch's Laplacian.
 
@@ -94,6 +95,8 @@ class Cloner:
         - ``feather``: soften the patch's outer edge over this many pixels.
         - ``boundary_data``: ``"hat-average"`` or ``"vertex"``.
         - ``bgr``: the source, every target and every result are BGR(A), as OpenCV's.
+        - ``threads``: threads each clone shades on (default: every core); the pixels are
+          the same for any count.
         """
     def clone(
         self,

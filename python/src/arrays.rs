@@ -255,16 +255,32 @@ fn load_rect_typed<T: Element + Copy + CanvasTexel>(
     })?;
     let channels = layout.channel_count();
     let (red, blue) = if bgr && channels >= 3 { (2, 0) } else { (0, 2) };
+    let texel = |px: &[T]| match channels {
+        1 => [px[0], px[0], px[0], opaque],
+        3 => [px[red], px[1], px[blue], opaque],
+        _ => [px[red], px[1], px[blue], px[3]],
+    };
+    let (x0, x1) = (rect.x0 as usize, rect.x1 as usize);
     for y in rect.y0 as usize..rect.y1 as usize {
         let row = view.index_axis(Axis(0), y);
-        let out = &mut pixels[y * width + rect.x0 as usize..y * width + rect.x1 as usize];
-        for (texel, x) in out.iter_mut().zip(rect.x0 as usize..) {
-            let px = row.index_axis(Axis(0), x);
-            *texel = match channels {
-                1 => [px[0], px[0], px[0], opaque],
-                3 => [px[red], px[1], px[blue], opaque],
-                _ => [px[red], px[1], px[blue], px[3]],
-            };
+        let out = &mut pixels[y * width + x0..y * width + x1];
+        match row.as_slice() {
+            // A contiguous row (the usual case): its samples in place.
+            Some(samples) => {
+                let samples = samples[x0 * channels..x1 * channels].chunks_exact(channels);
+                for (t, px) in out.iter_mut().zip(samples) {
+                    *t = texel(px);
+                }
+            }
+            None => {
+                for (t, x) in out.iter_mut().zip(x0..) {
+                    let mut px = [opaque; 4];
+                    for (k, &v) in row.index_axis(Axis(0), x).iter().enumerate() {
+                        px[k] = v;
+                    }
+                    *t = texel(&px);
+                }
+            }
         }
     }
     Ok(())
@@ -378,17 +394,31 @@ fn write_rect_typed<T: Element + Copy>(
         return Ok(());
     }
     let (red, blue) = if bgr && c >= 3 { (2, 0) } else { (0, 2) };
+    let channel = |k: usize| match k {
+        0 => red,
+        2 => blue,
+        other => other,
+    };
+    let x0 = rect.x0 as usize;
     for (row, y) in samples.chunks_exact(columns * c).zip(rect.y0..rect.y1) {
-        for (pixel, x) in row.chunks_exact(c).zip(rect.x0..rect.x1) {
-            let mut out = view.index_axis_mut(Axis(0), y as usize);
-            let mut out = out.index_axis_mut(Axis(0), x as usize);
-            for (k, &value) in pixel.iter().enumerate() {
-                let channel = match k {
-                    0 => red,
-                    2 => blue,
-                    other => other,
-                };
-                out[channel] = value;
+        let mut out = view.index_axis_mut(Axis(0), y as usize);
+        match out.as_slice_mut() {
+            // A contiguous row (the usual case): written in place.
+            Some(dst) => {
+                let dst = dst[x0 * c..(x0 + columns) * c].chunks_exact_mut(c);
+                for (d, pixel) in dst.zip(row.chunks_exact(c)) {
+                    for (k, &value) in pixel.iter().enumerate() {
+                        d[channel(k)] = value;
+                    }
+                }
+            }
+            None => {
+                for (pixel, x) in row.chunks_exact(c).zip(x0..) {
+                    let mut d = out.index_axis_mut(Axis(0), x);
+                    for (k, &value) in pixel.iter().enumerate() {
+                        d[channel(k)] = value;
+                    }
+                }
             }
         }
     }
@@ -439,7 +469,11 @@ fn copy_typed<T: Element + Copy>(
             .map_err(|e| PyValueError::new_err(format!("the target cannot be read now: {e}")))?;
         match out.try_readwrite() {
             Ok(mut writable) => {
-                writable.as_array_mut().assign(&readonly.as_array());
+                let (from, mut to) = (readonly.as_array(), writable.as_array_mut());
+                match (from.as_slice(), to.as_slice_mut()) {
+                    (Some(from), Some(to)) => to.copy_from_slice(from),
+                    _ => to.assign(&from),
+                }
                 return Ok(());
             }
             // `out` shares memory with the target under another view: through a buffer.

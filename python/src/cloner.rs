@@ -22,7 +22,7 @@ pub const MIXED_CLONE: i64 = 2;
 pub const MONOCHROME_TRANSFER: i64 = 3;
 
 /// Cloner(source, mask, *, density=3.0, laplacian="combinatorial", mode="normal",
-/// feather=0.0, boundary_data="hat-average", bgr=False)
+/// feather=0.0, boundary_data="hat-average", bgr=False, threads=None)
 ///
 /// A patch meshed and factored once, cloned onto any number of targets: a loop over video
 /// frames pays only the per-frame solve. Arrays are RGB(A) (BGR(A) with `bgr=True`), grey
@@ -38,7 +38,7 @@ pub struct Cloner {
 #[pymethods]
 impl Cloner {
     #[new]
-    #[pyo3(signature = (source, mask, *, density=3.0, laplacian="combinatorial", mode="normal", feather=0.0, boundary_data="hat-average", bgr=false))]
+    #[pyo3(signature = (source, mask, *, density=3.0, laplacian="combinatorial", mode="normal", feather=0.0, boundary_data="hat-average", bgr=false, threads=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -50,7 +50,11 @@ impl Cloner {
         feather: f64,
         boundary_data: &str,
         bgr: bool,
+        threads: Option<usize>,
     ) -> PyResult<Self> {
+        if threads == Some(0) {
+            return Err(PyValueError::new_err("threads must be at least 1"));
+        }
         let laplacian = LaplacianKind::from_name(laplacian).ok_or_else(|| {
             PyValueError::new_err(format!(
                 "laplacian must be 'combinatorial' or 'cotangent', not {laplacian:?}"
@@ -73,7 +77,7 @@ impl Cloner {
             feather: feather as f32,
             boundary_data,
         };
-        build(py, source, mask, density, &options, bgr)
+        build(py, source, mask, density, &options, bgr, threads)
     }
 
     /// Clones the patch onto `target` (any uint8/uint16 grey, RGB or RGBA array) with its
@@ -182,12 +186,13 @@ fn build(
     density: f64,
     options: &CloneOptions,
     bgr: bool,
+    threads: Option<usize>,
 ) -> PyResult<Cloner> {
     let mesh_options = mesh_options(density)?;
     let source = arrays::read_picture(source, "source", bgr)?;
     let mask = arrays::read_mask(mask, "mask")?;
     let source_layout = source.layout;
-    let patch = Patch::new(py, source, mask, &mesh_options, options)?;
+    let patch = Patch::new(py, source, mask, &mesh_options, options, threads)?;
     Ok(Cloner {
         patch,
         bgr,
@@ -331,6 +336,7 @@ pub fn seamless_clone<'py>(
         MeshOptions::default().density,
         &options,
         true,
+        None,
     )?;
     let placement = Placement::centred_on_pixel(cloner.patch.bbox_min, cloner.patch.bbox_max, p);
     let pose = Pose {

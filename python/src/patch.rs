@@ -60,6 +60,7 @@ impl Patch {
         mask: Picture,
         mesh_options: &MeshOptions,
         options: &CloneOptions,
+        threads: Option<usize>,
     ) -> PyResult<Patch> {
         let (state, patch) = py.allow_threads(|| -> PyResult<_> {
             let bits = BitMask::from_image(&mask.image, MASK_THRESHOLD);
@@ -70,7 +71,7 @@ impl Patch {
             let bbox = (patch.bbox_min, patch.bbox_max, patch.default_drag_radius());
             let triangles = patch.result.mesh.triangles.len();
             let mut cloner = PatchCloner::new(source, patch.result.mesh, options).map_err(to_py)?;
-            cloner.set_raster_threads(cores());
+            cloner.set_raster_threads(threads.unwrap_or_else(cores));
             let state = PatchState {
                 cloner,
                 laplacian: options.laplacian,
@@ -133,8 +134,8 @@ fn lock(mutex: &Mutex<PatchState>) -> MutexGuard<'_, PatchState> {
         .unwrap_or_else(|poisoned| poisoned.into_inner())
 }
 
-/// Threads a one-off clone shades on, as `lapclone clone` uses (the pixels are the same for
-/// any count).
+/// Threads a clone shades on unless told otherwise: every core, as `lapclone clone` uses (the
+/// pixels are the same for any count).
 fn cores() -> usize {
     std::thread::available_parallelism().map_or(1, |n| n.get())
 }

@@ -135,6 +135,18 @@ def test_grey_16bit_and_rgba_targets(cli, tmp_path):
         assert np.array_equal(got, want), target.dtype
 
 
+def test_sixteen_bit_and_grey_sources(cli, tmp_path):
+    rgb = textured_source(96, 96)
+    mask = spiral_mask(96, 96)
+    target = smooth_target(130, 110)
+    sixteen = rgb.astype(np.uint16) * 257 + 3
+    grey = rgb[:, :, 1].copy()
+    for source in [sixteen, grey]:
+        got = lapclone.Cloner(source, mask, mode="monochrome").clone(target, (60.5, 50))
+        want = cli_clone(cli, tmp_path, source, mask, target, ["--at", "60.5,50", "--mode", "monochrome"])
+        assert np.array_equal(got, want), source.dtype
+
+
 def test_bgr_non_contiguous_and_out(cli, tmp_path):
     src = load_asset("chelsea.png")
     mask = load_asset("masks/chelsea_face.png")

@@ -79,6 +79,13 @@ def test_bad_clone_arguments_raise_value_error(kw):
         cloner.clone(DST, **kw)
 
 
+def test_mask_of_another_size_raises_value_error():
+    with pytest.raises(ValueError, match="mask"):
+        lapclone.Cloner(SRC, MASK[:39])
+    with pytest.raises(ValueError):
+        lapclone.mesh(MASK[:, :0])
+
+
 def test_read_only_out_raises_value_error():
     out = np.zeros_like(DST)
     out.flags.writeable = False
