@@ -467,6 +467,45 @@ pub(crate) fn composite_over_straight(
 mod tests {
     use super::*;
 
+    /// `samples` are the samples its PNG decodes to (png crate), in every format and
+    /// depth; `samples_in` is their rectangle, clipped to the canvas.
+    #[test]
+    fn samples_are_what_the_png_decodes_to() {
+        let (w, h) = (23u32, 17u32);
+        let levels: Vec<[u8; 4]> = (0..w * h)
+            .map(|i| [(i * 7) as u8, (i * 13 + 5) as u8, (i * 3 + 1) as u8, (100 + i % 150) as u8])
+            .collect();
+        let eight = Canvas::from_rgba8(w, h, levels).unwrap();
+        let sixteen = Canvas::from_image(&eight.to_float_image(PixelFormat::RGBA16));
+        for canvas in [&eight, &sixteen] {
+            for color in [super::super::ColorKind::Grey, super::super::ColorKind::Rgb] {
+                for alpha in [false, true] {
+                    for depth in [Depth::Eight, Depth::Sixteen] {
+                        let format = PixelFormat { color, alpha, depth };
+                        let png = canvas.encode_png(format).unwrap();
+                        let mut reader = png::Decoder::new(std::io::Cursor::new(&png))
+                            .read_info()
+                            .unwrap();
+                        let mut decoded = vec![0; reader.output_buffer_size().unwrap()];
+                        reader.next_frame(&mut decoded).unwrap();
+                        let samples = canvas.samples(format);
+                        assert_eq!(samples, decoded, "{format:?}");
+                        let pixel = samples.len() / (w * h) as usize;
+                        let rect = canvas.samples_in(format, 5..40, 3..9);
+                        let expected: Vec<u8> = (3..9)
+                            .flat_map(|y| {
+                                let start = (y * w as usize + 5) * pixel;
+                                samples[start..start + (w as usize - 5) * pixel].to_vec()
+                            })
+                            .collect();
+                        assert_eq!(rect, expected, "{format:?}");
+                        assert!(canvas.samples_in(format, 30..40, 0..5).is_empty());
+                    }
+                }
+            }
+        }
+    }
+
     #[test]
     fn texel_round_trips_are_exact() {
         for v in 0..=255u8 {
