@@ -1,7 +1,7 @@
 //! The `lapclone._lapclone` extension module, which the `lapclone` Python package re-exports:
-//! numpy arrays in and out of lapclone's library. [`cloner`] has `seamless_clone` (a drop-in
-//! for `cv2.seamlessClone`), `Cloner` and `mesh`; [`scene`] has `Scene`; [`arrays`] converts
-//! arrays; [`errors`] maps lapclone's errors to Python exceptions.
+//! numpy arrays in and out of lapclone's library. `cloner` has `seamless_clone` (a drop-in
+//! for `cv2.seamlessClone`), `Cloner` and `mesh`; `scene` has `Scene`; `arrays` converts
+//! arrays; `errors` maps lapclone's errors to Python exceptions.
 
 #![forbid(unsafe_code)]
 
