@@ -80,10 +80,25 @@ pub use deform::{DeformError, DeformOptions, DeformRig, DeformStats, Deformed, H
 pub use mesh::{
     BitMask, BoundaryPlacement, Mesh, MeshError, MeshOptions, MeshResult, MeshStats, Polygon,
 };
-pub use pixels::{Canvas, ColorKind, Depth, FloatImage, FootageError, PixelError, PixelFormat};
+pub use pixels::{
+    Canvas, CanvasPixels, ColorKind, Depth, FloatImage, FootageError, PixelError, PixelFormat,
+};
 pub use render::{FrameStats, RenderError, Renderer};
 pub use script::{load_scene, LoadedScene, SceneError};
 pub use solve::LaplacianKind;
+
+/// Opens a scene file as `lapclone render` does: loads and runs it ([`load_scene`]),
+/// validates it (a canvas, patches whose masks and sources exist and fit, ...) and builds
+/// the [`Renderer`], which meshes and factors every patch. Every error is a [`SceneError`]
+/// positioned at the scene call it is about (the renderer's at the call that made the
+/// patch).
+pub fn open_scene(path: &std::path::Path) -> Result<(LoadedScene, Renderer), SceneError> {
+    let loaded = load_scene(path)?;
+    script::validate_scene(&loaded)?;
+    let renderer = Renderer::new(loaded.scene.clone())
+        .map_err(|e| loaded.error_at_patch(e.patch_name(), e.to_string()))?;
+    Ok((loaded, renderer))
+}
 
 /// Scenes: the animated description a [`Renderer`] draws, built in Rust or loaded from a
 /// `.rhai` file with [`load_scene`]. A [`Scene`](animation::Scene) is a

@@ -271,7 +271,7 @@ fn build_cloner(
         scale: args.scale,
         rotation_deg: args.rotate,
     };
-    let handles = handles_from(&args.drag, patch.bbox_min, patch.bbox_max);
+    let handles = handles_from(&args.drag, patch.default_drag_radius());
     let pins: Vec<Pin> = args.pin.iter().map(|&p| Pin(DVec2::from(p))).collect();
 
     let factor_started = Instant::now();
@@ -362,8 +362,7 @@ fn laplacian_kind(arg: LaplacianArg) -> LaplacianKind {
     }
 }
 
-fn handles_from(drags: &[DragArg], min: DVec2, max: DVec2) -> Vec<Handle> {
-    let default_radius = 0.25 * (max - min).max_element().max(1.0);
+fn handles_from(drags: &[DragArg], default_radius: f64) -> Vec<Handle> {
     drags
         .iter()
         .map(|d| Handle::drag(d.from, d.to, d.radius.unwrap_or(default_radius)))
@@ -470,11 +469,7 @@ fn load_target(path: &Path) -> anyhow::Result<(Canvas, PixelFormat)> {
     }
     let decoded = FloatImage::decode(path)?;
     let format = PixelFormat::of(&decoded);
-    let canvas = match Canvas::from_eight_bit(&decoded) {
-        Some(canvas) => canvas,
-        None => Canvas::from_image(&FloatImage::from_dynamic(&decoded)?),
-    };
-    Ok((canvas, format))
+    Ok((Canvas::from_dynamic(&decoded)?, format))
 }
 
 fn millis_since(start: Instant) -> f64 {

@@ -18,7 +18,7 @@ use lapclone::output::{
 };
 use lapclone::pixels::{Canvas, CanvasPixels, Depth};
 use lapclone::render::{RenderError, Renderer};
-use lapclone::script::{load_scene, validate_scene, ErrorKind, LoadedScene, SceneError};
+use lapclone::script::LoadedScene;
 
 use crate::cli::UsageError;
 
@@ -300,25 +300,11 @@ pub fn run_check(args: CheckArgs) -> anyhow::Result<()> {
 /// Parses, validates and builds the renderer (meshes and factors every patch); every error
 /// comes back positioned at the scene call it is about.
 fn load_renderer(scene: &Path) -> anyhow::Result<(LoadedScene, Renderer)> {
-    let loaded = load_scene(scene).map_err(|e| anyhow::anyhow!("{e}"))?;
-    validate_scene(&loaded).map_err(|e| anyhow::anyhow!("{e}"))?;
-    let renderer = Renderer::new(loaded.scene.clone()).map_err(|e| positioned(&loaded, e))?;
-    Ok((loaded, renderer))
+    lapclone::open_scene(scene).map_err(|e| anyhow::anyhow!("{e}"))
 }
 
 pub(crate) fn positioned(loaded: &LoadedScene, error: RenderError) -> anyhow::Error {
-    let index = error
-        .patch_name()
-        .and_then(|name| loaded.scene.patches.iter().position(|p| p.name == name));
-    let origin = index.and_then(|i| loaded.origins.patches.get(i));
-    let (file, position) = origin
-        .map(|o| (o.file.clone(), o.position))
-        .unwrap_or((loaded.file.clone(), rhai::Position::NONE));
-    let mut scene_error =
-        SceneError::new(ErrorKind::Validation, &file, position, error.to_string());
-    if file == loaded.file {
-        scene_error.load_source_line(Some(&loaded.text));
-    }
+    let scene_error = loaded.error_at_patch(error.patch_name(), error.to_string());
     anyhow::anyhow!("{scene_error}")
 }
 

@@ -21,6 +21,14 @@ pub struct PatchMesh {
     pub bbox_max: DVec2,
 }
 
+impl PatchMesh {
+    /// The radius of a drag given without one: a quarter of the bounding box's larger side
+    /// (at least a quarter pixel), so a drag moves a region in proportion to the patch.
+    pub fn default_drag_radius(&self) -> f64 {
+        0.25 * (self.bbox_max - self.bbox_min).max_element().max(1.0)
+    }
+}
+
 /// Meshes `mask`, whose pixel (0, 0) sits at `offset` in a source of `source_size`.
 /// Without an offset the mask must have the source's size. The boundary ends on the outside
 /// pixel centres: meshed there ([`BoundaryPlacement::OutsideCentres`]), or meshed on the

@@ -40,6 +40,15 @@ impl Placement {
         }
     }
 
+    /// OpenCV's `seamlessClone` placement of a patch whose mask's inside pixels span
+    /// `bbox_min`..`bbox_max` (pixel corners, whole numbers): the box's centre goes to the
+    /// target pixel `p` as OpenCV puts it, its top-left pixel landing on
+    /// `p − (⌊w / 2⌋, ⌊h / 2⌋)`. The patch moves by whole pixels, so it is never resampled.
+    pub fn centred_on_pixel(bbox_min: DVec2, bbox_max: DVec2, p: [i64; 2]) -> Self {
+        let half = ((bbox_max - bbox_min) / 2.0).floor();
+        Self::translate(bbox_min, DVec2::new(p[0] as f64, p[1] as f64) - half)
+    }
+
     /// The rest → target map.
     pub fn to_affine(&self) -> DAffine2 {
         DAffine2::from_translation(self.at)
@@ -96,6 +105,24 @@ fn on_placed_grid(p: DVec2) -> DVec2 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// OpenCV's placement: the box's top-left pixel lands on p − (⌊w/2⌋, ⌊h/2⌋), for even and
+    /// odd sides and negative targets, by a whole-pixel shift.
+    #[test]
+    fn centred_on_pixel_puts_the_top_left_pixel_where_opencv_does() {
+        for (min, max, p, top_left) in [
+            ((95.0, 40.0), (331.0, 261.0), [288, 143], (170.0, 33.0)),
+            ((10.0, 21.0), (101.0, 80.0), [150, 100], (105.0, 71.0)),
+            ((0.0, 0.0), (1.0, 1.0), [-7, 3], (-7.0, 3.0)),
+        ] {
+            let (min, max) = (DVec2::from(min), DVec2::from(max));
+            let placement = Placement::centred_on_pixel(min, max, p);
+            let mut placed = Vec::new();
+            placement.apply(&[min, max], &mut placed);
+            assert_eq!(placed[0], DVec2::from(top_left));
+            assert_eq!(placed[1] - placed[0], max - min);
+        }
+    }
 
     #[test]
     fn pivot_lands_on_target_position() {

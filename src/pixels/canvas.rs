@@ -3,9 +3,10 @@
 //! `u16` for 16-bit ones — with float reads, bilinear sampling, an allocation-free reset
 //! ([`Canvas::copy_from`]) and PNG output in any [`PixelFormat`].
 
+use std::ops::Range;
 use std::path::Path;
 
-use super::png_encode::write_png_rgba;
+use super::png_encode::{interleave, write_png_rgba};
 use super::PixelRect;
 use super::{sample_bilinear_rgba, Depth, FloatImage, PixelError, PixelFormat};
 
@@ -53,7 +54,9 @@ impl Texel for u16 {
 /// Canvas storage in the output bit depth (straight, non-premultiplied RGBA, row-major).
 #[derive(Clone, Debug, PartialEq)]
 pub enum CanvasPixels {
+    /// 8 bits per channel (an 8-bit target or background).
     Eight(Vec<[u8; 4]>),
+    /// 16 bits per channel.
     Sixteen(Vec<[u16; 4]>),
 }
 
@@ -268,6 +271,50 @@ impl Canvas {
         }
     }
 
+    /// The frame's channel samples as a PNG in `format` stores them, row-major and
+    /// interleaved (grey formats hold Rec. 709 luma; without alpha the alpha channel is
+    /// dropped, not composited; 16-bit samples big-endian): for callers that hand frames to
+    /// other software as arrays rather than files, with the values a saved PNG decodes to.
+    pub fn samples(&self, format: PixelFormat) -> Vec<u8> {
+        self.samples_in(format, 0..self.width, 0..self.height)
+    }
+
+    /// [`samples`](Self::samples) of the columns `x` and rows `y` only (clipped to the
+    /// canvas): the part of a frame a clone changed.
+    pub fn samples_in(&self, format: PixelFormat, x: Range<u32>, y: Range<u32>) -> Vec<u8> {
+        let sample_bytes = match format.depth {
+            Depth::Eight => 1,
+            Depth::Sixteen => 2,
+        };
+        let (x0, x1) = (x.start.min(self.width) as usize, x.end.min(self.width) as usize);
+        let (y0, y1) = (y.start.min(self.height), y.end.min(self.height));
+        let columns = x1.saturating_sub(x0);
+        let row_bytes = columns * format.channel_count() * sample_bytes;
+        let mut out = vec![0; row_bytes * y1.saturating_sub(y0) as usize];
+        if row_bytes == 0 {
+            return out;
+        }
+        let width = self.width as usize;
+        for (row, y) in out.chunks_exact_mut(row_bytes).zip(y0..y1) {
+            let start = y as usize * width + x0;
+            match &self.pixels {
+                CanvasPixels::Eight(p) => interleave(&p[start..start + columns], format, row),
+                CanvasPixels::Sixteen(p) => interleave(&p[start..start + columns], format, row),
+            }
+        }
+        out
+    }
+
+    /// A decoded image as a canvas in its own bit depth: 8-bit images straight from their
+    /// bytes ([`from_eight_bit`](Self::from_eight_bit)), others through their
+    /// [`FloatImage`] ([`from_image`](Self::from_image)).
+    pub fn from_dynamic(decoded: &image::DynamicImage) -> Result<Canvas, PixelError> {
+        match Canvas::from_eight_bit(decoded) {
+            Some(canvas) => Ok(canvas),
+            None => Ok(Canvas::from_image(&FloatImage::from_dynamic(decoded)?)),
+        }
+    }
+
     /// Writes a PNG in `format` atomically (temporary file, then rename), streamed into the
     /// file, on this thread.
     pub fn save_png(&self, path: &Path, format: PixelFormat) -> Result<(), PixelError> {
@@ -419,6 +466,45 @@ pub(crate) fn composite_over_straight(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `samples` are the samples its PNG decodes to (png crate), in every format and
+    /// depth; `samples_in` is their rectangle, clipped to the canvas.
+    #[test]
+    fn samples_are_what_the_png_decodes_to() {
+        let (w, h) = (23u32, 17u32);
+        let levels: Vec<[u8; 4]> = (0..w * h)
+            .map(|i| [(i * 7) as u8, (i * 13 + 5) as u8, (i * 3 + 1) as u8, (100 + i % 150) as u8])
+            .collect();
+        let eight = Canvas::from_rgba8(w, h, levels).unwrap();
+        let sixteen = Canvas::from_image(&eight.to_float_image(PixelFormat::RGBA16));
+        for canvas in [&eight, &sixteen] {
+            for color in [super::super::ColorKind::Grey, super::super::ColorKind::Rgb] {
+                for alpha in [false, true] {
+                    for depth in [Depth::Eight, Depth::Sixteen] {
+                        let format = PixelFormat { color, alpha, depth };
+                        let png = canvas.encode_png(format).unwrap();
+                        let mut reader = png::Decoder::new(std::io::Cursor::new(&png))
+                            .read_info()
+                            .unwrap();
+                        let mut decoded = vec![0; reader.output_buffer_size().unwrap()];
+                        reader.next_frame(&mut decoded).unwrap();
+                        let samples = canvas.samples(format);
+                        assert_eq!(samples, decoded, "{format:?}");
+                        let pixel = samples.len() / (w * h) as usize;
+                        let rect = canvas.samples_in(format, 5..40, 3..9);
+                        let expected: Vec<u8> = (3..9)
+                            .flat_map(|y| {
+                                let start = (y * w as usize + 5) * pixel;
+                                samples[start..start + (w as usize - 5) * pixel].to_vec()
+                            })
+                            .collect();
+                        assert_eq!(rect, expected, "{format:?}");
+                        assert!(canvas.samples_in(format, 30..40, 0..5).is_empty());
+                    }
+                }
+            }
+        }
+    }
 
     #[test]
     fn texel_round_trips_are_exact() {

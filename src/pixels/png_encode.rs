@@ -72,7 +72,7 @@ pub(crate) fn write_png_rgba<T: PngSample>(
 /// Writes the channel samples of `pixels` into `out` in PNG order and byte layout (16-bit
 /// big-endian). RGB samples in the texels' own depth are copied as they are (quantising a
 /// texel's value gives the texel back); grey and other depths go through [0, 1].
-fn interleave<T: PngSample>(pixels: &[[T; 4]], format: PixelFormat, out: &mut [u8]) {
+pub(crate) fn interleave<T: PngSample>(pixels: &[[T; 4]], format: PixelFormat, out: &mut [u8]) {
     let channels = if format.color == ColorKind::Grey { 1 } else { 3 } + usize::from(format.alpha);
     if format.color == ColorKind::Rgb && format.depth == T::DEPTH {
         for (px, bytes) in pixels.iter().zip(out.chunks_exact_mut(channels * T::BYTES)) {

@@ -75,6 +75,24 @@ pub struct LoadedScene {
     pub text: String,
 }
 
+impl LoadedScene {
+    /// A validation error about the patch named `patch` (the patch a renderer's error
+    /// names), positioned at the call that made that patch; at the scene file without a
+    /// position when no patch is named or known.
+    pub fn error_at_patch(&self, patch: Option<&str>, message: impl Into<String>) -> SceneError {
+        let index = patch.and_then(|name| self.scene.patches.iter().position(|p| p.name == name));
+        let origin = index.and_then(|i| self.origins.patches.get(i));
+        let (file, position) = origin
+            .map(|o| (o.file.clone(), o.position))
+            .unwrap_or((self.file.clone(), rhai::Position::NONE));
+        let mut error = SceneError::new(ErrorKind::Validation, &file, position, message);
+        if file == self.file {
+            error.load_source_line(Some(&self.text));
+        }
+        error
+    }
+}
+
 impl SceneEngine {
     pub fn new(options: &ScriptOptions) -> Self {
         let resolver = SandboxResolver::new(&options.scene_dir, options.scripts_dir.as_deref());

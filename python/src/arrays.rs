@@ -1,0 +1,504 @@
+//! numpy arrays in and out: takes an H×W or H×W×C (C = 1, 3, 4) `uint8`/`uint16` array,
+//! contiguous or not, in RGB or BGR order, and gives the `image::DynamicImage` lapclone reads
+//! (the same one a PNG of those pixels decodes to); takes a canvas's samples and gives an
+//! array of the input's dtype, shape and channel order back. Anything else is a `ValueError`
+//! (`TypeError` for what is not an array), never a crash.
+
+use lapclone::image::{DynamicImage, ImageBuffer, Luma, Rgb, Rgba};
+use lapclone::{Canvas, ColorKind, Depth, PixelFormat};
+use numpy::ndarray::{ArrayViewD, ArrayViewMut3, Axis, Ix3};
+use numpy::{
+    Element, PyArray2, PyArrayDescrMethods, PyArrayDyn, PyArrayMethods, PyUntypedArray,
+    PyUntypedArrayMethods,
+};
+use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::prelude::*;
+
+/// The sample type of an array.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Dtype {
+    U8,
+    U16,
+}
+
+/// An input array's layout, given back to outputs: rows, columns, channels (`None` for a
+/// 2-D grey array) and sample type.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Layout {
+    pub height: usize,
+    pub width: usize,
+    pub channels: Option<usize>,
+    pub dtype: Dtype,
+}
+
+impl Layout {
+    /// Channels per pixel (1 for a 2-D array).
+    pub fn channel_count(&self) -> usize {
+        self.channels.unwrap_or(1)
+    }
+
+    /// The PNG format an image of this layout has: what outputs are written in.
+    pub fn format(&self) -> PixelFormat {
+        let c = self.channel_count();
+        PixelFormat {
+            color: if c >= 3 {
+                ColorKind::Rgb
+            } else {
+                ColorKind::Grey
+            },
+            alpha: c == 4,
+            depth: match self.dtype {
+                Dtype::U8 => Depth::Eight,
+                Dtype::U16 => Depth::Sixteen,
+            },
+        }
+    }
+
+    fn shape_text(&self) -> String {
+        match self.channels {
+            None => format!("{}×{}", self.height, self.width),
+            Some(c) => format!("{}×{}×{c}", self.height, self.width),
+        }
+    }
+}
+
+/// An input image: the decoded image lapclone reads and the layout it came in.
+pub struct Picture {
+    pub image: DynamicImage,
+    pub layout: Layout,
+}
+
+/// The array behind `object`, or a `TypeError` naming `what`.
+fn untyped<'py>(object: &Bound<'py, PyAny>, what: &str) -> PyResult<Bound<'py, PyUntypedArray>> {
+    object.downcast::<PyUntypedArray>().cloned().map_err(|_| {
+        let kind = object
+            .get_type()
+            .name()
+            .map(|n| n.to_string())
+            .unwrap_or_default();
+        PyTypeError::new_err(format!("{what} must be a numpy array, not {kind}"))
+    })
+}
+
+/// The layout of an image array: dtype uint8/uint16 (and bool when `allow_bool`), 2 or 3
+/// dimensions, 1, 3 or 4 channels, no empty side.
+pub fn layout_of(object: &Bound<'_, PyAny>, what: &str, allow_bool: bool) -> PyResult<Layout> {
+    let array = untyped(object, what)?;
+    let py = object.py();
+    let dtype = array.dtype();
+    let dtype = if dtype.is_equiv_to(&numpy::dtype::<u8>(py))
+        || (allow_bool && dtype.is_equiv_to(&numpy::dtype::<bool>(py)))
+    {
+        Dtype::U8
+    } else if dtype.is_equiv_to(&numpy::dtype::<u16>(py)) {
+        Dtype::U16
+    } else {
+        let allowed = if allow_bool {
+            "uint8, uint16 or bool"
+        } else {
+            "uint8 or uint16"
+        };
+        return Err(PyValueError::new_err(format!(
+            "{what} must have dtype {allowed}, not {dtype}"
+        )));
+    };
+    let shape = array.shape();
+    let (height, width, channels) = match *shape {
+        [h, w] => (h, w, None),
+        [h, w, c] if matches!(c, 1 | 3 | 4) => (h, w, Some(c)),
+        _ => {
+            return Err(PyValueError::new_err(format!(
+                "{what} must be H×W (grey) or H×W×C with C = 1, 3 or 4, not of shape {shape:?}"
+            )))
+        }
+    };
+    if height == 0 || width == 0 {
+        return Err(PyValueError::new_err(format!(
+            "{what} is empty ({height}×{width} pixels)"
+        )));
+    }
+    let too_large = u32::try_from(height).is_err() || u32::try_from(width).is_err();
+    if too_large {
+        return Err(PyValueError::new_err(format!(
+            "{what} is {height}×{width} pixels: larger than an image can be"
+        )));
+    }
+    Ok(Layout {
+        height,
+        width,
+        channels,
+        dtype,
+    })
+}
+
+/// The samples of an array of element type `T`, row-major and interleaved, in RGB order
+/// (BGR arrays' first and third channels swapped).
+fn samples<T: Element + Copy>(
+    object: &Bound<'_, PyAny>,
+    layout: &Layout,
+    bgr: bool,
+) -> PyResult<Vec<T>> {
+    let array = object.downcast::<PyArrayDyn<T>>()?;
+    let readonly = array
+        .try_readonly()
+        .map_err(|e| PyValueError::new_err(format!("the array cannot be read now: {e}")))?;
+    let view: ArrayViewD<'_, T> = readonly.as_array();
+    let mut out: Vec<T> = match view.as_slice() {
+        Some(slice) => slice.to_vec(),
+        None => view.iter().copied().collect(),
+    };
+    if bgr && layout.channel_count() >= 3 {
+        for pixel in out.chunks_exact_mut(layout.channel_count()) {
+            pixel.swap(0, 2);
+        }
+    }
+    Ok(out)
+}
+
+/// Reads an image array (see [`layout_of`]) as the decoded image a PNG of it gives.
+pub fn read_picture(object: &Bound<'_, PyAny>, what: &str, bgr: bool) -> PyResult<Picture> {
+    read_with(object, what, bgr, false)
+}
+
+/// Reads a mask: as [`read_picture`], bool arrays too (`True` = 255).
+pub fn read_mask(object: &Bound<'_, PyAny>, what: &str) -> PyResult<Picture> {
+    read_with(object, what, true, true)
+}
+
+fn read_with(
+    object: &Bound<'_, PyAny>,
+    what: &str,
+    bgr: bool,
+    allow_bool: bool,
+) -> PyResult<Picture> {
+    let layout = layout_of(object, what, allow_bool)?;
+    let py = object.py();
+    let (w, h) = (layout.width as u32, layout.height as u32);
+    let untyped = untyped(object, what)?;
+    let image = if untyped.dtype().is_equiv_to(&numpy::dtype::<bool>(py)) {
+        let bits: Vec<bool> = samples(object, &layout, false)?;
+        let bytes = bits.iter().map(|&b| if b { 255 } else { 0 }).collect();
+        eight_bit(w, h, layout.channel_count(), bytes)
+    } else if layout.dtype == Dtype::U8 {
+        eight_bit(w, h, layout.channel_count(), samples(object, &layout, bgr)?)
+    } else {
+        sixteen_bit(w, h, layout.channel_count(), samples(object, &layout, bgr)?)
+    };
+    let image = image.ok_or_else(|| PyValueError::new_err(format!("{what}: bad buffer size")))?;
+    Ok(Picture { image, layout })
+}
+
+fn eight_bit(w: u32, h: u32, channels: usize, bytes: Vec<u8>) -> Option<DynamicImage> {
+    Some(match channels {
+        1 => DynamicImage::ImageLuma8(ImageBuffer::<Luma<u8>, _>::from_raw(w, h, bytes)?),
+        3 => DynamicImage::ImageRgb8(ImageBuffer::<Rgb<u8>, _>::from_raw(w, h, bytes)?),
+        _ => DynamicImage::ImageRgba8(ImageBuffer::<Rgba<u8>, _>::from_raw(w, h, bytes)?),
+    })
+}
+
+fn sixteen_bit(w: u32, h: u32, channels: usize, words: Vec<u16>) -> Option<DynamicImage> {
+    Some(match channels {
+        1 => DynamicImage::ImageLuma16(ImageBuffer::<Luma<u16>, _>::from_raw(w, h, words)?),
+        3 => DynamicImage::ImageRgb16(ImageBuffer::<Rgb<u16>, _>::from_raw(w, h, words)?),
+        _ => DynamicImage::ImageRgba16(ImageBuffer::<Rgba<u16>, _>::from_raw(w, h, words)?),
+    })
+}
+
+/// The rectangle of pixels `x0..x1` × `y0..y1` a clone read or changed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Rect {
+    pub x0: u32,
+    pub y0: u32,
+    pub x1: u32,
+    pub y1: u32,
+}
+
+/// Copies the pixels of `rect` from a target array into `canvas` (same size and depth), as
+/// [`Canvas::from_dynamic`] would make them: grey spread to R = G = B, a missing alpha
+/// opaque, BGR reordered.
+pub fn load_rect(
+    object: &Bound<'_, PyAny>,
+    layout: &Layout,
+    bgr: bool,
+    canvas: &mut Canvas,
+    rect: Rect,
+) -> PyResult<()> {
+    match layout.dtype {
+        Dtype::U8 => load_rect_typed::<u8>(object, layout, bgr, canvas, rect, u8::MAX),
+        Dtype::U16 => load_rect_typed::<u16>(object, layout, bgr, canvas, rect, u16::MAX),
+    }
+}
+
+fn load_rect_typed<T: Element + Copy + CanvasTexel>(
+    object: &Bound<'_, PyAny>,
+    layout: &Layout,
+    bgr: bool,
+    canvas: &mut Canvas,
+    rect: Rect,
+    opaque: T,
+) -> PyResult<()> {
+    let array = object.downcast::<PyArrayDyn<T>>()?;
+    let readonly = array
+        .try_readonly()
+        .map_err(|e| PyValueError::new_err(format!("the target cannot be read now: {e}")))?;
+    let view = readonly.as_array();
+    let view = match view.ndim() {
+        2 => view.insert_axis(Axis(2)),
+        _ => view,
+    };
+    let view = view
+        .into_dimensionality::<Ix3>()
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let width = layout.width;
+    let pixels = T::texels_mut(canvas).ok_or_else(|| {
+        PyValueError::new_err("the target's depth changed between frames".to_string())
+    })?;
+    let channels = layout.channel_count();
+    let (red, blue) = if bgr && channels >= 3 { (2, 0) } else { (0, 2) };
+    let texel = |px: &[T]| match channels {
+        1 => [px[0], px[0], px[0], opaque],
+        3 => [px[red], px[1], px[blue], opaque],
+        _ => [px[red], px[1], px[blue], px[3]],
+    };
+    let (x0, x1) = (rect.x0 as usize, rect.x1 as usize);
+    for y in rect.y0 as usize..rect.y1 as usize {
+        let row = view.index_axis(Axis(0), y);
+        let out = &mut pixels[y * width + x0..y * width + x1];
+        match row.as_slice() {
+            // A contiguous row (the usual case): its samples in place.
+            Some(samples) => {
+                let samples = samples[x0 * channels..x1 * channels].chunks_exact(channels);
+                for (t, px) in out.iter_mut().zip(samples) {
+                    *t = texel(px);
+                }
+            }
+            None => {
+                for (t, x) in out.iter_mut().zip(x0..) {
+                    let mut px = [opaque; 4];
+                    for (k, &v) in row.index_axis(Axis(0), x).iter().enumerate() {
+                        px[k] = v;
+                    }
+                    *t = texel(&px);
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Canvas storage of one sample type.
+pub trait CanvasTexel: Sized {
+    fn texels_mut(canvas: &mut Canvas) -> Option<&mut Vec<[Self; 4]>>;
+}
+
+impl CanvasTexel for u8 {
+    fn texels_mut(canvas: &mut Canvas) -> Option<&mut Vec<[u8; 4]>> {
+        match canvas.pixels_mut() {
+            lapclone::CanvasPixels::Eight(p) => Some(p),
+            _ => None,
+        }
+    }
+}
+
+impl CanvasTexel for u16 {
+    fn texels_mut(canvas: &mut Canvas) -> Option<&mut Vec<[u16; 4]>> {
+        match canvas.pixels_mut() {
+            lapclone::CanvasPixels::Sixteen(p) => Some(p),
+            _ => None,
+        }
+    }
+}
+
+/// Samples in `layout`'s format (8-bit, or 16-bit big-endian as [`Canvas::samples`] gives
+/// them) as an array of its dtype, shape and channel order.
+pub fn new_array<'py>(
+    py: Python<'py>,
+    samples: Vec<u8>,
+    layout: &Layout,
+    bgr: bool,
+) -> PyResult<Bound<'py, PyAny>> {
+    let (h, w, c) = (layout.height, layout.width, layout.channel_count());
+    match layout.dtype {
+        Dtype::U8 => shaped(py, reorder(samples, c, bgr), h, w, layout.channels),
+        Dtype::U16 => shaped(py, reorder(words(&samples), c, bgr), h, w, layout.channels),
+    }
+}
+
+fn words(samples: &[u8]) -> Vec<u16> {
+    samples
+        .chunks_exact(2)
+        .map(|b| u16::from_be_bytes([b[0], b[1]]))
+        .collect()
+}
+
+fn reorder<T>(mut samples: Vec<T>, channels: usize, bgr: bool) -> Vec<T> {
+    if bgr && channels >= 3 {
+        for pixel in samples.chunks_exact_mut(channels) {
+            pixel.swap(0, 2);
+        }
+    }
+    samples
+}
+
+fn shaped<'py, T: Element>(
+    py: Python<'py>,
+    data: Vec<T>,
+    h: usize,
+    w: usize,
+    channels: Option<usize>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let flat = numpy::PyArray1::from_vec(py, data);
+    Ok(match channels {
+        None => flat.reshape([h, w])?.into_any(),
+        Some(c) => flat.reshape([h, w, c])?.into_any(),
+    })
+}
+
+/// Writes samples of the `rect` part of an image in `layout` (as [`Canvas::samples_in`]
+/// gives them) into the same part of `array`, which has that layout.
+pub fn write_rect(
+    array: &Bound<'_, PyAny>,
+    layout: &Layout,
+    bgr: bool,
+    samples: &[u8],
+    rect: Rect,
+) -> PyResult<()> {
+    match layout.dtype {
+        Dtype::U8 => write_rect_typed(array, layout, bgr, samples, rect),
+        Dtype::U16 => write_rect_typed(array, layout, bgr, &words(samples), rect),
+    }
+}
+
+fn write_rect_typed<T: Element + Copy>(
+    array: &Bound<'_, PyAny>,
+    layout: &Layout,
+    bgr: bool,
+    samples: &[T],
+    rect: Rect,
+) -> PyResult<()> {
+    let array = array.downcast::<PyArrayDyn<T>>()?;
+    let mut writable = array
+        .try_readwrite()
+        .map_err(|e| PyValueError::new_err(format!("out cannot be written: {e}")))?;
+    let view = writable.as_array_mut();
+    let view = match view.ndim() {
+        2 => view.insert_axis(Axis(2)),
+        _ => view,
+    };
+    let mut view: ArrayViewMut3<'_, T> = view
+        .into_dimensionality::<Ix3>()
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let c = layout.channel_count();
+    let columns = (rect.x1 - rect.x0) as usize;
+    if columns == 0 {
+        return Ok(());
+    }
+    let (red, blue) = if bgr && c >= 3 { (2, 0) } else { (0, 2) };
+    let channel = |k: usize| match k {
+        0 => red,
+        2 => blue,
+        other => other,
+    };
+    let x0 = rect.x0 as usize;
+    for (row, y) in samples.chunks_exact(columns * c).zip(rect.y0..rect.y1) {
+        let mut out = view.index_axis_mut(Axis(0), y as usize);
+        match out.as_slice_mut() {
+            // A contiguous row (the usual case): written in place.
+            Some(dst) => {
+                let dst = dst[x0 * c..(x0 + columns) * c].chunks_exact_mut(c);
+                for (d, pixel) in dst.zip(row.chunks_exact(c)) {
+                    for (k, &value) in pixel.iter().enumerate() {
+                        d[channel(k)] = value;
+                    }
+                }
+            }
+            None => {
+                for (pixel, x) in row.chunks_exact(c).zip(x0..) {
+                    let mut d = out.index_axis_mut(Axis(0), x);
+                    for (k, &value) in pixel.iter().enumerate() {
+                        d[channel(k)] = value;
+                    }
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Checks that `out` is a writable array of exactly `layout`.
+pub fn check_out(out: &Bound<'_, PyAny>, layout: &Layout) -> PyResult<()> {
+    let out_layout = layout_of(out, "out", false)?;
+    if out_layout != *layout {
+        return Err(PyValueError::new_err(format!(
+            "out must be a {} {:?} array like the target, not {} {:?}",
+            layout.shape_text(),
+            layout.dtype,
+            out_layout.shape_text(),
+            out_layout.dtype
+        )));
+    }
+    Ok(())
+}
+
+/// Copies a whole array of `layout` into `out` (same layout), for a clone written into
+/// `out` rather than a new array.
+pub fn copy_into(
+    source: &Bound<'_, PyAny>,
+    out: &Bound<'_, PyAny>,
+    layout: &Layout,
+) -> PyResult<()> {
+    if source.is(out) {
+        return Ok(());
+    }
+    match layout.dtype {
+        Dtype::U8 => copy_typed::<u8>(source, out),
+        Dtype::U16 => copy_typed::<u16>(source, out),
+    }
+}
+
+fn copy_typed<T: Element + Copy>(
+    source: &Bound<'_, PyAny>,
+    out: &Bound<'_, PyAny>,
+) -> PyResult<()> {
+    let source = source.downcast::<PyArrayDyn<T>>()?;
+    let out = out.downcast::<PyArrayDyn<T>>()?;
+    let unwritable = |e| PyValueError::new_err(format!("out cannot be written: {e}"));
+    let copy = {
+        let readonly = source
+            .try_readonly()
+            .map_err(|e| PyValueError::new_err(format!("the target cannot be read now: {e}")))?;
+        match out.try_readwrite() {
+            Ok(mut writable) => {
+                let (from, mut to) = (readonly.as_array(), writable.as_array_mut());
+                match (from.as_slice(), to.as_slice_mut()) {
+                    (Some(from), Some(to)) => to.copy_from_slice(from),
+                    _ => to.assign(&from),
+                }
+                return Ok(());
+            }
+            // `out` shares memory with the target under another view: through a buffer.
+            Err(_) => readonly.as_array().to_owned(),
+        }
+    };
+    out.try_readwrite()
+        .map_err(unwritable)?
+        .as_array_mut()
+        .assign(&copy);
+    Ok(())
+}
+
+/// A mesh's vertices (N×2 float64) and triangles (M×3 uint32).
+pub type MeshArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<u32>>);
+
+/// An N×2 float64 and an M×3 uint32 array: a mesh's vertices and triangles.
+pub fn mesh_arrays<'py>(
+    py: Python<'py>,
+    vertices: &[[f64; 2]],
+    triangles: &[[u32; 3]],
+) -> PyResult<MeshArrays<'py>> {
+    let v: Vec<f64> = vertices.iter().flatten().copied().collect();
+    let t: Vec<u32> = triangles.iter().flatten().copied().collect();
+    let v = numpy::PyArray1::from_vec(py, v).reshape([vertices.len(), 2])?;
+    let t = numpy::PyArray1::from_vec(py, t).reshape([triangles.len(), 3])?;
+    Ok((v, t))
+}

@@ -1,0 +1,231 @@
+//! One patch, meshed and factored once: takes a source and a mask array, and for each clone a
+//! target array, a placement and optional drags and pins; gives the composited array. The
+//! target is read and the result written only over the pixels the clone can touch (the
+//! placed patch's bounding box and a margin), so a frame costs its patch, not its size; the
+//! mesh, factor and solve run with the GIL released.
+
+use std::sync::{Mutex, MutexGuard};
+
+use lapclone::glam::DVec2;
+use lapclone::{
+    mesh_from_mask, BitMask, Canvas, CloneOptions, DeformRig, Deformed, Handle, MeshOptions,
+    PatchCloner, PatchMesh, Pin, Placement,
+};
+use pyo3::prelude::*;
+
+use crate::arrays::{self, Layout, Picture, Rect};
+use crate::errors::to_py;
+
+/// The mask threshold of `lapclone clone` (`--threshold` default): inside where the mask's
+/// luma (or alpha, if it has one) is at least half scale.
+pub const MASK_THRESHOLD: f32 = 0.5;
+
+/// How a clone is placed and deformed (source coordinates for drags and pins).
+pub struct Pose {
+    pub placement: Placement,
+    pub handles: Vec<Handle>,
+    pub pins: Vec<Pin>,
+}
+
+/// What stays between clones: the cloner (mesh and factor), the deformation rig once a
+/// drag or pin asks for it, and the canvas frames are composited on.
+pub struct PatchState {
+    cloner: PatchCloner,
+    laplacian: lapclone::LaplacianKind,
+    rig: Option<DeformRig>,
+    deformed: Deformed,
+    /// Whether the prepared clone is deformed (and so depth-ordered).
+    deformed_now: bool,
+    canvas: Option<Canvas>,
+}
+
+/// A patch behind a lock: clones of one patch from several Python threads take turns, and
+/// the lock is only ever waited for with the GIL released.
+pub struct Patch {
+    state: Mutex<PatchState>,
+    /// The patch mesh's bounding box of inside mask pixels and its default drag radius.
+    pub bbox_min: DVec2,
+    pub bbox_max: DVec2,
+    pub drag_radius: f64,
+    pub vertex_count: usize,
+    pub triangle_count: usize,
+}
+
+impl Patch {
+    /// Meshes the mask and factors the patch's Laplacian (GIL released), as `lapclone clone`
+    /// does for the same images and options.
+    pub fn new(
+        py: Python<'_>,
+        source: Picture,
+        mask: Picture,
+        mesh_options: &MeshOptions,
+        options: &CloneOptions,
+        threads: Option<usize>,
+    ) -> PyResult<Patch> {
+        let (state, patch) = py.allow_threads(|| -> PyResult<_> {
+            let bits = BitMask::from_image(&mask.image, MASK_THRESHOLD);
+            let size = (source.image.width(), source.image.height());
+            let patch: PatchMesh =
+                mesh_from_mask(&bits, None, size, mesh_options).map_err(to_py)?;
+            let source = lapclone::FloatImage::from_dynamic(&source.image).map_err(to_py)?;
+            let bbox = (patch.bbox_min, patch.bbox_max, patch.default_drag_radius());
+            let triangles = patch.result.mesh.triangles.len();
+            let mut cloner = PatchCloner::new(source, patch.result.mesh, options).map_err(to_py)?;
+            cloner.set_raster_threads(threads.unwrap_or_else(cores));
+            let state = PatchState {
+                cloner,
+                laplacian: options.laplacian,
+                rig: None,
+                deformed: Deformed::default(),
+                deformed_now: false,
+                canvas: None,
+            };
+            Ok((state, (bbox, triangles)))
+        })?;
+        let ((bbox_min, bbox_max, drag_radius), triangle_count) = patch;
+        let vertex_count = state.cloner.mesh().vertex_count();
+        Ok(Patch {
+            state: Mutex::new(state),
+            bbox_min,
+            bbox_max,
+            drag_radius,
+            vertex_count,
+            triangle_count,
+        })
+    }
+
+    /// Clones onto `target` (an image array of `layout`): into `out` when given (after
+    /// copying the target there), else into a new array. Returns the result array.
+    pub fn clone_onto<'py>(
+        &self,
+        target: &Bound<'py, PyAny>,
+        layout: &Layout,
+        bgr: bool,
+        pose: &Pose,
+        out: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let py = target.py();
+        let shared: Py<PyAny> = target.clone().unbind();
+        let (rect, samples) = py.allow_threads(|| {
+            // Waited for without the GIL, so a thread holding the lock can always take it.
+            let mut state = lock(&self.state);
+            let rect = state.prepare(pose, layout)?;
+            Python::with_gil(|py| state.load_target(shared.bind(py), layout, bgr, rect))?;
+            let samples = state.draw(layout, rect)?;
+            Ok::<_, PyErr>((rect, samples))
+        })?;
+        let result = match out {
+            Some(out) => {
+                arrays::copy_into(target, out, layout)?;
+                out.clone()
+            }
+            None => target.call_method0("copy")?,
+        };
+        arrays::write_rect(&result, layout, bgr, &samples, rect)?;
+        Ok(result)
+    }
+}
+
+/// The state behind `mutex`, also after a panic on another thread (every clone starts by
+/// resetting what it uses, so a half-done one leaves nothing wrong behind).
+fn lock(mutex: &Mutex<PatchState>) -> MutexGuard<'_, PatchState> {
+    mutex
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner())
+}
+
+/// Threads a clone shades on unless told otherwise: every core, as `lapclone clone` uses (the
+/// pixels are the same for any count).
+fn cores() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
+}
+
+impl PatchState {
+    /// Places (and deforms) the patch and gives the target pixels the clone can read or
+    /// write: the placed vertices' bounding box grown by two pixels (the raster's
+    /// anti-aliasing band and the boundary's bilinear taps lie within one), clipped.
+    fn prepare(&mut self, pose: &Pose, layout: &Layout) -> PyResult<Rect> {
+        self.deformed_now = !(pose.handles.is_empty() && pose.pins.is_empty());
+        if !self.deformed_now {
+            self.cloner.prepare_rigid(&pose.placement).map_err(to_py)?;
+        } else {
+            if self.rig.is_none() {
+                let rig = DeformRig::new(self.cloner.mesh(), self.laplacian).map_err(to_py)?;
+                self.rig = Some(rig);
+            }
+            let rig = self.rig.as_mut().expect("built just above"); // invariant: set above
+            rig.deform(&pose.handles, &pose.pins, &mut self.deformed)
+                .map_err(to_py)?;
+            let d = &self.deformed;
+            self.cloner
+                .prepare_deformed(&pose.placement, &d.positions, Some(&d.depth))
+                .map_err(to_py)?;
+        }
+        Ok(touched_rect(self.cloner.placed(), layout))
+    }
+
+    /// Copies the target's `rect` into the canvas (a new canvas of the target's size and
+    /// depth when the last one differs).
+    fn load_target(
+        &mut self,
+        target: &Bound<'_, PyAny>,
+        layout: &Layout,
+        bgr: bool,
+        rect: Rect,
+    ) -> PyResult<()> {
+        let depth = layout.format().depth;
+        let fits = self.canvas.as_ref().is_some_and(|c| {
+            (c.width() as usize, c.height() as usize, c.depth())
+                == (layout.width, layout.height, depth)
+        });
+        if !fits {
+            let canvas = Canvas::new(layout.width as u32, layout.height as u32, depth);
+            self.canvas = Some(canvas.map_err(to_py)?);
+        }
+        let canvas = self.canvas.as_mut().expect("made just above"); // invariant: set above
+        arrays::load_rect(target, layout, bgr, canvas, rect)
+    }
+
+    /// The membrane solve and the raster on the canvas, and the samples of `rect` in the
+    /// target's format.
+    fn draw(&mut self, layout: &Layout, rect: Rect) -> PyResult<Vec<u8>> {
+        let canvas = self.canvas.as_mut().expect("loaded before drawing"); // invariant: load_target ran
+        let depth = self.deformed_now.then_some(&self.deformed.depth[..]);
+        self.cloner.clone_prepared(canvas, depth).map_err(to_py)?;
+        Ok(canvas.samples_in(layout.format(), rect.x0..rect.x1, rect.y0..rect.y1))
+    }
+}
+
+fn touched_rect(placed: &[DVec2], layout: &Layout) -> Rect {
+    let mut min = DVec2::splat(f64::INFINITY);
+    let mut max = DVec2::splat(f64::NEG_INFINITY);
+    for &p in placed {
+        min = min.min(p);
+        max = max.max(p);
+    }
+    let (w, h) = (layout.width as f64, layout.height as f64);
+    if !(min.x <= max.x && min.y <= max.y) {
+        return Rect {
+            x0: 0,
+            y0: 0,
+            x1: 0,
+            y1: 0,
+        };
+    }
+    let clip = |v: f64, limit: f64| v.clamp(0.0, limit) as u32;
+    let rect = Rect {
+        x0: clip(min.x.floor() - 2.0, w),
+        y0: clip(min.y.floor() - 2.0, h),
+        x1: clip(max.x.ceil() + 2.0, w),
+        y1: clip(max.y.ceil() + 2.0, h),
+    };
+    if rect.x0 >= rect.x1 || rect.y0 >= rect.y1 {
+        return Rect {
+            x0: 0,
+            y0: 0,
+            x1: 0,
+            y1: 0,
+        };
+    }
+    rect
+}

@@ -1,0 +1,160 @@
+//! `lapclone.Scene`: takes a `.rhai` scene file, opens it as `lapclone render` does (errors
+//! become `lapclone.SceneError` with the file, line and column, or `FileNotFoundError`) and
+//! gives its frames as arrays: H×W×4 RGBA (or BGRA), `uint8`, or `uint16` for a 16-bit
+//! canvas, the samples `lapclone render` writes to its PNG frames.
+
+use std::path::PathBuf;
+use std::sync::Mutex;
+
+use lapclone::{Depth, Renderer};
+use pyo3::exceptions::{PyFileNotFoundError, PyIndexError};
+use pyo3::prelude::*;
+
+use crate::arrays::{self, Dtype, Layout};
+use crate::errors::{scene_error, to_py};
+
+/// Scene(path, *, bgr=False)
+///
+/// A `.rhai` scene file, opened as `lapclone render` opens it: `len()`, `.fps`, `.size`,
+/// `.frame(i)` (an H×W×4 RGBA array, BGRA with `bgr=True`), indexing and iteration.
+/// FileNotFoundError for a missing file, lapclone.SceneError (file, line, column) for an
+/// error in it.
+#[pyclass(module = "lapclone", frozen)]
+pub struct Scene {
+    renderer: Mutex<Renderer>,
+    path: PathBuf,
+    frames: u64,
+    fps: f64,
+    width: u32,
+    height: u32,
+    bgr: bool,
+}
+
+#[pymethods]
+impl Scene {
+    #[new]
+    #[pyo3(signature = (path, *, bgr=false))]
+    fn new(py: Python<'_>, path: PathBuf, bgr: bool) -> PyResult<Self> {
+        if !path.is_file() {
+            return Err(PyFileNotFoundError::new_err((
+                2,
+                format!("no scene file {}", path.display()),
+                path.display().to_string(),
+            )));
+        }
+        let opened = py.allow_threads(|| lapclone::open_scene(&path));
+        let (loaded, renderer) = match opened {
+            Ok(opened) => opened,
+            Err(error) => return Err(scene_error(py, &error)?),
+        };
+        let canvas = &loaded.scene.canvas;
+        Ok(Scene {
+            frames: renderer.frame_count(),
+            fps: canvas.fps,
+            width: canvas.width,
+            height: canvas.height,
+            renderer: Mutex::new(renderer),
+            path,
+            bgr,
+        })
+    }
+
+    /// Number of frames: ⌈duration · fps⌉.
+    fn __len__(&self) -> usize {
+        self.frames as usize
+    }
+
+    /// Frames per second.
+    #[getter]
+    fn fps(&self) -> f64 {
+        self.fps
+    }
+
+    /// (width, height) in pixels.
+    #[getter]
+    fn size(&self) -> (u32, u32) {
+        (self.width, self.height)
+    }
+
+    /// The scene file.
+    #[getter]
+    fn path(&self) -> String {
+        self.path.display().to_string()
+    }
+
+    /// Frame `index` (from 0; negative counts from the end) as an H×W×4 array.
+    fn frame<'py>(&self, py: Python<'py>, index: i64) -> PyResult<Bound<'py, PyAny>> {
+        let frames = self.frames as i64;
+        let i = if index < 0 { index + frames } else { index };
+        if !(0..frames).contains(&i) {
+            return Err(PyIndexError::new_err(format!(
+                "frame {index} is out of range: the scene has {frames} frames"
+            )));
+        }
+        let (samples, depth) = py.allow_threads(|| {
+            let mut renderer = self
+                .renderer
+                .lock()
+                .unwrap_or_else(|poisoned| poisoned.into_inner());
+            let format = renderer.output_format();
+            let canvas = renderer.render_frame(i as u64).map_err(to_py)?;
+            Ok::<_, PyErr>((canvas.samples(format), canvas.depth()))
+        })?;
+        let layout = Layout {
+            height: self.height as usize,
+            width: self.width as usize,
+            channels: Some(4),
+            dtype: match depth {
+                Depth::Eight => Dtype::U8,
+                Depth::Sixteen => Dtype::U16,
+            },
+        };
+        arrays::new_array(py, samples, &layout, self.bgr)
+    }
+
+    fn __getitem__<'py>(&self, py: Python<'py>, index: i64) -> PyResult<Bound<'py, PyAny>> {
+        self.frame(py, index)
+    }
+
+    fn __iter__(slf: Py<Self>) -> SceneFrames {
+        SceneFrames {
+            scene: slf,
+            next: 0,
+        }
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "lapclone.Scene({:?}, frames={}, fps={}, size=({}, {}))",
+            self.path.display().to_string(),
+            self.frames,
+            self.fps,
+            self.width,
+            self.height
+        )
+    }
+}
+
+/// The frames of a scene, in order.
+#[pyclass(module = "lapclone")]
+pub struct SceneFrames {
+    scene: Py<Scene>,
+    next: u64,
+}
+
+#[pymethods]
+impl SceneFrames {
+    fn __iter__(slf: PyRef<'_, Self>) -> PyRef<'_, Self> {
+        slf
+    }
+
+    fn __next__<'py>(&mut self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        let scene = self.scene.get();
+        if self.next >= scene.frames {
+            return Ok(None);
+        }
+        let frame = scene.frame(py, self.next as i64)?;
+        self.next += 1;
+        Ok(Some(frame))
+    }
+}

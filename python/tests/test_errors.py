@@ -1,0 +1,173 @@
+"""Bad input raises the stated exception and never crashes the interpreter: wrong dtypes,
+shapes, empty and mismatched arrays, non-finite placements, MIXED_CLONE, bad options, scene
+files that are missing or wrong (lapclone.SceneError with file, line and column), and 1,000
+random fixed-seed cases run in a child interpreter so a crash would show."""
+
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+
+import lapclone
+from conftest import ROOT
+
+SRC = np.full((40, 50, 3), 120, np.uint8)
+DST = np.full((60, 70, 3), 30, np.uint8)
+MASK = np.zeros((40, 50), np.uint8)
+MASK[10:30, 10:40] = 255
+
+
+@pytest.mark.parametrize(
+    "src, dst, mask",
+    [
+        (SRC.astype(np.float32), DST, MASK),  # wrong dtype
+        (SRC, DST.astype(np.int16), MASK),
+        (SRC, DST, MASK.astype(np.float64)),
+        (SRC[:0], DST, MASK[:0]),  # 0-sized
+        (SRC, DST[:, :0], MASK),
+        (SRC, DST, MASK[:39]),  # mask and src sizes differ
+        (SRC[:, :, :2], DST, MASK),  # two channels
+        (SRC[None], DST, MASK),  # four dimensions
+        (SRC, DST, np.zeros_like(MASK)),  # nothing inside the mask
+    ],
+)
+def test_bad_arrays_raise_value_error(src, dst, mask):
+    with pytest.raises(ValueError):
+        lapclone.seamless_clone(src, dst, mask, (35, 30))
+
+
+def test_not_an_array_raises_type_error():
+    with pytest.raises(TypeError):
+        lapclone.seamless_clone(SRC.tolist(), DST, MASK, (35, 30))
+
+
+@pytest.mark.parametrize("p", [(float("nan"), 3), (1.5, 2), (1, float("inf")), (1,), "ab"])
+def test_bad_p_raises_value_error(p):
+    with pytest.raises(ValueError):
+        lapclone.seamless_clone(SRC, DST, MASK, p)
+
+
+def test_mixed_clone_names_what_lapclone_offers():
+    with pytest.raises(ValueError, match="NORMAL_CLONE.*MONOCHROME_TRANSFER"):
+        lapclone.seamless_clone(SRC, DST, MASK, (35, 30), lapclone.MIXED_CLONE)
+    with pytest.raises(ValueError):
+        lapclone.seamless_clone(SRC, DST, MASK, (35, 30), 7)
+
+
+@pytest.mark.parametrize(
+    "kw",
+    [
+        dict(at=(float("nan"), 1)),
+        dict(at=(1, float("inf"))),
+        dict(at=(1, 2), scale=0.0),
+        dict(at=(1, 2), scale=float("nan")),
+        dict(at=(1, 2), rotate=float("inf")),
+        dict(at=(1, 2), drags=[((1, 2),)]),
+        dict(at=(1, 2), drags=[((1, 2), (3, float("nan")))]),
+        dict(at=(1, 2), drags=[((1, 2), (3, 4), -1.0)]),
+        dict(at=(1, 2), pins=[(float("nan"), 0)]),
+        dict(at=(1, 2), anchor="middle"),
+        dict(at=(1, 2), out=np.zeros((60, 70, 3), np.uint16)),
+        dict(at=(1, 2), out=np.zeros((61, 70, 3), np.uint8)),
+    ],
+)
+def test_bad_clone_arguments_raise_value_error(kw):
+    cloner = lapclone.Cloner(SRC, MASK)
+    with pytest.raises(ValueError):
+        cloner.clone(DST, **kw)
+
+
+def test_mask_of_another_size_raises_value_error():
+    with pytest.raises(ValueError, match="mask"):
+        lapclone.Cloner(SRC, MASK[:39])
+    with pytest.raises(ValueError):
+        lapclone.mesh(MASK[:, :0])
+
+
+def test_read_only_out_raises_value_error():
+    out = np.zeros_like(DST)
+    out.flags.writeable = False
+    with pytest.raises(ValueError):
+        lapclone.Cloner(SRC, MASK).clone(DST, (30, 30), out=out)
+
+
+@pytest.mark.parametrize(
+    "kw",
+    [dict(density=0.0), dict(density=float("nan")), dict(laplacian="x"), dict(mode="mixed"),
+     dict(feather=-1.0), dict(boundary_data="edge")],
+)
+def test_bad_options_raise_value_error(kw):
+    with pytest.raises(ValueError):
+        lapclone.Cloner(SRC, MASK, **kw)
+
+
+def test_missing_scene_is_file_not_found(tmp_path):
+    with pytest.raises(FileNotFoundError):
+        lapclone.Scene(tmp_path / "nope.rhai")
+
+
+def test_scene_error_has_file_line_and_column(tmp_path):
+    path = tmp_path / "broken.rhai"
+    path.write_text("canvas(64, 48, 24.0, 1.0);\nlet x = ;\n")
+    with pytest.raises(lapclone.SceneError) as caught:
+        lapclone.Scene(path)
+    error = caught.value
+    assert error.file == str(path)
+    assert error.line == 2 and isinstance(error.column, int)
+    assert f"{path}:2:" in str(error)
+
+
+def test_scene_index_out_of_range():
+    scene = lapclone.Scene(ROOT / "scenes" / "cat_in_coffee.rhai")
+    with pytest.raises(IndexError):
+        scene.frame(len(scene))
+
+
+FUZZ = textwrap.dedent(
+    """
+    import numpy as np, lapclone
+    rng = np.random.default_rng(42)
+    dtypes = [np.uint8, np.uint16, np.float32, np.int32, bool]
+    outcomes = {"ok": 0, "ValueError": 0, "TypeError": 0}
+    for case in range(1000):
+        def image(h, w):
+            c = rng.choice([0, 1, 2, 3, 4, 5])
+            shape = (h, w) if c == 0 else (h, w, c)
+            dtype = dtypes[rng.integers(0, len(dtypes))] if rng.random() < 0.2 else np.uint8
+            a = (rng.random(shape) * 255).astype(dtype)
+            if rng.random() < 0.3 and a.ndim >= 2:
+                a = a[::-1, ::2]
+            return a
+        h, w = int(rng.integers(0, 40)), int(rng.integers(0, 40))
+        src = image(h, w)
+        mask = (rng.random((h, w)) < rng.random()).astype(np.uint8) * 255
+        if rng.random() < 0.1:
+            mask = mask[: max(h - 1, 0)]
+        dst = image(int(rng.integers(0, 50)), int(rng.integers(0, 50)))
+        p = (int(rng.integers(-60, 110)), int(rng.integers(-60, 110)))
+        try:
+            if rng.random() < 0.5:
+                out = lapclone.seamless_clone(src, dst, mask, p)
+            else:
+                at = (float(rng.normal(20, 40)), float(rng.normal(20, 40)))
+                if rng.random() < 0.05:
+                    at = (float("nan"), 0.0)
+                c = lapclone.Cloner(src, mask, density=float(rng.uniform(0.5, 6)))
+                out = c.clone(dst, at, scale=float(rng.uniform(0.2, 3)), rotate=float(rng.uniform(-180, 180)))
+            assert out.shape == dst.shape and out.dtype == dst.dtype
+            outcomes["ok"] += 1
+        except (ValueError, TypeError) as e:
+            outcomes[type(e).__name__] += 1
+    print(outcomes)
+    """
+)
+
+
+def test_random_inputs_never_crash():
+    done = subprocess.run([sys.executable, "-c", FUZZ], capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr[-2000:]
+    outcomes = eval(done.stdout.strip().splitlines()[-1])
+    assert sum(outcomes.values()) == 1000
+    assert outcomes["ok"] > 50 and outcomes["ValueError"] > 50, outcomes
