@@ -9,7 +9,9 @@ use anyhow::Context;
 use indicatif::{ProgressBar, ProgressStyle};
 use lapclone::glam::DVec2;
 use lapclone::pixels::{Footage, FootageError, FootageReader, FootageSource};
-use lapclone::track::{pair_motion, Estimate, PointTracker, TrackOptions, TrackedFrame};
+use lapclone::track::{
+    pair_motion, read_ahead, Estimate, PointTracker, TrackOptions, TrackedFrame,
+};
 
 use super::render::{frame_range, FrameRange};
 use super::UsageError;
@@ -49,7 +51,7 @@ pub fn run(args: TrackArgs) -> anyhow::Result<()> {
     check_arguments(&args)?;
     let footage = Footage::open(&args.footage, args.start, false, "hold")
         .with_context(|| format!("opening {}", args.footage.display()))?;
-    let mut reader = FootageReader::new(footage, args.fps);
+    let reader = FootageReader::new(footage, args.fps);
     let available = available_frames(&reader, args.fps)?;
     let range = args.frames.unwrap_or(FrameRange {
         first: 1,
@@ -67,31 +69,39 @@ pub fn run(args: TrackArgs) -> anyhow::Result<()> {
         search: args.search,
     };
     let points: Vec<DVec2> = args.points.iter().map(|p| DVec2::from_array(*p)).collect();
-    let first = reader
-        .frame(range.first - 1)
-        .with_context(|| format!("reading frame {}", range.first))?;
-    let (mut tracker, estimates) = PointTracker::start(first, &points, options)
-        .map_err(|e| UsageError(format!("--point: {e}")))?;
-    let mut frames = vec![tracked(range.first, estimates, &points)];
     let progress = progress_bar(range.last - range.first + 1);
-    progress.inc(1);
-    for number in range.first + 1..=range.last {
-        let frame = reader
-            .frame(number - 1)
-            .with_context(|| format!("reading frame {number}"))?;
-        let estimates = tracker
-            .next(frame)
-            .with_context(|| format!("frame {number}"))?;
-        let previous = frames.last().and_then(|f| f.pair).map_or(0.0, |p| p.0);
-        let mut next = tracked(number, estimates, &points);
-        if let (Some(_), [a0, b0, ..], [a, b, ..]) =
-            (next.pair, &frames[0].points[..], &next.points[..])
-        {
-            next.pair = Some(pair_motion(a0.at, b0.at, a.at, b.at, previous));
-        }
-        frames.push(next);
-        progress.inc(1);
-    }
+    let mut tracker: Option<PointTracker> = None;
+    let mut frames: Vec<TrackedFrame> = Vec::new();
+    let threads = lapclone::util::available_cores();
+    let indices = range.first - 1..=range.last - 1;
+    read_ahead(
+        reader.footage(),
+        args.fps,
+        indices,
+        threads,
+        |index, frame| {
+            let number = index + 1;
+            let estimates = match tracker.as_mut() {
+                Some(t) => t.next(frame).with_context(|| format!("frame {number}"))?,
+                None => {
+                    let (t, first) = PointTracker::start(frame, &points, options)
+                        .map_err(|e| UsageError(format!("--point: {e}")))?;
+                    tracker = Some(t);
+                    first
+                }
+            };
+            let mut next = tracked(number, estimates, &points);
+            if let (Some(first), Some(previous)) = (frames.first(), frames.last()) {
+                if let ([a0, b0, ..], [a, b, ..]) = (&first.points[..], &next.points[..]) {
+                    let turned = previous.pair.map_or(0.0, |p| p.0);
+                    next.pair = Some(pair_motion(a0.at, b0.at, a.at, b.at, turned));
+                }
+            }
+            frames.push(next);
+            progress.inc(1);
+            Ok::<(), anyhow::Error>(())
+        },
+    )?;
     progress.finish_and_clear();
     warn_lost(&frames);
     lapclone::util::write_atomic_with(&args.output, |file| {

@@ -11,6 +11,7 @@ mod csv;
 mod error;
 mod lucas_kanade;
 mod pyramid;
+mod read_ahead;
 mod tracker;
 
 use std::path::{Path, PathBuf};
@@ -19,6 +20,7 @@ use glam::DVec2;
 
 pub use csv::{write_csv, TrackedFrame};
 pub use error::TrackError;
+pub use read_ahead::read_ahead;
 pub use tracker::{
     pair_motion, Estimate, LostReason, PointTracker, TrackOptions, FOUND_ABOVE, LOST_BELOW, MAX_SEARCH,
     MAX_SIZE,

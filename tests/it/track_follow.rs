@@ -191,6 +191,27 @@ fn a_followed_track_is_written_back_as_one_call() {
     let again = dir.path().join("again.rhai");
     std::fs::write(&again, &text).unwrap();
     assert_eq!(load_scene(&again).unwrap().scene, loaded.scene);
+    // A handle follows too: its target keys are the track's, written back as one call.
+    let handle_body =
+        "let h = p.drag([20, 20], 10);\nh.follow(\"track.csv\", #{ rotate: false });\n";
+    std::fs::write(&scene, scene_text(handle_body)).unwrap();
+    let handled = load_scene(&scene).unwrap().scene;
+    let to = &handled.patches[0].handles[0].to;
+    let expected: Vec<(f64, DVec2)> = rows()
+        .iter()
+        .map(|&(n, x, y, _, _)| ((n - 1) as f64 / FPS, DVec2::new(x, y)))
+        .collect();
+    let got: Vec<(f64, DVec2)> = to.keys().iter().map(|k| (k.time, k.value)).collect();
+    assert_eq!(got, expected);
+    assert!(handled.patches[0].handles[0].rotation.is_empty());
+    let text = handled.to_rhai_in(dir.path());
+    assert!(
+        text.contains("tri_h1.follow(\"track.csv\", #{ point: 1, rotate: false });"),
+        "{text}"
+    );
+    std::fs::write(&again, &text).unwrap();
+    assert_eq!(load_scene(&again).unwrap().scene, handled);
+    std::fs::write(&scene, scene_text(body)).unwrap();
     // `check` warns that the first frame holds the track's first position.
     let out = lapclone(&["check".as_ref(), scene.as_os_str()]);
     let stderr = String::from_utf8_lossy(&out.stderr);
