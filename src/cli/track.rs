@@ -64,6 +64,12 @@ pub fn run(args: TrackArgs) -> anyhow::Result<()> {
         ))
         .into());
     }
+    if let FootageSource::Sequence { pattern, start } = &reader.footage().source {
+        let mut frame_files = (range.first - 1..range.last).map(|i| pattern.path(start + i));
+        if frame_files.any(|file| same_file(&file, &args.output)) {
+            return Err(UsageError("-o must not name a frame of the footage".into()).into());
+        }
+    }
     let options = TrackOptions {
         size: args.size,
         search: args.search,
@@ -136,8 +142,7 @@ fn check_arguments(args: &TrackArgs) -> anyhow::Result<()> {
     if args.fps <= 0.0 || args.fps > 1000.0 {
         return Err(UsageError(format!("--fps {} must be in (0, 1000]", args.fps)).into());
     }
-    let inputs = [&args.footage];
-    if inputs.iter().any(|p| same_file(p, &args.output)) {
+    if same_file(&args.footage, &args.output) {
         return Err(UsageError("-o must not name the footage".into()).into());
     }
     if args.output.is_dir() {

@@ -83,9 +83,9 @@ impl Template {
         for j in -self.half..=self.half {
             for i in -self.half..=self.half {
                 let s = self.steepest(k, i, j);
-                for r in 0..4 {
-                    for c in 0..4 {
-                        h[r][c] += s[r] * s[c];
+                for (row, sr) in h.iter_mut().zip(s) {
+                    for (cell, sc) in row.iter_mut().zip(s) {
+                        *cell += sr * sc;
                     }
                 }
                 k += 1;
@@ -112,8 +112,8 @@ impl Template {
                 for i in -self.half..=self.half {
                     let error = f64::from(level.sample(p + warp(m, i, j)) - self.values[k]);
                     let s = self.steepest(k, i, j);
-                    for r in 0..4 {
-                        b[r] += s[r] * error;
+                    for (br, sr) in b.iter_mut().zip(s) {
+                        *br += sr * error;
                     }
                     k += 1;
                 }
@@ -209,16 +209,17 @@ fn invert4(mut a: [[f64; 4]; 4]) -> Option<[[f64; 4]; 4]> {
         a.swap(c, pivot);
         inv.swap(c, pivot);
         let d = a[c][c];
-        for k in 0..4 {
-            a[c][k] /= d;
-            inv[c][k] /= d;
-        }
-        for r in 0..4 {
+        a[c] = a[c].map(|v| v / d);
+        inv[c] = inv[c].map(|v| v / d);
+        let (pivot_row, pivot_inv) = (a[c], inv[c]);
+        for (r, (row, inv_row)) in a.iter_mut().zip(inv.iter_mut()).enumerate() {
             if r != c {
-                let f = a[r][c];
-                for k in 0..4 {
-                    a[r][k] -= f * a[c][k];
-                    inv[r][k] -= f * inv[c][k];
+                let f = row[c];
+                for (v, p) in row.iter_mut().zip(pivot_row) {
+                    *v -= f * p;
+                }
+                for (v, p) in inv_row.iter_mut().zip(pivot_inv) {
+                    *v -= f * p;
                 }
             }
         }

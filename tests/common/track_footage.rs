@@ -50,13 +50,13 @@ impl Motion {
     /// Where frame 0's point `p` is in frame k (frame size `size`).
     pub fn truth(&self, size: (u32, u32), k: u32, p: DVec2) -> DVec2 {
         let centre = DVec2::new(f64::from(size.0), f64::from(size.1)) / 2.0;
-        let rest = self.to_photo(size, 0, p);
+        let rest = self.photo_offset(size, 0, p);
         let turn = DVec2::from_angle((self.degrees)(k).to_radians());
         centre + (self.shift)(k) + turn.rotate(rest) * (self.scale)(k)
     }
 
     /// Frame k's point `p` as an offset from the photo's centre.
-    fn to_photo(&self, size: (u32, u32), k: u32, p: DVec2) -> DVec2 {
+    fn photo_offset(&self, size: (u32, u32), k: u32, p: DVec2) -> DVec2 {
         let centre = DVec2::new(f64::from(size.0), f64::from(size.1)) / 2.0;
         let back = DVec2::from_angle(-(self.degrees)(k).to_radians());
         back.rotate(p - centre - (self.shift)(k)) / (self.scale)(k)
@@ -98,7 +98,7 @@ pub fn frame(
     let photo_centre = DVec2::new(f64::from(photo.width()), f64::from(photo.height())) / 2.0;
     image::RgbImage::from_fn(size.0, size.1, |i, j| {
         let p = DVec2::new(f64::from(i) + 0.5, f64::from(j) + 0.5);
-        let q = photo_centre + motion.to_photo(size, k, p);
+        let q = photo_centre + motion.photo_offset(size, k, p);
         let [r, g, b, _] = photo.sample_bilinear(q.x, q.y);
         let level = |v: f32, n: f64| (f64::from(v) * 255.0 + n).round().clamp(0.0, 255.0) as u8;
         let n = noise.gaussian(sigma);
