@@ -75,40 +75,7 @@ pub fn run(args: TrackArgs) -> anyhow::Result<()> {
         search: args.search,
     };
     let points: Vec<DVec2> = args.points.iter().map(|p| DVec2::from_array(*p)).collect();
-    let progress = progress_bar(range.last - range.first + 1);
-    let mut tracker: Option<PointTracker> = None;
-    let mut frames: Vec<TrackedFrame> = Vec::new();
-    let threads = lapclone::util::available_cores();
-    let indices = range.first - 1..=range.last - 1;
-    read_ahead(
-        reader.footage(),
-        args.fps,
-        indices,
-        threads,
-        |index, frame| {
-            let number = index + 1;
-            let estimates = match tracker.as_mut() {
-                Some(t) => t.next(frame).with_context(|| format!("frame {number}"))?,
-                None => {
-                    let (t, first) = PointTracker::start(frame, &points, options)
-                        .map_err(|e| UsageError(format!("--point: {e}")))?;
-                    tracker = Some(t);
-                    first
-                }
-            };
-            let mut next = tracked(number, estimates, &points);
-            if let (Some(first), Some(previous)) = (frames.first(), frames.last()) {
-                if let ([a0, b0, ..], [a, b, ..]) = (&first.points[..], &next.points[..]) {
-                    let turned = previous.pair.map_or(0.0, |p| p.0);
-                    next.pair = Some(pair_motion(a0.at, b0.at, a.at, b.at, turned));
-                }
-            }
-            frames.push(next);
-            progress.inc(1);
-            Ok::<(), anyhow::Error>(())
-        },
-    )?;
-    progress.finish_and_clear();
+    let frames = track_frames(&reader, range, &points, options, args.fps)?;
     warn_lost(&frames);
     lapclone::util::write_atomic_with(&args.output, |file| {
         let mut out = std::io::BufWriter::new(file);
@@ -125,6 +92,45 @@ pub fn run(args: TrackArgs) -> anyhow::Result<()> {
         args.output.display()
     );
     Ok(())
+}
+
+/// Every frame of `range` tracked, in order, with the pair's motion for two points.
+fn track_frames(
+    reader: &FootageReader,
+    range: FrameRange,
+    points: &[DVec2],
+    options: TrackOptions,
+    fps: f64,
+) -> anyhow::Result<Vec<TrackedFrame>> {
+    let progress = progress_bar(range.last - range.first + 1);
+    let mut tracker: Option<PointTracker> = None;
+    let mut frames: Vec<TrackedFrame> = Vec::new();
+    let threads = lapclone::util::available_cores();
+    let indices = range.first - 1..=range.last - 1;
+    read_ahead(reader.footage(), fps, indices, threads, |index, frame| {
+        let number = index + 1;
+        let estimates = match tracker.as_mut() {
+            Some(t) => t.next(frame).with_context(|| format!("frame {number}"))?,
+            None => {
+                let (t, first) = PointTracker::start(frame, points, options)
+                    .map_err(|e| UsageError(format!("--point: {e}")))?;
+                tracker = Some(t);
+                first
+            }
+        };
+        let mut next = tracked(number, estimates, points);
+        if let (Some(first), Some(previous)) = (frames.first(), frames.last()) {
+            if let ([a0, b0, ..], [a, b, ..]) = (&first.points[..], &next.points[..]) {
+                let turned = previous.pair.map_or(0.0, |p| p.0);
+                next.pair = Some(pair_motion(a0.at, b0.at, a.at, b.at, turned));
+            }
+        }
+        frames.push(next);
+        progress.inc(1);
+        Ok::<(), anyhow::Error>(())
+    })?;
+    progress.finish_and_clear();
+    Ok(frames)
 }
 
 fn tracked(frame: u64, points: Vec<Estimate>, starts: &[DVec2]) -> TrackedFrame {

@@ -107,3 +107,49 @@ fn follow_line(name: &str, f: &Follow) -> String {
 fn point(p: &DVec2) -> String {
     format!("[{}, {}]", p.x, p.y)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use lapclone::scene::{Easing, Shape};
+
+    #[test]
+    fn a_followed_track_is_one_entry_until_its_keys_change() {
+        let mut patch = Patch::new("p", "a.png".into(), Shape::Mask("m.png".into()));
+        for (t, x) in [(0.0, 1.0), (0.5, 2.0), (1.0, 3.5)] {
+            let at = DVec2::new(x, 4.0);
+            patch
+                .placement
+                .position
+                .push(t, at, Easing::Linear)
+                .unwrap();
+        }
+        patch.follows.push(Follow {
+            file: "shots/track.csv".into(),
+            target: FollowTarget::Patch,
+            point: 1,
+            offset: DVec2::ZERO,
+            rotate: None,
+            scale: None,
+            from_frame: None,
+            at: patch.placement.position.clone(),
+            rotation: None,
+            scale_keys: None,
+        });
+        let table = key_table(&patch);
+        assert!(
+            table.contains("  at: follows track.csv (3 keys)\n"),
+            "{table}"
+        );
+        assert!(!table.contains("[3.5, 4]"), "{table}");
+        // An edited key makes the keys the user's own again: listed one by one.
+        patch
+            .placement
+            .position
+            .push(2.0, DVec2::ONE, Easing::Linear)
+            .unwrap();
+        let table = key_table(&patch);
+        assert!(!table.contains("follows"), "{table}");
+        assert!(table.contains("[3.5, 4]"), "{table}");
+    }
+}
