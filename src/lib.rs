@@ -134,7 +134,7 @@ macro_rules! stage_modules {
 
 stage_modules!(
     clone, deform, golden, limits, mesh, output, pixels, png_bands, raster, render, scene, script,
-    simd, solve, util,
+    simd, solve, track, util,
 );
 
 // The CLI's files name library items as `lapclone::…`, as any other user would.

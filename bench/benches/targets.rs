@@ -163,6 +163,7 @@ fn measure(settings: &Settings) -> Result<(Vec<Check>, Vec<Skipped>), String> {
     render_checks(settings, &mut checks)?;
     paper_checks(&mut checks)?;
     whole_process_checks(settings, &mut checks, &mut skipped)?;
+    track_checks(settings, &mut checks, &mut skipped)?;
     Ok((checks, skipped))
 }
 
@@ -348,6 +349,62 @@ fn whole_process_checks(
                 what,
                 bound,
                 reason,
+            }),
+        }
+    }
+    Ok(())
+}
+
+/// Issue #41: one point through 1920×1080 PNG footage against decoding alone and an OpenCV
+/// calcOpticalFlowPyrLK loop, and the tracked path's error beside OpenCV's (skipped without
+/// cv2).
+fn track_checks(
+    settings: &Settings,
+    checks: &mut Vec<Check>,
+    skipped: &mut Vec<Skipped>,
+) -> Result<(), String> {
+    let (runs, frames) = settings.pick(("1", "60"), ("3", "240"));
+    let report = run_bench(&["track", "--runs", runs, "--frames", frames])?;
+    checks.push(Check {
+        issue: 41,
+        what: format!("track 1 point through {frames} 1920×1080 PNG ÷ decoding them (×)"),
+        measured: number(&report, "/track_over_decode")?,
+        bound: Bound::AtMost(1.2),
+    });
+    let opencv_missing = report
+        .pointer("/opencv_skipped")
+        .and_then(Value::as_str)
+        .map(str::to_string);
+    let mut figures = vec![(
+        format!("track {frames} 1920×1080 PNG ÷ OpenCV imread + calcOpticalFlowPyrLK loop (×)"),
+        report.pointer("/track_over_opencv").and_then(Value::as_f64),
+        0.5,
+    )];
+    for motion in ["translation", "similarity"] {
+        let ours = number(&report, &format!("/accuracy/{motion}/lapclone_rms_px"))?;
+        let theirs = report
+            .pointer(&format!("/accuracy/{motion}/opencv_rms_px"))
+            .and_then(Value::as_f64);
+        figures.push((
+            format!("{motion} track RMS error ÷ calcOpticalFlowPyrLK's (×)"),
+            theirs.map(|t| ours / t),
+            1.0,
+        ));
+    }
+    for (what, measured, limit) in figures {
+        let bound = Bound::AtMost(limit);
+        match (measured, &opencv_missing) {
+            (Some(measured), _) => checks.push(Check {
+                issue: 41,
+                what,
+                measured,
+                bound,
+            }),
+            (None, reason) => skipped.push(Skipped {
+                issue: 41,
+                what,
+                bound,
+                reason: reason.clone().unwrap_or_else(|| "no OpenCV figure".into()),
             }),
         }
     }

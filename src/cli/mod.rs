@@ -13,6 +13,7 @@ pub mod test;
 pub mod test_args;
 pub mod test_pending;
 pub mod test_report;
+pub mod track;
 
 /// An argument combination clap cannot reject by itself; exits with code 2.
 #[derive(Debug, thiserror::Error)]
@@ -63,6 +64,8 @@ pub enum Command {
     Repl(repl::ReplArgs),
     /// Compare scenes' frames with their golden frames (accept, reject, review changes).
     Test(test_args::TestArgs),
+    /// Follow points through footage and write their track as CSV (for a scene's `follow`).
+    Track(track::TrackArgs),
 }
 
 pub fn run(cli: Cli) -> anyhow::Result<()> {
@@ -74,6 +77,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Check(args) => render::run_check(args),
         Command::Repl(args) => repl::run(args),
         Command::Test(args) => test::run(args),
+        Command::Track(args) => track::run(args),
     }
 }
 

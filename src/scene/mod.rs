@@ -4,12 +4,14 @@
 //! ([`Scene::warnings`]). Parsing scene files lives in the script stage.
 
 mod evaluate;
+mod follow;
 mod to_rhai;
 mod track;
 mod types;
 mod warnings;
 
 pub use evaluate::{frame_time, FrameState, HandleState, PatchState};
+pub use follow::{Follow, FollowTarget};
 pub use to_rhai::rhai_string_literal;
 pub use track::{Easing, Interpolate, Key, KeyError, Track};
 pub use types::{

@@ -9,6 +9,7 @@ use std::path::{Component, Path, PathBuf};
 
 use glam::DVec2;
 
+use super::follow::{Follow, FollowTarget};
 use super::track::{Interpolate, Track};
 use super::types::{
     Background, Canvas, Footage, FootageSource, Handle, Patch, Pin, Polygon, Scene, Shape,
@@ -270,20 +271,59 @@ fn write_patch(out: &mut String, patch: &Patch, var: &str, paths: &Paths) {
         options.join(", ")
     );
     let p = &patch.placement;
-    write_track(out, var, "at", &p.position, point);
-    write_track(out, var, "scale", &p.scale, |v| num(*v));
-    write_track(out, var, "rotate", &p.rotation, |v| num(*v));
+    let follow = patch.intact_follows(FollowTarget::Patch).last();
+    match follow {
+        Some(f) => write_follow(out, var, f, paths),
+        None => write_track(out, var, "at", &p.position, point),
+    }
+    if follow.is_none_or(|f| f.scale_keys.is_none()) {
+        write_track(out, var, "scale", &p.scale, |v| num(*v));
+    }
+    if follow.is_none_or(|f| f.rotation.is_none()) {
+        write_track(out, var, "rotate", &p.rotation, |v| num(*v));
+    }
     write_track(out, var, "depth", &p.depth, |v| num(*v));
     write_track(out, var, "opacity", &p.opacity, |v| num(*v));
     for (i, handle) in patch.handles.iter().enumerate() {
-        write_handle(out, handle, &format!("{var}_h{}", i + 1), var);
+        let follow = patch.intact_follows(FollowTarget::Handle(i)).last();
+        write_handle(out, handle, &format!("{var}_h{}", i + 1), var, follow, paths);
     }
     for pin in &patch.pins {
         write_pin(out, pin, var);
     }
 }
 
-fn write_handle(out: &mut String, handle: &Handle, var: &str, patch_var: &str) {
+/// `var.follow("file", #{ … });` with the settings as the scene wrote them.
+fn write_follow(out: &mut String, var: &str, follow: &Follow, paths: &Paths) {
+    let mut options = vec![format!("point: {}", follow.point)];
+    if follow.offset != DVec2::ZERO {
+        options.push(format!("offset: {}", point(&follow.offset)));
+    }
+    if let Some(r) = follow.rotate {
+        options.push(format!("rotate: {r}"));
+    }
+    if let Some(s) = follow.scale {
+        options.push(format!("scale: {s}"));
+    }
+    if let Some(f) = follow.from_frame {
+        options.push(format!("from_frame: {f}"));
+    }
+    let _ = writeln!(
+        out,
+        "{var}.follow({}, #{{ {} }});",
+        paths.literal(&follow.file),
+        options.join(", ")
+    );
+}
+
+fn write_handle(
+    out: &mut String,
+    handle: &Handle,
+    var: &str,
+    patch_var: &str,
+    follow: Option<&Follow>,
+    paths: &Paths,
+) {
     let mut options = Vec::new();
     if let Some(d) = handle.depth {
         options.push(format!("depth: {}", num(d)));
@@ -298,8 +338,13 @@ fn write_handle(out: &mut String, handle: &Handle, var: &str, patch_var: &str) {
         num(handle.radius),
         options.join(", ")
     );
-    write_track(out, var, "key", &handle.to, point);
-    write_track(out, var, "rotate", &handle.rotation, |v| num(*v));
+    match follow {
+        Some(f) => write_follow(out, var, f, paths),
+        None => write_track(out, var, "key", &handle.to, point),
+    }
+    if follow.is_none_or(|f| f.rotation.is_none()) {
+        write_track(out, var, "rotate", &handle.rotation, |v| num(*v));
+    }
 }
 
 fn write_pin(out: &mut String, pin: &Pin, var: &str) {

@@ -151,6 +151,8 @@ pub struct Patch {
     pub handles: Vec<Handle>,
     /// Points held still while active.
     pub pins: Vec<Pin>,
+    /// Tracks this patch's keys came from (`follow` calls), latest last.
+    pub follows: Vec<super::follow::Follow>,
 }
 
 impl Patch {
@@ -170,6 +172,7 @@ impl Patch {
             placement: Placement::default(),
             handles: Vec::new(),
             pins: Vec::new(),
+            follows: Vec::new(),
         }
     }
 }

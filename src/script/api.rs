@@ -87,6 +87,7 @@ pub fn register(engine: &mut Engine, draft: &SharedDraft) {
             .ok_or_else(|| fail(&ctx, guard.no_patch_message(name)))
     });
     super::edit_api::register(engine, draft);
+    super::follow_api::register(engine, draft);
     engine.register_fn("easings", || -> rhai::Array {
         Easing::ALL
             .iter()

@@ -10,6 +10,7 @@ mod edit_api;
 mod engine;
 mod error;
 mod golden;
+mod follow_api;
 mod footage_options;
 mod sandbox;
 mod validate;

@@ -13,6 +13,8 @@ mod fixtures;
 mod golden;
 #[path = "../common/raster_meshes.rs"]
 mod raster_meshes;
+#[path = "../common/track_footage.rs"]
+mod track_footage;
 
 mod bad_input;
 mod clone_cli;
@@ -54,5 +56,7 @@ mod solve_panels;
 mod solve_supernodal;
 mod solve_update;
 mod test_cli;
+mod track_cli;
+mod track_follow;
 mod video_cli;
 mod video_encode;

@@ -176,6 +176,7 @@ fn patch(index: usize) -> impl Strategy<Value = Patch> {
                 },
                 handles,
                 pins,
+                follows: Vec::new(),
             },
         )
 }

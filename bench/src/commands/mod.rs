@@ -9,6 +9,7 @@ pub mod bench_opencv;
 pub mod bench_paper;
 pub mod bench_render;
 pub mod bench_solver;
+pub mod bench_track;
 pub mod child_run;
 
 pub use lapclone::cli::{describe, finite_f64, mesh_args, UsageError};
@@ -37,6 +38,9 @@ pub enum BenchCommand {
     /// scene to PNG files against an OpenCV loop and to MP4 against PNG, and a 6000×5000
     /// clone against seamlessClone, with its peak memory.
     Opencv(bench_opencv::OpencvBenchArgs),
+    /// Point tracking: 1920×1080 PNG footage against decoding alone and an OpenCV
+    /// calcOpticalFlowPyrLK loop, and the tracked path's error beside OpenCV's.
+    Track(bench_track::TrackBenchArgs),
 }
 
 /// Runs one benchmark.
@@ -50,5 +54,6 @@ pub fn run(which: BenchCommand) -> anyhow::Result<()> {
         BenchCommand::Clone(args) => bench_clone::run(args),
         BenchCommand::Paper(args) => bench_paper::run(args),
         BenchCommand::Opencv(args) => bench_opencv::run(args),
+        BenchCommand::Track(args) => bench_track::run(args),
     }
 }

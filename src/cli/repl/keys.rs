@@ -4,29 +4,51 @@
 use std::fmt::Write as _;
 
 use glam::DVec2;
-use lapclone::scene::{Interpolate, Patch, Track};
+use lapclone::scene::{Follow, FollowTarget, Interpolate, Patch, Track};
 
 /// The table for `patch`.
 pub fn key_table(patch: &Patch) -> String {
     let mut rows: Vec<[String; 4]> = Vec::new();
+    let mut followed: Vec<String> = Vec::new();
     let p = &patch.placement;
-    track_rows(&mut rows, "at", &p.position, point);
-    track_rows(&mut rows, "scale", &p.scale, |v| v.to_string());
-    track_rows(&mut rows, "rotate", &p.rotation, |v| v.to_string());
+    let follow = patch.intact_follows(FollowTarget::Patch).last();
+    if let Some(f) = follow {
+        followed.push(follow_line("at", f));
+    } else {
+        track_rows(&mut rows, "at", &p.position, point);
+    }
+    if follow.is_none_or(|f| f.scale_keys.is_none()) {
+        track_rows(&mut rows, "scale", &p.scale, |v| v.to_string());
+    }
+    if follow.is_none_or(|f| f.rotation.is_none()) {
+        track_rows(&mut rows, "rotate", &p.rotation, |v| v.to_string());
+    }
     track_rows(&mut rows, "depth", &p.depth, |v| v.to_string());
     track_rows(&mut rows, "opacity", &p.opacity, |v| v.to_string());
     for (i, h) in patch.handles.iter().enumerate() {
-        track_rows(&mut rows, &format!("handle {i} at"), &h.to, point);
-        track_rows(&mut rows, &format!("handle {i} rotate"), &h.rotation, |v| {
-            v.to_string()
-        });
+        let follow = patch.intact_follows(FollowTarget::Handle(i)).last();
+        match follow {
+            Some(f) => followed.push(follow_line(&format!("handle {i} at"), f)),
+            None => track_rows(&mut rows, &format!("handle {i} at"), &h.to, point),
+        }
+        if follow.is_none_or(|f| f.rotation.is_none()) {
+            track_rows(&mut rows, &format!("handle {i} rotate"), &h.rotation, |v| {
+                v.to_string()
+            });
+        }
     }
     let mut out = format!("patch {:?}", patch.name);
-    if rows.is_empty() {
+    if rows.is_empty() && followed.is_empty() {
         out.push_str(": no keys\n");
         return out;
     }
     out.push('\n');
+    for line in &followed {
+        let _ = writeln!(out, "  {line}");
+    }
+    if rows.is_empty() {
+        return out;
+    }
     let header = ["track", "t", "value", "easing"].map(String::from);
     let mut widths = [0usize; 4];
     for row in std::iter::once(&header).chain(&rows) {
@@ -66,6 +88,68 @@ fn track_rows<T: Interpolate>(
     }
 }
 
+/// `at: follows track.csv (96 keys)`, plus `rotate` and `scale` when the track drives them.
+fn follow_line(name: &str, f: &Follow) -> String {
+    let mut also = String::new();
+    if f.rotation.is_some() {
+        also.push_str(", rotate");
+    }
+    if f.scale_keys.is_some() {
+        also.push_str(", scale");
+    }
+    format!(
+        "{name}{also}: follows {} ({} keys)",
+        f.file_name(),
+        f.key_count()
+    )
+}
+
 fn point(p: &DVec2) -> String {
     format!("[{}, {}]", p.x, p.y)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use lapclone::scene::{Easing, Shape};
+
+    #[test]
+    fn a_followed_track_is_one_entry_until_its_keys_change() {
+        let mut patch = Patch::new("p", "a.png".into(), Shape::Mask("m.png".into()));
+        for (t, x) in [(0.0, 1.0), (0.5, 2.0), (1.0, 3.5)] {
+            let at = DVec2::new(x, 4.0);
+            patch
+                .placement
+                .position
+                .push(t, at, Easing::Linear)
+                .unwrap();
+        }
+        patch.follows.push(Follow {
+            file: "shots/track.csv".into(),
+            target: FollowTarget::Patch,
+            point: 1,
+            offset: DVec2::ZERO,
+            rotate: None,
+            scale: None,
+            from_frame: None,
+            at: patch.placement.position.clone(),
+            rotation: None,
+            scale_keys: None,
+        });
+        let table = key_table(&patch);
+        assert!(
+            table.contains("  at: follows track.csv (3 keys)\n"),
+            "{table}"
+        );
+        assert!(!table.contains("[3.5, 4]"), "{table}");
+        // An edited key makes the keys the user's own again: listed one by one.
+        patch
+            .placement
+            .position
+            .push(2.0, DVec2::ONE, Easing::Linear)
+            .unwrap();
+        let table = key_table(&patch);
+        assert!(!table.contains("follows"), "{table}");
+        assert!(table.contains("[3.5, 4]"), "{table}");
+    }
 }

@@ -1,0 +1,234 @@
+//! `lapclone track`: takes footage (a `%04d` plate pattern or a video), points on its first
+//! frame and tracking settings, and writes the track CSV (atomically), warning on stderr for
+//! each run of frames where a point was lost.
+
+use std::io::{IsTerminal, Write};
+use std::path::PathBuf;
+
+use anyhow::Context;
+use indicatif::{ProgressBar, ProgressStyle};
+use lapclone::glam::DVec2;
+use lapclone::pixels::{Footage, FootageError, FootageReader, FootageSource};
+use lapclone::track::{
+    pair_motion, read_ahead, Estimate, PointTracker, TrackOptions, TrackedFrame,
+};
+
+use super::render::{frame_range, FrameRange};
+use super::UsageError;
+
+/// Most points one run follows.
+const MAX_POINTS: usize = 16;
+
+#[derive(clap::Args, Debug)]
+pub struct TrackArgs {
+    /// Footage: numbered images (`plates/frame_%04d.png`) or a video (.mp4, .mov, .webm, .mkv).
+    pub footage: PathBuf,
+    /// A point to follow, X,Y in pixels on the first frame of the range (repeat for two:
+    /// the CSV then also has the pair's rotation and scale).
+    #[arg(long = "point", value_name = "X,Y", required = true, value_parser = super::point)]
+    pub points: Vec<[f64; 2]>,
+    /// Side of the square matched around each point, in pixels.
+    #[arg(long, value_name = "PX", default_value_t = TrackOptions::default().size)]
+    pub size: u32,
+    /// How far a point may move from one frame to the next, in pixels.
+    #[arg(long, value_name = "PX", default_value_t = TrackOptions::default().search)]
+    pub search: u32,
+    /// Frames to track, A..B (numbered as `render` numbers them, from 1); default: all.
+    #[arg(long, value_name = "A..B", value_parser = frame_range)]
+    pub frames: Option<FrameRange>,
+    /// The file number of frame 1 of a pattern (default: the lowest number with a file).
+    #[arg(long, value_name = "N")]
+    pub start: Option<u64>,
+    /// The rate a video is decoded at, frames per second (as the scene's `fps`).
+    #[arg(long, default_value_t = 24.0, value_parser = super::finite_f64)]
+    pub fps: f64,
+    /// The track CSV to write.
+    #[arg(short, long)]
+    pub output: PathBuf,
+}
+
+pub fn run(args: TrackArgs) -> anyhow::Result<()> {
+    check_arguments(&args)?;
+    let footage = Footage::open(&args.footage, args.start, false, "hold")
+        .with_context(|| format!("opening {}", args.footage.display()))?;
+    let reader = FootageReader::new(footage, args.fps);
+    let available = available_frames(&reader, args.fps)?;
+    let range = args.frames.unwrap_or(FrameRange {
+        first: 1,
+        last: available,
+    });
+    if range.last > available {
+        return Err(UsageError(format!(
+            "--frames {}..{}: the footage has {available} frames",
+            range.first, range.last
+        ))
+        .into());
+    }
+    if let FootageSource::Sequence { pattern, start } = &reader.footage().source {
+        let mut frame_files = (range.first - 1..range.last).map(|i| pattern.path(start + i));
+        if frame_files.any(|file| same_file(&file, &args.output)) {
+            return Err(UsageError("-o must not name a frame of the footage".into()).into());
+        }
+    }
+    let options = TrackOptions {
+        size: args.size,
+        search: args.search,
+    };
+    let points: Vec<DVec2> = args.points.iter().map(|p| DVec2::from_array(*p)).collect();
+    let frames = track_frames(&reader, range, &points, options, args.fps)?;
+    warn_lost(&frames);
+    lapclone::util::write_atomic_with(&args.output, |file| {
+        let mut out = std::io::BufWriter::new(file);
+        lapclone::track::write_csv(&mut out, &frames)?;
+        out.flush()
+    })
+    .with_context(|| format!("writing {}", args.output.display()))?;
+    eprintln!(
+        "tracked {} point{} through frames {}..{} into {}",
+        points.len(),
+        if points.len() == 1 { "" } else { "s" },
+        range.first,
+        range.last,
+        args.output.display()
+    );
+    Ok(())
+}
+
+/// Every frame of `range` tracked, in order, with the pair's motion for two points.
+fn track_frames(
+    reader: &FootageReader,
+    range: FrameRange,
+    points: &[DVec2],
+    options: TrackOptions,
+    fps: f64,
+) -> anyhow::Result<Vec<TrackedFrame>> {
+    let progress = progress_bar(range.last - range.first + 1);
+    let mut tracker: Option<PointTracker> = None;
+    let mut frames: Vec<TrackedFrame> = Vec::new();
+    let threads = lapclone::util::available_cores();
+    let indices = range.first - 1..=range.last - 1;
+    read_ahead(reader.footage(), fps, indices, threads, |index, frame| {
+        let number = index + 1;
+        let estimates = match tracker.as_mut() {
+            Some(t) => t.next(frame).with_context(|| format!("frame {number}"))?,
+            None => {
+                let (t, first) = PointTracker::start(frame, points, options)
+                    .map_err(|e| UsageError(format!("--point: {e}")))?;
+                tracker = Some(t);
+                first
+            }
+        };
+        let mut next = tracked(number, estimates, points);
+        if let (Some(first), Some(previous)) = (frames.first(), frames.last()) {
+            if let ([a0, b0, ..], [a, b, ..]) = (&first.points[..], &next.points[..]) {
+                let turned = previous.pair.map_or(0.0, |p| p.0);
+                next.pair = Some(pair_motion(a0.at, b0.at, a.at, b.at, turned));
+            }
+        }
+        frames.push(next);
+        progress.inc(1);
+        Ok::<(), anyhow::Error>(())
+    })?;
+    progress.finish_and_clear();
+    Ok(frames)
+}
+
+fn tracked(frame: u64, points: Vec<Estimate>, starts: &[DVec2]) -> TrackedFrame {
+    TrackedFrame {
+        frame,
+        points,
+        pair: (starts.len() > 1).then_some((0.0, 1.0)),
+    }
+}
+
+fn check_arguments(args: &TrackArgs) -> anyhow::Result<()> {
+    if args.points.len() > MAX_POINTS {
+        return Err(UsageError(format!("at most {MAX_POINTS} --point options")).into());
+    }
+    if args.fps <= 0.0 || args.fps > 1000.0 {
+        return Err(UsageError(format!("--fps {} must be in (0, 1000]", args.fps)).into());
+    }
+    if same_file(&args.footage, &args.output) {
+        return Err(UsageError("-o must not name the footage".into()).into());
+    }
+    if args.output.is_dir() {
+        return Err(UsageError(format!("-o {} is a folder", args.output.display())).into());
+    }
+    super::clone::check_output_folder(&args.output)
+}
+
+fn same_file(a: &std::path::Path, b: &std::path::Path) -> bool {
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    }
+}
+
+/// How many frames the footage has: the unbroken run of files from the start, or a
+/// video's frames at `fps`.
+fn available_frames(reader: &FootageReader, fps: f64) -> anyhow::Result<u64> {
+    let limit = lapclone::limits::MAX_FRAMES;
+    match &reader.footage().source {
+        FootageSource::Sequence { pattern, start } => {
+            let count = (0..=limit)
+                .find(|i| !pattern.path(start + i).is_file())
+                .unwrap_or(limit);
+            Ok(count)
+        }
+        FootageSource::Video(_) => match reader.footage().check_covers(limit, fps) {
+            Err(FootageError::VideoTooShort { available, .. }) => Ok(available),
+            Err(other) => Err(other.into()),
+            Ok(()) => {
+                Err(UsageError("the video's length is unknown: give --frames A..B".into()).into())
+            }
+        },
+    }
+}
+
+/// One warning per run of frames in which a point was lost.
+fn warn_lost(frames: &[TrackedFrame]) {
+    let count = frames.first().map_or(0, |f| f.points.len());
+    for point in 0..count {
+        let mut run: Option<(u64, u64, &'static str, f64)> = None;
+        let flush = |run: &mut Option<(u64, u64, &'static str, f64)>| {
+            if let Some((a, b, why, worst)) = run.take() {
+                let span = if a == b {
+                    format!("frame {a}")
+                } else {
+                    format!("frames {a}–{b}")
+                };
+                eprintln!(
+                    "lapclone: warning: point {} lost at {span} ({why}; confidence down to {worst:.2}); its last sure position is kept there",
+                    point + 1
+                );
+            }
+        };
+        for frame in frames {
+            let e = &frame.points[point];
+            match (e.lost, run.as_mut()) {
+                (Some(_), Some(r)) => {
+                    r.1 = frame.frame;
+                    r.3 = r.3.min(e.confidence);
+                }
+                (Some(why), None) => {
+                    run = Some((frame.frame, frame.frame, why.describe(), e.confidence))
+                }
+                (None, _) => flush(&mut run),
+            }
+        }
+        flush(&mut run);
+    }
+}
+
+fn progress_bar(frames: u64) -> ProgressBar {
+    if !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::new(frames);
+    if let Ok(style) =
+        ProgressStyle::with_template("{bar:40} {pos}/{len} frames  {per_sec}  eta {eta}")
+    {
+        bar.set_style(style);
+    }
+    bar
+}

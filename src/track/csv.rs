@@ -1,0 +1,259 @@
+//! Track CSV: takes tracked frames and gives the text `lapclone track` writes (a header,
+//! then `frame,x,y,confidence` per frame for one point; `frame,point,x,y,confidence,rotate,
+//! scale` per point per frame for two or more); and takes CSV text whose header names its
+//! columns — `frame` (numbered as `render` numbers frames) or `t` (seconds), `x`, `y`, and
+//! optionally `point`, `confidence`, `rotate`, `scale` — and gives each point's rows, or the
+//! line and what is wrong with it.
+
+use std::io::Write;
+
+use glam::DVec2;
+
+use super::{Estimate, TrackRow, TrackTime, MAX_POINTS, MAX_ROWS};
+
+/// One tracked frame: its number (as `render` numbers frames), each point's estimate, and
+/// with two or more points the pair's rotation (degrees) and scale against the first frame.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TrackedFrame {
+    /// The frame number, from 1.
+    pub frame: u64,
+    /// One estimate per point.
+    pub points: Vec<Estimate>,
+    /// Rotation and scale of points 1 → 2 relative to the first frame.
+    pub pair: Option<(f64, f64)>,
+}
+
+/// Writes `frames` as track CSV.
+pub fn write_csv(out: &mut impl Write, frames: &[TrackedFrame]) -> std::io::Result<()> {
+    let several = frames.first().is_some_and(|f| f.points.len() > 1);
+    if several {
+        writeln!(out, "frame,point,x,y,confidence,rotate,scale")?;
+    } else {
+        writeln!(out, "frame,x,y,confidence")?;
+    }
+    for frame in frames {
+        for (i, e) in frame.points.iter().enumerate() {
+            let (x, y, c) = (e.at.x, e.at.y, e.confidence);
+            if several {
+                let (r, s) = frame.pair.unwrap_or((0.0, 1.0));
+                let n = frame.frame;
+                writeln!(out, "{n},{},{x:.4},{y:.4},{c:.3},{r:.4},{s:.6}", i + 1)?;
+            } else {
+                writeln!(out, "{},{x:.4},{y:.4},{c:.3}", frame.frame)?;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// A column a track CSV may have.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Column {
+    Frame,
+    Seconds,
+    Point,
+    X,
+    Y,
+    Confidence,
+    Rotate,
+    Scale,
+}
+
+const COLUMNS: [(&str, Column); 8] = [
+    ("frame", Column::Frame),
+    ("t", Column::Seconds),
+    ("point", Column::Point),
+    ("x", Column::X),
+    ("y", Column::Y),
+    ("confidence", Column::Confidence),
+    ("rotate", Column::Rotate),
+    ("scale", Column::Scale),
+];
+
+type Failure = (usize, String);
+
+/// Each point's rows from CSV `text`.
+pub(super) fn parse(text: &str) -> Result<Vec<Vec<TrackRow>>, Failure> {
+    let mut lines = text
+        .lines()
+        .enumerate()
+        .map(|(i, l)| (i + 1, l.trim()))
+        .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
+    let Some((header_line, header)) = lines.next() else {
+        return Err((1, "the file is empty: expected a header such as frame,x,y".into()));
+    };
+    let columns = parse_header(header_line, header)?;
+    let mut points: Vec<Vec<TrackRow>> = Vec::new();
+    let mut count = 0usize;
+    let mut last_line = header_line;
+    for (number, line) in lines {
+        last_line = number;
+        count += 1;
+        if count > MAX_ROWS {
+            return Err((number, format!("more than {MAX_ROWS} rows")));
+        }
+        let (point, row) = parse_row(number, line, &columns)?;
+        if points.len() < point {
+            points.resize_with(point, Vec::new);
+        }
+        let rows = &mut points[point - 1];
+        if let Some(previous) = rows.last() {
+            check_order(number, point, previous.time, row.time)?;
+        }
+        rows.push(row);
+    }
+    if count == 0 {
+        return Err((last_line + 1, "the file has a header but no rows".into()));
+    }
+    if let Some(missing) = points.iter().position(Vec::is_empty) {
+        return Err((header_line, format!("point {} has no rows", missing + 1)));
+    }
+    Ok(points)
+}
+
+fn parse_header(line: usize, header: &str) -> Result<Vec<Column>, Failure> {
+    let names: Vec<&str> = header.split(',').map(str::trim).collect();
+    if names.iter().any(|n| n.parse::<f64>().is_ok()) {
+        return Err((
+            line,
+            "missing header: the first line must name the columns, e.g. frame,x,y or t,x,y".into(),
+        ));
+    }
+    let mut columns = Vec::with_capacity(names.len());
+    for name in &names {
+        let column = COLUMNS
+            .iter()
+            .find(|(n, _)| n.eq_ignore_ascii_case(name))
+            .map(|(_, c)| *c)
+            .ok_or_else(|| {
+                let known: Vec<&str> = COLUMNS.iter().map(|(n, _)| *n).collect();
+                (line, format!("unknown column `{name}` (known: {})", known.join(", ")))
+            })?;
+        if columns.contains(&column) {
+            return Err((line, format!("column `{name}` appears twice")));
+        }
+        columns.push(column);
+    }
+    let has = |c| columns.contains(&c);
+    if has(Column::Frame) == has(Column::Seconds) {
+        return Err((line, "the header needs one time column: `frame` or `t` (seconds)".into()));
+    }
+    if !has(Column::X) || !has(Column::Y) {
+        return Err((line, "the header needs `x` and `y` columns".into()));
+    }
+    Ok(columns)
+}
+
+fn parse_row(line: usize, text: &str, columns: &[Column]) -> Result<(usize, TrackRow), Failure> {
+    let cells: Vec<&str> = text.split(',').map(str::trim).collect();
+    if cells.len() != columns.len() {
+        return Err((
+            line,
+            format!("expected {} values, found {}", columns.len(), cells.len()),
+        ));
+    }
+    let mut row = TrackRow {
+        time: TrackTime::Seconds(0.0),
+        at: DVec2::ZERO,
+        confidence: None,
+        rotate: None,
+        scale: None,
+    };
+    let mut point = 1;
+    for (cell, column) in cells.iter().zip(columns) {
+        let name = COLUMNS.iter().find(|(_, c)| c == column).map_or("", |(n, _)| n);
+        let value: f64 = cell
+            .parse()
+            .ok()
+            .filter(|v: &f64| v.is_finite())
+            .ok_or_else(|| (line, format!("column `{name}`: `{cell}` is not a number")))?;
+        match column {
+            Column::Frame => row.time = TrackTime::Frame(whole(line, name, value, u64::MAX)?),
+            Column::Seconds if value < 0.0 => {
+                return Err((line, format!("column `t`: {value} is negative")))
+            }
+            Column::Seconds => row.time = TrackTime::Seconds(value),
+            Column::Point => point = whole(line, name, value, MAX_POINTS as u64)? as usize,
+            Column::X => row.at.x = value,
+            Column::Y => row.at.y = value,
+            Column::Confidence => row.confidence = Some(value),
+            Column::Rotate => row.rotate = Some(value),
+            Column::Scale if value <= 0.0 => {
+                return Err((line, format!("column `scale`: {value} must be positive")))
+            }
+            Column::Scale => row.scale = Some(value),
+        }
+    }
+    Ok((point, row))
+}
+
+/// A whole number from 1 to `max`.
+fn whole(line: usize, name: &str, value: f64, max: u64) -> Result<u64, Failure> {
+    if value.fract() != 0.0 || value < 1.0 || value > max as f64 {
+        return Err((
+            line,
+            format!("column `{name}`: {value} must be a whole number from 1 to {max}"),
+        ));
+    }
+    Ok(value as u64)
+}
+
+fn check_order(line: usize, point: usize, before: TrackTime, now: TrackTime) -> Result<(), Failure> {
+    let (a, b, what) = match (before, now) {
+        (TrackTime::Frame(a), TrackTime::Frame(b)) => (a as f64, b as f64, "frame"),
+        (TrackTime::Seconds(a), TrackTime::Seconds(b)) => (a, b, "t"),
+        // invariant: one header gives every row the same kind of time.
+        _ => unreachable!("one time column per file"),
+    };
+    if b <= a {
+        return Err((
+            line,
+            format!("{what} {b} comes after {what} {a} (point {point}): times must increase"),
+        ));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn written_csv_reads_back() {
+        let e = |x, y, c| Estimate {
+            at: DVec2::new(x, y),
+            confidence: c,
+            lost: None,
+        };
+        let frames = vec![
+            TrackedFrame {
+                frame: 3,
+                points: vec![e(1.5, 2.25, 1.0), e(11.5, 2.25, 1.0)],
+                pair: Some((0.0, 1.0)),
+            },
+            TrackedFrame {
+                frame: 4,
+                points: vec![e(1.75, 2.5, 0.9), e(11.75, 3.5, 0.95)],
+                pair: Some((5.7106, 1.004988)),
+            },
+        ];
+        let mut text = Vec::new();
+        write_csv(&mut text, &frames).unwrap();
+        let points = parse(std::str::from_utf8(&text).unwrap()).unwrap();
+        assert_eq!(points.len(), 2);
+        assert_eq!(points[1][1].at, DVec2::new(11.75, 3.5));
+        assert_eq!(points[0][1].time, TrackTime::Frame(4));
+        assert_eq!(points[0][1].rotate, Some(5.7106));
+        assert_eq!(points[0][1].confidence, Some(0.9));
+    }
+
+    #[test]
+    fn problems_are_placed_on_their_line() {
+        let err = |text: &str| parse(text).unwrap_err();
+        assert_eq!(err("\n1,2,3\n").0, 2);
+        assert!(err("frame,x,y\n1,2,zz\n").1.contains("`zz` is not a number"));
+        assert_eq!(err("frame,x,y\n2,0,0\n\n1,0,0\n").0, 4);
+        assert_eq!(err("frame,x,y\n").0, 2);
+        assert!(err("frame,x\n").1.contains("`x` and `y`"));
+    }
+}

@@ -1,0 +1,127 @@
+//! Grey pyramids of a window of a frame: takes a frame, a centre and a radius and gives the
+//! Rec. 709 luma of the pixels around the centre at full size and halved `levels − 1` times
+//! (2 × 2 means), sampled bilinearly in pixel coordinates (pixel (i, j) covers [i, i + 1] ×
+//! [j, j + 1] at its level). Only the window is converted, never the whole frame, so a
+//! tracked point costs the same on a 4K plate as on a thumbnail.
+
+use glam::DVec2;
+
+use crate::pixels::FloatImage;
+
+/// Rec. 709 luma weights, as the `monochrome` clone mode uses.
+const LUMA: [f32; 3] = [0.2126, 0.7152, 0.0722];
+
+/// One level: a rectangle of grey values, `origin` in this level's pixels.
+pub(super) struct Level {
+    origin: [i64; 2],
+    width: usize,
+    height: usize,
+    values: Vec<f32>,
+}
+
+impl Level {
+    /// Bilinear sample at `p` (this level's pixel coordinates), edges replicated.
+    #[inline]
+    pub(super) fn sample(&self, p: DVec2) -> f32 {
+        let u = (p.x - 0.5 - self.origin[0] as f64).clamp(0.0, (self.width - 1) as f64);
+        let v = (p.y - 0.5 - self.origin[1] as f64).clamp(0.0, (self.height - 1) as f64);
+        let (i, j) = (u.floor() as usize, v.floor() as usize);
+        let (fx, fy) = ((u - i as f64) as f32, (v - j as f64) as f32);
+        let i1 = (i + 1).min(self.width - 1);
+        let j1 = (j + 1).min(self.height - 1);
+        let row0 = j * self.width;
+        let row1 = j1 * self.width;
+        let top = self.values[row0 + i] * (1.0 - fx) + self.values[row0 + i1] * fx;
+        let bottom = self.values[row1 + i] * (1.0 - fx) + self.values[row1 + i1] * fx;
+        top * (1.0 - fy) + bottom * fy
+    }
+
+    /// The level below, halved by 2 × 2 means (the width and height are even).
+    fn halved(&self) -> Level {
+        let (width, height) = (self.width / 2, self.height / 2);
+        let mut values = Vec::with_capacity(width * height);
+        for j in 0..height {
+            let (a, b) = (2 * j * self.width, (2 * j + 1) * self.width);
+            for i in 0..width {
+                let sum = self.values[a + 2 * i]
+                    + self.values[a + 2 * i + 1]
+                    + self.values[b + 2 * i]
+                    + self.values[b + 2 * i + 1];
+                values.push(sum * 0.25);
+            }
+        }
+        Level {
+            origin: [self.origin[0] / 2, self.origin[1] / 2],
+            width,
+            height,
+            values,
+        }
+    }
+}
+
+/// Levels 0 (full size) to `levels − 1`.
+pub(super) struct Pyramid {
+    pub(super) levels: Vec<Level>,
+}
+
+impl Pyramid {
+    /// The pyramid of the square of half-side `radius` around `centre` in `frame`; pixels
+    /// beyond the frame repeat its edge. The window is aligned to the coarsest level's grid
+    /// so every level's pixels are exact means of the level below.
+    pub(super) fn around(frame: &FloatImage, centre: DVec2, radius: f64, levels: usize) -> Self {
+        let step = 1i64 << (levels - 1);
+        let align_down = |v: f64| (v.floor() as i64).div_euclid(step) * step;
+        let x0 = align_down(centre.x - radius);
+        let y0 = align_down(centre.y - radius);
+        let x1 = align_down(centre.x + radius) + step;
+        let y1 = align_down(centre.y + radius) + step;
+        let (width, height) = ((x1 - x0) as usize, (y1 - y0) as usize);
+        let (fw, fh) = (i64::from(frame.width()), i64::from(frame.height()));
+        let mut values = Vec::with_capacity(width * height);
+        for y in y0..y1 {
+            let j = y.clamp(0, fh - 1) as u32;
+            for x in x0..x1 {
+                let i = x.clamp(0, fw - 1) as u32;
+                // invariant: i and j were clamped into the frame just above.
+                let [r, g, b, _] = frame.pixel(i, j).expect("clamped into the frame");
+                values.push(LUMA[0] * r + LUMA[1] * g + LUMA[2] * b);
+            }
+        }
+        let mut out = vec![Level {
+            origin: [x0, y0],
+            width,
+            height,
+            values,
+        }];
+        for _ in 1..levels {
+            // invariant: the loop runs only while levels remain, after the first was pushed.
+            let next = out.last().expect("level 0 pushed").halved();
+            out.push(next);
+        }
+        Pyramid { levels: out }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::pixels::PixelFormat;
+
+    #[test]
+    fn levels_halve_and_samples_interpolate() {
+        let frame = FloatImage::from_fn(64, 48, PixelFormat::RGBA8, |i, _| {
+            let v = i as f32 / 64.0;
+            [v, v, v, 1.0]
+        })
+        .unwrap();
+        let pyramid = Pyramid::around(&frame, DVec2::new(30.0, 20.0), 10.0, 3);
+        assert_eq!(pyramid.levels.len(), 3);
+        // Luma of a grey ramp is the ramp; pixel i's centre is at i + 0.5.
+        let level0 = &pyramid.levels[0];
+        assert!((level0.sample(DVec2::new(30.5, 20.5)) - 30.0 / 64.0).abs() < 1e-5);
+        assert!((level0.sample(DVec2::new(31.0, 20.5)) - 30.5 / 64.0).abs() < 1e-5);
+        // Level 1 pixel 15 is the mean of level-0 pixels 30 and 31.
+        let level1 = &pyramid.levels[1];
+        assert!((level1.sample(DVec2::new(15.5, 10.5)) - 30.5 / 64.0).abs() < 1e-5);
+    }
+}
