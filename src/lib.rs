@@ -79,6 +79,7 @@ pub use clone::{
 pub use deform::{DeformError, DeformOptions, DeformRig, DeformStats, Deformed, Handle, Pin};
 pub use mesh::{
     BitMask, BoundaryPlacement, Mesh, MeshError, MeshOptions, MeshResult, MeshStats, Polygon,
+    MASK_THRESHOLD,
 };
 pub use pixels::{Canvas, ColorKind, Depth, FloatImage, FootageError, PixelError, PixelFormat};
 pub use render::{FrameStats, RenderError, Renderer};

@@ -40,7 +40,7 @@ pub struct MeshArgs {
 
 pub fn run(args: MeshArgs) -> anyhow::Result<()> {
     let options = options_from(&args)?;
-    let threshold = args.threshold.unwrap_or(0.5);
+    let threshold = args.threshold.unwrap_or(f64::from(lapclone::mesh::MASK_THRESHOLD));
     if !(0.0..=1.0).contains(&threshold) {
         return Err(UsageError(format!("--threshold must be in [0, 1], got {threshold}")).into());
     }

@@ -32,7 +32,7 @@ pub mod synth;
 mod triangulate;
 mod types;
 
-pub use bitmask::BitMask;
+pub use bitmask::{BitMask, MASK_THRESHOLD};
 pub use contour::{label_pieces, trace_crack_loops, CrackLoop};
 pub use coverage::{
     distance_to_mask, max_outside_distance, uncovered_mask_pixels, COVERAGE_TOLERANCE_PX,

@@ -22,4 +22,4 @@ pub use engine::{
 };
 pub use error::{ErrorKind, SceneError};
 pub use sandbox::{Limits, ModuleFiles, SandboxResolver};
-pub use validate::{validate_scene, CheckSummary, MASK_THRESHOLD};
+pub use validate::{validate_scene, CheckSummary};

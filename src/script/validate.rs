@@ -8,6 +8,7 @@ use std::path::Path;
 use super::draft::Origin;
 use super::engine::LoadedScene;
 use super::error::{ErrorKind, SceneError};
+use crate::mesh::{BitMask, MASK_THRESHOLD};
 use crate::scene::{Background, FrameState, Shape};
 
 /// What a valid scene contains.
@@ -20,9 +21,6 @@ pub struct CheckSummary {
     /// Inside pixels of each patch's mask (polygon patches: rounded polygon area).
     pub inside_pixels: Vec<u64>,
 }
-
-/// A mask pixel is inside when its luma is at least half scale.
-pub const MASK_THRESHOLD: u8 = 128;
 
 pub fn validate_scene(loaded: &LoadedScene) -> Result<CheckSummary, SceneError> {
     let scene = &loaded.scene;
@@ -68,17 +66,11 @@ pub fn validate_scene(loaded: &LoadedScene) -> Result<CheckSummary, SceneError> 
                         source.1
                     )));
                 }
-                let luma = mask.to_luma8();
-                luma.pixels().filter(|p| p.0[0] >= MASK_THRESHOLD).count() as u64
+                BitMask::from_image(&mask, MASK_THRESHOLD).count_inside() as u64
             }
-            Shape::Polygons(polygons) => polygons
-                .iter()
-                .map(|p| {
-                    let holes: f64 = p.holes.iter().map(|h| ring_area(h)).sum();
-                    (ring_area(&p.outer) - holes).max(0.0)
-                })
-                .sum::<f64>()
-                .round() as u64,
+            Shape::Polygons(polygons) => {
+                polygons.iter().map(|p| p.area()).sum::<f64>().round() as u64
+            }
         };
         if inside == 0 {
             let what = match &patch.shape {
@@ -118,15 +110,6 @@ pub fn validate_scene(loaded: &LoadedScene) -> Result<CheckSummary, SceneError> 
 
 fn decode(path: &Path) -> Result<image::DynamicImage, String> {
     crate::limits::open_image(path).map_err(|e| format!("cannot decode {}: {e}", path.display()))
-}
-
-fn ring_area(ring: &[glam::DVec2]) -> f64 {
-    let twice: f64 = ring
-        .iter()
-        .zip(ring.iter().cycle().skip(1))
-        .map(|(a, b)| a.perp_dot(*b))
-        .sum();
-    (twice / 2.0).abs()
 }
 
 fn state_is_finite(p: &crate::scene::PatchState) -> bool {
