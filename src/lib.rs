@@ -119,8 +119,8 @@ macro_rules! stage_modules {
 }
 
 stage_modules!(
-    clone, deform, golden, limits, mesh, output, pixels, png_bands, raster, render, scene, script,
-    simd, solve, util,
+    clone, deform, golden, limits, mesh, output, pixels, png_bands, process, raster, render, scene,
+    script, simd, solve, util,
 );
 
 // The CLI's files name library items as `lapclone::…`, as any other user would.

@@ -87,15 +87,6 @@ pub enum MeshError {
     /// The mesh broke an invariant.
     #[error("the mesh failed its sanity check")]
     Sanity(#[from] SanityError),
-    /// A mesh or Laplacian file cannot be written.
-    #[error("cannot write {path}")]
-    Write {
-        /// The file.
-        path: PathBuf,
-        /// The I/O error.
-        #[source]
-        source: std::io::Error,
-    },
 }
 
 /// The first broken invariant `Mesh::sanity_check` found.

@@ -24,9 +24,7 @@ fn masks() -> Vec<(&'static str, DynamicImage)> {
     vec![
         (
             "grey8",
-            DynamicImage::ImageLuma8(ImageBuffer::from_fn(SIZE, SIZE, |x, y| {
-                Luma([luma8(x, y)])
-            })),
+            DynamicImage::ImageLuma8(ImageBuffer::from_fn(SIZE, SIZE, |x, y| Luma([luma8(x, y)]))),
         ),
         (
             "rgb8",
@@ -81,7 +79,11 @@ fn lapclone(args: &[&std::ffi::OsStr]) -> (i32, String, String) {
         .output()
         .unwrap();
     let text = |b: Vec<u8>| String::from_utf8(b).unwrap();
-    (out.status.code().unwrap(), text(out.stdout), text(out.stderr))
+    (
+        out.status.code().unwrap(),
+        text(out.stdout),
+        text(out.stderr),
+    )
 }
 
 /// The source and target: smooth, different gradients so the clone changes pixels.
@@ -108,7 +110,9 @@ fn changed(picture: &Path, target: &Path) -> Vec<(u32, u32)> {
 }
 
 fn mesh_vertices(check_stdout: &str) -> u64 {
-    let (before, _) = check_stdout.split_once(" mesh vertices").expect(check_stdout);
+    let (before, _) = check_stdout
+        .split_once(" mesh vertices")
+        .expect(check_stdout);
     before.rsplit('(').next().unwrap().parse().unwrap()
 }
 
@@ -171,10 +175,15 @@ fn clone_check_and_render_agree_on_every_kind_of_mask() {
         let by_render = changed(&frame.path(), &target);
         assert!(!by_clone.is_empty(), "{name}: the clone changed nothing");
         assert!(
-            by_clone.iter().all(|&(x, y)| (11..37).contains(&x) && (11..37).contains(&y)),
+            by_clone
+                .iter()
+                .all(|&(x, y)| (11..37).contains(&x) && (11..37).contains(&y)),
             "{name}: the clone reaches outside the square"
         );
-        assert_eq!(by_render, by_clone, "{name}: render and clone cover the same pixels");
+        assert_eq!(
+            by_render, by_clone,
+            "{name}: render and clone cover the same pixels"
+        );
         cases += 1;
     }
     assert_eq!(cases, 8);

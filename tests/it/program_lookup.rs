@@ -51,7 +51,13 @@ fn an_extension_of_pathext_is_tried() {
     let tools = tempfile::tempdir().unwrap();
     std::fs::write(tools.path().join("ffmpeg.exe"), "stand-in").unwrap();
     let found = find_program_in("ffmpeg", tools.path().as_os_str()).unwrap();
-    assert!(found.to_string_lossy().to_lowercase().ends_with("ffmpeg.exe"), "{found:?}");
+    assert!(
+        found
+            .to_string_lossy()
+            .to_lowercase()
+            .ends_with("ffmpeg.exe"),
+        "{found:?}"
+    );
 }
 
 #[cfg(unix)]
