@@ -67,6 +67,7 @@
 //! add those input decoders (PNG and JPEG are always read).
 
 #![warn(missing_docs)]
+#![warn(unnameable_types)]
 #![forbid(unsafe_code)]
 
 pub use glam;
@@ -74,17 +75,24 @@ pub use image;
 
 pub use clone::{
     mesh_from_mask, mesh_from_polygons, Anchor, BoundaryData, CloneError, CloneMode, CloneOptions,
-    CloneStats, PatchCloner, PatchMesh, Placement,
+    CloneStats, GlueStats, MembraneStats, PatchCloner, PatchMesh, Placement,
 };
 pub use deform::{DeformError, DeformOptions, DeformRig, DeformStats, Deformed, Handle, Pin};
+pub use limits::LimitError;
 pub use mesh::{
-    BitMask, BoundaryPlacement, Mesh, MeshError, MeshOptions, MeshResult, MeshStats, Polygon,
-    MASK_THRESHOLD,
+    BitMask, BoundaryLoop, BoundaryPlacement, LoopKind, Mesh, MeshError, MeshOptions, MeshResult,
+    MeshStats, Polygon, SanityError, MASK_THRESHOLD,
 };
-pub use pixels::{Canvas, ColorKind, Depth, FloatImage, FootageError, PixelError, PixelFormat};
-pub use render::{FrameStats, RenderError, Renderer};
-pub use script::{load_scene, LoadedScene, SceneError};
-pub use solve::LaplacianKind;
+pub use pixels::{
+    Canvas, CanvasPixels, ColorKind, Depth, FloatImage, FootageError, PixelError, PixelFormat,
+    PixelRect,
+};
+pub use raster::{RasterError, RasterStats};
+pub use render::{FrameStats, RenderError, Renderer, SceneUpdate};
+/// The scene language's engine: [`SceneError::position`] is its [`rhai::Position`].
+pub use rhai;
+pub use script::{load_scene, ErrorKind as SceneErrorKind, LoadedScene, SceneError};
+pub use solve::{FactorMethod, LaplacianKind, PenaltyOptions, SolveError, SwitchStats};
 
 /// Scenes: the animated description a [`Renderer`] draws, built in Rust or loaded from a
 /// `.rhai` file with [`load_scene`]. A [`Scene`](animation::Scene) is a
@@ -97,10 +105,26 @@ pub use solve::LaplacianKind;
 /// [`Pattern`](animation::Pattern), or a video) is a background or a patch's animated source;
 /// [`Footage::open`](animation::Footage::open) reads its size. Errors: [`FootageError`].
 pub mod animation {
+    pub use crate::golden::{GoldenSettings, Thresholds};
     pub use crate::pixels::footage::Pattern;
     pub use crate::scene::{
-        Background, Canvas, Easing, Footage, FootageSource, Handle, Key, KeyError, ModelError,
-        Patch, Pin, Placement, Scene, Shape, Track,
+        Background, Canvas, Easing, Footage, FootageSource, FrameState, Handle, HandleState,
+        Interpolate, Key, KeyError, ModelError, Patch, PatchState, Pin, Placement, Scene, Shape,
+        Track,
+    };
+}
+
+/// Declares methods that name stage-internal types: public (and hidden) with the
+/// `internals` feature for lapclone's own tests and benchmarks, crate-private otherwise, so
+/// the API names only types a user can name.
+macro_rules! internal_fn {
+    ($(#[$meta:meta])* fn $($rest:tt)*) => {
+        #[cfg(feature = "internals")]
+        #[doc(hidden)]
+        $(#[$meta])* pub fn $($rest)*
+        #[cfg(not(feature = "internals"))]
+        #[allow(dead_code)]
+        $(#[$meta])* pub(crate) fn $($rest)*
     };
 }
 

@@ -90,6 +90,8 @@ pub enum MeshError {
 }
 
 /// The first broken invariant `Mesh::sanity_check` found.
+// Each variant's `#[error]` text says what it is and names its fields.
+#[allow(missing_docs)]
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SanityError {
     #[error("per-vertex arrays have lengths {is_boundary} (is_boundary) and {piece} (piece) for {positions} positions")]

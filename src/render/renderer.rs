@@ -219,16 +219,18 @@ impl Renderer {
         kept
     }
 
-    /// Each patch's mesh and where the last frame placed it, in scene order.
-    pub fn placed_meshes(&self) -> Vec<PlacedMesh<'_>> {
-        self.layers
-            .iter()
-            .map(|l| PlacedMesh {
-                name: &l.name,
-                mesh: l.mesh(),
-                placed: l.placed(),
-            })
-            .collect()
+    internal_fn! {
+        /// Each patch's mesh and where the last frame placed it, in scene order.
+        fn placed_meshes(&self) -> Vec<PlacedMesh<'_>> {
+            self.layers
+                .iter()
+                .map(|l| PlacedMesh {
+                    name: &l.name,
+                    mesh: l.mesh(),
+                    placed: l.placed(),
+                })
+                .collect()
+        }
     }
 
     /// Whether each patch (scene order) has a deformation rig built.

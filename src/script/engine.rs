@@ -68,7 +68,7 @@ pub struct LoadedScene {
     /// The scene the file describes.
     pub scene: Scene,
     /// Where in the file each patch and handle was made (for positioned errors).
-    pub origins: Origins,
+    pub(crate) origins: Origins,
     /// The scene file.
     pub file: PathBuf,
     /// The file's text.

@@ -38,7 +38,7 @@ pub enum FootageError {
         frame: u64,
         /// The file it needs.
         file: PathBuf,
-        /// The setting that would hold the last frame ([`Footage::hold_key`]).
+        /// The setting that would hold the last frame ([`Footage::hold_key`](super::Footage::hold_key)).
         hold_key: String,
     },
     /// A frame's size differs from the first frame's.
@@ -77,7 +77,7 @@ pub enum FootageError {
         frame: u64,
         /// Frames it has at the scene's frame rate.
         available: u64,
-        /// The setting that would hold the last frame ([`Footage::hold_key`]).
+        /// The setting that would hold the last frame ([`Footage::hold_key`](super::Footage::hold_key)).
         hold_key: String,
     },
     /// A frame's file cannot be read or decoded.
