@@ -96,22 +96,37 @@ pub use solve::{FactorMethod, LaplacianKind, PenaltyOptions, SolveError, SwitchS
 
 /// Scenes: the animated description a [`Renderer`] draws, built in Rust or loaded from a
 /// `.rhai` file with [`load_scene`]. A [`Scene`](animation::Scene) is a
-/// [`Canvas`](animation::Canvas) (size, frame rate, duration,
+/// [`SceneCanvas`](animation::SceneCanvas) (size, frame rate, duration,
 /// [`Background`](animation::Background)) and layered [`Patch`](animation::Patch)es, each
-/// with a [`Shape`](animation::Shape), an animated [`Placement`](animation::Placement), drag
-/// [`Handle`](animation::Handle)s and [`Pin`](animation::Pin)s; every animated value is a
+/// with a [`Shape`](animation::Shape), an animated
+/// [`ScenePlacement`](animation::ScenePlacement), drag [`SceneHandle`](animation::SceneHandle)s
+/// and [`ScenePin`](animation::ScenePin)s; every animated value is a
 /// [`Track`](animation::Track) of [`Key`](animation::Key)s, each with an
 /// [`Easing`](animation::Easing). [`Footage`](animation::Footage) (numbered plates through a
 /// [`Pattern`](animation::Pattern), or a video) is a background or a patch's animated source;
 /// [`Footage::open`](animation::Footage::open) reads its size. Errors: [`FootageError`].
+/// The four `Scene…` names keep these apart from the root's [`Canvas`], [`Handle`], [`Pin`]
+/// and [`Placement`], which are a frame's pixels and one clone's or deformation's values.
 pub mod animation {
     pub use crate::golden::{GoldenSettings, Thresholds};
     pub use crate::pixels::footage::Pattern;
     pub use crate::scene::{
-        Background, Canvas, Easing, Footage, FootageSource, FrameState, Handle, HandleState,
-        Interpolate, Key, KeyError, ModelError, Patch, PatchState, Pin, Placement, Scene, Shape,
-        Track,
+        Background, Canvas as SceneCanvas, Easing, Footage, FootageSource, FrameState,
+        Handle as SceneHandle, HandleState, Interpolate, Key, KeyError, ModelError, Patch,
+        PatchState, Pin as ScenePin, Placement as ScenePlacement, Scene, Shape, Track,
     };
+    /// Renamed [`SceneCanvas`].
+    #[deprecated(note = "renamed `SceneCanvas`")]
+    pub type Canvas = SceneCanvas;
+    /// Renamed [`SceneHandle`].
+    #[deprecated(note = "renamed `SceneHandle`")]
+    pub type Handle = SceneHandle;
+    /// Renamed [`ScenePin`].
+    #[deprecated(note = "renamed `ScenePin`")]
+    pub type Pin = ScenePin;
+    /// Renamed [`ScenePlacement`].
+    #[deprecated(note = "renamed `ScenePlacement`")]
+    pub type Placement = ScenePlacement;
 }
 
 /// Declares methods that name stage-internal types: public (and hidden) with the

@@ -75,6 +75,16 @@ pub struct LoadedScene {
     pub text: String,
 }
 
+impl LoadedScene {
+    /// What `lapclone check` warns about: old spellings the file used (positioned), then
+    /// [`Scene::warnings`].
+    pub fn warnings(&self) -> Vec<String> {
+        let mut all = self.origins.warnings.clone();
+        all.extend(self.scene.warnings());
+        all
+    }
+}
+
 impl SceneEngine {
     pub fn new(options: &ScriptOptions) -> Self {
         let resolver = SandboxResolver::new(&options.scene_dir, options.scripts_dir.as_deref());

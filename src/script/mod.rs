@@ -15,7 +15,7 @@ mod sandbox;
 mod validate;
 mod values;
 
-pub use refs::{HandleRef, PatchRef};
+pub use refs::{HandleRef, PatchRef, PinRef};
 pub use draft::{Draft, Ids, Origin, Origins};
 pub use engine::{
     find_scripts_dir, load_scene, parse_scene, LoadedScene, SceneEngine, ScriptOptions,

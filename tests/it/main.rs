@@ -48,6 +48,7 @@ mod scene_check_cli;
 mod scene_editing;
 mod scene_golden;
 mod scene_language;
+mod scene_renames;
 mod scene_roundtrip;
 mod simd_paths;
 mod solve_factor;
