@@ -189,7 +189,14 @@ fn parse_canvas(
     Ok(canvas)
 }
 
-const PATCH_OPTIONS: [&str; 11] = [
+/// The option keys of `canvas`, polygons, `drag`, `pin` and key maps in their current
+/// spelling (the REPL completes them; `PATCH_OPTIONS` has the rest).
+pub const OTHER_OPTION_KEYS: [&str; 15] = [
+    "fps", "duration", "background", "background_start_number", "background_hold", "outer",
+    "holes", "pivot", "start", "end", "t", "scale", "depth", "opacity", "ease",
+];
+
+pub const PATCH_OPTIONS: [&str; 11] = [
     "source",
     "source_start_number",
     "source_hold",
@@ -594,21 +601,26 @@ impl CustomType for PatchRef {
                 |ctx: NativeCallContext, p: &mut PatchRef, at: Dynamic, o: Map| p.pin(ctx, at, o),
             );
         super::edit_api::build_patch(&mut b);
-        for which in Placed::ALL {
-            let name = which.name();
-            b.with_fn(
-                name,
-                move |ctx: NativeCallContext, p: &mut PatchRef, t: Dynamic, v: Dynamic| {
-                    p.track_key(ctx, which, t, v, "linear")
-                },
-            )
-            .with_fn(
-                name,
-                move |ctx: NativeCallContext, p: &mut PatchRef, t: Dynamic, v: Dynamic, e: &str| {
-                    p.track_key(ctx, which, t, v, e)
-                },
-            );
-        }
+        build_tracks(&mut b);
+    }
+}
+
+/// `p.at(t, v [, easing])` and the other placement tracks, one function each.
+fn build_tracks(b: &mut TypeBuilder<PatchRef>) {
+    for which in Placed::ALL {
+        let name = which.name();
+        b.with_fn(
+            name,
+            move |ctx: NativeCallContext, p: &mut PatchRef, t: Dynamic, v: Dynamic| {
+                p.track_key(ctx, which, t, v, "linear")
+            },
+        )
+        .with_fn(
+            name,
+            move |ctx: NativeCallContext, p: &mut PatchRef, t: Dynamic, v: Dynamic, e: &str| {
+                p.track_key(ctx, which, t, v, e)
+            },
+        );
     }
 }
 

@@ -22,4 +22,5 @@ pub use engine::{
 };
 pub use error::{ErrorKind, SceneError};
 pub use sandbox::{Limits, ModuleFiles, SandboxResolver};
+pub use api::{OTHER_OPTION_KEYS, PATCH_OPTIONS};
 pub use validate::{validate_scene, CheckSummary};

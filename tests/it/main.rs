@@ -14,6 +14,7 @@ mod golden;
 #[path = "../common/raster_meshes.rs"]
 mod raster_meshes;
 
+mod architecture;
 mod bad_input;
 mod clone_cli;
 mod clone_glue;
