@@ -1,6 +1,6 @@
 //! Footage: takes a printf-style numbered image pattern (`plate_%04d.png`, `%d`, `%0Nd`,
 //! `%%`) with a start number, or a video file decoded by an `ffmpeg` process, and gives one
-//! frame at a time as a [`FloatImage`]. Only the frame asked for is held: sequences load one
+//! frame at a time as a [`FloatImage`](super::FloatImage). Only the frame asked for is held: sequences load one
 //! file per frame, videos are streamed as raw RGBA frames at the scene's frame rate (frame i
 //! is the picture shown at t = i / fps), never all at once. This file says what footage is
 //! and checks it covers a scene; the pattern, ffprobe, the reader and the decoding ffmpeg
