@@ -5,7 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-use lapclone::animation::{Background, Canvas, Easing, Patch, Scene, Shape, Track};
+use lapclone::animation::{Background, Easing, Patch, Scene, SceneCanvas, Shape, Track};
 use lapclone::glam::DVec2;
 use lapclone::Renderer;
 
@@ -32,7 +32,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     face.placement.scale.push(1.0, 0.42, Easing::Smooth)?;
 
     let coffee = image::image_dimensions(assets.join("coffee.png"))?;
-    let canvas = Canvas {
+    let canvas = SceneCanvas {
         width: coffee.0,
         height: coffee.1,
         fps: 8.0,

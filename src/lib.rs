@@ -67,6 +67,7 @@
 //! add those input decoders (PNG and JPEG are always read).
 
 #![warn(missing_docs)]
+#![warn(unnameable_types)]
 #![forbid(unsafe_code)]
 
 pub use glam;
@@ -74,18 +75,24 @@ pub use image;
 
 pub use clone::{
     mesh_from_mask, mesh_from_polygons, Anchor, BoundaryData, CloneError, CloneMode, CloneOptions,
-    CloneStats, PatchCloner, PatchMesh, Placement,
+    CloneStats, GlueStats, MembraneStats, PatchCloner, PatchMesh, Placement,
 };
 pub use deform::{DeformError, DeformOptions, DeformRig, DeformStats, Deformed, Handle, Pin};
+pub use limits::LimitError;
 pub use mesh::{
-    BitMask, BoundaryPlacement, Mesh, MeshError, MeshOptions, MeshResult, MeshStats, Polygon,
+    BitMask, BoundaryLoop, BoundaryPlacement, LoopKind, Mesh, MeshError, MeshOptions, MeshResult,
+    MeshStats, Polygon, SanityError, MASK_THRESHOLD,
 };
 pub use pixels::{
     Canvas, CanvasPixels, ColorKind, Depth, FloatImage, FootageError, PixelError, PixelFormat,
+    PixelRect,
 };
-pub use render::{FrameStats, RenderError, Renderer};
-pub use script::{load_scene, LoadedScene, SceneError};
-pub use solve::LaplacianKind;
+pub use raster::{RasterError, RasterStats};
+pub use render::{FrameStats, RenderError, Renderer, SceneUpdate};
+/// The scene language's engine: [`SceneError::position`] is its [`rhai::Position`].
+pub use rhai;
+pub use script::{load_scene, ErrorKind as SceneErrorKind, LoadedScene, SceneError};
+pub use solve::{FactorMethod, LaplacianKind, PenaltyOptions, SolveError, SwitchStats};
 
 /// Opens a scene file as `lapclone render` does: loads and runs it ([`load_scene`]),
 /// validates it (a canvas, patches whose masks and sources exist and fit, ...) and builds
@@ -102,19 +109,50 @@ pub fn open_scene(path: &std::path::Path) -> Result<(LoadedScene, Renderer), Sce
 
 /// Scenes: the animated description a [`Renderer`] draws, built in Rust or loaded from a
 /// `.rhai` file with [`load_scene`]. A [`Scene`](animation::Scene) is a
-/// [`Canvas`](animation::Canvas) (size, frame rate, duration,
+/// [`SceneCanvas`](animation::SceneCanvas) (size, frame rate, duration,
 /// [`Background`](animation::Background)) and layered [`Patch`](animation::Patch)es, each
-/// with a [`Shape`](animation::Shape), an animated [`Placement`](animation::Placement), drag
-/// [`Handle`](animation::Handle)s and [`Pin`](animation::Pin)s; every animated value is a
+/// with a [`Shape`](animation::Shape), an animated
+/// [`ScenePlacement`](animation::ScenePlacement), drag [`SceneHandle`](animation::SceneHandle)s
+/// and [`ScenePin`](animation::ScenePin)s; every animated value is a
 /// [`Track`](animation::Track) of [`Key`](animation::Key)s, each with an
 /// [`Easing`](animation::Easing). [`Footage`](animation::Footage) (numbered plates through a
 /// [`Pattern`](animation::Pattern), or a video) is a background or a patch's animated source;
 /// [`Footage::open`](animation::Footage::open) reads its size. Errors: [`FootageError`].
+/// The four `Scene…` names keep these apart from the root's [`Canvas`], [`Handle`], [`Pin`]
+/// and [`Placement`], which are a frame's pixels and one clone's or deformation's values.
 pub mod animation {
+    pub use crate::golden::{GoldenSettings, Thresholds};
     pub use crate::pixels::footage::Pattern;
     pub use crate::scene::{
-        Background, Canvas, Easing, Footage, FootageSource, Handle, Key, KeyError, ModelError,
-        Patch, Pin, Placement, Scene, Shape, Track,
+        Background, Canvas as SceneCanvas, Easing, Footage, FootageSource, FrameState,
+        Handle as SceneHandle, HandleState, Interpolate, Key, KeyError, ModelError, Patch,
+        PatchState, Pin as ScenePin, Placement as ScenePlacement, Scene, Shape, Track,
+    };
+    /// Renamed [`SceneCanvas`].
+    #[deprecated(note = "renamed `SceneCanvas`")]
+    pub type Canvas = SceneCanvas;
+    /// Renamed [`SceneHandle`].
+    #[deprecated(note = "renamed `SceneHandle`")]
+    pub type Handle = SceneHandle;
+    /// Renamed [`ScenePin`].
+    #[deprecated(note = "renamed `ScenePin`")]
+    pub type Pin = ScenePin;
+    /// Renamed [`ScenePlacement`].
+    #[deprecated(note = "renamed `ScenePlacement`")]
+    pub type Placement = ScenePlacement;
+}
+
+/// Declares methods that name stage-internal types: public (and hidden) with the
+/// `internals` feature for lapclone's own tests and benchmarks, crate-private otherwise, so
+/// the API names only types a user can name.
+macro_rules! internal_fn {
+    ($(#[$meta:meta])* fn $($rest:tt)*) => {
+        #[cfg(feature = "internals")]
+        #[doc(hidden)]
+        $(#[$meta])* pub fn $($rest)*
+        #[cfg(not(feature = "internals"))]
+        #[allow(dead_code)]
+        $(#[$meta])* pub(crate) fn $($rest)*
     };
 }
 
@@ -133,8 +171,8 @@ macro_rules! stage_modules {
 }
 
 stage_modules!(
-    clone, deform, golden, limits, mesh, output, pixels, png_bands, raster, render, scene, script,
-    simd, solve, track, util,
+    clone, deform, golden, limits, mesh, output, pixels, png_bands, process, raster, render, scene,
+    script, simd, solve, track, util,
 );
 
 // The CLI's files name library items as `lapclone::…`, as any other user would.

@@ -26,6 +26,8 @@ pub const MAX_FRAMES: u64 = 1_000_000;
 pub(crate) const MAX_DECODER_ALLOC: u64 = MAX_IMAGE_PIXELS * 8 + (64 << 20);
 
 /// An input larger than the documented limits.
+// Each variant's `#[error]` text says what it is and names its fields.
+#[allow(missing_docs)]
 #[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
 pub enum LimitError {
     #[error(

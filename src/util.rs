@@ -24,25 +24,16 @@ pub fn available_cores() -> usize {
     *CORES.get_or_init(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
 }
 
-/// The first executable file called `name` in a folder of `PATH`.
+/// The first executable file called `name` in a folder of `PATH` (on Windows also `name`
+/// with an extension of `PATHEXT`, such as `ffmpeg.exe`).
 pub fn find_program(name: &str) -> Option<PathBuf> {
-    let path = std::env::var_os("PATH")?;
-    std::env::split_paths(&path)
-        .map(|dir| dir.join(name))
-        .find(|candidate| is_executable(candidate))
+    find_program_in(name, &std::env::var_os("PATH")?)
 }
 
-fn is_executable(path: &Path) -> bool {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        path.metadata()
-            .is_ok_and(|m| m.is_file() && m.permissions().mode() & 0o111 != 0)
-    }
-    #[cfg(not(unix))]
-    {
-        path.is_file()
-    }
+/// [`find_program`] over the folders of `search`, a `PATH`-style list.
+pub fn find_program_in(name: &str, search: &std::ffi::OsStr) -> Option<PathBuf> {
+    let cwd = std::env::current_dir().ok()?;
+    which::which_in(name, Some(search), cwd).ok()
 }
 
 /// Writes `bytes` to `path` through a temporary sibling file and a rename.

@@ -50,7 +50,7 @@ pub struct CloneArgs {
     #[command(flatten)]
     pub mesh: super::mesh_args::MeshQualityArgs,
     /// Inside threshold of the mask in [0, 1].
-    #[arg(long, default_value_t = 0.5, value_parser = finite_f64, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = f64::from(lapclone::mesh::MASK_THRESHOLD), value_parser = finite_f64, allow_hyphen_values = true)]
     pub threshold: f64,
     #[arg(long, value_enum, default_value_t = LaplacianArg::Combinatorial)]
     pub laplacian: LaplacianArg,

@@ -40,7 +40,9 @@ pub struct MeshArgs {
 
 pub fn run(args: MeshArgs) -> anyhow::Result<()> {
     let options = options_from(&args)?;
-    let threshold = args.threshold.unwrap_or(0.5);
+    let threshold = args
+        .threshold
+        .unwrap_or(f64::from(lapclone::mesh::MASK_THRESHOLD));
     if !(0.0..=1.0).contains(&threshold) {
         return Err(UsageError(format!("--threshold must be in [0, 1], got {threshold}")).into());
     }
@@ -65,7 +67,7 @@ pub fn run(args: MeshArgs) -> anyhow::Result<()> {
         write_picture(&result.mesh, &mask, path)?;
     }
     if let Some(path) = &args.laplacian_out {
-        mesh::write_laplacian(&result.mesh, path)?;
+        write_laplacian(&result.mesh, path)?;
     }
     let stats = &result.stats;
     if args.stats {
@@ -98,6 +100,19 @@ fn options_from(args: &MeshArgs) -> anyhow::Result<MeshOptions> {
         options.validate().map_err(|e| UsageError(e.to_string()))?;
     }
     Ok(options)
+}
+
+/// The combinatorial Laplacian at `path` and the boundary vertices (0-based, one a line) at
+/// `path.boundary`.
+fn write_laplacian(mesh: &Mesh, path: &Path) -> anyhow::Result<()> {
+    let l = lapclone::solve::laplacian(mesh, lapclone::solve::LaplacianKind::Combinatorial);
+    let comment = "combinatorial Laplacian of a lapclone mesh";
+    lapclone::solve::write_matrix_market(path, &l, comment)?;
+    let mut boundary = path.as_os_str().to_os_string();
+    boundary.push(".boundary");
+    let list: String = mesh.boundary_vertices().map(|v| format!("{v}\n")).collect();
+    lapclone::util::write_atomic(Path::new(&boundary), list.as_bytes())
+        .with_context(|| format!("cannot write {}", Path::new(&boundary).display()))
 }
 
 /// The mesh over the mask (light grey inside, dark grey outside), upscaled for viewing.

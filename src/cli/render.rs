@@ -291,7 +291,7 @@ pub fn run_check(args: CheckArgs) -> anyhow::Result<()> {
         c.frame_count(),
         loaded.scene.patches.len(),
     );
-    for warning in loaded.scene.warnings() {
+    for warning in loaded.warnings() {
         eprintln!("warning: {warning}");
     }
     Ok(())

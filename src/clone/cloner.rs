@@ -178,9 +178,11 @@ impl PatchCloner {
         &self.placed
     }
 
-    /// The membrane of the last clone.
-    pub fn membrane(&self) -> &MembraneSolver {
-        &self.membrane
+    internal_fn! {
+        /// The membrane of the last clone.
+        fn membrane(&self) -> &MembraneSolver {
+            &self.membrane
+        }
     }
 
     /// The glued vertices of the last clone (the glue's internals, for lapclone's own tests).

@@ -43,6 +43,7 @@ pub struct MembraneStats {
     pub glued: usize,
     /// Back-substitutions the glue added.
     pub glue_iterations: usize,
+    /// How the factor's constraint switches went.
     pub switches: SwitchStats,
 }
 

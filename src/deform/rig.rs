@@ -120,14 +120,18 @@ impl DeformRig {
         &self.options
     }
 
-    /// The Laplacian the rig factors (assembled from the per-triangle shares).
-    pub fn laplacian(&self) -> &SymmetricCsc {
-        &self.laplacian
+    internal_fn! {
+        /// The Laplacian the rig factors (assembled from the per-triangle shares).
+        fn laplacian(&self) -> &SymmetricCsc {
+            &self.laplacian
+        }
     }
 
-    /// The rig's own penalty factor (its constrained set is the last frame's).
-    pub fn factor(&self) -> &PenaltyFactor {
-        &self.factor
+    internal_fn! {
+        /// The rig's own penalty factor (its constrained set is the last frame's).
+        fn factor(&self) -> &PenaltyFactor {
+            &self.factor
+        }
     }
 
     /// Vertices constrained in the last solved frame (far field, pins and handles).

@@ -40,11 +40,17 @@ impl Default for Thresholds {
 pub struct GoldenSettings {
     /// Frame numbers (from 1, as `lapclone render` numbers them) to check.
     pub frames: Option<Vec<u64>>,
+    /// [`Thresholds::fail`].
     pub fail: Option<f64>,
+    /// [`Thresholds::fail_percent`].
     pub fail_percent: Option<f64>,
+    /// [`Thresholds::hard_fail`].
     pub hard_fail: Option<f64>,
+    /// [`Thresholds::warn`].
     pub warn: Option<f64>,
+    /// [`Thresholds::warn_percent`].
     pub warn_percent: Option<f64>,
+    /// [`Thresholds::min_ssim`].
     pub min_ssim: Option<f64>,
 }
 

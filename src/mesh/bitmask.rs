@@ -6,6 +6,11 @@ use std::path::Path;
 
 use super::MeshError;
 
+/// The one definition of "inside" every caller shares (`lapclone clone` and `mesh` by
+/// default, a scene's check and its render): alpha, or luminance without alpha, at least
+/// half scale.
+pub const MASK_THRESHOLD: f32 = 0.5;
+
 /// The first index from `from` on whose byte differs from `value` (`bytes.len()` if none),
 /// eight bytes per test where it can.
 pub fn run_end(bytes: &[u8], from: usize, value: u8) -> usize {

@@ -87,18 +87,11 @@ pub enum MeshError {
     /// The mesh broke an invariant.
     #[error("the mesh failed its sanity check")]
     Sanity(#[from] SanityError),
-    /// A mesh or Laplacian file cannot be written.
-    #[error("cannot write {path}")]
-    Write {
-        /// The file.
-        path: PathBuf,
-        /// The I/O error.
-        #[source]
-        source: std::io::Error,
-    },
 }
 
 /// The first broken invariant `Mesh::sanity_check` found.
+// Each variant's `#[error]` text says what it is and names its fields.
+#[allow(missing_docs)]
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SanityError {
     #[error("per-vertex arrays have lengths {is_boundary} (is_boundary) and {piece} (piece) for {positions} positions")]

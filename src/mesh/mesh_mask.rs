@@ -26,6 +26,15 @@ pub struct Polygon {
     pub holes: Vec<Vec<DVec2>>,
 }
 
+impl Polygon {
+    /// The enclosed area in px²: the outer ring's less its holes', never below zero.
+    pub fn area(&self) -> f64 {
+        let ring = |r: &[DVec2]| doubled_signed_area(r).abs() / 2.0;
+        let holes: f64 = self.holes.iter().map(|h| ring(h)).sum();
+        (ring(&self.outer) - holes).max(0.0)
+    }
+}
+
 /// Meshes the inside of a mask.
 pub fn mesh_mask(mask: &BitMask, options: &MeshOptions) -> Result<MeshResult, MeshError> {
     options.validate()?;

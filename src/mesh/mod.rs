@@ -13,7 +13,7 @@
 //! (`triangulate`) → [`Mesh`], verified by [`Mesh::sanity_check`]. Every mask is meshed
 //! whole, on the calling thread. [`relax_interior`] evens out the interior for the
 //! combinatorial Laplacian (the clone stage applies it). Mask-aware checks are in
-//! `coverage`; the Laplacian export in `laplacian_mtx`; test/bench masks in [`synth`].
+//! `coverage`; test/bench masks in [`synth`].
 
 mod bitmask;
 mod centre_loops;
@@ -22,7 +22,6 @@ mod coverage;
 mod error;
 #[doc(hidden)]
 pub mod fixtures;
-mod laplacian_mtx;
 mod mesh_mask;
 mod options;
 mod relax;
@@ -32,13 +31,12 @@ pub mod synth;
 mod triangulate;
 mod types;
 
-pub use bitmask::BitMask;
+pub use bitmask::{BitMask, MASK_THRESHOLD};
 pub use contour::{label_pieces, trace_crack_loops, CrackLoop};
 pub use coverage::{
     distance_to_mask, max_outside_distance, uncovered_mask_pixels, COVERAGE_TOLERANCE_PX,
 };
 pub use error::{MeshError, SanityError};
-pub use laplacian_mtx::{boundary_list, boundary_path, laplacian_matrix_market, write_laplacian};
 pub use mesh_mask::{mesh_mask, mesh_polygons, Polygon, MAX_POLYGON_COORDINATE};
 pub use options::{
     min_angle_deg, BoundaryPlacement, MeshOptions, MeshResult, MeshStats, MAX_RELAX_SWEEPS,

@@ -5,7 +5,9 @@ use glam::DVec2;
 /// Whether a boundary loop bounds a piece from outside or a hole inside it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum LoopKind {
+    /// Bounds a piece from outside (positive signed area).
     Outer,
+    /// Bounds a hole inside a piece (negative signed area).
     Hole,
 }
 
@@ -14,9 +16,11 @@ pub enum LoopKind {
 /// holes negative, so the inside is always on the same side of every boundary edge.
 #[derive(Clone, Debug, PartialEq)]
 pub struct BoundaryLoop {
+    /// Outer boundary or hole.
     pub kind: LoopKind,
     /// Connected piece this loop belongs to.
     pub piece: u32,
+    /// Vertex indices in order around the loop.
     pub vertices: Vec<u32>,
 }
 

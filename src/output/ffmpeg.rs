@@ -22,19 +22,19 @@
 //! and converted by ffmpeg (to 10-bit 4:4:4 with alpha), with the same BT.709 matrix,
 //! limited range and tags.
 
-use std::io::{Read, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::process::{Child, ChildStdin, Command, ExitStatus, Stdio};
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::process::{ChildStdin, Command, ExitStatus, Stdio};
+use std::sync::atomic::AtomicBool;
 use std::sync::mpsc::{sync_channel, Receiver, SyncSender};
 use std::sync::Arc;
-use std::time::Duration;
 use std::thread::JoinHandle;
 
 use super::atomic::TempOutput;
 use super::yuv::{frame_to_yuv420, yuv420_size};
 use super::y4m::{check_stream, fps_fraction, stream_header};
 use super::{FrameRef, OutputError};
+use crate::process::Child;
 
 /// How lapclone's videos are tagged, as ffmpeg options (before `-i` for the 4:2:0 input,
 /// after it for the encoded stream): BT.709 matrix, primaries and transfer, limited range.
@@ -201,30 +201,16 @@ fn codec_args(kind: VideoKind, crf: Option<u32>, keeps_alpha: bool) -> Vec<Strin
 }
 
 /// The ffmpeg process and the temporary file it writes. Dropped unfinished, it stops
-/// ffmpeg, then the temporary file is removed.
+/// ffmpeg (the child field drops first), then the temporary file is removed.
 struct Encoder {
     child: Child,
     temp: Option<TempOutput>,
-}
-
-impl Encoder {
-    fn stop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
-}
-
-impl Drop for Encoder {
-    fn drop(&mut self) {
-        self.stop();
-    }
 }
 
 /// A started ffmpeg with its input pipe still in hand.
 struct Spawned {
     encoder: Encoder,
     stdin: ChildStdin,
-    stderr: JoinHandle<String>,
 }
 
 /// Starts ffmpeg writing `path`'s temporary file with `args` (input and codec).
@@ -237,8 +223,7 @@ fn spawn_ffmpeg(path: &Path, args: Vec<String>) -> Result<Spawned, OutputError> 
         .args(args)
         .arg(temp.temp_path())
         .stdin(Stdio::piped())
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped());
+        .stdout(Stdio::null());
     #[cfg(unix)]
     {
         // Its own process group: Ctrl-C reaches lapclone, which then stops ffmpeg and
@@ -246,23 +231,16 @@ fn spawn_ffmpeg(path: &Path, args: Vec<String>) -> Result<Spawned, OutputError> 
         use std::os::unix::process::CommandExt;
         command.process_group(0);
     }
-    let mut child = command.spawn().map_err(|e| OutputError::io(path, e))?;
-    // invariant: both were requested as pipes just above.
-    let stdin = child.stdin.take().expect("piped stdin");
+    let mut child = Child::spawn(&mut command).map_err(|e| OutputError::io(path, e))?;
+    // invariant: requested as a pipe just above.
+    let stdin = child.take_stdin().expect("piped stdin");
     widen_pipe(&stdin);
-    let mut stderr_pipe = child.stderr.take().expect("piped stderr");
-    let stderr = std::thread::spawn(move || {
-        let mut text = String::new();
-        let _ = stderr_pipe.read_to_string(&mut text);
-        text
-    });
     Ok(Spawned {
         encoder: Encoder {
             child,
             temp: Some(temp),
         },
         stdin,
-        stderr,
     })
 }
 
@@ -320,7 +298,6 @@ pub struct FfmpegWriter {
     sender: Option<SyncSender<Vec<u8>>>,
     spare: Receiver<Vec<u8>>,
     feeder: Option<JoinHandle<std::io::Result<()>>>,
-    stderr: Option<JoinHandle<String>>,
     options: VideoOptions,
     /// Threads converting a frame to 4:2:0.
     threads: usize,
@@ -356,7 +333,6 @@ impl FfmpegWriter {
         let Spawned {
             encoder,
             mut stdin,
-            stderr,
         } = spawned;
         let y4m = !options.keeps_alpha();
         let header = if y4m { options.y4m_header() } else { Vec::new() };
@@ -379,7 +355,6 @@ impl FfmpegWriter {
             sender: Some(sender),
             spare,
             feeder: Some(feeder),
-            stderr: Some(stderr),
             options,
             threads: threads.max(1),
             cancel: None,
@@ -441,31 +416,16 @@ impl FfmpegWriter {
     /// ffmpeg's exit status; `Cancelled` as soon as the cancel flag is set (dropping the
     /// writer then stops ffmpeg and removes the temporary file).
     fn wait_unless_cancelled(&mut self) -> Result<ExitStatus, OutputError> {
-        let io = |e| OutputError::io(&self.path, e);
-        let Some(cancel) = self.cancel.clone() else {
-            return self.encoder.child.wait().map_err(io);
-        };
-        loop {
-            if let Some(status) = self.encoder.child.try_wait().map_err(io)? {
-                return Ok(status);
-            }
-            if cancel.load(Ordering::Relaxed) {
-                return Err(OutputError::Cancelled);
-            }
-            std::thread::sleep(Duration::from_millis(2));
-        }
+        let waited = self.encoder.child.wait(self.cancel.as_deref());
+        waited
+            .map_err(|e| OutputError::io(&self.path, e))?
+            .ok_or(OutputError::Cancelled)
     }
 
     fn failure(&mut self) -> OutputError {
         self.sender = None;
-        self.encoder.stop();
-        let stderr = self
-            .stderr
-            .take()
-            .and_then(|h| h.join().ok())
-            .unwrap_or_default();
-        let lines: Vec<&str> = stderr.lines().filter(|l| !l.trim().is_empty()).collect();
-        let last = lines[lines.len().saturating_sub(5)..].join("\n  ");
+        self.encoder.child.stop();
+        let last = self.encoder.child.last_lines(5).join("\n  ");
         OutputError::Ffmpeg {
             path: self.path.clone(),
             stderr: if last.is_empty() {
@@ -482,7 +442,7 @@ impl Drop for FfmpegWriter {
         // Unless finished: stop ffmpeg (so the feeder's write fails) before the temporary
         // file is removed.
         self.sender = None;
-        self.encoder.stop();
+        self.encoder.child.stop();
         if let Some(feeder) = self.feeder.take() {
             let _ = feeder.join();
         }

@@ -54,7 +54,7 @@ impl<'a> FrameRef<'a> {
         matches!(self.pixels, Pixels::Rgba16(_))
     }
 
-    pub fn to_owned_frame(&self) -> Frame {
+    pub fn to_owned_frame(self) -> Frame {
         let data = match self.pixels {
             Pixels::Rgba8(p) => FrameData::Rgba8(p.to_vec()),
             Pixels::Rgba16(p) => FrameData::Rgba16(p.to_vec()),

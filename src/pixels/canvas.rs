@@ -362,49 +362,53 @@ impl Canvas {
         image.expect("buffer size") // invariant: the buffer holds width × height RGBA pixels
     }
 
-    /// An 8-bit premultiplied copy for tiny-skia drawing (16-bit values are rounded).
-    pub fn to_tiny_skia_pixmap(&self) -> tiny_skia::Pixmap {
-        let mut pixmap = tiny_skia::Pixmap::new(self.width, self.height).expect("non-empty"); // invariant: the canvas size is non-zero (checked at construction).
-        let write = |dst: &mut [tiny_skia::PremultipliedColorU8],
-                     rgba: &mut dyn Iterator<Item = [f32; 4]>| {
-            for (d, [r, g, b, a]) in dst.iter_mut().zip(rgba) {
-                let c = tiny_skia::ColorU8::from_rgba(
-                    u8::from_unit(r),
-                    u8::from_unit(g),
-                    u8::from_unit(b),
-                    u8::from_unit(a),
-                );
-                *d = c.premultiply();
+    internal_fn! {
+        /// An 8-bit premultiplied copy for tiny-skia drawing (16-bit values are rounded).
+        fn to_tiny_skia_pixmap(&self) -> tiny_skia::Pixmap {
+            let mut pixmap = tiny_skia::Pixmap::new(self.width, self.height).expect("non-empty"); // invariant: the canvas size is non-zero (checked at construction).
+            let write = |dst: &mut [tiny_skia::PremultipliedColorU8],
+                         rgba: &mut dyn Iterator<Item = [f32; 4]>| {
+                for (d, [r, g, b, a]) in dst.iter_mut().zip(rgba) {
+                    let c = tiny_skia::ColorU8::from_rgba(
+                        u8::from_unit(r),
+                        u8::from_unit(g),
+                        u8::from_unit(b),
+                        u8::from_unit(a),
+                    );
+                    *d = c.premultiply();
+                }
+            };
+            match &self.pixels {
+                CanvasPixels::Eight(p) => write(
+                    pixmap.pixels_mut(),
+                    &mut p.iter().map(|px| px.map(Texel::to_unit)),
+                ),
+                CanvasPixels::Sixteen(p) => write(
+                    pixmap.pixels_mut(),
+                    &mut p.iter().map(|px| px.map(Texel::to_unit)),
+                ),
             }
-        };
-        match &self.pixels {
-            CanvasPixels::Eight(p) => write(
-                pixmap.pixels_mut(),
-                &mut p.iter().map(|px| px.map(Texel::to_unit)),
-            ),
-            CanvasPixels::Sixteen(p) => write(
-                pixmap.pixels_mut(),
-                &mut p.iter().map(|px| px.map(Texel::to_unit)),
-            ),
+            pixmap
         }
-        pixmap
     }
 
-    /// Composites a premultiplied tiny-skia pixmap of the same size over the canvas
-    /// (source-over; overlays drawn on a transparent pixmap). Other sizes are an error.
-    pub fn draw_pixmap_over(&mut self, pixmap: &tiny_skia::Pixmap) -> Result<(), PixelError> {
-        if pixmap.width() != self.width || pixmap.height() != self.height {
-            return Err(PixelError::BufferSize {
-                width: self.width,
-                height: self.height,
-                actual: pixmap.pixels().len(),
-            });
+    internal_fn! {
+        /// Composites a premultiplied tiny-skia pixmap of the same size over the canvas
+        /// (source-over; overlays drawn on a transparent pixmap). Other sizes are an error.
+        fn draw_pixmap_over(&mut self, pixmap: &tiny_skia::Pixmap) -> Result<(), PixelError> {
+            if pixmap.width() != self.width || pixmap.height() != self.height {
+                return Err(PixelError::BufferSize {
+                    width: self.width,
+                    height: self.height,
+                    actual: pixmap.pixels().len(),
+                });
+            }
+            match &mut self.pixels {
+                CanvasPixels::Eight(p) => blend_premultiplied_over(p, pixmap.pixels()),
+                CanvasPixels::Sixteen(p) => blend_premultiplied_over(p, pixmap.pixels()),
+            }
+            Ok(())
         }
-        match &mut self.pixels {
-            CanvasPixels::Eight(p) => blend_premultiplied_over(p, pixmap.pixels()),
-            CanvasPixels::Sixteen(p) => blend_premultiplied_over(p, pixmap.pixels()),
-        }
-        Ok(())
     }
 }
 

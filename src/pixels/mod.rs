@@ -10,9 +10,8 @@
 //! pixel centres and clamps to the edge outside the image.
 //!
 //! 16-bit output: tiny-skia only holds 8-bit premultiplied pixmaps, so 16-bit canvases are
-//! stored as `u16` here and encoded here (Up filter, fdeflate, the `png` crate's chunks);
-//! [`Canvas::to_tiny_skia_pixmap`] exists for 8-bit overlays (a 16-bit canvas is rounded
-//! down to 8 bits for it).
+//! stored as `u16` here and encoded through `png_bands` like 8-bit ones; an 8-bit copy
+//! exists for tiny-skia overlays (a 16-bit canvas is rounded down to 8 bits for it).
 
 mod bilinear;
 mod canvas;

@@ -1,6 +1,9 @@
 //! Errors of the raster stage: takes malformed patch input and gives a typed error naming the
 //! offending array and index.
 
+/// Why a patch cannot be drawn.
+// Each variant's `#[error]` text says what it is and names its fields.
+#[allow(missing_docs)]
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum RasterError {
     #[error("{what} has {actual} entries, expected {expected}")]

@@ -9,14 +9,11 @@ use crate::clone::{
     mesh_from_mask, mesh_from_polygons, CloneOptions, CloneStats, PatchCloner, PatchMesh, Placement,
 };
 use crate::deform::{DeformRig, DeformStats, Deformed, Handle, Pin};
-use crate::mesh::{BitMask, Mesh, MeshOptions};
+use crate::mesh::{BitMask, Mesh, MeshOptions, MASK_THRESHOLD};
 use crate::pixels::{Canvas, FloatImage, Footage, FootageReader};
 use crate::scene::{
     BoundaryData, BoundaryPlacement, CloneMode, LaplacianKind, Patch, PatchState, Shape,
 };
-
-/// Mask pixels at or above this luminance (or alpha) are inside.
-const MASK_THRESHOLD: f32 = 0.5;
 
 /// The patch settings a layer's mesh, cloning factor and rig are built from: a layer can be
 /// kept for a new version of its patch exactly when these are equal.

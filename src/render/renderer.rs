@@ -1,35 +1,25 @@
 //! The scene renderer: takes a [`Scene`] once and frame indices or times after, and gives
-//! each frame in a [`Canvas`] it keeps (no allocation per frame once warm).
+//! each frame in a [`Canvas`] it keeps (no allocation per frame once warm). This file is the
+//! frame loop; loading the layers and the background is in `setup`, switching to an edited
+//! scene in `diff`.
 
-use std::collections::HashMap;
-use std::path::PathBuf;
 use std::time::Instant;
 
 use glam::DVec2;
 
-use super::layer::{Layer, LayerSettings};
+use super::layer::Layer;
 use super::opacity::blend_over_below;
 use super::RenderError;
 use crate::mesh::Mesh;
-use crate::pixels::{Canvas, Depth, FloatImage, FootageReader, PixelFormat, PixelRect};
-use crate::scene::{frame_time, Background, FrameState, Patch, Scene};
+use crate::pixels::{Canvas, Depth, FootageReader, PixelFormat, PixelRect};
+use crate::scene::{frame_time, FrameState, Scene};
 use crate::util::lock;
 
-/// What [`Renderer::set_scene`] kept and built.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct SceneUpdate {
-    /// Layers kept with their mesh, cloning factor and rig.
-    pub reused: usize,
-    /// Layers meshed and factored anew (new patches, or changed mesh-defining settings).
-    pub rebuilt: usize,
-    /// Old layers not kept: their patch was removed or changed its mesh settings (a renamed
-    /// patch keeps its layer).
-    pub dropped: usize,
-    /// Deformation rigs built for kept layers whose patch gained its first handle or pin.
-    pub rigs_built: usize,
-    /// Whether the background was reloaded (changed background or canvas size).
-    pub background_changed: bool,
-}
+mod diff;
+mod setup;
+
+pub use diff::SceneUpdate;
+use setup::{background_canvas, build_layers, canvas_over, check_footage};
 
 /// One patch's mesh where the last frame put it: for mesh overlays.
 #[derive(Clone, Copy, Debug)]
@@ -119,116 +109,18 @@ impl Renderer {
         &self.scene
     }
 
-    /// Switches to a new version of the scene, keeping every layer (mesh, cloning factor,
-    /// deformation rig) whose patch — matched by name, else (a rename) by settings alone — has the same mesh-defining settings
-    /// (source, shape, density, Laplacian kind, mode, feather, boundary data). Only new or changed patches
-    /// are meshed and factored; a kept patch that gained its first handle or pin gets a rig.
-    /// On error the renderer is unchanged.
-    pub fn set_scene(&mut self, scene: Scene) -> Result<SceneUpdate, RenderError> {
-        scene.sanity_check()?;
-        check_footage(&scene)?;
-        let mut update = SceneUpdate::default();
-        let canvas_changed = scene.canvas.background != self.scene.canvas.background
-            || (scene.canvas.width, scene.canvas.height)
-                != (self.scene.canvas.width, self.scene.canvas.height);
-        let background = if canvas_changed {
-            update.background_changed = true;
-            Some(background_canvas(&scene)?)
-        } else {
-            None
-        };
-        let plan = self.plan_layers(&scene.patches)?;
-        let mut old: Vec<Option<Layer>> = std::mem::take(&mut self.layers)
-            .into_iter()
-            .map(Some)
-            .collect();
-        for (patch, planned) in scene.patches.iter().zip(plan) {
-            let layer = match planned {
-                Planned::Keep { index, rig } => {
-                    update.reused += 1;
-                    update.rigs_built += usize::from(rig.is_some());
-                    let mut layer = old[index].take().expect("layer kept once"); // invariant: plan_layers hands out each old index at most once.
-                    layer.update(patch, rig.map(|rig| *rig));
-                    layer
-                }
-                Planned::Build(layer) => {
-                    update.rebuilt += 1;
-                    *layer
-                }
-            };
-            self.layers.push(layer);
+    internal_fn! {
+        /// Each patch's mesh and where the last frame placed it, in scene order.
+        fn placed_meshes(&self) -> Vec<PlacedMesh<'_>> {
+            self.layers
+                .iter()
+                .map(|l| PlacedMesh {
+                    name: &l.name,
+                    mesh: l.mesh(),
+                    placed: l.placed(),
+                })
+                .collect()
         }
-        update.dropped = old.iter().filter(|l| l.is_some()).count();
-        if let Some((background, plates)) = background {
-            self.frame = background.clone();
-            self.background = background;
-            self.plates = plates;
-            self.dirty.clear();
-            self.dirty_valid = true;
-        }
-        self.scene = scene;
-        Ok(update)
-    }
-
-    /// For each new patch, the old layer it keeps (and a rig it still needs) or a new layer.
-    /// Does all fallible work without touching `self`.
-    fn plan_layers(&self, patches: &[Patch]) -> Result<Vec<Planned>, RenderError> {
-        let kept = self.match_layers(patches);
-        let mut sources: HashMap<PathBuf, FloatImage> = self
-            .layers
-            .iter()
-            .map(|l| (l.settings_source().to_path_buf(), l.source().clone()))
-            .collect();
-        let mut plan = Vec::with_capacity(patches.len());
-        for (patch, kept) in patches.iter().zip(kept) {
-            plan.push(match kept {
-                Some(index) => {
-                    let rig = self.layers[index].missing_rig(patch)?.map(Box::new);
-                    Planned::Keep { index, rig }
-                }
-                None => {
-                    let source = source_image(&mut sources, patch)?;
-                    let fps = self.scene.canvas.fps;
-                    Planned::Build(Box::new(Layer::new(patch, source, fps)?))
-                }
-            });
-        }
-        Ok(plan)
-    }
-
-    /// The old layer each new patch keeps: first one of its own name with equal settings, then
-    /// (a renamed patch) any unclaimed layer with equal settings — a layer's mesh, factor and
-    /// rig depend on the settings alone.
-    fn match_layers(&self, patches: &[Patch]) -> Vec<Option<usize>> {
-        let settings: Vec<LayerSettings> = patches.iter().map(LayerSettings::of).collect();
-        let mut taken = vec![false; self.layers.len()];
-        let mut kept = vec![None; patches.len()];
-        for by_name in [true, false] {
-            for (i, patch) in patches.iter().enumerate() {
-                if kept[i].is_some() {
-                    continue;
-                }
-                kept[i] = self.layers.iter().enumerate().position(|(j, l)| {
-                    !taken[j] && (!by_name || l.name == patch.name) && l.settings == settings[i]
-                });
-                if let Some(j) = kept[i] {
-                    taken[j] = true;
-                }
-            }
-        }
-        kept
-    }
-
-    /// Each patch's mesh and where the last frame placed it, in scene order.
-    pub fn placed_meshes(&self) -> Vec<PlacedMesh<'_>> {
-        self.layers
-            .iter()
-            .map(|l| PlacedMesh {
-                name: &l.name,
-                mesh: l.mesh(),
-                placed: l.placed(),
-            })
-            .collect()
     }
 
     /// Whether each patch (scene order) has a deformation rig built.
@@ -404,128 +296,6 @@ impl Renderer {
             Depth::Sixteen => PixelFormat::RGBA16,
         }
     }
-}
-
-enum Planned {
-    Keep {
-        index: usize,
-        rig: Option<Box<crate::deform::DeformRig>>,
-    },
-    Build(Box<Layer>),
-}
-
-fn build_layers(scene: &Scene) -> Result<Vec<Layer>, RenderError> {
-    let mut sources: HashMap<PathBuf, FloatImage> = HashMap::new();
-    let mut layers = Vec::with_capacity(scene.patches.len());
-    for patch in &scene.patches {
-        let source = source_image(&mut sources, patch)?;
-        layers.push(Layer::new(patch, source, scene.canvas.fps)?);
-    }
-    Ok(layers)
-}
-
-/// The patch's source image, loaded once per path (an animated source's first frame).
-fn source_image(
-    sources: &mut HashMap<PathBuf, FloatImage>,
-    patch: &Patch,
-) -> Result<FloatImage, RenderError> {
-    if let Some(footage) = &patch.footage {
-        let mut reader = FootageReader::new(footage.clone(), 1.0);
-        let image = reader.frame(0).map_err(|e| RenderError::Footage {
-            patch: Some(patch.name.clone()),
-            source: Box::new(e),
-        })?;
-        return Ok(image.clone());
-    }
-    if let Some(image) = sources.get(&patch.source) {
-        return Ok(image.clone());
-    }
-    let image = FloatImage::load(&patch.source)?;
-    sources.insert(patch.source.clone(), image.clone());
-    Ok(image)
-}
-
-/// Refuses, before anything is drawn, footage that runs out before the scene does (unless
-/// it holds its last frame).
-fn check_footage(scene: &Scene) -> Result<(), RenderError> {
-    let (frames, fps) = (scene.canvas.frame_count(), scene.canvas.fps);
-    if let Background::Footage(footage) = &scene.canvas.background {
-        footage
-            .check_covers(frames, fps)
-            .map_err(|e| RenderError::Footage {
-                patch: None,
-                source: Box::new(e),
-            })?;
-    }
-    for patch in &scene.patches {
-        if let Some(footage) = &patch.footage {
-            footage
-                .check_covers(frames, fps)
-                .map_err(|e| RenderError::Footage {
-                    patch: Some(patch.name.clone()),
-                    source: Box::new(e),
-                })?;
-        }
-    }
-    Ok(())
-}
-
-/// The canvas every frame starts from: the background image (or footage's first plate, with
-/// its reader) at the origin over opaque black (16-bit when the image is), or a plain colour.
-fn background_canvas(scene: &Scene) -> Result<(Canvas, Option<(FootageReader, u64)>), RenderError> {
-    let (width, height) = (scene.canvas.width, scene.canvas.height);
-    match &scene.canvas.background {
-        Background::Colour(rgba) => {
-            let image = FloatImage::from_fn(width, height, PixelFormat::RGBA8, |_, _| *rgba)?;
-            Ok((Canvas::from_image(&image), None))
-        }
-        Background::Image(path) => {
-            let decoded = FloatImage::decode(path)?;
-            if let Some(canvas) = eight_bit_canvas(&decoded, width, height)? {
-                return Ok((canvas, None));
-            }
-            let picture = FloatImage::from_dynamic(&decoded)?;
-            Ok((canvas_over(&picture, width, height)?, None))
-        }
-        Background::Footage(footage) => {
-            let mut reader = FootageReader::new(footage.clone(), scene.canvas.fps);
-            let plate = reader.frame(0).map_err(|e| RenderError::Footage {
-                patch: None,
-                source: Box::new(e),
-            })?;
-            let canvas = canvas_over(plate, width, height)?;
-            Ok((canvas, Some((reader, 0))))
-        }
-    }
-}
-
-/// A decoded 8-bit image of the canvas's size as the canvas, straight from its bytes (no
-/// float copy; the same bytes as the float path); `None` for other depths and sizes.
-fn eight_bit_canvas(
-    decoded: &image::DynamicImage,
-    width: u32,
-    height: u32,
-) -> Result<Option<Canvas>, RenderError> {
-    if (decoded.width(), decoded.height()) != (width, height) {
-        return Ok(None);
-    }
-    Ok(Canvas::from_eight_bit(decoded))
-}
-
-/// `picture` at the origin of a `width`×`height` canvas, opaque black where it does not
-/// reach, in the picture's bit depth.
-fn canvas_over(picture: &FloatImage, width: u32, height: u32) -> Result<Canvas, RenderError> {
-    if (picture.width(), picture.height()) == (width, height) {
-        return Ok(Canvas::from_image(picture));
-    }
-    let format = PixelFormat {
-        alpha: true,
-        ..picture.format()
-    };
-    let image = FloatImage::from_fn(width, height, format, |x, y| {
-        picture.pixel(x, y).unwrap_or([0.0, 0.0, 0.0, 1.0])
-    })?;
-    Ok(Canvas::from_image(&image))
 }
 
 fn millis(duration: std::time::Duration) -> f64 {

@@ -11,30 +11,41 @@ use super::types::{Patch, Scene};
 pub struct PatchState {
     /// Canvas position of the patch's bounding-box centre; `None` keeps the source position.
     pub position: Option<DVec2>,
+    /// Uniform scale.
     pub scale: f64,
     /// Degrees, clockwise on screen.
     pub rotation: f64,
+    /// Depth of the whole layer (nearer is larger).
     pub depth: f64,
     /// In [0, 1]; 1 draws the clone as is, 0 leaves the layers below untouched.
     pub opacity: f64,
+    /// The drag handles active at this time.
     pub handles: Vec<HandleState>,
     /// Rest points of the pins active at this time.
     pub pins: Vec<DVec2>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
+/// One drag handle's evaluated state.
 pub struct HandleState {
+    /// Rest point in the source's frame.
     pub from: DVec2,
+    /// Where the rest point is dragged to, in the source's frame.
     pub to: DVec2,
+    /// Radius of influence in pixels.
     pub radius: f64,
+    /// Depth override of the dragged region.
     pub depth: Option<f64>,
+    /// Pivot override of the rotation.
     pub pivot: Option<DVec2>,
     /// Rotation override in degrees.
     pub rotation: Option<f64>,
 }
 
 #[derive(Clone, Debug, PartialEq, Default)]
+/// Every patch's evaluated state at one time ([`Scene::evaluate`]).
 pub struct FrameState {
+    /// Seconds.
     pub time: f64,
     /// One entry per scene patch, in scene order.
     pub patches: Vec<PatchState>,

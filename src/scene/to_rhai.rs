@@ -226,12 +226,12 @@ fn write_canvas(out: &mut String, canvas: &Canvas, paths: &Paths) {
     .expect("write to String"); // invariant: writing to a String cannot fail
 }
 
-/// `KEY: "pattern or video", KEY_start: N, KEY_hold: b`, with `background: ` left out of the
+/// `KEY: "pattern or video", KEY_start_number: N, KEY_hold: b`, with `background: ` left out of the
 /// background's own text (the caller writes the key).
 fn footage_options(footage: &Footage, key: &str, paths: &Paths) -> String {
     let mut text = match &footage.source {
         FootageSource::Sequence { pattern, start } => format!(
-            "{}, {key}_start: {start}",
+            "{}, {key}_start_number: {start}",
             rhai_string_literal(pattern.text())
         ),
         FootageSource::Video(path) => paths.literal(path),
@@ -262,8 +262,8 @@ fn write_patch(out: &mut String, patch: &Patch, var: &str, paths: &Paths) {
     options.push(format!("laplacian: \"{}\"", patch.laplacian.name()));
     options.push(format!("mode: \"{}\"", patch.mode.name()));
     options.push(format!("feather: {}", num(patch.feather)));
-    options.push(format!("boundary_data: \"{}\"", patch.boundary_data.name()));
-    options.push(format!("boundary: \"{}\"", patch.boundary.name()));
+    options.push(format!("boundary_sampling: \"{}\"", patch.boundary_data.name()));
+    options.push(format!("mesh_boundary: \"{}\"", patch.boundary.name()));
     let _ = writeln!(
         out,
         "let {var} = patch({}, #{{ {} }});",

@@ -85,7 +85,9 @@ impl Easing {
 
 /// Values a track can blend between keys.
 pub trait Interpolate: Copy {
+    /// `a` blended towards `b` by `weight` in [0, 1].
     fn interpolate(a: Self, b: Self, weight: f64) -> Self;
+    /// Whether every component is finite.
     fn is_finite_value(&self) -> bool;
 }
 

@@ -59,7 +59,8 @@ pub use crate::mesh::Polygon;
 /// Which pixels of the source make up the patch.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Shape {
-    /// A mask image of the source's size: non-zero pixels are inside.
+    /// A mask image of the source's size: alpha (or luma without alpha) at least
+    /// [`MASK_THRESHOLD`](crate::MASK_THRESHOLD) is inside.
     Mask(PathBuf),
     /// Polygons with holes, source-pixel coordinates.
     Polygons(Vec<Polygon>),

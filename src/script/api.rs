@@ -10,13 +10,34 @@ use glam::DVec2;
 use rhai::{CustomType, Dynamic, Engine, Map, NativeCallContext, TypeBuilder};
 
 use super::draft::{Origin, SharedDraft};
-use super::refs::{fail, Fallible, HandleRef, PatchRef, Placed, PLACEMENT_KEYS};
+use super::refs::{fail, Fallible, HandleRef, PatchRef, PinRef, Placed, PLACEMENT_KEYS};
 use super::footage_options::{footage_keys, footage_option};
 use super::values::{self, number};
 use crate::scene::{
     Background, Canvas, CloneMode, Easing, Handle, LaplacianKind, Patch, Pin, Polygon, Shape, Track,
 };
 
+
+/// `options` with renamed keys under their new names; each old one found is noted as a
+/// warning at the call.
+fn renamed(ctx: &NativeCallContext, draft: &SharedDraft, options: &Map) -> Fallible<Map> {
+    let mut options = options.clone();
+    let old = values::rename_keys(&mut options).map_err(|m| fail(ctx, m))?;
+    let mut d = draft.lock();
+    let at = origin(ctx, &d.base_dir);
+    for old in old {
+        // invariant: rename_keys gives only names from RENAMED_KEYS.
+        let new = values::RENAMED_KEYS.iter().find(|(o, _)| *o == old).expect("renamed").1;
+        let (line, column) = (at.position.line(), at.position.position());
+        d.origins.warnings.push(format!(
+            "{}:{}:{}: `{old}` is now `{new}` (the old name still works)",
+            at.file.display(),
+            line.unwrap_or(0),
+            column.unwrap_or(0)
+        ));
+    }
+    Ok(options)
+}
 
 fn origin(ctx: &NativeCallContext, base_dir: &Path) -> Origin {
     Origin {
@@ -48,7 +69,10 @@ fn existing_file(base_dir: &Path, text: &str, what: &str) -> Result<PathBuf, Str
 
 
 pub fn register(engine: &mut Engine, draft: &SharedDraft) {
-    engine.build_type::<PatchRef>().build_type::<HandleRef>();
+    engine
+        .build_type::<PatchRef>()
+        .build_type::<HandleRef>()
+        .build_type::<PinRef>();
     let d = draft.clone();
     engine.register_fn(
         "canvas",
@@ -102,8 +126,9 @@ fn set_canvas(
     size: Option<(&Dynamic, &Dynamic)>,
     options: &Map,
 ) -> Fallible<()> {
+    let options = renamed(ctx, draft, options)?;
     let mut d = draft.lock();
-    let canvas = parse_canvas(&d.base_dir, size, options).map_err(|m| fail(ctx, m))?;
+    let canvas = parse_canvas(&d.base_dir, size, &options).map_err(|m| fail(ctx, m))?;
     d.origins.canvas = Some(origin(ctx, &d.base_dir));
     d.canvas = Some(canvas);
     Ok(())
@@ -165,9 +190,16 @@ fn parse_canvas(
     Ok(canvas)
 }
 
-const PATCH_OPTIONS: [&str; 11] = [
+/// The option keys of `canvas`, polygons, `drag`, `pin` and key maps in their current
+/// spelling (the REPL completes them; `PATCH_OPTIONS` has the rest).
+pub const OTHER_OPTION_KEYS: [&str; 15] = [
+    "fps", "duration", "background", "background_start_number", "background_hold", "outer",
+    "holes", "pivot", "start", "end", "t", "scale", "depth", "opacity", "ease",
+];
+
+pub const PATCH_OPTIONS: [&str; 11] = [
     "source",
-    "source_start",
+    "source_start_number",
     "source_hold",
     "mask",
     "polygons",
@@ -175,8 +207,8 @@ const PATCH_OPTIONS: [&str; 11] = [
     "laplacian",
     "mode",
     "feather",
-    "boundary_data",
-    "boundary",
+    "boundary_sampling",
+    "mesh_boundary",
 ];
 
 fn new_patch(
@@ -185,8 +217,10 @@ fn new_patch(
     name: &Dynamic,
     options: &Dynamic,
 ) -> Fallible<PatchRef> {
+    let options = values::map(options, "patch options").map_err(|m| fail(ctx, m))?;
+    let options = renamed(ctx, draft, &options)?;
     let mut d = draft.lock();
-    let patch = parse_patch(&d.base_dir, name, options).map_err(|m| fail(ctx, m))?;
+    let patch = parse_patch(&d.base_dir, name, &options).map_err(|m| fail(ctx, m))?;
     if d.patches.iter().any(|p| p.name == patch.name) {
         return Err(fail(
             ctx,
@@ -201,18 +235,17 @@ fn new_patch(
     })
 }
 
-fn parse_patch(base_dir: &Path, name: &Dynamic, options: &Dynamic) -> Result<Patch, String> {
+fn parse_patch(base_dir: &Path, name: &Dynamic, options: &Map) -> Result<Patch, String> {
     let name = values::string(name, "patch name")?;
     if name.is_empty() {
         return Err("patch name must not be empty".into());
     }
-    let options = values::map(options, "patch options")?;
-    values::check_keys(&options, &PATCH_OPTIONS, "patch")?;
+    values::check_keys(options, &PATCH_OPTIONS, "patch")?;
     let source = options
         .get("source")
         .ok_or("patch needs a `source` image")
         .and_then(|v| values::string(v, "source").map_err(|_| "`source` must be a string path"))?;
-    let footage = footage_option(base_dir, &source, &options, "source")?;
+    let footage = footage_option(base_dir, &source, options, "source")?;
     let source = match &footage {
         Some(footage) => footage.first_path(),
         None => existing_file(base_dir, &source, "source")?,
@@ -245,11 +278,11 @@ fn parse_patch(base_dir: &Path, name: &Dynamic, options: &Dynamic) -> Result<Pat
     if let Some(v) = options.get("feather") {
         patch.feather = values::non_negative(v, "feather")?;
     }
-    if let Some(v) = options.get("boundary_data") {
-        patch.boundary_data = values::string(v, "boundary_data")?.parse()?;
+    if let Some(v) = options.get("boundary_sampling") {
+        patch.boundary_data = values::string(v, "boundary_sampling")?.parse()?;
     }
-    if let Some(v) = options.get("boundary") {
-        patch.boundary = values::string(v, "boundary")?.parse()?;
+    if let Some(v) = options.get("mesh_boundary") {
+        patch.boundary = values::string(v, "mesh_boundary")?.parse()?;
     }
     Ok(patch)
 }
@@ -317,16 +350,21 @@ impl PatchRef {
             .unwrap_or_default()
     }
 
+    /// `key(t, #{ at, …, ease })` or `key(t, #{ at, … }, ease)`: the easing once, either way.
     fn key_map(
         &mut self,
         ctx: NativeCallContext,
         t: Dynamic,
-        values: Map,
-        easing: &str,
+        mut values: Map,
+        easing: Option<&str>,
     ) -> Fallible<Self> {
         self.edit(&ctx, |p| {
             let t = values::time(&t)?;
-            let easing = values::easing(easing)?;
+            let easing = match (values.contains_key("ease"), easing) {
+                (true, Some(_)) => return Err("give the easing once: `ease` or a last argument".into()),
+                (false, Some(name)) => values::easing(name)?,
+                (_, None) => take_easing(&mut values)?,
+            };
             add_placement_keys(p, t, &values, easing)
         })?;
         Ok(self.clone())
@@ -400,8 +438,8 @@ impl PatchRef {
         })
     }
 
-    fn pin(&mut self, ctx: NativeCallContext, at: Dynamic, options: Map) -> Fallible<Self> {
-        self.edit(&ctx, |p| {
+    fn pin(&mut self, ctx: NativeCallContext, at: Dynamic, options: Map) -> Fallible<PinRef> {
+        let at = self.edit(&ctx, |p| {
             values::check_keys(&options, &["start", "end"], "pin")?;
             let start = match options.get("start") {
                 Some(v) => values::time(v)?,
@@ -411,14 +449,14 @@ impl PatchRef {
             if end.is_some_and(|e| e <= start) {
                 return Err(format!("pin `end` must be after `start` ({start})"));
             }
-            p.pins.push(Pin {
-                at: values::point(&at, "pin point")?,
-                start,
-                end,
-            });
-            Ok(())
+            let at = values::point(&at, "pin point")?;
+            p.pins.push(Pin { at, start, end });
+            Ok(at)
         })?;
-        Ok(self.clone())
+        Ok(PinRef {
+            patch: self.clone(),
+            at,
+        })
     }
 }
 
@@ -530,13 +568,13 @@ impl CustomType for PatchRef {
             .with_fn(
                 "key",
                 |ctx: NativeCallContext, p: &mut PatchRef, t: Dynamic, m: Map| {
-                    p.key_map(ctx, t, m, "linear")
+                    p.key_map(ctx, t, m, None)
                 },
             )
             .with_fn(
                 "key",
                 |ctx: NativeCallContext, p: &mut PatchRef, t: Dynamic, m: Map, e: &str| {
-                    p.key_map(ctx, t, m, e)
+                    p.key_map(ctx, t, m, Some(e))
                 },
             )
             .with_fn(
@@ -564,21 +602,50 @@ impl CustomType for PatchRef {
                 |ctx: NativeCallContext, p: &mut PatchRef, at: Dynamic, o: Map| p.pin(ctx, at, o),
             );
         super::edit_api::build_patch(&mut b);
-        for which in Placed::ALL {
-            let name = which.name();
-            b.with_fn(
-                name,
-                move |ctx: NativeCallContext, p: &mut PatchRef, t: Dynamic, v: Dynamic| {
-                    p.track_key(ctx, which, t, v, "linear")
+        build_tracks(&mut b);
+    }
+}
+
+/// `p.at(t, v [, easing])` and the other placement tracks, one function each.
+fn build_tracks(b: &mut TypeBuilder<PatchRef>) {
+    for which in Placed::ALL {
+        let name = which.name();
+        b.with_fn(
+            name,
+            move |ctx: NativeCallContext, p: &mut PatchRef, t: Dynamic, v: Dynamic| {
+                p.track_key(ctx, which, t, v, "linear")
+            },
+        )
+        .with_fn(
+            name,
+            move |ctx: NativeCallContext, p: &mut PatchRef, t: Dynamic, v: Dynamic, e: &str| {
+                p.track_key(ctx, which, t, v, e)
+            },
+        );
+    }
+}
+
+impl CustomType for PinRef {
+    fn build(mut b: TypeBuilder<Self>) {
+        b.with_name("Pin")
+            .with_fn("to_string", |q: &mut PinRef| format!("pin([{}, {}])", q.at.x, q.at.y))
+            .with_fn("remove", |ctx: NativeCallContext, q: &mut PinRef| {
+                let at = Dynamic::from_array(vec![q.at.x.into(), q.at.y.into()]);
+                q.patch.remove_pin(ctx, at).map(|_| ())
+            })
+            // A pin's `pin` pins its patch again, so `p.pin(a).pin(b)` still pins both.
+            .with_fn(
+                "pin",
+                |ctx: NativeCallContext, q: &mut PinRef, at: Dynamic| {
+                    q.patch.pin(ctx, at, Map::new())
                 },
             )
             .with_fn(
-                name,
-                move |ctx: NativeCallContext, p: &mut PatchRef, t: Dynamic, v: Dynamic, e: &str| {
-                    p.track_key(ctx, which, t, v, e)
+                "pin",
+                |ctx: NativeCallContext, q: &mut PinRef, at: Dynamic, o: Map| {
+                    q.patch.pin(ctx, at, o)
                 },
             );
-        }
     }
 }
 

@@ -22,6 +22,8 @@ pub struct Origin {
 pub struct Origins {
     pub canvas: Option<Origin>,
     pub patches: Vec<Origin>,
+    /// `file:line:col: …` for each old spelling the script used.
+    pub warnings: Vec<String>,
 }
 
 /// Stable identities of the draft's patches and handles, so a script's `Patch` and `Handle`

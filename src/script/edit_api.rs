@@ -230,7 +230,11 @@ impl PatchRef {
         Ok(self.clone())
     }
 
-    fn remove_pin(&mut self, ctx: NativeCallContext, which: Dynamic) -> Fallible<Self> {
+    pub(super) fn remove_pin(
+        &mut self,
+        ctx: NativeCallContext,
+        which: Dynamic,
+    ) -> Fallible<Self> {
         self.edit(&ctx, |p| {
             let i = if which.is_array() {
                 let at = values::point(&which, "pin point")?;

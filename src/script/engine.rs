@@ -68,7 +68,7 @@ pub struct LoadedScene {
     /// The scene the file describes.
     pub scene: Scene,
     /// Where in the file each patch and handle was made (for positioned errors).
-    pub origins: Origins,
+    pub(crate) origins: Origins,
     /// The scene file.
     pub file: PathBuf,
     /// The file's text.
@@ -90,6 +90,14 @@ impl LoadedScene {
             error.load_source_line(Some(&self.text));
         }
         error
+    }
+
+    /// What `lapclone check` warns about: old spellings the file used (positioned), then
+    /// [`Scene::warnings`].
+    pub fn warnings(&self) -> Vec<String> {
+        let mut all = self.origins.warnings.clone();
+        all.extend(self.scene.warnings());
+        all
     }
 }
 

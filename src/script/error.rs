@@ -10,6 +10,7 @@ use rhai::{EvalAltResult, ParseError, Position};
 /// What kind of failure a [`SceneError`] reports (the REPL treats cancellation differently).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ErrorKind {
+    /// The file does not parse.
     Syntax,
     /// A failure while running the script: bad values, unknown functions, missing files.
     Runtime,
@@ -19,6 +20,7 @@ pub enum ErrorKind {
     Cancelled,
     /// The scene was complete but invalid (e.g. no canvas), or a referenced file is unusable.
     Validation,
+    /// A file cannot be read.
     Io,
 }
 

@@ -1,5 +1,5 @@
 //! Footage options of `canvas` and `patch`: takes a `background` or `source` string and the
-//! call's option map (`KEY_start`, `KEY_hold`) and gives the [`Footage`] it names — a
+//! call's option map (`KEY_start_number`, `KEY_hold`) and gives the [`Footage`] it names — a
 //! printf-style numbered pattern (`plate_%04d.png`) or a video file — or `None` for a plain
 //! image path.
 
@@ -13,7 +13,7 @@ use crate::scene::Footage;
 
 /// The option keys footage adds to a call whose path option is `key`.
 pub fn footage_keys(key: &str) -> [String; 2] {
-    [format!("{key}_start"), format!("{key}_hold")]
+    [format!("{key}_start_number"), format!("{key}_hold")]
 }
 
 /// The footage `text` names (resolved against `base_dir`), or `None` when it is a plain

@@ -16,11 +16,12 @@ mod sandbox;
 mod validate;
 mod values;
 
-pub use refs::{HandleRef, PatchRef};
+pub use refs::{HandleRef, PatchRef, PinRef};
 pub use draft::{Draft, Ids, Origin, Origins};
 pub use engine::{
     find_scripts_dir, load_scene, parse_scene, LoadedScene, SceneEngine, ScriptOptions,
 };
 pub use error::{ErrorKind, SceneError};
 pub use sandbox::{Limits, ModuleFiles, SandboxResolver};
-pub use validate::{validate_scene, CheckSummary, MASK_THRESHOLD};
+pub use api::{OTHER_OPTION_KEYS, PATCH_OPTIONS};
+pub use validate::{validate_scene, CheckSummary};

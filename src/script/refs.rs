@@ -1,5 +1,5 @@
 //! The script-side handles on a scene and what the scene functions share: takes nothing and
-//! gives the `PatchRef` and `HandleRef` types scripts hold (stable ids into the shared
+//! gives the `PatchRef`, `HandleRef` and `PinRef` types scripts hold (stable ids into the shared
 //! draft), the keyframable placement properties by name, and the positioned runtime error.
 
 use rhai::{Dynamic, EvalAltResult, NativeCallContext};
@@ -29,6 +29,14 @@ pub struct HandleRef {
     pub(super) draft: SharedDraft,
     pub(super) patch: u64,
     pub(super) handle: u64,
+}
+
+/// A pin of a patch, as seen from a script: its patch's stable id and its rest point
+/// (two pins at one point hold the same point, so the point names the pin).
+#[derive(Clone, Debug)]
+pub struct PinRef {
+    pub(super) patch: PatchRef,
+    pub(super) at: glam::DVec2,
 }
 
 /// The keyframable placement properties, by their scene-language names.

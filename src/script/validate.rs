@@ -8,7 +8,8 @@ use std::path::Path;
 use super::draft::Origin;
 use super::engine::LoadedScene;
 use super::error::{ErrorKind, SceneError};
-use crate::scene::{Background, FrameState, Shape};
+use crate::mesh::{BitMask, MASK_THRESHOLD};
+use crate::scene::{Background, FrameState, Patch, Shape};
 
 /// What a valid scene contains.
 #[derive(Clone, Debug, PartialEq)]
@@ -21,74 +22,17 @@ pub struct CheckSummary {
     pub inside_pixels: Vec<u64>,
 }
 
-/// A mask pixel is inside when its luma is at least half scale.
-pub const MASK_THRESHOLD: u8 = 128;
-
 pub fn validate_scene(loaded: &LoadedScene) -> Result<CheckSummary, SceneError> {
     let scene = &loaded.scene;
-    let fail = |origin: Option<&Origin>, message: String| {
-        let (file, position) = origin
-            .map(|o| (o.file.clone(), o.position))
-            .unwrap_or((loaded.file.clone(), rhai::Position::NONE));
-        let file = if file.is_dir() {
-            loaded.file.clone()
-        } else {
-            file
-        };
-        let mut e = SceneError::new(ErrorKind::Validation, &file, position, message);
-        if file == loaded.file {
-            e.load_source_line(Some(&loaded.text));
-        }
-        e
-    };
+    let fail = |origin: Option<&Origin>, message: String| failure(loaded, origin, message);
     if let Background::Image(path) = &scene.canvas.background {
         decode(path).map_err(|m| fail(loaded.origins.canvas.as_ref(), m))?;
     }
     let mut inside_pixels = Vec::with_capacity(scene.patches.len());
     for (i, patch) in scene.patches.iter().enumerate() {
         let origin = loaded.origins.patches.get(i);
-        let named = |m: String| fail(origin, format!("patch `{}`: {m}", patch.name));
-        // Footage was sized when the scene named it; a video is not an image file.
-        let source = match &patch.footage {
-            Some(f) => (f.width, f.height),
-            None => {
-                let image = decode(&patch.source).map_err(named)?;
-                (image.width(), image.height())
-            }
-        };
-        let inside = match &patch.shape {
-            Shape::Mask(path) => {
-                let mask = decode(path).map_err(named)?;
-                if (mask.width(), mask.height()) != source {
-                    return Err(named(format!(
-                        "mask is {}×{} but the source is {}×{}",
-                        mask.width(),
-                        mask.height(),
-                        source.0,
-                        source.1
-                    )));
-                }
-                let luma = mask.to_luma8();
-                luma.pixels().filter(|p| p.0[0] >= MASK_THRESHOLD).count() as u64
-            }
-            Shape::Polygons(polygons) => polygons
-                .iter()
-                .map(|p| {
-                    let holes: f64 = p.holes.iter().map(|h| ring_area(h)).sum();
-                    (ring_area(&p.outer) - holes).max(0.0)
-                })
-                .sum::<f64>()
-                .round() as u64,
-        };
-        if inside == 0 {
-            let what = match &patch.shape {
-                Shape::Polygons(_) => {
-                    "the polygons are empty: they enclose no area (less than half a pixel)"
-                }
-                _ => "the mask is empty (no inside pixels)",
-            };
-            return Err(named(what.into()));
-        }
+        let inside = inside_pixels_of(patch)
+            .map_err(|m| fail(origin, format!("patch `{}`: {m}", patch.name)))?;
         inside_pixels.push(inside);
     }
     let mut state = FrameState::default();
@@ -116,17 +60,60 @@ pub fn validate_scene(loaded: &LoadedScene) -> Result<CheckSummary, SceneError> 
     })
 }
 
-fn decode(path: &Path) -> Result<image::DynamicImage, String> {
-    crate::limits::open_image(path).map_err(|e| format!("cannot decode {}: {e}", path.display()))
+/// A validation error at `origin` (the scene file itself when there is none).
+fn failure(loaded: &LoadedScene, origin: Option<&Origin>, message: String) -> SceneError {
+    let (file, position) = origin
+        .map(|o| (o.file.clone(), o.position))
+        .unwrap_or((loaded.file.clone(), rhai::Position::NONE));
+    let file = if file.is_dir() {
+        loaded.file.clone()
+    } else {
+        file
+    };
+    let mut e = SceneError::new(ErrorKind::Validation, &file, position, message);
+    if file == loaded.file {
+        e.load_source_line(Some(&loaded.text));
+    }
+    e
 }
 
-fn ring_area(ring: &[glam::DVec2]) -> f64 {
-    let twice: f64 = ring
-        .iter()
-        .zip(ring.iter().cycle().skip(1))
-        .map(|(a, b)| a.perp_dot(*b))
-        .sum();
-    (twice / 2.0).abs()
+/// The patch's inside pixels (polygons: their rounded area); an empty patch, or a mask whose
+/// size is not its source's, is refused.
+fn inside_pixels_of(patch: &Patch) -> Result<u64, String> {
+    // Footage was sized when the scene named it; a video is not an image file.
+    let source = match &patch.footage {
+        Some(f) => (f.width, f.height),
+        None => {
+            let image = decode(&patch.source)?;
+            (image.width(), image.height())
+        }
+    };
+    let inside = match &patch.shape {
+        Shape::Mask(path) => {
+            let mask = decode(path)?;
+            if (mask.width(), mask.height()) != source {
+                let (w, h) = (mask.width(), mask.height());
+                return Err(format!(
+                    "mask is {w}×{h} but the source is {}×{}",
+                    source.0, source.1
+                ));
+            }
+            BitMask::from_image(&mask, MASK_THRESHOLD).count_inside() as u64
+        }
+        Shape::Polygons(polygons) => polygons.iter().map(|p| p.area()).sum::<f64>().round() as u64,
+    };
+    if inside > 0 {
+        return Ok(inside);
+    }
+    Err(match &patch.shape {
+        Shape::Polygons(_) => "the polygons are empty: they enclose no area (less than half a pixel)",
+        Shape::Mask(_) => "the mask is empty (no inside pixels)",
+    }
+    .into())
+}
+
+fn decode(path: &Path) -> Result<image::DynamicImage, String> {
+    crate::limits::open_image(path).map_err(|e| format!("cannot decode {}: {e}", path.display()))
 }
 
 fn state_is_finite(p: &crate::scene::PatchState) -> bool {

@@ -133,6 +133,30 @@ pub fn check_keys(options: &Map, allowed: &[&str], what: &str) -> Result<(), Str
     Ok(())
 }
 
+/// Option keys the scene language renamed, old spelling first; the old one still works,
+/// with a warning.
+pub const RENAMED_KEYS: [(&str, &str); 4] = [
+    ("boundary", "mesh_boundary"),
+    ("boundary_data", "boundary_sampling"),
+    ("background_start", "background_start_number"),
+    ("source_start", "source_start_number"),
+];
+
+/// Moves every old spelling in `options` to its new name; gives the old names it found.
+pub fn rename_keys(options: &mut Map) -> Result<Vec<&'static str>, String> {
+    let mut found = Vec::new();
+    for (old, new) in RENAMED_KEYS {
+        let Some(value) = options.remove(old) else {
+            continue;
+        };
+        if options.insert(new.into(), value).is_some() {
+            return Err(format!("give `{new}` only (`{old}` is its old name)"));
+        }
+        found.push(old);
+    }
+    Ok(found)
+}
+
 /// A colour: `"#rrggbb"`, `"#rrggbbaa"`, `[r, g, b]` or `[r, g, b, a]` with channels in [0, 1].
 pub fn colour(value: &Dynamic) -> Result<[f32; 4], String> {
     if let Some(text) = value.read_lock::<rhai::ImmutableString>() {

@@ -53,6 +53,8 @@ pub use symbolic::FactorMethod;
 use std::path::PathBuf;
 
 /// Everything that can go wrong in the solve stage.
+// Each variant's `#[error]` text says what it is and names its fields.
+#[allow(missing_docs)]
 #[derive(Debug, thiserror::Error)]
 pub enum SolveError {
     #[error("{path}: {source}")]

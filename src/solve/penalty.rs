@@ -26,11 +26,13 @@ use super::symbolic::{FactorMethod, SymbolicFactor};
 use super::update::{pivot_from_row, rank1_diagonal, Rank1Outcome, RowScratch};
 use super::{SolveError, SymmetricCsc};
 
-/// Penalty and guard settings. `None` picks the scale-relative default documented in
-/// [`solve`](super) (α = 1e8·s, ε = 1e-12·s, s = max |l_ii|).
+/// Penalty and guard settings of a factor. `None` picks the default relative to the
+/// diagonal scale s = max |l_ii| (α = 1e8·s, ε = 1e-12·s).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PenaltyOptions {
+    /// Penalty weight α; by default relative to the diagonal scale.
     pub alpha: Option<f64>,
+    /// Regularisation ε; by default relative to the diagonal scale.
     pub epsilon: Option<f64>,
     /// Refactor when the accumulated downdate drift estimate exceeds this (default 1e-11).
     pub drift_budget: f64,
@@ -115,8 +117,11 @@ fn permute_out<const K: usize, const L: usize>(
 /// What one batch of switches did.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct SwitchStats {
+    /// Constraints switched on by rank-1 updates.
     pub updates: usize,
+    /// Constraints switched off by rank-1 downdates.
     pub downdates: usize,
+    /// Whether a guard refactored from the matrix instead.
     pub refactored: bool,
 }
 

@@ -20,9 +20,10 @@ use faer::sparse::linalg::{SupernodalThreshold, SymbolicSupernodalParams};
 /// Which faer numeric factorisation fills the factor.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum FactorMethod {
-    /// Supernodal from [`SUPERNODAL_MIN_VERTICES`] vertices on, simplicial below.
+    /// Supernodal from 10 000 vertices on, simplicial below.
     #[default]
     Auto,
+    /// One column at a time.
     Simplicial,
     /// faer's fundamental supernodes: the same pattern as simplicial, no stored zeros.
     Supernodal,

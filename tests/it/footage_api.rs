@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use lapclone::animation::{
-    Background, Canvas, Footage, FootageSource, Patch, Pattern, Scene, Shape, Track,
+    Background, Footage, FootageSource, Patch, Pattern, Scene, SceneCanvas, Shape, Track,
 };
 use lapclone::glam::DVec2;
 use lapclone::{Polygon, Renderer};
@@ -68,7 +68,7 @@ fn scene(dir: &Path) -> Scene {
     let mut patch = Patch::new("p", dir.join("src_1.png"), Shape::Polygons(vec![triangle]));
     patch.footage = Some(Footage::open(&dir.join("src_%d.png"), Some(1), false, "hold").unwrap());
     patch.placement.position = Track::constant(DVec2::new(30.0, 24.0));
-    let canvas = Canvas {
+    let canvas = SceneCanvas {
         width: plates.width,
         height: plates.height,
         fps: 3.0,
@@ -145,4 +145,20 @@ fn footage_errors_are_typed_and_name_the_file() {
     scene.canvas.duration = 4.0 / 3.0;
     let error = Renderer::new(scene).err().expect("too few plates");
     assert!(error.to_string().contains("plate_008.png"), "{error}");
+}
+
+#[test]
+#[allow(deprecated)]
+fn the_old_animation_names_still_name_the_scene_types() {
+    use lapclone::animation::{Canvas, Placement, ScenePlacement};
+    let placement: ScenePlacement = Placement::default();
+    assert_eq!(placement, ScenePlacement::default());
+    let canvas: SceneCanvas = Canvas {
+        width: W,
+        height: H,
+        fps: 3.0,
+        duration: 1.0,
+        background: Background::Colour([0.0, 0.0, 0.0, 1.0]),
+    };
+    assert_eq!(canvas.frame_count(), 3);
 }

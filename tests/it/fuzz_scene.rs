@@ -225,8 +225,19 @@ fn quoted_png_paths(text: &str) -> Vec<String> {
         .collect()
 }
 
+/// How far a mutated scene got.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Outcome {
+    /// Parsing, running or validating it failed with a well-formed error.
+    Refused,
+    /// Valid, but too large to render here or refused by the renderer.
+    NotRendered,
+    /// Frames rendered (each of the canvas's size) or failed with a message.
+    Rendered,
+}
+
 /// Runs one mutated scene through the front end; an `Err` is a finding.
-fn check(world: &World, text: &str) -> Result<(), TestCaseError> {
+fn check(world: &World, text: &str) -> Result<Outcome, TestCaseError> {
     let file = world.scene_path();
     let options = ScriptOptions {
         // Small enough that runaway loops end quickly, large enough for the seeds.
@@ -238,23 +249,46 @@ fn check(world: &World, text: &str) -> Result<(), TestCaseError> {
     };
     let loaded = match parse_scene(text, &file, &options) {
         Ok(loaded) => loaded,
-        Err(error) => return check_error(&file, &error),
+        Err(error) => return check_error(&file, &error).map(|()| Outcome::Refused),
     };
     if let Err(error) = validate_scene(&loaded) {
-        return check_error(&file, &error);
+        return check_error(&file, &error).map(|()| Outcome::Refused);
     }
     let canvas = &loaded.scene.canvas;
     if u64::from(canvas.width) * u64::from(canvas.height) > 64 * 64 {
-        return Ok(());
+        return Ok(Outcome::NotRendered);
     }
-    let Ok(mut renderer) = Renderer::new(loaded.scene.clone()) else {
-        return Ok(());
+    let mut renderer = match Renderer::new(loaded.scene.clone()) {
+        Ok(renderer) => renderer,
+        Err(error) => {
+            // A refusal names the patch it is about, when it is about one.
+            let names: Vec<&str> = loaded
+                .scene
+                .patches
+                .iter()
+                .map(|p| p.name.as_str())
+                .collect();
+            let named = error.patch_name().is_none_or(|n| names.contains(&n));
+            prop_assert!(named, "{error} names no patch of {names:?}");
+            return Ok(Outcome::NotRendered);
+        }
     };
+    prop_assert_eq!(renderer.frame_count(), canvas.frame_count());
     let last = renderer.frame_count() - 1;
     for index in [0, last / 2, last] {
-        let _ = renderer.render_frame(index);
+        match renderer.render_frame(index) {
+            Ok(frame) => prop_assert_eq!(
+                (frame.width(), frame.height()),
+                (canvas.width, canvas.height),
+                "frame {} of a {}×{} canvas",
+                index,
+                canvas.width,
+                canvas.height
+            ),
+            Err(error) => prop_assert!(!error.to_string().is_empty(), "an empty error"),
+        }
     }
-    Ok(())
+    Ok(Outcome::Rendered)
 }
 
 fn check_error(file: &Path, error: &lapclone::script::SceneError) -> Result<(), TestCaseError> {
@@ -282,7 +316,8 @@ fn scene_strategy(seeds: usize) -> impl Strategy<Value = (usize, Vec<Mutation>)>
     (0..seeds, prop::collection::vec(mutation(), 0..6))
 }
 
-fn run(world: &World, cases: u32, seed: u64) -> u32 {
+/// Runs `cases` mutated scenes; gives how many ended each way.
+fn run(world: &World, cases: u32, seed: u64) -> std::collections::BTreeMap<String, u32> {
     let config = Config {
         cases,
         rng_seed: RngSeed::Fixed(seed),
@@ -290,9 +325,8 @@ fn run(world: &World, cases: u32, seed: u64) -> u32 {
         ..Config::default()
     };
     let mut runner = TestRunner::new(config);
-    let executed = std::cell::Cell::new(0u32);
+    let tally = std::cell::RefCell::new(std::collections::BTreeMap::new());
     let outcome = runner.run(&scene_strategy(world.seeds.len()), |(seed, mutations)| {
-        executed.set(executed.get() + 1);
         let mut text = world.seeds[seed].clone();
         for m in &mutations {
             apply(&mut text, m);
@@ -301,12 +335,18 @@ fn run(world: &World, cases: u32, seed: u64) -> u32 {
         if let Ok(trace) = std::env::var("LAPCLONE_FUZZ_TRACE") {
             let _ = std::fs::write(trace, &text);
         }
-        check(world, &text).map_err(|e| TestCaseError::fail(format!("{e}\n--- scene ---\n{text}")))
+        let outcome = check(world, &text)
+            .map_err(|e| TestCaseError::fail(format!("{e}\n--- scene ---\n{text}")))?;
+        *tally
+            .borrow_mut()
+            .entry(format!("{outcome:?}"))
+            .or_insert(0) += 1;
+        Ok(())
     });
     if let Err(e) = outcome {
         panic!("{e}");
     }
-    executed.get()
+    tally.into_inner()
 }
 
 #[test]
@@ -333,9 +373,8 @@ fn regressions_found_by_fuzzing() {
         "import \"shapes\" as s;\ncanvas(24, 20);\nlet r = patch(\"r\", #{ source: \"src.png\", polygons: [#{ outer: s::circle(10, 10, 8, 1e308) }] });\n",
     ];
     for text in found {
-        if let Err(e) = check(&world, text) {
-            panic!("{e}\n{text}");
-        }
+        let outcome = check(&world, text).unwrap_or_else(|e| panic!("{e}\n{text}"));
+        assert_ne!(outcome, Outcome::Rendered, "{text}");
     }
     let file = world.scene_path();
     let loaded = parse_scene(found[0], &file, &ScriptOptions::for_scene_file(&file)).unwrap();
@@ -348,8 +387,12 @@ fn regressions_found_by_fuzzing() {
 #[test]
 fn mutated_scenes_small_fixed_seed() {
     let world = World::new();
-    let executed = run(&world, 48, 0x5ce7e);
-    eprintln!("fuzz_scene: {executed} executions");
+    let tally = run(&world, 48, 0x5ce7e);
+    eprintln!("fuzz_scene: {tally:?}");
+    assert_eq!(tally.values().sum::<u32>(), 48, "every case ran: {tally:?}");
+    // The fixed seed reaches both ends: scenes refused with positioned errors, and frames.
+    assert!(tally.get("Refused").is_some_and(|&n| n > 0), "{tally:?}");
+    assert!(tally.get("Rendered").is_some_and(|&n| n > 0), "{tally:?}");
 }
 
 #[test]
@@ -364,6 +407,11 @@ fn mutated_scenes_long() {
         .ok()
         .and_then(|v| v.parse().ok())
         .unwrap_or(0xf022_5ce7);
-    let executed = run(&world, cases, seed);
-    eprintln!("fuzz_scene: {executed} executions (seed {seed})");
+    let tally = run(&world, cases, seed);
+    eprintln!("fuzz_scene: {tally:?} (seed {seed})");
+    assert_eq!(
+        tally.values().sum::<u32>(),
+        cases,
+        "every case ran: {tally:?}"
+    );
 }

@@ -236,3 +236,29 @@ fn quality_flags_shape_the_mask_mesh() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("area"));
 }
+
+#[test]
+fn the_laplacian_text_of_two_triangles_is_exact_and_reads_back() {
+    use lapclone::glam::DVec2;
+    use lapclone::solve::{laplacian, read_matrix_market, write_matrix_market, LaplacianKind};
+    let p = vec![DVec2::ZERO, DVec2::X, DVec2::ONE, DVec2::Y];
+    let mesh = lapclone::mesh::assemble_mesh(p, vec![[0, 1, 2], [0, 2, 3]]);
+    let l = laplacian(&mesh, LaplacianKind::Combinatorial);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("L.mtx");
+    write_matrix_market(&path, &l, "combinatorial Laplacian of a lapclone mesh").unwrap();
+    let expected = "%%MatrixMarket matrix coordinate real symmetric\n\
+                    % combinatorial Laplacian of a lapclone mesh\n\
+                    4 4 9\n1 1 3\n2 1 -1\n3 1 -1\n4 1 -1\n2 2 2\n3 2 -1\n3 3 3\n4 3 -1\n4 4 2\n";
+    assert_eq!(std::fs::read_to_string(&path).unwrap(), expected);
+    let back = read_matrix_market(&path).unwrap();
+    assert_eq!(
+        (back.col_ptr, back.row_idx, back.values),
+        (l.col_ptr, l.row_idx, l.values)
+    );
+    // Values that are not integers read back exactly too.
+    let mut cot = laplacian(&mesh, LaplacianKind::Cotangent);
+    cot.values.iter_mut().for_each(|v| *v /= 3.0);
+    write_matrix_market(&path, &cot, "").unwrap();
+    assert_eq!(read_matrix_market(&path).unwrap().values, cot.values);
+}

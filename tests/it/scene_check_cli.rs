@@ -125,3 +125,20 @@ fn preview_time_and_frame_are_exclusive() {
         .unwrap();
     assert_eq!(out.status.code(), Some(2));
 }
+
+#[test]
+fn check_warns_about_an_old_option_name_at_its_call() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = format!(
+        "canvas(320, 240);\nlet p = patch(\"p\", #{{ source: \"{}\", polygons: [[[10, 10], [200, 20], [50, 180]]], boundary_data: \"vertex\" }});\n",
+        asset("astronaut.png")
+    );
+    let (code, _, stderr) = check(dir.path(), &text);
+    assert_eq!(code, 0, "{stderr}");
+    let scene = dir.path().join("scene.rhai");
+    let expected = format!(
+        "warning: {}:2:9: `boundary_data` is now `boundary_sampling` (the old name still works)",
+        scene.display()
+    );
+    assert!(stderr.contains(&expected), "{stderr}");
+}

@@ -259,11 +259,11 @@ fn bad_inputs_are_positioned() {
         "no key at t = 0 on handle 0 of patch \"p\"; its keys are at 1",
     );
     assert_error_at(
-        "canvas(64, 48);\nlet p = patch(\"p\", #{ source: \"assets/astronaut.png\", mask: \"assets/horse_mask.png\", boundary_data: \"pointy\" });",
+        "canvas(64, 48);\nlet p = patch(\"p\", #{ source: \"assets/astronaut.png\", mask: \"assets/horse_mask.png\", boundary_sampling: \"pointy\" });",
         2, 9, "unknown boundary data \"pointy\"",
     );
     assert_error_at(
-        "canvas(64, 48);\nlet p = patch(\"p\", #{ source: \"assets/astronaut.png\", mask: \"assets/horse_mask.png\", boundary: \"edges\" });",
+        "canvas(64, 48);\nlet p = patch(\"p\", #{ source: \"assets/astronaut.png\", mask: \"assets/horse_mask.png\", mesh_boundary: \"edges\" });",
         2, 9, "unknown boundary placement \"edges\"",
     );
 }
@@ -274,7 +274,10 @@ fn the_boundary_defaults_to_the_outside_centres_and_can_be_the_cracks() {
         parse(HEAD).unwrap().patches[0].boundary,
         BoundaryPlacement::OutsideCentres
     );
-    let text = HEAD.replace("horse_mask.png\"", "horse_mask.png\", boundary: \"cracks\"");
+    let text = HEAD.replace(
+        "horse_mask.png\"",
+        "horse_mask.png\", mesh_boundary: \"cracks\"",
+    );
     assert_eq!(
         parse(&text).unwrap().patches[0].boundary,
         BoundaryPlacement::Cracks
@@ -289,7 +292,7 @@ fn boundary_data_defaults_to_the_hat_average_and_can_be_the_vertex_sample() {
     );
     let text = HEAD.replace(
         "horse_mask.png\"",
-        "horse_mask.png\", boundary_data: \"vertex\"",
+        "horse_mask.png\", boundary_sampling: \"vertex\"",
     );
     assert_eq!(
         parse(&text).unwrap().patches[0].boundary_data,

@@ -116,7 +116,7 @@ fn follow_renders_the_same_frames_as_the_keys_written_by_hand() {
 }
 
 /// The patch's placement after running `body` in the test scene in `dir`.
-fn placement(dir: &Path, body: &str) -> lapclone::animation::Placement {
+fn placement(dir: &Path, body: &str) -> lapclone::animation::ScenePlacement {
     let scene = dir.join("probe.rhai");
     std::fs::write(&scene, scene_text(body)).unwrap();
     let loaded = load_scene(&scene).unwrap_or_else(|e| panic!("{e}"));

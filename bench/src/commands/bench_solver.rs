@@ -338,7 +338,7 @@ fn write_disc(
 ) -> anyhow::Result<()> {
     std::fs::create_dir_all(folder).with_context(|| format!("creating {}", folder.display()))?;
     let stem = folder.join(format!("disc_{}", l.n));
-    write_matrix_market(&stem.with_extension("mtx"), l)?;
+    write_matrix_market(&stem.with_extension("mtx"), l, "")?;
     let list: String = constrained.iter().map(|v| format!("{v}\n")).collect();
     let path = stem.with_extension("constrained");
     std::fs::write(&path, list).with_context(|| format!("writing {}", path.display()))

@@ -1,7 +1,7 @@
 //! Tab completion: takes the line being edited, the cursor and the words the session knows
 //! (patch names, variables, registered Rhai functions) and gives the candidates — `:commands`
 //! at the start, file paths after `:load`/`:save`/`:gif`/`-o`, patch names inside a string
-//! literal, and variables, functions and keywords elsewhere.
+//! literal, and variables, functions, keywords and scene option keys elsewhere.
 
 use std::sync::{Arc, Mutex};
 
@@ -103,6 +103,12 @@ pub fn classify(before: &str) -> Completion {
     }
 }
 
+/// The scene calls' option keys (`at`, `rotate` are functions too), new spellings only.
+fn option_keys() -> impl Iterator<Item = &'static str> {
+    let patch = lapclone::script::PATCH_OPTIONS.iter();
+    patch.chain(&lapclone::script::OTHER_OPTION_KEYS).copied()
+}
+
 /// Candidates for a word completion: sorted, unique, starting with `prefix`.
 pub fn word_candidates(prefix: &str, in_string: bool, words: &Words) -> Vec<String> {
     let mut out: Vec<String> = if in_string {
@@ -114,6 +120,7 @@ pub fn word_candidates(prefix: &str, in_string: bool, words: &Words) -> Vec<Stri
             .chain(&words.functions)
             .cloned()
             .chain(KEYWORDS.iter().map(|k| k.to_string()))
+            .chain(option_keys().map(String::from))
             .collect()
     };
     out.retain(|w| w.starts_with(prefix));
@@ -232,6 +239,15 @@ mod tests {
         );
         assert_eq!(word_candidates("c", true, &words()), ["cat", "coffee_cup"]);
         assert_eq!(word_candidates("le", false, &words()), ["let"]);
+        assert_eq!(word_candidates("mesh_", false, &words()), ["mesh_boundary"]);
+        assert_eq!(
+            word_candidates("boundary_", false, &words()),
+            ["boundary_sampling"]
+        );
+        assert_eq!(
+            word_candidates("source_", false, &words()),
+            ["source_hold", "source_start_number"]
+        );
         assert!(word_candidates("zz", false, &words()).is_empty());
     }
 
