@@ -82,7 +82,7 @@ pub use mesh::{
 };
 pub use pixels::{Canvas, ColorKind, Depth, FloatImage, FootageError, PixelError, PixelFormat};
 pub use render::{FrameStats, RenderError, Renderer};
-pub use script::{load_scene, LoadedScene, SceneError};
+pub use script::{load_scene, set_allocation_probe, LoadedScene, SceneError};
 pub use solve::LaplacianKind;
 
 /// Scenes: the animated description a [`Renderer`] draws, built in Rust or loaded from a

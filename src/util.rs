@@ -1,7 +1,8 @@
-//! Small helpers shared by every stage: atomic file output (write to a temporary file in the
-//! destination folder, then rename, so a failure never leaves a partial file), a lock that
-//! survives poisoning, finding an external program (ffmpeg) on `PATH`, and the number of
-//! cores this process may use.
+//! Small helpers shared by every stage: the one rule for output files ([`TempOutput`]: a
+//! temporary file in the destination folder, then a rename, so a failure never leaves a
+//! partial file; streams written through, nothing else replaced), whether two paths name one
+//! file, a lock that survives poisoning, finding an external program (ffmpeg) on `PATH`, and
+//! the number of cores this process may use.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -45,39 +46,188 @@ fn is_executable(path: &Path) -> bool {
     }
 }
 
-/// Writes `bytes` to `path` through a temporary sibling file and a rename.
+/// Writes `bytes` to `path` by the one output rule ([`TempOutput`]).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     write_atomic_with(path, |file| file.write_all(bytes))
 }
 
-/// Calls `fill` with a temporary sibling file of `path`, then renames it onto `path`.
-/// On any error the temporary file is removed and `path` is untouched.
+/// Calls `fill` with the file [`TempOutput`] gives for `path`, then commits it. On any error
+/// the temporary file is removed and `path` is untouched.
 pub fn write_atomic_with(
     path: &Path,
     fill: impl FnOnce(&mut std::fs::File) -> std::io::Result<()>,
 ) -> std::io::Result<()> {
-    let tmp = temporary_sibling(path);
-    let result = (|| {
-        let mut file = std::fs::File::create(&tmp)?;
-        fill(&mut file)?;
+    let output = TempOutput::new(path)?;
+    let mut file = output.open()?;
+    fill(&mut file)?;
+    if output.is_temporary() {
         file.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
     }
-    result
+    drop(file);
+    output.commit()
 }
 
-fn temporary_sibling(path: &Path) -> PathBuf {
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp_name = format!(".{name}.{}.tmp", std::process::id());
-    match path.parent() {
-        Some(dir) if !dir.as_os_str().is_empty() => dir.join(tmp_name),
-        _ => PathBuf::from(tmp_name),
+/// What an output path names, decided once before anything is written.
+enum Destination {
+    /// Missing, or a regular file (also through a symbolic link): written to a temporary
+    /// file in the same folder, renamed over it at the end.
+    Replace(PathBuf),
+    /// A FIFO or a character device (`/dev/null`, a terminal): the user asked for a stream,
+    /// so it is written through and never unlinked.
+    Through(PathBuf),
+}
+
+/// Why an output path is refused before anything is written.
+fn refuse(what: &str) -> std::io::Error {
+    std::io::Error::new(
+        std::io::ErrorKind::InvalidInput,
+        format!(
+            "it is {what}; lapclone writes only regular files, FIFOs and character devices, and never replaces anything else"
+        ),
+    )
+}
+
+/// Classifies `path`. A symbolic link is followed: its target is what gets written (the
+/// link itself stays); a link to nothing is refused, since writing would create a file at
+/// a place the command line does not show.
+fn destination(path: &Path) -> std::io::Result<Destination> {
+    let link = std::fs::symlink_metadata(path);
+    let meta = match (&link, std::fs::metadata(path)) {
+        (Err(e), _) if e.kind() == std::io::ErrorKind::NotFound => {
+            return Ok(Destination::Replace(path.to_path_buf()))
+        }
+        (Err(e), _) => return Err(std::io::Error::new(e.kind(), e.to_string())),
+        (Ok(_), Err(_)) => return Err(refuse("a symbolic link to nothing")),
+        (Ok(_), Ok(meta)) => meta,
+    };
+    let is_link = link.is_ok_and(|m| m.file_type().is_symlink());
+    let target = if is_link {
+        path.canonicalize()?
+    } else {
+        path.to_path_buf()
+    };
+    let kind = meta.file_type();
+    if kind.is_file() {
+        return Ok(Destination::Replace(target));
+    }
+    if kind.is_dir() {
+        return Err(refuse("a folder"));
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if kind.is_fifo() || kind.is_char_device() {
+            return Ok(Destination::Through(target));
+        }
+        if kind.is_block_device() {
+            return Err(refuse("a block device"));
+        }
+        if kind.is_socket() {
+            return Err(refuse("a socket"));
+        }
+    }
+    Err(refuse("not a regular file"))
+}
+
+/// The one way lapclone writes an output file. A regular (or missing) destination gets a
+/// temporary file in its folder (`tempfile`'s unique name, so two writes of one path never
+/// collide) that [`TempOutput::commit`] renames over it, and dropping it uncommitted removes
+/// it: no reader ever sees a half-written output. A FIFO or character device is written
+/// through, never unlinked; folders, block devices, sockets and dangling links are refused.
+/// A missing parent folder is an error: lapclone never creates one.
+#[derive(Debug)]
+pub struct TempOutput {
+    inner: Inner,
+}
+
+#[derive(Debug)]
+enum Inner {
+    Temporary {
+        file: tempfile::NamedTempFile,
+        dest: PathBuf,
+    },
+    Through(PathBuf),
+}
+
+impl TempOutput {
+    /// Prepares writing `dest` (creates the temporary file for a regular destination).
+    pub fn new(dest: &Path) -> std::io::Result<Self> {
+        let inner = match destination(dest)? {
+            Destination::Through(path) => Inner::Through(path),
+            Destination::Replace(dest) => {
+                let name = dest
+                    .file_name()
+                    .map(|n| n.to_string_lossy().into_owned())
+                    .unwrap_or_default();
+                let folder = match dest.parent() {
+                    Some(dir) if !dir.as_os_str().is_empty() => dir.to_path_buf(),
+                    _ => PathBuf::from("."),
+                };
+                let prefix = format!(".{name}.");
+                let mut builder = tempfile::Builder::new();
+                builder.prefix(&prefix).suffix(".tmp");
+                // An output is an ordinary file: the umask decides, as for any new file.
+                #[cfg(unix)]
+                {
+                    use std::os::unix::fs::PermissionsExt;
+                    builder.permissions(std::fs::Permissions::from_mode(0o666));
+                }
+                let file = builder
+                    .tempfile_in(&folder)
+                    .map_err(|e| std::io::Error::new(e.kind(), e.to_string()))?;
+                Inner::Temporary { file, dest }
+            }
+        };
+        Ok(TempOutput { inner })
+    }
+
+    /// The path to write: the temporary file, or the FIFO / device itself.
+    pub fn temp_path(&self) -> &Path {
+        match &self.inner {
+            Inner::Temporary { file, .. } => file.path(),
+            Inner::Through(path) => path,
+        }
+    }
+
+    /// Whether writes go to a temporary file (false: through a FIFO or device).
+    pub fn is_temporary(&self) -> bool {
+        matches!(self.inner, Inner::Temporary { .. })
+    }
+
+    /// Opens [`TempOutput::temp_path`] for writing.
+    pub fn open(&self) -> std::io::Result<std::fs::File> {
+        match &self.inner {
+            Inner::Temporary { file, .. } => file.reopen(),
+            Inner::Through(path) => std::fs::OpenOptions::new().write(true).open(path),
+        }
+    }
+
+    /// Renames the temporary file over the destination (nothing to do for a stream).
+    pub fn commit(self) -> std::io::Result<()> {
+        match self.inner {
+            Inner::Temporary { file, dest } => file
+                .persist(&dest)
+                .map(drop)
+                .map_err(|e| std::io::Error::new(e.error.kind(), e.error.to_string())),
+            Inner::Through(_) => Ok(()),
+        }
+    }
+}
+
+/// Whether `a` and `b` name one existing file: after following links, and on Unix also
+/// through hard links (same device and inode).
+pub fn same_file(a: &Path, b: &Path) -> bool {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        if let (Ok(x), Ok(y)) = (a.metadata(), b.metadata()) {
+            return x.dev() == y.dev() && x.ino() == y.ino();
+        }
+        false
+    }
+    #[cfg(not(unix))]
+    {
+        matches!((a.canonicalize(), b.canonicalize()), (Ok(x), Ok(y)) if x == y)
     }
 }
 

@@ -185,7 +185,7 @@ pub fn run(args: CloneArgs) -> anyhow::Result<()> {
             "reclone_ms": reclone_ms,
             "load_ms": load_ms,
         });
-        println!("{json}");
+        super::say(json)?;
     }
     Ok(())
 }
@@ -338,7 +338,8 @@ fn check_arguments(args: &CloneArgs) -> anyhow::Result<()> {
             .validate()
             .map_err(|e| UsageError(format!("--density: {e}")))?;
     }
-    check_output_folder(&args.output)
+    check_output_folder(&args.output)?;
+    super::inputs::refuse_input(&args.output, &[&args.source, &args.mask, &args.target])
 }
 
 /// Fails before any work when the output's folder does not exist.

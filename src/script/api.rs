@@ -309,6 +309,21 @@ impl PatchRef {
         Ok(result)
     }
 
+    /// Applies `edit` to the patch itself, for edits that change it only once every check
+    /// has passed (one key, one drag, one pin): no copy, so a scene adding keys one call at
+    /// a time stays linear in its keys.
+    fn edit_in_place<R>(
+        &self,
+        ctx: &NativeCallContext,
+        edit: impl FnOnce(&mut Patch) -> Result<R, String>,
+    ) -> Fallible<R> {
+        let mut d = self.draft.lock();
+        let Some(index) = d.patch_index(self.id) else {
+            return Err(fail(ctx, "this patch no longer exists in the scene"));
+        };
+        edit(&mut d.patches[index]).map_err(|m| fail(ctx, m))
+    }
+
     pub(super) fn name(&mut self) -> String {
         let d = self.draft.lock();
         d.patch_index(self.id)
@@ -323,9 +338,13 @@ impl PatchRef {
         values: Map,
         easing: &str,
     ) -> Fallible<Self> {
-        self.edit(&ctx, |p| {
+        self.edit_in_place(&ctx, |p| {
             let t = values::time(&t)?;
             let easing = values::easing(easing)?;
+            // A key refused for one property must leave the others unkeyed too: try them
+            // on empty tracks first (a key's checks never depend on the keys already there).
+            let mut trial = Patch::new(String::new(), PathBuf::new(), Shape::Polygons(Vec::new()));
+            add_placement_keys(&mut trial, t, &values, easing)?;
             add_placement_keys(p, t, &values, easing)
         })?;
         Ok(self.clone())
@@ -354,7 +373,7 @@ impl PatchRef {
         value: Dynamic,
         easing: &str,
     ) -> Fallible<Self> {
-        self.edit(&ctx, |p| {
+        self.edit_in_place(&ctx, |p| {
             let t = values::time(&t)?;
             let easing = values::easing(easing)?;
             which.push(p, t, &value, easing)
@@ -369,7 +388,7 @@ impl PatchRef {
         radius: Dynamic,
         options: Map,
     ) -> Fallible<HandleRef> {
-        self.edit(&ctx, |p| {
+        self.edit_in_place(&ctx, |p| {
             values::check_keys(&options, &["depth", "pivot"], "drag")?;
             let handle = Handle {
                 from: values::point(&from, "drag rest point")?,
@@ -400,7 +419,7 @@ impl PatchRef {
     }
 
     fn pin(&mut self, ctx: NativeCallContext, at: Dynamic, options: Map) -> Fallible<Self> {
-        self.edit(&ctx, |p| {
+        self.edit_in_place(&ctx, |p| {
             values::check_keys(&options, &["start", "end"], "pin")?;
             let start = match options.get("start") {
                 Some(v) => values::time(v)?,
@@ -464,6 +483,21 @@ impl HandleRef {
         Ok(self.clone())
     }
 
+    /// Applies `edit` to the handle itself, for edits that change it only once every check
+    /// has passed (one key): no copy per call.
+    fn edit_in_place(
+        &self,
+        ctx: &NativeCallContext,
+        edit: impl FnOnce(&mut Handle) -> Result<(), String>,
+    ) -> Fallible<Self> {
+        let mut d = self.draft.lock();
+        let Some((p, h)) = self.indices(&d) else {
+            return Err(fail(ctx, "this handle no longer exists in the scene"));
+        };
+        edit(&mut d.patches[p].handles[h]).map_err(|m| fail(ctx, m))?;
+        Ok(self.clone())
+    }
+
     fn key(
         &mut self,
         ctx: NativeCallContext,
@@ -471,7 +505,7 @@ impl HandleRef {
         to: Dynamic,
         easing: &str,
     ) -> Fallible<Self> {
-        self.edit(&ctx, |h| {
+        self.edit_in_place(&ctx, |h| {
             let t = values::time(&t)?;
             let easing = values::easing(easing)?;
             h.to.push(t, values::point(&to, "handle target")?, easing)
@@ -507,7 +541,7 @@ impl HandleRef {
         degrees: Dynamic,
         easing: &str,
     ) -> Fallible<Self> {
-        self.edit(&ctx, |h| {
+        self.edit_in_place(&ctx, |h| {
             let t = values::time(&t)?;
             let easing = values::easing(easing)?;
             let r = number(&degrees, "handle rotation")?;

@@ -10,6 +10,7 @@ mod edit_api;
 mod engine;
 mod error;
 mod golden;
+mod memory;
 mod footage_options;
 mod sandbox;
 mod validate;
@@ -18,8 +19,9 @@ mod values;
 pub use refs::{HandleRef, PatchRef};
 pub use draft::{Draft, Ids, Origin, Origins};
 pub use engine::{
-    find_scripts_dir, load_scene, parse_scene, LoadedScene, SceneEngine, ScriptOptions,
+    find_scripts_dir, load_scene, load_scene_and_imports, parse_scene, LoadedScene, SceneEngine, ScriptOptions,
 };
 pub use error::{ErrorKind, SceneError};
+pub use memory::set_allocation_probe;
 pub use sandbox::{Limits, ModuleFiles, SandboxResolver};
 pub use validate::{validate_scene, CheckSummary, MASK_THRESHOLD};
