@@ -19,6 +19,9 @@ pub(crate) fn lock<T>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {
 /// What to tell a user who asked for something that needs ffmpeg when it is not installed.
 pub const FFMPEG_MISSING: &str = "ffmpeg not found on PATH: install it (for example: apt-get install ffmpeg) or use --format png|gif|apng|y4m";
 
+/// What to tell a user whose scene reads video footage when ffmpeg or ffprobe is missing.
+pub const FFMPEG_MISSING_FOR_FOOTAGE: &str = "ffmpeg and ffprobe not found on PATH: reading video footage needs them; install ffmpeg (for example: apt-get install ffmpeg) or use numbered image files (frame_%04d.png)";
+
 /// Cores available to this process (1 if unknown), looked up once.
 pub fn available_cores() -> usize {
     static CORES: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
@@ -210,6 +213,56 @@ impl TempOutput {
                 .map(drop)
                 .map_err(|e| std::io::Error::new(e.error.kind(), e.error.to_string())),
             Inner::Through(_) => Ok(()),
+        }
+    }
+}
+
+/// What kind of thing `path` is, for a message about an input that cannot be read as a
+/// file: `None` for a regular file (also through links), else "does not exist", "is a
+/// folder, not a file" or "is not a regular file (a FIFO)" and the like.
+pub fn not_a_file(path: &Path) -> Option<&'static str> {
+    let Ok(meta) = path.metadata() else {
+        return Some(if path.symlink_metadata().is_ok() {
+            "is a symbolic link to nothing"
+        } else {
+            "does not exist"
+        });
+    };
+    let kind = meta.file_type();
+    if kind.is_file() {
+        return None;
+    }
+    if kind.is_dir() {
+        return Some("is a folder, not a file");
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if kind.is_fifo() {
+            return Some("is not a regular file (a FIFO)");
+        }
+        if kind.is_char_device() || kind.is_block_device() {
+            return Some("is not a regular file (a device)");
+        }
+        if kind.is_socket() {
+            return Some("is not a regular file (a socket)");
+        }
+    }
+    Some("is not a regular file")
+}
+
+/// An input must be a regular file: reading a FIFO or a device could wait forever, and a
+/// folder is no file. The error says which of these `path` is.
+pub fn check_input_file(path: &Path) -> std::io::Result<()> {
+    match not_a_file(path) {
+        None => Ok(()),
+        Some(what) => {
+            let kind = if what == "does not exist" {
+                std::io::ErrorKind::NotFound
+            } else {
+                std::io::ErrorKind::InvalidInput
+            };
+            Err(std::io::Error::new(kind, format!("it {what}")))
         }
     }
 }

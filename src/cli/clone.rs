@@ -243,12 +243,13 @@ fn mesh_patch(
     source_size: (u32, u32),
     options: &MeshOptions,
 ) -> anyhow::Result<PatchMesh> {
-    Ok(mesh_from_mask(
+    mesh_from_mask(
         mask,
         args.mask_offset.map(DVec2::from),
         source_size,
         options,
-    )?)
+    )
+    .with_context(|| format!("mask {}", args.mask.display()))
 }
 
 /// The cloner on the patch's mesh (the factor), and the deformation of the drags and pins.
@@ -346,8 +347,13 @@ fn check_arguments(args: &CloneArgs) -> anyhow::Result<()> {
 pub fn check_output_folder(output: &Path) -> anyhow::Result<()> {
     match output.parent() {
         Some(dir) if !dir.as_os_str().is_empty() && !dir.is_dir() => {
+            let problem = if dir.exists() {
+                "is not a folder"
+            } else {
+                "does not exist"
+            };
             anyhow::bail!(
-                "{}: the output folder {} does not exist",
+                "{}: the output folder {} {problem}",
                 output.display(),
                 dir.display()
             )

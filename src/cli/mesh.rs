@@ -49,7 +49,8 @@ pub fn run(args: MeshArgs) -> anyhow::Result<()> {
     }
     let mask = BitMask::load(&args.mask, threshold as f32)?;
     let started = Instant::now();
-    let mut result = mesh::mesh_mask(&mask, &options)?;
+    let mut result = mesh::mesh_mask(&mask, &options)
+        .with_context(|| format!("mask {}", args.mask.display()))?;
     // The raw mask mesh (boundary on the pixel cracks unless `--boundary outside-centres`);
     // relaxation is the only finishing step that belongs to the mesh itself.
     if options.relax_sweeps > 0 {

@@ -193,6 +193,9 @@ pub fn run_render(args: RenderArgs) -> anyhow::Result<()> {
     // Before the scene: a video's ffmpeg starts up while the scene loads.
     let plan = SinkPlan::new(kind, &args.output, settings)?;
     let (loaded, imports, mut renderer) = load_renderer(&args.scene)?;
+    for warning in renderer.point_warnings() {
+        eprintln!("warning: {warning}");
+    }
     if kind == OutputKind::PngFolder {
         super::inputs::refuse_scene_input_frames(&args.output, &loaded, &imports)?;
     } else {
@@ -300,7 +303,12 @@ pub fn run_check(args: CheckArgs) -> anyhow::Result<()> {
         c.frame_count(),
         loaded.scene.patches.len(),
     ))?;
-    for warning in loaded.scene.warnings() {
+    for warning in loaded
+        .scene
+        .warnings()
+        .into_iter()
+        .chain(renderer.point_warnings())
+    {
         eprintln!("warning: {warning}");
     }
     Ok(())

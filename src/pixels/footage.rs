@@ -47,7 +47,7 @@ pub enum FootageError {
     #[error("{} not found", .0.display())]
     NotFound(PathBuf),
     /// A frame's file is missing and the footage does not hold its last frame.
-    #[error("frame {frame} needs {}, which does not exist (add `{hold_key}: true` to hold the last one)", file.display())]
+    #[error("frame {frame} needs {}, which does not exist{}", file.display(), hold_hint(hold_key, *held))]
     MissingFrame {
         /// The frame, counted from 1.
         frame: u64,
@@ -55,6 +55,8 @@ pub enum FootageError {
         file: PathBuf,
         /// The setting that would hold the last frame ([`Footage::hold_key`]).
         hold_key: String,
+        /// Whether that setting is already on (then only an earlier file can help).
+        held: bool,
     },
     /// A frame's size differs from the first frame's.
     #[error("{}: frame {frame} is {width}×{height}, but the footage is {expected_width}×{expected_height}", file.display())]
@@ -73,7 +75,7 @@ pub enum FootageError {
         expected_height: u32,
     },
     /// A video needs `ffmpeg` / `ffprobe`, and neither is on `PATH`.
-    #[error("{}", crate::util::FFMPEG_MISSING)]
+    #[error("{}", crate::util::FFMPEG_MISSING_FOR_FOOTAGE)]
     NoFfmpeg,
     /// ffmpeg or ffprobe cannot read the video.
     #[error("cannot read video {}: {message}", path.display())]
@@ -98,6 +100,15 @@ pub enum FootageError {
     /// A frame's file cannot be read or decoded.
     #[error(transparent)]
     Image(#[from] Box<PixelError>),
+}
+
+/// The end of a missing-frame message: how holding would help, unless it is already on.
+fn hold_hint(hold_key: &str, held: bool) -> String {
+    if held {
+        format!(" (`{hold_key}` holds the last file of the unbroken run from the first one; the first is missing)")
+    } else {
+        format!(" (add `{hold_key}: true` to hold the last one)")
+    }
 }
 
 /// A printf-style file name: a prefix, one frame number (zero-padded to `digits`, 0 for
@@ -300,6 +311,7 @@ impl Footage {
                     frame: 1,
                     file: first,
                     hold_key: hold_key.into(),
+                    held: hold,
                 });
             }
             let size = image_size(&first)?;
@@ -346,6 +358,7 @@ impl Footage {
                             frame: i + 1,
                             file,
                             hold_key: self.hold_key.clone(),
+                            held: self.hold,
                         });
                     }
                     let (width, height) = image_size(&file)?;
@@ -504,7 +517,8 @@ impl FootageReader {
         start: u64,
         index: u64,
     ) -> Result<FloatImage, FootageError> {
-        let mut file = pattern.path(start + index);
+        // Saturating: a time far beyond any footage names a far frame, never frame 0.
+        let mut file = pattern.path(start.saturating_add(index));
         if !file.is_file() && self.footage.hold {
             // The last file of the unbroken run from the start holds.
             let mut last = 0;
@@ -518,9 +532,10 @@ impl FootageReader {
         }
         if !file.is_file() {
             return Err(FootageError::MissingFrame {
-                frame: index + 1,
+                frame: index.saturating_add(1),
                 file,
                 hold_key: self.footage.hold_key.clone(),
+                held: self.footage.hold,
             });
         }
         let image = FloatImage::load(&file).map_err(|e| FootageError::Image(Box::new(e)))?;
@@ -532,7 +547,7 @@ impl FootageReader {
         if (w, h) != (self.footage.width, self.footage.height) {
             return Err(FootageError::SizeChanged {
                 file: file.to_path_buf(),
-                frame: index + 1,
+                frame: index.saturating_add(1),
                 width: w,
                 height: h,
                 expected_width: self.footage.width,
@@ -559,7 +574,7 @@ impl FootageReader {
             (Some(bytes), true) => rgba8_image(w, h, bytes),
             _ => Err(FootageError::VideoTooShort {
                 path: path.to_path_buf(),
-                frame: index + 1,
+                frame: index.saturating_add(1),
                 available: stream.next,
                 hold_key: self.footage.hold_key.clone(),
             }),

@@ -28,24 +28,18 @@ fn origin(ctx: &NativeCallContext, base_dir: &Path) -> Origin {
     }
 }
 
-/// Resolves `text` against the scene folder and insists the file exists.
+/// Resolves `text` against the scene folder and insists it is a regular file.
 fn existing_file(base_dir: &Path, text: &str, what: &str) -> Result<PathBuf, String> {
     let path = base_dir.join(text);
-    if path.is_file() {
-        Ok(path)
-    } else if path.is_dir() {
-        Err(format!(
-            "{what} `{text}` is a folder, not a file ({})",
-            path.display()
-        ))
-    } else {
-        Err(format!(
+    match crate::util::not_a_file(&path) {
+        None => Ok(path),
+        Some("does not exist") => Err(format!(
             "{what} file `{text}` not found (looked for {})",
             path.display()
-        ))
+        )),
+        Some(problem) => Err(format!("{what} `{text}` {problem} ({})", path.display())),
     }
 }
-
 
 pub fn register(engine: &mut Engine, draft: &SharedDraft) {
     engine.build_type::<PatchRef>().build_type::<HandleRef>();

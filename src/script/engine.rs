@@ -189,7 +189,10 @@ pub fn load_scene(path: &Path) -> Result<LoadedScene, SceneError> {
 /// [`load_scene`], also giving the module files the scene imported (directly or through
 /// other modules): with the scene and its images, what a render reads.
 pub fn load_scene_and_imports(path: &Path) -> Result<(LoadedScene, Vec<PathBuf>), SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|e| {
+    // A FIFO or a device would be read until it ends, which may be never.
+    let text = crate::util::check_input_file(path)
+        .and_then(|()| std::fs::read_to_string(path))
+        .map_err(|e| {
         SceneError::new(
             ErrorKind::Io,
             path,

@@ -167,7 +167,10 @@ impl SandboxResolver {
             let Ok(found) = root.join(&file_name).canonicalize() else {
                 continue;
             };
-            if found.is_file() && found.starts_with(root) {
+            if found.starts_with(root) {
+                if let Some(problem) = crate::util::not_a_file(&found) {
+                    return Err(format!("module `{name}` {problem} ({})", found.display()));
+                }
                 return Ok(found);
             }
             escaped = escaped.or(Some(found));

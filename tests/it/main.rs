@@ -25,6 +25,7 @@ mod determinism_cli;
 mod footage_api;
 mod fuzz_mesh;
 mod fuzz_scene;
+mod hostile_cli;
 mod interrupt_cli;
 mod mesh_cli;
 mod mesh_quality_options;
