@@ -65,7 +65,7 @@ fn outside(mesh: &Mesh, p: DVec2) -> Option<(f64, DVec2)> {
             distance = distance.min(segment_distance(s, e, p));
         }
     }
-    if !(distance > OUTSIDE_TOLERANCE) {
+    if distance.is_nan() || distance <= OUTSIDE_TOLERANCE {
         return None;
     }
     let nearest = mesh
