@@ -307,6 +307,35 @@ mod tests {
     }
 
     #[test]
+    fn two_writes_of_one_path_never_share_a_temporary_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("out.bin");
+        let first = TempOutput::new(&path).unwrap();
+        let second = TempOutput::new(&path).unwrap();
+        assert_ne!(first.temp_path(), second.temp_path());
+        std::fs::write(first.temp_path(), b"one").unwrap();
+        std::fs::write(second.temp_path(), b"two").unwrap();
+        first.commit().unwrap();
+        assert_eq!(std::fs::read(&path).unwrap(), b"one");
+        second.commit().unwrap();
+        assert_eq!(std::fs::read(&path).unwrap(), b"two");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn devices_are_written_through_and_folders_refused() {
+        let null = TempOutput::new(Path::new("/dev/null")).unwrap();
+        assert!(!null.is_temporary());
+        assert_eq!(null.temp_path(), Path::new("/dev/null"));
+        null.open().unwrap().write_all(b"gone").unwrap();
+        null.commit().unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let error = TempOutput::new(dir.path()).unwrap_err();
+        assert!(error.to_string().contains("it is a folder"), "{error}");
+    }
+
+    #[test]
     fn missing_folder_is_an_error() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("nope").join("out.bin");

@@ -748,3 +748,46 @@ fn unicode_paths_render() {
     expect(&output, 0, "");
     assert_eq!(sorted_names(&out).len(), 3);
 }
+
+#[test]
+fn the_repl_survives_loading_an_import_cycle() {
+    let world = World::new();
+    world.write("a.rhai", "import \"b\" as b;\n");
+    world.write("b.rhai", "import \"a\" as a;\n");
+    world.scene("cycle.rhai", "import \"a\" as a;\n");
+    world.scene("fine.rhai", "");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_lapclone"))
+        .args(["repl", "--preview"])
+        .arg(world.path("preview.png"))
+        .current_dir(world.root.path())
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    use std::io::Write as _;
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(b":load cycle.rhai\n:load fine.rhai\n:list\n")
+        .unwrap();
+    let output = child.wait_with_output().unwrap();
+    let all = format!(
+        "{}{}",
+        String::from_utf8_lossy(&output.stdout),
+        String::from_utf8_lossy(&output.stderr)
+    );
+    // Exit 1 only because a piped session reports its failed entry at the end.
+    assert_eq!(output.status.code(), Some(1), "{all}");
+    assert!(all.contains("1 failed entry"), "{all}");
+    assert!(
+        all.contains("import cycle: a.rhai → b.rhai → a.rhai"),
+        "{all}"
+    );
+    assert!(
+        all.contains("loaded") && all.contains("patch \"p\""),
+        "the session did not go on: {all}"
+    );
+    assert!(!all.contains("overflowed"), "{all}");
+}
