@@ -91,20 +91,27 @@ pub use raster::{RasterError, RasterStats};
 pub use render::{FrameStats, RenderError, Renderer, SceneUpdate};
 /// The scene language's engine: [`SceneError::position`] is its [`rhai::Position`].
 pub use rhai;
-pub use script::{load_scene, ErrorKind as SceneErrorKind, LoadedScene, SceneError};
+pub use script::{
+    load_scene, set_allocation_probe, ErrorKind as SceneErrorKind, LoadedScene, SceneError,
+};
 pub use solve::{FactorMethod, LaplacianKind, PenaltyOptions, SolveError, SwitchStats};
 
-/// Opens a scene file as `lapclone render` does: loads and runs it ([`load_scene`]),
-/// validates it (a canvas, patches whose masks and sources exist and fit, ...) and builds
-/// the [`Renderer`], which meshes and factors every patch. Every error is a [`SceneError`]
-/// positioned at the scene call it is about (the renderer's at the call that made the
-/// patch).
+/// Opens a scene file as `lapclone render` does: loads and runs it ([`load_scene`]), then
+/// [`build_renderer`].
 pub fn open_scene(path: &std::path::Path) -> Result<(LoadedScene, Renderer), SceneError> {
     let loaded = load_scene(path)?;
-    script::validate_scene(&loaded)?;
-    let renderer = Renderer::new(loaded.scene.clone())
-        .map_err(|e| loaded.error_at_patch(e.patch_name(), e.to_string()))?;
+    let renderer = build_renderer(&loaded)?;
     Ok((loaded, renderer))
+}
+
+/// Validates a loaded scene (a canvas, patches whose masks and sources exist and fit, ...)
+/// and builds its [`Renderer`], which meshes and factors every patch. Every error is a
+/// [`SceneError`] positioned at the scene call it is about (the renderer's at the call that
+/// made the patch).
+pub fn build_renderer(loaded: &LoadedScene) -> Result<Renderer, SceneError> {
+    script::validate_scene(loaded)?;
+    Renderer::new(loaded.scene.clone())
+        .map_err(|e| loaded.error_at_patch(e.patch_name(), e.to_string()))
 }
 
 /// Scenes: the animated description a [`Renderer`] draws, built in Rust or loaded from a

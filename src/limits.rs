@@ -71,6 +71,7 @@ pub fn check_frame_count(frames: u64) -> Result<(), LimitError> {
 /// The width and height in an image file's header (format guessed from its content),
 /// without decoding its pixels.
 pub fn image_dimensions(path: &Path) -> Result<(u32, u32), ImageOpenError> {
+    crate::util::check_input_file(path)?;
     let reader = image::ImageReader::open(path)?.with_guessed_format()?;
     Ok(reader.into_dimensions()?)
 }

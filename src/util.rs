@@ -1,7 +1,8 @@
-//! Small helpers shared by every stage: atomic file output (write to a temporary file in the
-//! destination folder, then rename, so a failure never leaves a partial file), a lock that
-//! survives poisoning, finding an external program (ffmpeg) on `PATH`, and the number of
-//! cores this process may use.
+//! Small helpers shared by every stage: the one rule for output files ([`TempOutput`]: a
+//! temporary file in the destination folder, then a rename, so a failure never leaves a
+//! partial file; streams written through, nothing else replaced), whether two paths name one
+//! file, a lock that survives poisoning, finding an external program (ffmpeg) on `PATH`, and
+//! the number of cores this process may use.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -17,6 +18,9 @@ pub(crate) fn lock<T>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {
 
 /// What to tell a user who asked for something that needs ffmpeg when it is not installed.
 pub const FFMPEG_MISSING: &str = "ffmpeg not found on PATH: install it (for example: apt-get install ffmpeg) or use --format png|gif|apng|y4m";
+
+/// What to tell a user whose scene reads video footage when ffmpeg or ffprobe is missing.
+pub const FFMPEG_MISSING_FOR_FOOTAGE: &str = "ffmpeg and ffprobe not found on PATH: reading video footage needs them; install ffmpeg (for example: apt-get install ffmpeg) or use numbered image files (frame_%04d.png)";
 
 /// Cores available to this process (1 if unknown), looked up once.
 pub fn available_cores() -> usize {
@@ -36,39 +40,238 @@ pub fn find_program_in(name: &str, search: &std::ffi::OsStr) -> Option<PathBuf> 
     which::which_in(name, Some(search), cwd).ok()
 }
 
-/// Writes `bytes` to `path` through a temporary sibling file and a rename.
+/// Writes `bytes` to `path` by the one output rule ([`TempOutput`]).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     write_atomic_with(path, |file| file.write_all(bytes))
 }
 
-/// Calls `fill` with a temporary sibling file of `path`, then renames it onto `path`.
-/// On any error the temporary file is removed and `path` is untouched.
+/// Calls `fill` with the file [`TempOutput`] gives for `path`, then commits it. On any error
+/// the temporary file is removed and `path` is untouched.
 pub fn write_atomic_with(
     path: &Path,
     fill: impl FnOnce(&mut std::fs::File) -> std::io::Result<()>,
 ) -> std::io::Result<()> {
-    let tmp = temporary_sibling(path);
-    let result = (|| {
-        let mut file = std::fs::File::create(&tmp)?;
-        fill(&mut file)?;
+    let output = TempOutput::new(path)?;
+    let mut file = output.open()?;
+    fill(&mut file)?;
+    if output.is_temporary() {
         file.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
     }
-    result
+    drop(file);
+    output.commit()
 }
 
-fn temporary_sibling(path: &Path) -> PathBuf {
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp_name = format!(".{name}.{}.tmp", std::process::id());
-    match path.parent() {
-        Some(dir) if !dir.as_os_str().is_empty() => dir.join(tmp_name),
-        _ => PathBuf::from(tmp_name),
+/// What an output path names, decided once before anything is written.
+enum Destination {
+    /// Missing, or a regular file (also through a symbolic link): written to a temporary
+    /// file in the same folder, renamed over it at the end.
+    Replace(PathBuf),
+    /// A FIFO or a character device (`/dev/null`, a terminal): the user asked for a stream,
+    /// so it is written through and never unlinked.
+    Through(PathBuf),
+}
+
+/// Why an output path is refused before anything is written.
+fn refuse(what: &str) -> std::io::Error {
+    std::io::Error::new(
+        std::io::ErrorKind::InvalidInput,
+        format!(
+            "it is {what}; lapclone writes only regular files, FIFOs and character devices, and never replaces anything else"
+        ),
+    )
+}
+
+/// Classifies `path`. A symbolic link is followed: its target is what gets written (the
+/// link itself stays); a link to nothing is refused, since writing would create a file at
+/// a place the command line does not show.
+fn destination(path: &Path) -> std::io::Result<Destination> {
+    let link = std::fs::symlink_metadata(path);
+    let meta = match (&link, std::fs::metadata(path)) {
+        (Err(e), _) if e.kind() == std::io::ErrorKind::NotFound => {
+            return Ok(Destination::Replace(path.to_path_buf()))
+        }
+        (Err(e), _) => return Err(std::io::Error::new(e.kind(), e.to_string())),
+        (Ok(_), Err(_)) => return Err(refuse("a symbolic link to nothing")),
+        (Ok(_), Ok(meta)) => meta,
+    };
+    let is_link = link.is_ok_and(|m| m.file_type().is_symlink());
+    let target = if is_link {
+        path.canonicalize()?
+    } else {
+        path.to_path_buf()
+    };
+    let kind = meta.file_type();
+    if kind.is_file() {
+        return Ok(Destination::Replace(target));
+    }
+    if kind.is_dir() {
+        return Err(refuse("a folder"));
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if kind.is_fifo() || kind.is_char_device() {
+            return Ok(Destination::Through(target));
+        }
+        if kind.is_block_device() {
+            return Err(refuse("a block device"));
+        }
+        if kind.is_socket() {
+            return Err(refuse("a socket"));
+        }
+    }
+    Err(refuse("not a regular file"))
+}
+
+/// The one way lapclone writes an output file. A regular (or missing) destination gets a
+/// temporary file in its folder (`tempfile`'s unique name, so two writes of one path never
+/// collide) that [`TempOutput::commit`] renames over it, and dropping it uncommitted removes
+/// it: no reader ever sees a half-written output. A FIFO or character device is written
+/// through, never unlinked; folders, block devices, sockets and dangling links are refused.
+/// A missing parent folder is an error: lapclone never creates one.
+#[derive(Debug)]
+pub struct TempOutput {
+    inner: Inner,
+}
+
+#[derive(Debug)]
+enum Inner {
+    Temporary {
+        file: tempfile::NamedTempFile,
+        dest: PathBuf,
+    },
+    Through(PathBuf),
+}
+
+impl TempOutput {
+    /// Prepares writing `dest` (creates the temporary file for a regular destination).
+    pub fn new(dest: &Path) -> std::io::Result<Self> {
+        let inner = match destination(dest)? {
+            Destination::Through(path) => Inner::Through(path),
+            Destination::Replace(dest) => {
+                let name = dest
+                    .file_name()
+                    .map(|n| n.to_string_lossy().into_owned())
+                    .unwrap_or_default();
+                let folder = match dest.parent() {
+                    Some(dir) if !dir.as_os_str().is_empty() => dir.to_path_buf(),
+                    _ => PathBuf::from("."),
+                };
+                let prefix = format!(".{name}.");
+                let mut builder = tempfile::Builder::new();
+                builder.prefix(&prefix).suffix(".tmp");
+                // An output is an ordinary file: the umask decides, as for any new file.
+                #[cfg(unix)]
+                {
+                    use std::os::unix::fs::PermissionsExt;
+                    builder.permissions(std::fs::Permissions::from_mode(0o666));
+                }
+                let file = builder
+                    .tempfile_in(&folder)
+                    .map_err(|e| std::io::Error::new(e.kind(), e.to_string()))?;
+                Inner::Temporary { file, dest }
+            }
+        };
+        Ok(TempOutput { inner })
+    }
+
+    /// The path to write: the temporary file, or the FIFO / device itself.
+    pub fn temp_path(&self) -> &Path {
+        match &self.inner {
+            Inner::Temporary { file, .. } => file.path(),
+            Inner::Through(path) => path,
+        }
+    }
+
+    /// Whether writes go to a temporary file (false: through a FIFO or device).
+    pub fn is_temporary(&self) -> bool {
+        matches!(self.inner, Inner::Temporary { .. })
+    }
+
+    /// Opens [`TempOutput::temp_path`] for writing.
+    pub fn open(&self) -> std::io::Result<std::fs::File> {
+        match &self.inner {
+            Inner::Temporary { file, .. } => file.reopen(),
+            Inner::Through(path) => std::fs::OpenOptions::new().write(true).open(path),
+        }
+    }
+
+    /// Renames the temporary file over the destination (nothing to do for a stream).
+    pub fn commit(self) -> std::io::Result<()> {
+        match self.inner {
+            Inner::Temporary { file, dest } => file
+                .persist(&dest)
+                .map(drop)
+                .map_err(|e| std::io::Error::new(e.error.kind(), e.error.to_string())),
+            Inner::Through(_) => Ok(()),
+        }
+    }
+}
+
+/// What kind of thing `path` is, for a message about an input that cannot be read as a
+/// file: `None` for a regular file (also through links), else "does not exist", "is a
+/// folder, not a file" or "is not a regular file (a FIFO)" and the like.
+pub fn not_a_file(path: &Path) -> Option<&'static str> {
+    let Ok(meta) = path.metadata() else {
+        return Some(if path.symlink_metadata().is_ok() {
+            "is a symbolic link to nothing"
+        } else {
+            "does not exist"
+        });
+    };
+    let kind = meta.file_type();
+    if kind.is_file() {
+        return None;
+    }
+    if kind.is_dir() {
+        return Some("is a folder, not a file");
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if kind.is_fifo() {
+            return Some("is not a regular file (a FIFO)");
+        }
+        if kind.is_char_device() || kind.is_block_device() {
+            return Some("is not a regular file (a device)");
+        }
+        if kind.is_socket() {
+            return Some("is not a regular file (a socket)");
+        }
+    }
+    Some("is not a regular file")
+}
+
+/// An input must be a regular file: reading a FIFO or a device could wait forever, and a
+/// folder is no file. The error says which of these `path` is.
+pub fn check_input_file(path: &Path) -> std::io::Result<()> {
+    match not_a_file(path) {
+        None => Ok(()),
+        Some(what) => {
+            let kind = if what == "does not exist" {
+                std::io::ErrorKind::NotFound
+            } else {
+                std::io::ErrorKind::InvalidInput
+            };
+            Err(std::io::Error::new(kind, format!("it {what}")))
+        }
+    }
+}
+
+/// Whether `a` and `b` name one existing file: after following links, and on Unix also
+/// through hard links (same device and inode).
+pub fn same_file(a: &Path, b: &Path) -> bool {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        if let (Ok(x), Ok(y)) = (a.metadata(), b.metadata()) {
+            return x.dev() == y.dev() && x.ino() == y.ino();
+        }
+        false
+    }
+    #[cfg(not(unix))]
+    {
+        matches!((a.canonicalize(), b.canonicalize()), (Ok(x), Ok(y)) if x == y)
     }
 }
 
@@ -92,6 +295,35 @@ mod tests {
         let path = dir.path().join("out.bin");
         write_atomic(&path, b"hello").unwrap();
         assert_eq!(std::fs::read(&path).unwrap(), b"hello");
+    }
+
+    #[test]
+    fn two_writes_of_one_path_never_share_a_temporary_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("out.bin");
+        let first = TempOutput::new(&path).unwrap();
+        let second = TempOutput::new(&path).unwrap();
+        assert_ne!(first.temp_path(), second.temp_path());
+        std::fs::write(first.temp_path(), b"one").unwrap();
+        std::fs::write(second.temp_path(), b"two").unwrap();
+        first.commit().unwrap();
+        assert_eq!(std::fs::read(&path).unwrap(), b"one");
+        second.commit().unwrap();
+        assert_eq!(std::fs::read(&path).unwrap(), b"two");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn devices_are_written_through_and_folders_refused() {
+        let null = TempOutput::new(Path::new("/dev/null")).unwrap();
+        assert!(!null.is_temporary());
+        assert_eq!(null.temp_path(), Path::new("/dev/null"));
+        null.open().unwrap().write_all(b"gone").unwrap();
+        null.commit().unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let error = TempOutput::new(dir.path()).unwrap_err();
+        assert!(error.to_string().contains("it is a folder"), "{error}");
     }
 
     #[test]

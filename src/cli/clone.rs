@@ -185,7 +185,7 @@ pub fn run(args: CloneArgs) -> anyhow::Result<()> {
             "reclone_ms": reclone_ms,
             "load_ms": load_ms,
         });
-        println!("{json}");
+        super::say(json)?;
     }
     Ok(())
 }
@@ -243,12 +243,13 @@ fn mesh_patch(
     source_size: (u32, u32),
     options: &MeshOptions,
 ) -> anyhow::Result<PatchMesh> {
-    Ok(mesh_from_mask(
+    mesh_from_mask(
         mask,
         args.mask_offset.map(DVec2::from),
         source_size,
         options,
-    )?)
+    )
+    .with_context(|| format!("mask {}", args.mask.display()))
 }
 
 /// The cloner on the patch's mesh (the factor), and the deformation of the drags and pins.
@@ -338,15 +339,21 @@ fn check_arguments(args: &CloneArgs) -> anyhow::Result<()> {
             .validate()
             .map_err(|e| UsageError(format!("--density: {e}")))?;
     }
-    check_output_folder(&args.output)
+    check_output_folder(&args.output)?;
+    super::inputs::refuse_input(&args.output, &[&args.source, &args.mask, &args.target])
 }
 
 /// Fails before any work when the output's folder does not exist.
 pub fn check_output_folder(output: &Path) -> anyhow::Result<()> {
     match output.parent() {
         Some(dir) if !dir.as_os_str().is_empty() && !dir.is_dir() => {
+            let problem = if dir.exists() {
+                "is not a folder"
+            } else {
+                "does not exist"
+            };
             anyhow::bail!(
-                "{}: the output folder {} does not exist",
+                "{}: the output folder {} {problem}",
                 output.display(),
                 dir.display()
             )

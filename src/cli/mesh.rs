@@ -46,9 +46,13 @@ pub fn run(args: MeshArgs) -> anyhow::Result<()> {
     if !(0.0..=1.0).contains(&threshold) {
         return Err(UsageError(format!("--threshold must be in [0, 1], got {threshold}")).into());
     }
+    for output in args.output.iter().chain(&args.laplacian_out) {
+        super::inputs::refuse_input(output, &[&args.mask])?;
+    }
     let mask = BitMask::load(&args.mask, threshold as f32)?;
     let started = Instant::now();
-    let mut result = mesh::mesh_mask(&mask, &options)?;
+    let mut result = mesh::mesh_mask(&mask, &options)
+        .with_context(|| format!("mask {}", args.mask.display()))?;
     // The raw mask mesh (boundary on the pixel cracks unless `--boundary outside-centres`);
     // relaxation is the only finishing step that belongs to the mesh itself.
     if options.relax_sweeps > 0 {
@@ -83,12 +87,12 @@ pub fn run(args: MeshArgs) -> anyhow::Result<()> {
             "boundary": stats.boundary.name(),
             "mesh_ms": mesh_ms,
         });
-        println!("{json}");
+        super::say(json)?;
     } else {
-        println!(
+        super::say(format_args!(
             "{} vertices, {} triangles, {} boundary vertices ({}), {} piece(s), {} hole(s), min angle {:.1}°, {:.2} ms",
             stats.vertices, stats.triangles, stats.boundary_vertices, stats.boundary.name(), stats.pieces, stats.holes, stats.min_angle_deg, mesh_ms
-        );
+        ))?;
     }
     Ok(())
 }

@@ -5,6 +5,7 @@
 use clap::{Parser, Subcommand};
 
 pub mod clone;
+mod inputs;
 pub mod mesh;
 pub mod mesh_args;
 pub mod render;
@@ -19,6 +20,65 @@ pub mod track;
 #[derive(Debug, thiserror::Error)]
 #[error("{0}")]
 pub struct UsageError(pub String);
+
+/// `--jobs` above this is a usage error: it is far beyond any machine's cores, and each
+/// thread costs a stack.
+pub const MAX_JOBS: usize = 1024;
+
+/// The one limit on worker threads, for every command's `--jobs`: 0 or more than
+/// [`MAX_JOBS`] is a usage error; more than `useful` (the cores this process may use) is
+/// lowered to it with a note on stderr, since more threads than cores only cost memory.
+/// Without `--jobs`: `useful`.
+pub fn jobs(asked: Option<usize>, useful: usize) -> Result<usize, UsageError> {
+    let useful = useful.max(1);
+    match asked {
+        None => Ok(useful),
+        Some(0) => Err(UsageError("--jobs must be at least 1".into())),
+        Some(n) if n > MAX_JOBS => Err(UsageError(format!(
+            "--jobs {n}: at most {MAX_JOBS} (this machine has {useful} cores to use)"
+        ))),
+        Some(n) if n > useful => {
+            eprintln!("note: --jobs {n} lowered to {useful}, the cores this process may use");
+            Ok(useful)
+        }
+        Some(n) => Ok(n),
+    }
+}
+
+/// Whether standard output is open. Rust's runtime reopens a closed one (`>&-`) on
+/// `/dev/null`, read-write, so writes would vanish without an error; a shell's
+/// `>/dev/null` opens it write-only, which stays a legitimate sink.
+pub fn stdout_is_open() -> bool {
+    #[cfg(target_os = "linux")]
+    {
+        let on_null = std::fs::read_link("/proc/self/fd/1")
+            .is_ok_and(|p| p == std::path::Path::new("/dev/null"));
+        let read_write = std::fs::read_to_string("/proc/self/fdinfo/1").is_ok_and(|info| {
+            info.lines()
+                .find_map(|l| l.strip_prefix("flags:"))
+                .and_then(|f| u32::from_str_radix(f.trim(), 8).ok())
+                .is_some_and(|flags| flags & 0o3 == 0o2)
+        });
+        !(on_null && read_write)
+    }
+    #[cfg(not(target_os = "linux"))]
+    {
+        true
+    }
+}
+
+/// Writes `line` and a newline to standard output; a failed write (closed, a full disk, a
+/// broken pipe) is an error (exit 1), never a panic and never silently lost.
+pub fn say(line: impl std::fmt::Display) -> anyhow::Result<()> {
+    use std::io::Write as _;
+    if !stdout_is_open() {
+        anyhow::bail!("standard output is closed");
+    }
+    let mut out = std::io::stdout().lock();
+    writeln!(out, "{line}")
+        .and_then(|()| out.flush())
+        .map_err(|e| anyhow::anyhow!("writing to standard output: {e}"))
+}
 
 /// The error and its causes as one line, `outer: cause: …`. The library's errors already
 /// end their message with their cause's, so a cause whose text the line holds is not

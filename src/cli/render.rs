@@ -18,7 +18,7 @@ use lapclone::output::{
 };
 use lapclone::pixels::{Canvas, CanvasPixels, Depth};
 use lapclone::render::{RenderError, Renderer};
-use lapclone::script::LoadedScene;
+use lapclone::script::{load_scene_and_imports, LoadedScene};
 
 use crate::cli::UsageError;
 
@@ -145,6 +145,9 @@ fn output_kind(args: &RenderArgs) -> anyhow::Result<OutputKind> {
     if args.output.as_os_str() == "-" && kind != OutputKind::Y4m {
         return Err(UsageError("-o - (standard output) needs --format y4m".into()).into());
     }
+    if args.output.as_os_str() == "-" && !super::stdout_is_open() {
+        anyhow::bail!("-o -: standard output is closed");
+    }
     if kind.needs_ffmpeg() && lapclone::util::find_program("ffmpeg").is_none() {
         anyhow::bail!("{}", lapclone::util::FFMPEG_MISSING);
     }
@@ -172,9 +175,9 @@ pub struct CheckArgs {
 }
 
 pub fn run_render(args: RenderArgs) -> anyhow::Result<()> {
-    if args.jobs == Some(0) {
-        return Err(UsageError("--jobs must be at least 1".into()).into());
-    }
+    let jobs = super::jobs(args.jobs, default_jobs())?;
+    // Before any output exists, so that Ctrl-C always goes through the clean-up below.
+    let cancel = install_cancel_handler();
     let kind = output_kind(&args)?;
     let settings = SinkSettings {
         force: args.force,
@@ -187,7 +190,15 @@ pub fn run_render(args: RenderArgs) -> anyhow::Result<()> {
     };
     // Before the scene: a video's ffmpeg starts up while the scene loads.
     let plan = SinkPlan::new(kind, &args.output, settings)?;
-    let (loaded, mut renderer) = load_renderer(&args.scene)?;
+    let (loaded, imports, mut renderer) = load_renderer(&args.scene)?;
+    for warning in renderer.point_warnings() {
+        eprintln!("warning: {warning}");
+    }
+    if kind == OutputKind::PngFolder {
+        super::inputs::refuse_scene_input_frames(&args.output, &loaded, &imports)?;
+    } else {
+        super::inputs::refuse_scene_input(&args.output, &loaded, &imports)?;
+    }
     let total = renderer.frame_count();
     let range = match args.frames {
         None => FrameRange {
@@ -203,8 +214,6 @@ pub fn run_render(args: RenderArgs) -> anyhow::Result<()> {
         }
         Some(r) => r,
     };
-    let cancel = install_cancel_handler();
-    let jobs = args.jobs.unwrap_or_else(default_jobs);
     let started = Instant::now();
     let mut sink = plan.open(&renderer, range, jobs, cancel.clone())?;
     let progress = progress_bar(range.last - range.first + 1);
@@ -251,7 +260,7 @@ pub fn run_render(args: RenderArgs) -> anyhow::Result<()> {
     if args.output.as_os_str() == "-" {
         eprintln!("{summary}");
     } else {
-        println!("{summary}");
+        super::say(summary)?;
     }
     Ok(())
 }
@@ -261,7 +270,8 @@ pub fn run_preview(args: PreviewArgs) -> anyhow::Result<()> {
         return Err(UsageError("--t must be ≥ 0 and --frame ≥ 1".into()).into());
     }
     super::clone::check_output_folder(&args.output)?;
-    let (loaded, mut renderer) = load_renderer(&args.scene)?;
+    let (loaded, imports, mut renderer) = load_renderer(&args.scene)?;
+    super::inputs::refuse_scene_input(&args.output, &loaded, &imports)?;
     let format = renderer.output_format();
     let canvas = match (args.t, args.frame) {
         (Some(t), _) => renderer.render_time(t),
@@ -276,12 +286,12 @@ pub fn run_preview(args: PreviewArgs) -> anyhow::Result<()> {
 }
 
 pub fn run_check(args: CheckArgs) -> anyhow::Result<()> {
-    let (loaded, renderer) = load_renderer(&args.scene)?;
+    let (loaded, _, renderer) = load_renderer(&args.scene)?;
     let c = &loaded.scene.canvas;
     let handles: usize = loaded.scene.patches.iter().map(|p| p.handles.len()).sum();
     let pins: usize = loaded.scene.patches.iter().map(|p| p.pins.len()).sum();
     let vertices: usize = renderer.vertex_counts().iter().sum();
-    println!(
+    super::say(format_args!(
         "{}: ok — {}×{}, {} fps, {} s ({} frames), {} patches ({vertices} mesh vertices), {handles} handles, {pins} pins",
         args.scene.display(),
         c.width,
@@ -290,8 +300,8 @@ pub fn run_check(args: CheckArgs) -> anyhow::Result<()> {
         c.duration,
         c.frame_count(),
         loaded.scene.patches.len(),
-    );
-    for warning in loaded.warnings() {
+    ))?;
+    for warning in loaded.warnings().into_iter().chain(renderer.point_warnings()) {
         eprintln!("warning: {warning}");
     }
     Ok(())
@@ -299,8 +309,10 @@ pub fn run_check(args: CheckArgs) -> anyhow::Result<()> {
 
 /// Parses, validates and builds the renderer (meshes and factors every patch); every error
 /// comes back positioned at the scene call it is about.
-fn load_renderer(scene: &Path) -> anyhow::Result<(LoadedScene, Renderer)> {
-    lapclone::open_scene(scene).map_err(|e| anyhow::anyhow!("{e}"))
+fn load_renderer(scene: &Path) -> anyhow::Result<(LoadedScene, Vec<PathBuf>, Renderer)> {
+    let (loaded, imports) = load_scene_and_imports(scene).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let renderer = lapclone::build_renderer(&loaded).map_err(|e| anyhow::anyhow!("{e}"))?;
+    Ok((loaded, imports, renderer))
 }
 
 pub(crate) fn positioned(loaded: &LoadedScene, error: RenderError) -> anyhow::Error {
@@ -337,7 +349,7 @@ fn progress_bar(frames: u64) -> ProgressBar {
 /// Where rendered frames go: a PNG folder (encoded in parallel), a GIF, an APNG, a Y4M
 /// stream or a video through ffmpeg.
 pub(crate) enum FrameSink {
-    Png(PngSequenceWriter, PathBuf),
+    Png(PngSequenceWriter, Box<PngStaging>),
     Gif(Box<GifWriter>),
     Apng(Box<ApngWriter>),
     Y4m(Box<Y4mWriter>),
@@ -398,8 +410,9 @@ impl SinkPlan {
         let output = self.output.as_path();
         Ok(match self.kind {
             OutputKind::PngFolder => {
-                let writer = open_png_folder(output, renderer, range, jobs, cancel, self.settings)?;
-                FrameSink::Png(writer, self.output)
+                let (writer, staging) =
+                    open_png_folder(output, renderer, range, jobs, cancel, self.settings)?;
+                FrameSink::Png(writer, Box::new(staging))
             }
             OutputKind::Gif => {
                 super::clone::check_output_folder(output)?;
@@ -467,9 +480,9 @@ impl FrameSink {
 
     pub(crate) fn finish(self) -> anyhow::Result<PathBuf> {
         Ok(match self {
-            FrameSink::Png(writer, dir) => {
-                writer.finish()?;
-                dir
+            FrameSink::Png(writer, staging) => {
+                let written = writer.finish()?;
+                staging.commit(&written)?
             }
             FrameSink::Gif(writer) => writer.finish()?,
             FrameSink::Apng(writer) => writer.finish()?,
@@ -478,7 +491,8 @@ impl FrameSink {
         })
     }
 
-    /// Drops the sink after an interruption: writers remove their temporary files.
+    /// Drops the sink after a failure or an interruption: writers remove their temporary
+    /// files (a PNG sequence its temporary folder).
     pub(crate) fn abandon(self) {
         if let FrameSink::Png(writer, _) = self {
             let _ = writer.finish();
@@ -486,8 +500,45 @@ impl FrameSink {
     }
 }
 
-/// The PNG frame folder, created if missing; frame files of another render in it are
-/// refused, or removed with `--force`, so the folder never holds a mixed set.
+/// A PNG sequence's frames, written into a temporary folder beside the destination and
+/// moved into place only once every frame is written: a failed or interrupted render
+/// leaves no new folder, and an existing folder exactly as it was.
+pub(crate) struct PngStaging {
+    dest: PathBuf,
+    temp: tempfile::TempDir,
+    /// Frame files of an earlier render to remove at the end (`--force`).
+    foreign: Vec<PathBuf>,
+}
+
+impl PngStaging {
+    /// Moves the written frames into the destination (or the whole folder, if it is new).
+    fn commit(self, written: &[PathBuf]) -> anyhow::Result<PathBuf> {
+        let dest = self.dest;
+        if !dest.exists() {
+            let temp = self.temp.keep();
+            if let Err(e) = std::fs::rename(&temp, &dest) {
+                let _ = std::fs::remove_dir_all(&temp);
+                return Err(e).with_context(|| format!("moving the frames to {}", dest.display()));
+            }
+            return Ok(dest);
+        }
+        for path in &self.foreign {
+            std::fs::remove_file(path).with_context(|| format!("removing {}", path.display()))?;
+        }
+        for path in written {
+            // invariant: the writer names every frame `temp/frame_N.png`.
+            let name = path.file_name().expect("a frame file name");
+            let target = dest.join(name);
+            std::fs::rename(path, &target)
+                .with_context(|| format!("moving the frames to {}", dest.display()))?;
+        }
+        Ok(dest)
+    }
+}
+
+/// The PNG frame folder (created at the end if missing, its parent never); frame files of
+/// another render in it are refused, or removed at the end with `--force`, so the folder
+/// never holds a mixed set.
 fn open_png_folder(
     output: &Path,
     renderer: &Renderer,
@@ -495,11 +546,51 @@ fn open_png_folder(
     jobs: usize,
     cancel: Arc<AtomicBool>,
     settings: SinkSettings,
-) -> anyhow::Result<PngSequenceWriter> {
-    if !output.is_dir() {
+) -> anyhow::Result<(PngSequenceWriter, PngStaging)> {
+    let foreign = if output.is_dir() {
+        existing_frames(output, renderer, range, settings)?
+    } else if output.exists() || output.symlink_metadata().is_ok() {
+        anyhow::bail!(
+            "{} exists and is not a folder; name a folder for PNG frames",
+            output.display()
+        );
+    } else {
         super::clone::check_output_folder(output)?;
-        std::fs::create_dir(output).with_context(|| format!("creating {}", output.display()))?;
-    }
+        Vec::new()
+    };
+    let parent = match output.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() => dir,
+        _ => Path::new("."),
+    };
+    let name = output.file_name().unwrap_or_default().to_string_lossy();
+    let temp = tempfile::Builder::new()
+        .prefix(&format!(".{name}."))
+        .suffix(".tmp")
+        .tempdir_in(parent)
+        .with_context(|| format!("creating a folder beside {}", output.display()))?;
+    let writer = PngSequenceWriter::new(
+        temp.path(),
+        renderer.frame_count(),
+        jobs,
+        settings.png_compression,
+        cancel,
+    )?;
+    let staging = PngStaging {
+        dest: output.to_path_buf(),
+        temp,
+        foreign,
+    };
+    Ok((writer, staging))
+}
+
+/// The frame files of another render in the existing folder `output`: an error without
+/// `--force`, else the files to remove once the new frames are in.
+fn existing_frames(
+    output: &Path,
+    renderer: &Renderer,
+    range: FrameRange,
+    settings: SinkSettings,
+) -> anyhow::Result<Vec<PathBuf>> {
     let digits = frame_digits(renderer.frame_count());
     let ours: std::collections::HashSet<String> = (range.first..=range.last)
         .map(|n| frame_file_name(n, digits))
@@ -515,17 +606,8 @@ fn open_png_folder(
                 first.file_name().unwrap_or_default().to_string_lossy()
             );
         }
-        for path in &foreign {
-            std::fs::remove_file(path).with_context(|| format!("removing {}", path.display()))?;
-        }
     }
-    Ok(PngSequenceWriter::new(
-        output,
-        renderer.frame_count(),
-        jobs,
-        settings.png_compression,
-        cancel,
-    )?)
+    Ok(foreign)
 }
 
 fn frame_ref(canvas: &Canvas) -> anyhow::Result<FrameRef<'_>> {

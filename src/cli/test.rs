@@ -34,9 +34,7 @@ struct Job<'a> {
 }
 
 pub fn run(args: TestArgs) -> anyhow::Result<()> {
-    if args.jobs == Some(0) {
-        return Err(UsageError("--jobs must be at least 1".into()).into());
-    }
+    let jobs = super::jobs(args.jobs, default_jobs())?;
     let paths = if args.paths.is_empty() {
         vec![PathBuf::from(".")]
     } else {
@@ -54,13 +52,17 @@ pub fn run(args: TestArgs) -> anyhow::Result<()> {
             .into());
         }
     }
+    // lapclone never creates a missing parent of a path it is given.
+    for path in args.junit.iter().chain(&args.out).chain(&args.goldens) {
+        super::clone::check_output_folder(path)?;
+    }
     let scenes = find_scenes(&paths, &args.out_dir())?;
     if scenes.is_empty() {
         return Err(
             UsageError(format!("no scene files (*.rhai) found in {}", list(&paths))).into(),
         );
     }
-    check_all(&args, &scenes)
+    check_all(&args, &scenes, jobs.min(scenes.len()))
 }
 
 fn list(paths: &[PathBuf]) -> String {
@@ -68,10 +70,9 @@ fn list(paths: &[PathBuf]) -> String {
     names.join(", ")
 }
 
-fn check_all(args: &TestArgs, scenes: &[PathBuf]) -> anyhow::Result<()> {
+fn check_all(args: &TestArgs, scenes: &[PathBuf], jobs: usize) -> anyhow::Result<()> {
     let started = Instant::now();
     let job = Job { args, ci: is_ci() };
-    let jobs = args.jobs.unwrap_or_else(default_jobs).min(scenes.len());
     let mut reporter = Reporter::new(args.json);
     let mut results: Vec<Option<SceneResult>> = (0..scenes.len()).map(|_| None).collect();
     let next = AtomicUsize::new(0);
@@ -176,11 +177,7 @@ fn check_scene(job: &Job, scene: &Path) -> SceneResult {
 }
 
 fn load(scene: &Path) -> anyhow::Result<(lapclone::script::LoadedScene, Renderer)> {
-    use lapclone::script::{load_scene, validate_scene};
-    let loaded = load_scene(scene).map_err(|e| anyhow::anyhow!("{e}"))?;
-    validate_scene(&loaded).map_err(|e| anyhow::anyhow!("{e}"))?;
-    let renderer = Renderer::new(loaded.scene.clone()).map_err(|e| positioned(&loaded, e))?;
-    Ok((loaded, renderer))
+    lapclone::open_scene(scene).map_err(|e| anyhow::anyhow!("{e}"))
 }
 
 /// `--frames`, else the scene's own, else first, middle and last; all within the scene.

@@ -25,13 +25,14 @@ impl Reporter {
         if let Some(failure) = &result.failure {
             eprintln!("ERROR {}", failure.message);
         }
+        // A failed write here is reported by the summary line, written the same way.
         for frame in &result.frames {
             if self.json {
-                println!("{}", frame_json(&result.scene, frame));
+                let _ = super::say(frame_json(&result.scene, frame));
             } else {
-                println!("{}", frame_line(&result.scene, frame));
+                let _ = super::say(frame_line(&result.scene, frame));
                 if let Some(detail) = detail_line(frame) {
-                    println!("{detail}");
+                    let _ = super::say(detail);
                 }
             }
         }
@@ -120,8 +121,10 @@ pub fn finish(
         eprintln!("{summary}");
         notes.iter().for_each(|n| eprintln!("{n}"));
     } else {
-        println!("{summary}");
-        notes.iter().for_each(|n| println!("{n}"));
+        super::say(&summary)?;
+        for note in &notes {
+            super::say(note)?;
+        }
     }
     if counts.load_errors > 0 {
         return Err(UsageError(format!(

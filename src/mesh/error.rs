@@ -30,8 +30,8 @@ pub enum MeshError {
     EmptyMask,
     /// Every piece of the mask is below `min_piece_area`.
     #[error(
-        "every piece of the mask is smaller than the minimum piece area ({min_piece_area} px²); \
-         lower min_piece_area to keep them"
+        "every piece of the mask is smaller than the minimum piece area ({min_piece_area} px²), \
+         so nothing is left to mesh: make the mask's pieces larger"
     )]
     AllPiecesTooSmall {
         /// The option's value, px².

@@ -11,7 +11,7 @@ use std::fs::File;
 use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 
-use super::atomic::TempOutput;
+use crate::util::TempOutput;
 use super::{FrameRef, OutputError};
 
 pub struct ApngWriter {
@@ -47,8 +47,9 @@ impl ApngWriter {
         if !(fps.is_finite() && fps > 0.0) {
             return Err(OutputError::BadFrame(format!("fps {fps} must be > 0")));
         }
-        let temp = TempOutput::new(path);
-        let file = File::create(temp.temp_path()).map_err(|e| OutputError::io(path, e))?;
+        let io = |e| OutputError::io(path, e);
+        let temp = TempOutput::new(path).map_err(io)?;
+        let file = temp.open().map_err(io)?;
         let mut encoder = png::Encoder::new(BufWriter::with_capacity(1 << 16, file), width, height);
         encoder.set_color(png::ColorType::Rgba);
         encoder.set_depth(if sixteen_bit {

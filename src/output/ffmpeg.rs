@@ -30,7 +30,7 @@ use std::sync::mpsc::{sync_channel, Receiver, SyncSender};
 use std::sync::Arc;
 use std::thread::JoinHandle;
 
-use super::atomic::TempOutput;
+use crate::util::TempOutput;
 use super::yuv::{frame_to_yuv420, yuv420_size};
 use super::y4m::{check_stream, fps_fraction, stream_header};
 use super::{FrameRef, OutputError};
@@ -216,7 +216,7 @@ struct Spawned {
 /// Starts ffmpeg writing `path`'s temporary file with `args` (input and codec).
 fn spawn_ffmpeg(path: &Path, args: Vec<String>) -> Result<Spawned, OutputError> {
     let ffmpeg = crate::util::find_program("ffmpeg").ok_or(OutputError::NoFfmpeg)?;
-    let temp = TempOutput::new(path);
+    let temp = TempOutput::new(path).map_err(|e| OutputError::io(path, e))?;
     let mut command = Command::new(ffmpeg);
     command
         .args(["-v", "error", "-nostdin", "-y"])

@@ -18,7 +18,7 @@ use std::sync::mpsc::{channel, sync_channel, Receiver, Sender, SyncSender};
 use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 
-use super::atomic::TempOutput;
+use crate::util::TempOutput;
 use super::gif_frame::{EncodedFrame, FrameEncoder};
 use super::gif_palette::{Palette, PaletteMap};
 use super::{FrameRef, OutputError};
@@ -101,8 +101,9 @@ impl GifWriter {
         if !(fps.is_finite() && fps > 0.0) {
             return Err(OutputError::BadFrame(format!("fps {fps} must be > 0")));
         }
-        let temp = TempOutput::new(path);
-        let file = File::create(temp.temp_path()).map_err(|e| OutputError::io(path, e))?;
+        let io = |e| OutputError::io(path, e);
+        let temp = TempOutput::new(path).map_err(io)?;
+        let file = temp.open().map_err(io)?;
         Ok(GifWriter {
             path: path.to_path_buf(),
             temp: Some(temp),

@@ -5,7 +5,6 @@
 //! (temporary file + rename).
 
 mod apng;
-mod atomic;
 mod encode;
 mod ffmpeg;
 mod format;
@@ -18,7 +17,7 @@ mod y4m;
 mod yuv;
 
 pub use apng::{apng_delays, ApngWriter};
-pub use atomic::TempOutput;
+pub use crate::util::TempOutput;
 pub use encode::{FrameEncoder, PngCompression};
 pub use ffmpeg::{FfmpegWriter, PendingVideo, VideoFrames, VideoKind};
 pub use format::OutputKind;

@@ -12,7 +12,7 @@ use std::sync::mpsc::{sync_channel, Receiver, SyncSender};
 use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 
-use super::atomic::TempOutput;
+use crate::util::TempOutput;
 use super::encode::{FrameEncoder, PngCompression};
 use super::{Frame, OutputError};
 
@@ -52,9 +52,9 @@ pub fn write_png_file(
     frame: Frame,
     encoder: &mut FrameEncoder,
 ) -> Result<Option<Frame>, OutputError> {
-    let temp = TempOutput::new(path);
     let io = |e: std::io::Error| OutputError::io(path, e);
-    let file = std::fs::File::create(temp.temp_path()).map_err(io)?;
+    let temp = TempOutput::new(path).map_err(io)?;
+    let file = temp.open().map_err(io)?;
     let mut out = BufWriter::with_capacity(1 << 16, file);
     let spare = encoder.encode(frame, &mut out)?;
     out.flush().map_err(io)?;

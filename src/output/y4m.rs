@@ -13,7 +13,7 @@
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
-use super::atomic::TempOutput;
+use crate::util::TempOutput;
 use super::yuv::rgb_to_ycbcr;
 use super::{FrameRef, OutputError};
 
@@ -87,9 +87,9 @@ impl Y4mWriter {
         check_stream("a Y4M stream", width, height, fps)?;
         let mut sink = match path {
             Some(path) => {
-                let temp = TempOutput::new(path);
-                let file = std::fs::File::create(temp.temp_path())
-                    .map_err(|e| OutputError::io(path, e))?;
+                let io = |e| OutputError::io(path, e);
+                let temp = TempOutput::new(path).map_err(io)?;
+                let file = temp.open().map_err(io)?;
                 Sink::File {
                     temp,
                     path: path.to_path_buf(),

@@ -276,8 +276,17 @@ fn mesh_patch(
                 path: path.clone(),
                 source: Box::new(source),
             })?;
-            mesh_from_mask(&mask, None, (source.width(), source.height()), options)
-                .map_err(clone_error)
+            mesh_from_mask(&mask, None, (source.width(), source.height()), options).map_err(
+                |error| match error {
+                    // A mesh error of a mask names the mask, as a read error does.
+                    crate::clone::CloneError::Mesh(source) => RenderError::Mask {
+                        patch: patch.name.clone(),
+                        path: path.clone(),
+                        source: Box::new(source),
+                    },
+                    other => clone_error(other),
+                },
+            )
         }
         Shape::Polygons(polygons) => mesh_from_polygons(polygons, options).map_err(clone_error),
     }

@@ -13,6 +13,7 @@
 mod error;
 mod layer;
 mod opacity;
+mod point_warnings;
 mod renderer;
 
 pub use error::RenderError;

@@ -59,6 +59,9 @@ fn short_track(out: &mut Vec<String>, owner: &str, follow: &Follow, last: f64) {
     }
 }
 
+/// How many key times a warning lists before it only counts them.
+const SHOWN_TIMES: usize = 5;
+
 fn late<T: Interpolate>(
     out: &mut Vec<String>,
     owner: &str,
@@ -66,15 +69,52 @@ fn late<T: Interpolate>(
     track: &Track<T>,
     end: f64,
 ) {
-    let times: Vec<String> = track
-        .times()
-        .filter(|&t| t > end)
-        .map(|t| t.to_string())
+    let keys = track.keys();
+    // Keys are in time order: the late ones are a tail.
+    let late = &keys[keys.partition_point(|k| k.time <= end)..];
+    let Some(last) = late.last() else { return };
+    let shown: Vec<String> = late
+        .iter()
+        .take(SHOWN_TIMES)
+        .map(|k| k.time.to_string())
         .collect();
-    if !times.is_empty() {
-        out.push(format!(
-            "{owner}: {name:?} key(s) at t = {} after the scene's end ({end} s); no frame shows them",
-            times.join(", ")
-        ));
+    let times = if late.len() > SHOWN_TIMES {
+        format!(
+            "{} keys at t = {}, … {}",
+            late.len(),
+            shown.join(", "),
+            last.time
+        )
+    } else {
+        format!("key(s) at t = {}", shown.join(", "))
+    };
+    out.push(format!(
+        "{owner}: {name:?} {times} after the scene's end ({end} s); no frame shows them"
+    ));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Easing;
+
+    #[test]
+    fn many_late_keys_are_counted_not_listed() {
+        let mut track = Track::<f64>::new();
+        for i in 0..1000 {
+            track.push(f64::from(i), 0.0, Easing::Linear).unwrap();
+        }
+        let mut out = Vec::new();
+        late(&mut out, "patch \"p\"", "scale", &track, 10.5);
+        assert_eq!(
+            out,
+            ["patch \"p\": \"scale\" 989 keys at t = 11, 12, 13, 14, 15, … 999 after the scene's end (10.5 s); no frame shows them"]
+        );
+        out.clear();
+        late(&mut out, "patch \"p\"", "scale", &track, 996.0);
+        assert_eq!(
+            out,
+            ["patch \"p\": \"scale\" key(s) at t = 997, 998, 999 after the scene's end (996 s); no frame shows them"]
+        );
     }
 }

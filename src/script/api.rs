@@ -49,24 +49,18 @@ fn origin(ctx: &NativeCallContext, base_dir: &Path) -> Origin {
     }
 }
 
-/// Resolves `text` against the scene folder and insists the file exists.
+/// Resolves `text` against the scene folder and insists it is a regular file.
 fn existing_file(base_dir: &Path, text: &str, what: &str) -> Result<PathBuf, String> {
     let path = base_dir.join(text);
-    if path.is_file() {
-        Ok(path)
-    } else if path.is_dir() {
-        Err(format!(
-            "{what} `{text}` is a folder, not a file ({})",
-            path.display()
-        ))
-    } else {
-        Err(format!(
+    match crate::util::not_a_file(&path) {
+        None => Ok(path),
+        Some("does not exist") => Err(format!(
             "{what} file `{text}` not found (looked for {})",
             path.display()
-        ))
+        )),
+        Some(problem) => Err(format!("{what} `{text}` {problem} ({})", path.display())),
     }
 }
-
 
 pub fn register(engine: &mut Engine, draft: &SharedDraft) {
     engine
@@ -343,6 +337,21 @@ impl PatchRef {
         Ok(result)
     }
 
+    /// Applies `edit` to the patch itself, for edits that change it only once every check
+    /// has passed (one key, one drag, one pin): no copy, so a scene adding keys one call at
+    /// a time stays linear in its keys.
+    fn edit_in_place<R>(
+        &self,
+        ctx: &NativeCallContext,
+        edit: impl FnOnce(&mut Patch) -> Result<R, String>,
+    ) -> Fallible<R> {
+        let mut d = self.draft.lock();
+        let Some(index) = d.patch_index(self.id) else {
+            return Err(fail(ctx, "this patch no longer exists in the scene"));
+        };
+        edit(&mut d.patches[index]).map_err(|m| fail(ctx, m))
+    }
+
     pub(super) fn name(&mut self) -> String {
         let d = self.draft.lock();
         d.patch_index(self.id)
@@ -358,13 +367,17 @@ impl PatchRef {
         mut values: Map,
         easing: Option<&str>,
     ) -> Fallible<Self> {
-        self.edit(&ctx, |p| {
+        self.edit_in_place(&ctx, |p| {
             let t = values::time(&t)?;
             let easing = match (values.contains_key("ease"), easing) {
                 (true, Some(_)) => return Err("give the easing once: `ease` or a last argument".into()),
                 (false, Some(name)) => values::easing(name)?,
                 (_, None) => take_easing(&mut values)?,
             };
+            // A key refused for one property must leave the others unkeyed too: try them
+            // on empty tracks first (a key's checks never depend on the keys already there).
+            let mut trial = Patch::new(String::new(), PathBuf::new(), Shape::Polygons(Vec::new()));
+            add_placement_keys(&mut trial, t, &values, easing)?;
             add_placement_keys(p, t, &values, easing)
         })?;
         Ok(self.clone())
@@ -393,7 +406,7 @@ impl PatchRef {
         value: Dynamic,
         easing: &str,
     ) -> Fallible<Self> {
-        self.edit(&ctx, |p| {
+        self.edit_in_place(&ctx, |p| {
             let t = values::time(&t)?;
             let easing = values::easing(easing)?;
             which.push(p, t, &value, easing)
@@ -408,7 +421,7 @@ impl PatchRef {
         radius: Dynamic,
         options: Map,
     ) -> Fallible<HandleRef> {
-        self.edit(&ctx, |p| {
+        self.edit_in_place(&ctx, |p| {
             values::check_keys(&options, &["depth", "pivot"], "drag")?;
             let handle = Handle {
                 from: values::point(&from, "drag rest point")?,
@@ -439,7 +452,7 @@ impl PatchRef {
     }
 
     fn pin(&mut self, ctx: NativeCallContext, at: Dynamic, options: Map) -> Fallible<PinRef> {
-        let at = self.edit(&ctx, |p| {
+        let at = self.edit_in_place(&ctx, |p| {
             values::check_keys(&options, &["start", "end"], "pin")?;
             let start = match options.get("start") {
                 Some(v) => values::time(v)?,
@@ -503,6 +516,21 @@ impl HandleRef {
         Ok(self.clone())
     }
 
+    /// Applies `edit` to the handle itself, for edits that change it only once every check
+    /// has passed (one key): no copy per call.
+    fn edit_in_place(
+        &self,
+        ctx: &NativeCallContext,
+        edit: impl FnOnce(&mut Handle) -> Result<(), String>,
+    ) -> Fallible<Self> {
+        let mut d = self.draft.lock();
+        let Some((p, h)) = self.indices(&d) else {
+            return Err(fail(ctx, "this handle no longer exists in the scene"));
+        };
+        edit(&mut d.patches[p].handles[h]).map_err(|m| fail(ctx, m))?;
+        Ok(self.clone())
+    }
+
     fn key(
         &mut self,
         ctx: NativeCallContext,
@@ -510,7 +538,7 @@ impl HandleRef {
         to: Dynamic,
         easing: &str,
     ) -> Fallible<Self> {
-        self.edit(&ctx, |h| {
+        self.edit_in_place(&ctx, |h| {
             let t = values::time(&t)?;
             let easing = values::easing(easing)?;
             h.to.push(t, values::point(&to, "handle target")?, easing)
@@ -546,7 +574,7 @@ impl HandleRef {
         degrees: Dynamic,
         easing: &str,
     ) -> Fallible<Self> {
-        self.edit(&ctx, |h| {
+        self.edit_in_place(&ctx, |h| {
             let t = values::time(&t)?;
             let easing = values::easing(easing)?;
             let r = number(&degrees, "handle rotation")?;

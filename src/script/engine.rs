@@ -9,6 +9,7 @@ use rhai::{Dynamic, Engine, Scope, AST};
 
 use super::draft::{Draft, Origins, SharedDraft};
 use super::error::{ErrorKind, SceneError};
+use super::memory::MemoryBudget;
 use super::sandbox::{sandboxed_engine, Limits, ModuleFiles, SandboxResolver};
 use super::{api, golden};
 use crate::scene::Scene;
@@ -60,6 +61,7 @@ pub struct SceneEngine {
     draft: SharedDraft,
     modules: ModuleFiles,
     cancel: Arc<AtomicBool>,
+    budget: MemoryBudget,
 }
 
 /// A parsed scene with the source positions of its objects.
@@ -105,7 +107,13 @@ impl SceneEngine {
     pub fn new(options: &ScriptOptions) -> Self {
         let resolver = SandboxResolver::new(&options.scene_dir, options.scripts_dir.as_deref());
         let modules = resolver.module_files();
-        let mut engine = sandboxed_engine(resolver, &options.limits, options.cancel.clone());
+        let budget = MemoryBudget::new(options.limits.max_memory);
+        let mut engine = sandboxed_engine(
+            resolver,
+            &options.limits,
+            options.cancel.clone(),
+            budget.clone(),
+        );
         let draft = SharedDraft::new(Draft::new(&options.scene_dir));
         api::register(&mut engine, &draft);
         golden::register(&mut engine, &draft);
@@ -114,6 +122,7 @@ impl SceneEngine {
             draft,
             modules,
             cancel: options.cancel.clone(),
+            budget,
         }
     }
 
@@ -154,6 +163,7 @@ impl SceneEngine {
         text: &str,
         file: &Path,
     ) -> Result<Dynamic, SceneError> {
+        self.budget.start();
         self.engine
             .eval_ast_with_scope::<Dynamic>(scope, ast)
             .map_err(|e| SceneError::from_eval(e, file, text, &|name| self.modules.file_of(name)))
@@ -199,7 +209,16 @@ impl SceneEngine {
 
 /// Reads, runs and finishes the scene file at `path`.
 pub fn load_scene(path: &Path) -> Result<LoadedScene, SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|e| {
+    load_scene_and_imports(path).map(|(loaded, _)| loaded)
+}
+
+/// [`load_scene`], also giving the module files the scene imported (directly or through
+/// other modules): with the scene and its images, what a render reads.
+pub fn load_scene_and_imports(path: &Path) -> Result<(LoadedScene, Vec<PathBuf>), SceneError> {
+    // A FIFO or a device would be read until it ends, which may be never.
+    let text = crate::util::check_input_file(path)
+        .and_then(|()| std::fs::read_to_string(path))
+        .map_err(|e| {
         SceneError::new(
             ErrorKind::Io,
             path,
@@ -207,7 +226,7 @@ pub fn load_scene(path: &Path) -> Result<LoadedScene, SceneError> {
             format!("cannot read scene: {e}"),
         )
     })?;
-    parse_scene(&text, path, &ScriptOptions::for_scene_file(path))
+    run_scene(&text, path, &ScriptOptions::for_scene_file(path))
 }
 
 /// Runs scene source `text` (named `file`) with `options` and finishes the scene.
@@ -216,13 +235,22 @@ pub fn parse_scene(
     file: &Path,
     options: &ScriptOptions,
 ) -> Result<LoadedScene, SceneError> {
+    run_scene(text, file, options).map(|(loaded, _)| loaded)
+}
+
+fn run_scene(
+    text: &str,
+    file: &Path,
+    options: &ScriptOptions,
+) -> Result<(LoadedScene, Vec<PathBuf>), SceneError> {
     let engine = SceneEngine::new(options);
     let _ = engine.run(&mut Scope::new(), text, file)?;
     let (scene, origins) = engine.scene(file)?;
-    Ok(LoadedScene {
+    let loaded = LoadedScene {
         scene,
         origins,
         file: file.to_path_buf(),
         text: text.to_string(),
-    })
+    };
+    Ok((loaded, engine.module_files().files()))
 }

@@ -150,6 +150,9 @@ fn classify(error: &EvalAltResult) -> (ErrorKind, String) {
     match error {
         E::ErrorRuntime(value, _) => (ErrorKind::Runtime, value.to_string()),
         E::ErrorParsing(p, _) => (ErrorKind::Syntax, format!("syntax error: {p}")),
+        E::ErrorTerminated(value, _) if value.to_string() != super::sandbox::CANCELLED => {
+            (ErrorKind::Limit, value.to_string())
+        }
         E::ErrorTerminated(..) => (ErrorKind::Cancelled, "evaluation cancelled".into()),
         E::ErrorTooManyOperations(_) => (
             ErrorKind::Limit,

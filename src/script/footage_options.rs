@@ -51,6 +51,11 @@ pub fn footage_option(
             "`{start_key}` applies to numbered image patterns, not to a video"
         ));
     }
+    if is_video_path(&path) {
+        if let Some(problem) = crate::util::not_a_file(&path).filter(|p| *p != "does not exist") {
+            return Err(format!("{key} `{text}` {problem} ({})", path.display()));
+        }
+    }
     Footage::open(&path, start, hold.unwrap_or(false), &hold_key)
         .map(Some)
         .map_err(|e| format!("{key} footage: {e}"))

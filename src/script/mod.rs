@@ -11,6 +11,7 @@ mod engine;
 mod error;
 mod golden;
 mod follow_api;
+mod memory;
 mod footage_options;
 mod sandbox;
 mod validate;
@@ -19,9 +20,10 @@ mod values;
 pub use refs::{HandleRef, PatchRef, PinRef};
 pub use draft::{Draft, Ids, Origin, Origins};
 pub use engine::{
-    find_scripts_dir, load_scene, parse_scene, LoadedScene, SceneEngine, ScriptOptions,
+    find_scripts_dir, load_scene, load_scene_and_imports, parse_scene, LoadedScene, SceneEngine, ScriptOptions,
 };
 pub use error::{ErrorKind, SceneError};
+pub use memory::set_allocation_probe;
 pub use sandbox::{Limits, ModuleFiles, SandboxResolver};
 pub use api::{OTHER_OPTION_KEYS, PATCH_OPTIONS};
 pub use validate::{validate_scene, CheckSummary};

@@ -12,9 +12,13 @@ use std::sync::{Arc, Mutex};
 use rhai::module_resolvers::ModuleResolver;
 use rhai::{Dynamic, Engine, EvalAltResult, Module, Position, Scope, Shared};
 
+use super::memory::MemoryBudget;
 use crate::util::lock;
 
 type SharedModule = Shared<Module>;
+
+/// What a cancelled evaluation ends with (any other termination is a limit).
+pub(super) const CANCELLED: &str = "cancelled";
 
 /// Bounds on what a script may use.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -27,6 +31,9 @@ pub struct Limits {
     pub max_array_size: usize,
     pub max_map_size: usize,
     pub max_modules: usize,
+    /// Bytes an evaluation may allocate in all (its strings, arrays and maps together),
+    /// when the program measures allocations (`set_allocation_probe`).
+    pub max_memory: usize,
 }
 
 impl Default for Limits {
@@ -42,6 +49,7 @@ impl Default for Limits {
             max_array_size: 100_000,
             max_map_size: 10_000,
             max_modules: 64,
+            max_memory: 256 << 20,
         }
     }
 }
@@ -51,6 +59,7 @@ pub fn sandboxed_engine(
     resolver: SandboxResolver,
     limits: &Limits,
     cancel: Arc<AtomicBool>,
+    budget: MemoryBudget,
 ) -> Engine {
     let mut engine = Engine::new();
     engine
@@ -65,9 +74,9 @@ pub fn sandboxed_engine(
         .disable_symbol("eval");
     engine.on_progress(move |_| {
         if cancel.load(Ordering::Relaxed) {
-            Some(Dynamic::from("cancelled"))
+            Some(Dynamic::from(CANCELLED))
         } else {
-            None
+            budget.exceeded().map(Dynamic::from)
         }
     });
     // Script output goes to stderr so stdout stays machine-readable.
@@ -86,6 +95,8 @@ pub struct SandboxResolver {
     files: Arc<Mutex<HashMap<String, PathBuf>>>,
     /// Successfully evaluated modules by file.
     modules: Arc<Mutex<HashMap<PathBuf, SharedModule>>>,
+    /// Modules being evaluated, outermost first: an import of one of them is a cycle.
+    loading: Arc<Mutex<Vec<PathBuf>>>,
 }
 
 impl SandboxResolver {
@@ -98,7 +109,34 @@ impl SandboxResolver {
             roots,
             files: Arc::default(),
             modules: Arc::default(),
+            loading: Arc::default(),
         }
+    }
+
+    /// How an error names a module file: relative to the folder it was found in.
+    fn short_name(&self, file: &Path) -> String {
+        self.roots
+            .iter()
+            .find_map(|root| file.strip_prefix(root).ok())
+            .unwrap_or(file)
+            .display()
+            .to_string()
+    }
+
+    /// Refuses an import of a module still being evaluated, naming the chain
+    /// (`a.rhai → b.rhai → a.rhai`); else marks `file` as being evaluated.
+    fn enter(&self, file: &Path) -> Result<(), String> {
+        let mut loading = lock(&self.loading);
+        if let Some(first) = loading.iter().position(|f| f == file) {
+            let chain: Vec<String> = loading[first..]
+                .iter()
+                .chain(std::iter::once(&file.to_path_buf()))
+                .map(|f| self.short_name(f))
+                .collect();
+            return Err(format!("import cycle: {}", chain.join(" → ")));
+        }
+        loading.push(file.to_path_buf());
+        Ok(())
     }
 
     /// A shared view of the resolved modules, for mapping import names to files.
@@ -129,7 +167,10 @@ impl SandboxResolver {
             let Ok(found) = root.join(&file_name).canonicalize() else {
                 continue;
             };
-            if found.is_file() && found.starts_with(root) {
+            if found.starts_with(root) {
+                if let Some(problem) = crate::util::not_a_file(&found) {
+                    return Err(format!("module `{name}` {problem} ({})", found.display()));
+                }
                 return Ok(found);
             }
             escaped = escaped.or(Some(found));
@@ -159,6 +200,13 @@ impl ModuleFiles {
         lock(&self.files).get(name).cloned()
     }
 
+    /// Every module file imported so far (directly or by another module), sorted.
+    pub fn files(&self) -> Vec<PathBuf> {
+        let mut files: Vec<PathBuf> = lock(&self.modules).keys().cloned().collect();
+        files.sort();
+        files
+    }
+
     /// Forgets loaded modules so the next import re-reads them (the REPL's `:reload`).
     pub fn clear(&self) {
         lock(&self.files).clear();
@@ -181,7 +229,24 @@ impl ModuleResolver for SandboxResolver {
         if let Some(module) = lock(&self.modules).get(&file) {
             return Ok(module.clone());
         }
-        let text = std::fs::read_to_string(&file).map_err(|e| {
+        self.enter(&file)
+            .map_err(|message| EvalAltResult::ErrorRuntime(message.into(), pos))?;
+        let result = self.load(engine, path, &file, pos);
+        lock(&self.loading).pop();
+        result
+    }
+}
+
+impl SandboxResolver {
+    /// Reads, compiles and evaluates the module `path` found at `file`, and keeps it.
+    fn load(
+        &self,
+        engine: &Engine,
+        path: &str,
+        file: &Path,
+        pos: Position,
+    ) -> Result<SharedModule, Box<EvalAltResult>> {
+        let text = std::fs::read_to_string(file).map_err(|e| {
             EvalAltResult::ErrorRuntime(
                 format!("cannot read module {}: {e}", file.display()).into(),
                 pos,
@@ -194,7 +259,7 @@ impl ModuleResolver for SandboxResolver {
         let module: SharedModule = Module::eval_ast_as_new(Scope::new(), &ast, engine)
             .map_err(|e| EvalAltResult::ErrorInModule(path.to_string(), e, pos))?
             .into();
-        lock(&self.modules).insert(file, module.clone());
+        lock(&self.modules).insert(file.to_path_buf(), module.clone());
         Ok(module)
     }
 }

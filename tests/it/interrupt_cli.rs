@@ -1,5 +1,5 @@
-//! Interrupted renders (docs/robustness.md): SIGINT during `lapclone render` leaves only
-//! complete frames (each decodes fully) and no temporary file, and the render exits 1
+//! Interrupted renders (docs/robustness.md): SIGINT during `lapclone render` leaves no
+//! frame and no temporary folder (a PNG sequence is all or nothing), and the render exits 1
 //! saying it was interrupted; an interrupted GIF/APNG leaves no file at all, and an
 //! interrupted MP4 neither a file nor an ffmpeg process, whether it comes while frames are
 //! still going in (skipped without ffmpeg) or while ffmpeg finishes the file (a stand-in
@@ -67,36 +67,29 @@ fn interrupt(child: &Child) {
 }
 
 #[test]
-fn sigint_leaves_only_complete_frames() {
+fn sigint_during_a_png_sequence_leaves_nothing() {
     let dir = tempfile::tempdir().unwrap();
     let scene = write_scene(dir.path());
     let frames = dir.path().join("frames");
     let mut child = spawn_render(&scene, &frames, &["--jobs", "2"]);
-    let first = frames.join("frame_0001.png");
-    assert!(
-        wait_until(&mut child, || first.exists()),
-        "the render ended before its first frame appeared"
-    );
+    // The frames go into a temporary folder beside `frames` until the last one is written.
+    let started = wait_until(&mut child, || {
+        sorted_names(dir.path())
+            .iter()
+            .filter(|n| n.starts_with(".frames.") && n.ends_with(".tmp"))
+            .any(|n| dir.path().join(n).join("frame_0001.png").exists())
+    });
+    assert!(started, "the render ended before its first frame appeared");
     interrupt(&child);
     let output = child.wait_with_output().unwrap();
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert_eq!(output.status.code(), Some(1), "{stderr}");
     assert!(stderr.contains("interrupted"), "{stderr}");
-    let written = sorted_names(&frames);
-    assert!(!written.is_empty());
-    assert!(
-        written.len() < 2000,
-        "all frames were written: the signal came too late to test anything"
+    assert_eq!(
+        sorted_names(dir.path()),
+        ["long.rhai"],
+        "the interrupted render left files"
     );
-    for name in &written {
-        assert!(
-            name.starts_with("frame_") && name.ends_with(".png"),
-            "stray file {name}"
-        );
-        let image = image::open(frames.join(name))
-            .unwrap_or_else(|e| panic!("{name} does not decode: {e}"));
-        assert_eq!((image.width(), image.height()), (64, 48), "{name}");
-    }
 }
 
 #[test]
@@ -167,9 +160,11 @@ fn sigint_during_a_video_stops_ffmpeg_and_leaves_no_file() {
     let scene = write_scene(dir.path());
     let out = dir.path().join("movie.mp4");
     let mut child = spawn_render(&scene, &out, &[]);
-    // ffmpeg creates its temporary file once it is encoding.
+    let id = child.id();
+    // The temporary file exists once the render has started ffmpeg.
     let started = wait_until(&mut child, || {
         sorted_names(dir.path()).iter().any(|n| n.ends_with(".tmp"))
+            && children_named(id, "ffmpeg").len() == 1
     });
     assert!(started, "the render ended before ffmpeg wrote anything");
     let ffmpeg = children_named(child.id(), "ffmpeg");

@@ -28,6 +28,7 @@ mod determinism_cli;
 mod footage_api;
 mod fuzz_mesh;
 mod fuzz_scene;
+mod hostile_cli;
 mod interrupt_cli;
 mod mask_agreement;
 mod mesh_cli;

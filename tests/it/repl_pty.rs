@@ -84,21 +84,25 @@ fn ctrl_c_cancels_a_running_render_and_keeps_the_session() {
         .env("LAPCLONE_INLINE", "off");
     let mut p = spawn_command(command, Some(60_000)).unwrap();
     p.exp_string("lapclone> ").unwrap();
-    // Interrupt the render once its first frame file exists.
+    // Interrupt the render once its first frame file exists (in the temporary folder the
+    // frames stay in until the last one is written).
     p.send_line(&format!(":render -o {}", frames.display()))
         .unwrap();
-    let first = frames.join("frame_0001.png");
-    while !first.exists() {
+    let started = || {
+        std::fs::read_dir(dir.path()).unwrap().flatten().any(|e| {
+            let name = e.file_name().to_string_lossy().into_owned();
+            name.starts_with(".frames.") && e.path().join("frame_0001.png").exists()
+        })
+    };
+    while !started() {
         std::thread::yield_now();
     }
     p.send_control('c').unwrap();
     p.exp_string("cancelled").unwrap();
     p.exp_string("lapclone> ").unwrap();
-    let written = std::fs::read_dir(&frames).unwrap().count();
-    assert!(
-        written < 2880,
-        "all {written} frames were written: nothing was cancelled"
-    );
+    // A cancelled PNG sequence leaves nothing: no frame folder, no temporary folder.
+    assert!(!frames.exists(), "the cancelled render left its frames");
+    assert!(!started(), "the cancelled render left its temporary folder");
     // The session goes on.
     p.send_line("1 + 1").unwrap();
     p.exp_string("=> 2").unwrap();

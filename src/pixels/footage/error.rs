@@ -32,7 +32,7 @@ pub enum FootageError {
     #[error("{} not found", .0.display())]
     NotFound(PathBuf),
     /// A frame's file is missing and the footage does not hold its last frame.
-    #[error("frame {frame} needs {}, which does not exist (add `{hold_key}: true` to hold the last one)", file.display())]
+    #[error("frame {frame} needs {}, which does not exist{}", file.display(), hold_hint(hold_key, *held))]
     MissingFrame {
         /// The frame, counted from 1.
         frame: u64,
@@ -40,6 +40,8 @@ pub enum FootageError {
         file: PathBuf,
         /// The setting that would hold the last frame ([`Footage::hold_key`](super::Footage::hold_key)).
         hold_key: String,
+        /// Whether that setting is already on (then only an earlier file can help).
+        held: bool,
     },
     /// A frame's size differs from the first frame's.
     #[error("{}: frame {frame} is {width}×{height}, but the footage is {expected_width}×{expected_height}", file.display())]
@@ -58,7 +60,7 @@ pub enum FootageError {
         expected_height: u32,
     },
     /// A video needs `ffmpeg` / `ffprobe`, and neither is on `PATH`.
-    #[error("{}", crate::util::FFMPEG_MISSING)]
+    #[error("{}", crate::util::FFMPEG_MISSING_FOR_FOOTAGE)]
     NoFfmpeg,
     /// ffmpeg or ffprobe cannot read the video.
     #[error("cannot read video {}: {message}", path.display())]
@@ -83,4 +85,13 @@ pub enum FootageError {
     /// A frame's file cannot be read or decoded.
     #[error(transparent)]
     Image(#[from] Box<PixelError>),
+}
+
+/// The end of a missing-frame message: how holding would help, unless it is already on.
+fn hold_hint(hold_key: &str, held: bool) -> String {
+    if held {
+        format!(" (`{hold_key}` holds the last file of the unbroken run from the first one; the first is missing)")
+    } else {
+        format!(" (add `{hold_key}: true` to hold the last one)")
+    }
 }

@@ -97,6 +97,7 @@ impl Footage {
                     frame: 1,
                     file: first,
                     hold_key: hold_key.into(),
+                    held: hold,
                 });
             }
             let size = image_size(&first)?;
@@ -168,9 +169,10 @@ impl Footage {
     /// Scene frame `index`'s `file` is missing.
     fn missing(&self, index: u64, file: PathBuf) -> FootageError {
         FootageError::MissingFrame {
-            frame: index + 1,
+            frame: index.saturating_add(1),
             file,
             hold_key: self.hold_key.clone(),
+            held: self.hold,
         }
     }
 
@@ -181,7 +183,7 @@ impl Footage {
         }
         Err(FootageError::SizeChanged {
             file: file.to_path_buf(),
-            frame: index + 1,
+            frame: index.saturating_add(1),
             width: size.0,
             height: size.1,
             expected_width: self.width,

@@ -52,7 +52,8 @@ impl FootageReader {
         start: u64,
         index: u64,
     ) -> Result<FloatImage, FootageError> {
-        let mut file = pattern.path(start + index);
+        // Saturating: a time far beyond any footage names a far frame, never frame 0.
+        let mut file = pattern.path(start.saturating_add(index));
         if !file.is_file() && self.footage.hold {
             // The last file of the unbroken run from the start holds.
             let mut last = 0;
@@ -90,7 +91,7 @@ impl FootageReader {
             (Some(bytes), true) => rgba8_image(w, h, bytes),
             _ => Err(FootageError::VideoTooShort {
                 path: path.to_path_buf(),
-                frame: index + 1,
+                frame: index.saturating_add(1),
                 available: stream.next,
                 hold_key: self.footage.hold_key.clone(),
             }),

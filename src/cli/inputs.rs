@@ -1,0 +1,149 @@
+//! The files a command reads, and the refusal of an output that is one of them: takes a
+//! loaded scene (with its imports) or a command's input paths and an output path, and
+//! gives an error naming the input when writing the output would replace it. Files are
+//! compared by identity (links and hard links followed, `lapclone::util::same_file`), so
+//! `-o` cannot reach an input through another spelling of its path.
+
+use std::path::{Path, PathBuf};
+
+use lapclone::animation::{Background, FootageSource, Pattern};
+use lapclone::output::foreign_frames;
+use lapclone::script::LoadedScene;
+use lapclone::util::same_file;
+
+/// Something a render reads: a file, or the files of a numbered sequence it shows.
+enum Input {
+    File(PathBuf),
+    Sequence {
+        pattern: Pattern,
+        first: u64,
+        count: u64,
+    },
+}
+
+impl Input {
+    /// Whether `path` (an existing file) is this input or one of its files.
+    fn covers(&self, path: &Path) -> bool {
+        match self {
+            Input::File(file) => same_file(file, path),
+            Input::Sequence {
+                pattern,
+                first,
+                count,
+            } => {
+                let Some(name) = path.file_name() else {
+                    return false;
+                };
+                let folder = pattern.path(*first);
+                let same_folder = match (folder.parent(), path.parent()) {
+                    (Some(a), Some(b)) => same_file(&dir_or_here(a), &dir_or_here(b)),
+                    _ => false,
+                };
+                same_folder
+                    && (*first..first.saturating_add(*count))
+                        .any(|n| pattern.path(n).file_name() == Some(name))
+            }
+        }
+    }
+
+    fn describe(&self) -> String {
+        match self {
+            Input::File(file) => file.display().to_string(),
+            Input::Sequence { pattern, .. } => pattern.text().to_string(),
+        }
+    }
+}
+
+fn dir_or_here(dir: &Path) -> PathBuf {
+    if dir.as_os_str().is_empty() {
+        PathBuf::from(".")
+    } else {
+        dir.to_path_buf()
+    }
+}
+
+/// Every file the scene's render reads: the scene, its imports, images, plates, videos.
+fn scene_inputs(loaded: &LoadedScene, imports: &[PathBuf]) -> Vec<Input> {
+    let scene = &loaded.scene;
+    let count = scene.canvas.frame_count();
+    let mut inputs: Vec<Input> = std::iter::once(loaded.file.clone())
+        .chain(imports.iter().cloned())
+        .map(Input::File)
+        .collect();
+    let footage = |f: &lapclone::animation::Footage| match &f.source {
+        FootageSource::Sequence { pattern, start } => Input::Sequence {
+            pattern: pattern.clone(),
+            first: *start,
+            count,
+        },
+        FootageSource::Video(path) => Input::File(path.clone()),
+    };
+    match &scene.canvas.background {
+        Background::Image(path) => inputs.push(Input::File(path.clone())),
+        Background::Footage(f) => inputs.push(footage(f)),
+        Background::Colour(_) => {}
+    }
+    for patch in &scene.patches {
+        inputs.push(Input::File(patch.source.clone()));
+        if let Some(f) = &patch.footage {
+            inputs.push(footage(f));
+        }
+        if let lapclone::animation::Shape::Mask(mask) = &patch.shape {
+            inputs.push(Input::File(mask.clone()));
+        }
+    }
+    inputs
+}
+
+/// Refuses a file output (`-o`) that is one of the scene's inputs.
+pub(crate) fn refuse_scene_input(
+    output: &Path,
+    loaded: &LoadedScene,
+    imports: &[PathBuf],
+) -> anyhow::Result<()> {
+    if output.as_os_str() == "-" || !output.exists() {
+        return Ok(());
+    }
+    match scene_inputs(loaded, imports)
+        .iter()
+        .find(|input| input.covers(output))
+    {
+        Some(input) => Err(overwrite(output, &input.describe())),
+        None => Ok(()),
+    }
+}
+
+/// Refuses a PNG frame folder holding frame files that are also the scene's inputs (a
+/// render would replace them, or `--force` remove them).
+pub(crate) fn refuse_scene_input_frames(
+    folder: &Path,
+    loaded: &LoadedScene,
+    imports: &[PathBuf],
+) -> anyhow::Result<()> {
+    if !folder.is_dir() {
+        return Ok(());
+    }
+    let frames = foreign_frames(folder, |_| false).unwrap_or_default();
+    let inputs = scene_inputs(loaded, imports);
+    for frame in &frames {
+        if let Some(input) = inputs.iter().find(|input| input.covers(frame)) {
+            return Err(overwrite(frame, &input.describe()));
+        }
+    }
+    Ok(())
+}
+
+/// Refuses an output that is one of `inputs` (a command's input files).
+pub(crate) fn refuse_input(output: &Path, inputs: &[&Path]) -> anyhow::Result<()> {
+    match inputs.iter().find(|input| same_file(input, output)) {
+        Some(input) => Err(overwrite(output, &input.display().to_string())),
+        None => Ok(()),
+    }
+}
+
+fn overwrite(output: &Path, input: &str) -> anyhow::Error {
+    anyhow::anyhow!(
+        "{}: the output would replace an input of this command ({input}); write it elsewhere",
+        output.display()
+    )
+}

@@ -1,0 +1,793 @@
+//! Hostile input, second catalogue (docs/robustness.md): the real `lapclone` binary over
+//! what a suspicious user tries against footage, modules, outputs and flags. Every case
+//! must end in seconds with its exit code (0 ok, 1 failure, 2 usage), say what was wrong,
+//! never print panic text or abort, and leave no partial, misplaced or replaced output.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+
+use crate::files::sorted_names;
+
+const W: u32 = 40;
+const H: u32 = 30;
+
+/// A temporary folder holding small images and the scenes of one test.
+struct World {
+    root: tempfile::TempDir,
+}
+
+impl World {
+    fn new() -> Self {
+        let root = tempfile::tempdir().unwrap();
+        let world = World { root };
+        image::RgbImage::from_fn(W, H, |x, y| image::Rgb([(x * 6) as u8, (y * 8) as u8, 90]))
+            .save(world.path("bg.png"))
+            .unwrap();
+        image::RgbImage::from_fn(W, H, |x, y| image::Rgb([200, (x * 5) as u8, (y * 7) as u8]))
+            .save(world.path("src.png"))
+            .unwrap();
+        image::GrayImage::from_fn(W, H, |x, y| {
+            image::Luma([if (10..30).contains(&x) && (8..22).contains(&y) {
+                255
+            } else {
+                0
+            }])
+        })
+        .save(world.path("mask.png"))
+        .unwrap();
+        world
+    }
+
+    fn path(&self, relative: &str) -> PathBuf {
+        self.root.path().join(relative)
+    }
+
+    fn write(&self, relative: &str, text: &str) -> PathBuf {
+        let path = self.path(relative);
+        std::fs::write(&path, text).unwrap();
+        path
+    }
+
+    /// A valid 3-frame scene over the world's images, with `extra` appended.
+    fn scene(&self, name: &str, extra: &str) -> PathBuf {
+        self.write(
+            name,
+            &format!(
+                "canvas({W}, {H}, #{{ fps: 3, duration: 1, background: \"bg.png\" }});\n\
+                 let p = patch(\"p\", #{{ source: \"src.png\", mask: \"mask.png\" }});\n\
+                 p.at(0, [20, 15]).at(1, [22, 16]);\n{extra}"
+            ),
+        )
+    }
+
+    fn run(&self, args: &[&str]) -> Output {
+        Command::new(env!("CARGO_BIN_EXE_lapclone"))
+            .args(args)
+            .current_dir(self.root.path())
+            .env("RUST_BACKTRACE", "0")
+            .output()
+            .unwrap()
+    }
+
+    fn names(&self) -> Vec<String> {
+        sorted_names(self.root.path())
+    }
+}
+
+/// Asserts the exit code, a message substring and the absence of panic text; gives stderr.
+#[track_caller]
+fn expect(output: &Output, code: i32, message: &str) -> String {
+    let stderr = String::from_utf8_lossy(&output.stderr).into_owned();
+    assert_eq!(output.status.code(), Some(code), "stderr: {stderr}");
+    assert!(stderr.contains(message), "no `{message}` in: {stderr}");
+    assert!(
+        !stderr.contains("panicked") && !stderr.contains("overflowed"),
+        "{stderr}"
+    );
+    stderr
+}
+
+#[test]
+fn import_cycles_are_positioned_errors_naming_the_chain() {
+    let world = World::new();
+    world.write("a.rhai", "import \"b\" as b;\n");
+    world.write("b.rhai", "import \"a\" as a;\n");
+    world.write("me.rhai", "import \"me\" as me;\n");
+    let cycle = world.scene("cycle.rhai", "import \"a\" as a;\n");
+    let own = world.scene("own.rhai", "import \"me\" as me;\n");
+    let cycle = cycle.to_str().unwrap();
+    for args in [
+        vec!["check", cycle],
+        vec!["render", cycle, "-o", "frames"],
+        vec!["preview", cycle, "-o", "p.png"],
+    ] {
+        let stderr = expect(
+            &world.run(&args),
+            1,
+            "import cycle: a.rhai → b.rhai → a.rhai",
+        );
+        assert!(stderr.contains("b.rhai:1:8:"), "{stderr}");
+    }
+    let test = world.run(&["test", cycle]);
+    let stderr = String::from_utf8_lossy(&test.stderr);
+    assert!(matches!(test.status.code(), Some(1 | 2)), "{stderr}");
+    assert!(
+        stderr.contains("import cycle: a.rhai → b.rhai → a.rhai"),
+        "{stderr}"
+    );
+    expect(
+        &world.run(&["check", own.to_str().unwrap()]),
+        1,
+        "import cycle: me.rhai → me.rhai",
+    );
+    assert!(!world.names().iter().any(|n| n == "frames" || n == "p.png"));
+}
+
+#[test]
+fn a_long_acyclic_import_chain_loads() {
+    let world = World::new();
+    for i in 0..40 {
+        world.write(
+            &format!("m{i}.rhai"),
+            &format!("import \"m{}\" as next;\n", i + 1),
+        );
+    }
+    world.write("m40.rhai", "fn depth() { 40 }\n");
+    let scene = world.scene("chain.rhai", "import \"m0\" as m;\n");
+    expect(&world.run(&["check", scene.to_str().unwrap()]), 0, "");
+}
+
+#[test]
+fn jobs_are_clamped_to_the_cores_and_absurd_values_refused() {
+    let world = World::new();
+    let scene = world.scene("s.rhai", "");
+    let scene = scene.to_str().unwrap();
+    for jobs in ["40000", "1025"] {
+        expect(
+            &world.run(&["render", scene, "-o", "frames", "--jobs", jobs]),
+            2,
+            "at most 1024",
+        );
+        expect(
+            &world.run(&["test", scene, "--jobs", jobs]),
+            2,
+            "at most 1024",
+        );
+    }
+    assert!(!world.names().contains(&"frames".to_string()));
+    let output = world.run(&["render", scene, "-o", "frames", "--jobs", "1024"]);
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    if cores < 1024 {
+        expect(&output, 0, "lowered to");
+    }
+    assert_eq!(sorted_names(&world.path("frames")).len(), 3);
+}
+
+#[test]
+fn keys_added_one_call_at_a_time_stay_linear_and_late_keys_are_counted() {
+    let world = World::new();
+    // 60 000 keys after the scene's end: quadratic appends took minutes here, and the
+    // warning listed every key.
+    let scene = world.scene(
+        "keys.rhai",
+        "for i in 0..60000 { p.scale(2 + i * 0.001, 1.0); }\n",
+    );
+    let stderr = expect(
+        &world.run(&["check", scene.to_str().unwrap()]),
+        0,
+        "60000 keys at t = 2, ",
+    );
+    assert!(stderr.len() < 2000, "{} bytes of stderr", stderr.len());
+    // A million keys end at the operation limit, with a position.
+    let scene = world.scene(
+        "million.rhai",
+        "for i in 0..1000000 { p.at(i * 0.001, [20, 15]); }\n",
+    );
+    expect(
+        &world.run(&["check", scene.to_str().unwrap()]),
+        1,
+        "million.rhai:4:",
+    );
+}
+
+#[test]
+fn scene_memory_is_bounded_by_one_budget() {
+    let world = World::new();
+    let half_mib = "let s = \"x\"; for i in 0..19 { s += s; }\n";
+    for (name, body) in [
+        (
+            "map",
+            "let m = #{}; let i = 0; loop { m[`k${i}`] = s + i; i += 1; }\n",
+        ),
+        (
+            "array",
+            "let a = []; a.pad(90000, \"\"); for i in 0..90000 { a[i] = s + i; }\n",
+        ),
+        (
+            "nested",
+            "let a = []; a.pad(1000, []); for i in 0..1000 { a[i] = [s + i]; }\n",
+        ),
+    ] {
+        let scene = world.scene(&format!("{name}.rhai"), &format!("{half_mib}{body}"));
+        let output = world.run(&["check", scene.to_str().unwrap()]);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(1), "{name}: {stderr}");
+        assert!(
+            stderr.contains("scene memory budget of 256 MiB"),
+            "{name}: {stderr}"
+        );
+        assert!(
+            stderr.contains(&format!("{name}.rhai:")),
+            "{name}: {stderr}"
+        );
+    }
+}
+
+/// Numbered plates `plates/plate_0001.png …`, the middle one corrupt.
+fn plates_with_a_corrupt_one(world: &World) -> PathBuf {
+    std::fs::create_dir(world.path("plates")).unwrap();
+    for i in 1..=3 {
+        std::fs::copy(
+            world.path("bg.png"),
+            world.path(&format!("plates/plate_000{i}.png")),
+        )
+        .unwrap();
+    }
+    let bytes = std::fs::read(world.path("bg.png")).unwrap();
+    std::fs::write(
+        world.path("plates/plate_0002.png"),
+        &bytes[..bytes.len() / 2],
+    )
+    .unwrap();
+    world.write(
+        "plates.rhai",
+        "canvas(#{ fps: 3, duration: 1, background: \"plates/plate_%04d.png\" });\n\
+         let p = patch(\"p\", #{ source: \"src.png\", mask: \"mask.png\" });\n",
+    )
+}
+
+#[test]
+fn a_failed_png_render_leaves_no_new_folder_and_an_old_one_as_it_was() {
+    let world = World::new();
+    let scene = plates_with_a_corrupt_one(&world);
+    let scene = scene.to_str().unwrap();
+    expect(
+        &world.run(&["render", scene, "-o", "frames"]),
+        1,
+        "plate_0002.png",
+    );
+    let names = world.names();
+    assert!(!names.iter().any(|n| n.contains("frames")), "{names:?}");
+    // An existing folder with an earlier render's frames keeps them, byte for byte.
+    let good = world.scene("good.rhai", "");
+    expect(
+        &world.run(&["render", good.to_str().unwrap(), "-o", "frames"]),
+        0,
+        "",
+    );
+    let before: Vec<Vec<u8>> = sorted_names(&world.path("frames"))
+        .iter()
+        .map(|n| std::fs::read(world.path("frames").join(n)).unwrap())
+        .collect();
+    expect(
+        &world.run(&["render", scene, "-o", "frames"]),
+        1,
+        "plate_0002.png",
+    );
+    let after: Vec<Vec<u8>> = sorted_names(&world.path("frames"))
+        .iter()
+        .map(|n| std::fs::read(world.path("frames").join(n)).unwrap())
+        .collect();
+    assert_eq!(before, after);
+    assert!(!world.names().iter().any(|n| n.ends_with(".tmp")));
+}
+
+#[test]
+fn an_output_that_is_an_input_is_refused() {
+    let world = World::new();
+    world.write("lib.rhai", "fn width() { 40 }\n");
+    let scene = world.scene("victim.rhai", "import \"lib\" as lib;\n");
+    let original = std::fs::read(&scene).unwrap();
+    #[cfg(unix)]
+    {
+        std::os::unix::fs::symlink(world.path("lib.rhai"), world.path("lib_link.gif")).unwrap();
+        std::fs::hard_link(world.path("bg.png"), world.path("hard.png")).unwrap();
+    }
+    let mut cases = vec![
+        vec![
+            "render",
+            "victim.rhai",
+            "-o",
+            "victim.rhai",
+            "--format",
+            "gif",
+        ],
+        vec![
+            "render",
+            "victim.rhai",
+            "-o",
+            "lib.rhai",
+            "--format",
+            "apng",
+        ],
+        vec!["render", "victim.rhai", "-o", "src.png", "--format", "apng"],
+        vec!["render", "victim.rhai", "-o", "mask.png", "--format", "y4m"],
+        vec!["preview", "victim.rhai", "-o", "bg.png"],
+        vec!["preview", "victim.rhai", "-o", "./src.png"],
+        vec![
+            "clone", "--source", "src.png", "--mask", "mask.png", "--target", "bg.png", "--at",
+            "20,15", "-o", "bg.png",
+        ],
+        vec!["mesh", "mask.png", "-o", "mask.png"],
+    ];
+    #[cfg(unix)]
+    cases.extend([
+        vec!["render", "victim.rhai", "-o", "lib_link.gif"],
+        vec!["preview", "victim.rhai", "-o", "hard.png"],
+    ]);
+    let snapshot = |w: &World| -> Vec<(String, Vec<u8>)> {
+        w.names()
+            .into_iter()
+            .filter(|n| !w.path(n).is_dir())
+            .map(|n| (n.clone(), std::fs::read(w.path(&n)).unwrap()))
+            .collect()
+    };
+    let before = snapshot(&world);
+    for args in &cases {
+        expect(&world.run(args), 1, "would replace an input");
+    }
+    assert_eq!(snapshot(&world), before);
+    assert_eq!(std::fs::read(&scene).unwrap(), original);
+    // Plates rendered into their own folder would be replaced (or removed by --force).
+    std::fs::create_dir(world.path("out")).unwrap();
+    std::fs::copy(world.path("bg.png"), world.path("out/frame_0001.png")).unwrap();
+    std::fs::copy(world.path("bg.png"), world.path("out/frame_0002.png")).unwrap();
+    let plates = world.write(
+        "plates.rhai",
+        "canvas(#{ fps: 2, duration: 1, background: \"out/frame_%04d.png\" });\n",
+    );
+    for extra in [None, Some("--force")] {
+        let mut args = vec!["render", plates.to_str().unwrap(), "-o", "out"];
+        args.extend(extra);
+        expect(&world.run(&args), 1, "would replace an input");
+    }
+    assert_eq!(
+        sorted_names(&world.path("out")),
+        ["frame_0001.png", "frame_0002.png"]
+    );
+}
+
+#[cfg(unix)]
+#[test]
+fn streams_are_written_through_and_other_special_files_never_replaced() {
+    use std::os::unix::fs::FileTypeExt;
+    let world = World::new();
+    let scene = world.scene("s.rhai", "");
+    let scene = scene.to_str().unwrap();
+    // /dev/null is a sink: written, never replaced.
+    expect(
+        &world.run(&["render", scene, "-o", "/dev/null", "--format", "gif"]),
+        0,
+        "",
+    );
+    expect(&world.run(&["preview", scene, "-o", "/dev/null"]), 0, "");
+    assert!(std::fs::metadata("/dev/null")
+        .unwrap()
+        .file_type()
+        .is_char_device());
+    // A FIFO is written through: its reader gets the whole GIF and it stays a FIFO.
+    let fifo = world.path("pipe.gif");
+    assert!(Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap()
+        .success());
+    let reader = {
+        let fifo = fifo.clone();
+        std::thread::spawn(move || std::fs::read(fifo).unwrap())
+    };
+    expect(&world.run(&["render", scene, "-o", "pipe.gif"]), 0, "");
+    let gif = reader.join().unwrap();
+    assert!(
+        gif.starts_with(b"GIF89a") && gif.ends_with(&[0x3b]),
+        "{} bytes",
+        gif.len()
+    );
+    assert!(std::fs::symlink_metadata(&fifo)
+        .unwrap()
+        .file_type()
+        .is_fifo());
+    // A link to a regular file: the file is written, the link stays.
+    std::fs::write(world.path("old.gif"), b"old").unwrap();
+    std::os::unix::fs::symlink(world.path("old.gif"), world.path("link.gif")).unwrap();
+    expect(&world.run(&["render", scene, "-o", "link.gif"]), 0, "");
+    assert!(std::fs::symlink_metadata(world.path("link.gif"))
+        .unwrap()
+        .file_type()
+        .is_symlink());
+    assert!(std::fs::read(world.path("old.gif"))
+        .unwrap()
+        .starts_with(b"GIF89a"));
+    // A link to nothing is refused and stays as it was.
+    std::os::unix::fs::symlink(world.path("nowhere.gif"), world.path("dangling.gif")).unwrap();
+    expect(
+        &world.run(&["render", scene, "-o", "dangling.gif"]),
+        1,
+        "a symbolic link to nothing",
+    );
+    assert!(std::fs::symlink_metadata(world.path("dangling.gif")).is_ok());
+    assert!(!world.path("nowhere.gif").exists());
+    assert!(!world.names().iter().any(|n| n.ends_with(".tmp")));
+}
+
+#[cfg(unix)]
+#[test]
+fn special_files_as_inputs_fail_at_once_instead_of_waiting() {
+    let world = World::new();
+    assert!(Command::new("mkfifo")
+        .arg(world.path("fifo.png"))
+        .status()
+        .unwrap()
+        .success());
+    assert!(Command::new("mkfifo")
+        .arg(world.path("fifo.rhai"))
+        .status()
+        .unwrap()
+        .success());
+    std::fs::create_dir(world.path("folder.png")).unwrap();
+    let clone = |source: &str| {
+        world.run(&[
+            "clone", "--source", source, "--mask", "mask.png", "--target", "bg.png", "--at",
+            "20,15", "-o", "o.png",
+        ])
+    };
+    expect(
+        &clone("fifo.png"),
+        1,
+        "fifo.png: it is not a regular file (a FIFO)",
+    );
+    expect(
+        &clone("folder.png"),
+        1,
+        "folder.png: it is a folder, not a file",
+    );
+    expect(
+        &world.run(&["mesh", "fifo.png"]),
+        1,
+        "not a regular file (a FIFO)",
+    );
+    expect(
+        &world.run(&["check", "fifo.rhai"]),
+        1,
+        "not a regular file (a FIFO)",
+    );
+    let scene = world.write(
+        "bgfifo.rhai",
+        "canvas(40, 30, #{ background: \"fifo.png\" });\n",
+    );
+    expect(
+        &world.run(&["check", scene.to_str().unwrap()]),
+        1,
+        "background `fifo.png` is not a regular file (a FIFO)",
+    );
+    world.write("pipe.rhai", "");
+    std::fs::remove_file(world.path("pipe.rhai")).unwrap();
+    assert!(Command::new("mkfifo")
+        .arg(world.path("pipe.rhai"))
+        .status()
+        .unwrap()
+        .success());
+    let scene = world.scene("imp.rhai", "import \"pipe\" as pipe;\n");
+    expect(
+        &world.run(&["check", scene.to_str().unwrap()]),
+        1,
+        "module `pipe` is not a regular file (a FIFO)",
+    );
+    let scene = world.scene("dirbg.rhai", "");
+    std::fs::write(&scene, "canvas(40, 30, #{ background: \"folder.png\" });\n").unwrap();
+    expect(
+        &world.run(&["check", scene.to_str().unwrap()]),
+        1,
+        "is a folder, not a file",
+    );
+    expect(
+        &clone_into(&world, "bg.png/o.png"),
+        1,
+        "the output folder bg.png is not a folder",
+    );
+}
+
+fn clone_into(world: &World, output: &str) -> Output {
+    world.run(&[
+        "clone", "--source", "src.png", "--mask", "mask.png", "--target", "bg.png", "--at",
+        "20,15", "-o", output,
+    ])
+}
+
+#[cfg(unix)]
+#[test]
+fn a_failed_write_to_standard_output_is_exit_1() {
+    let world = World::new();
+    let scene = world.scene("s.rhai", "");
+    let scene = scene.to_str().unwrap();
+    let closed = |args: &[&str]| {
+        Command::new("sh")
+            .arg("-c")
+            .arg("exec \"$0\" \"$@\" >&-")
+            .arg(env!("CARGO_BIN_EXE_lapclone"))
+            .args(args)
+            .current_dir(world.root.path())
+            .output()
+            .unwrap()
+    };
+    expect(
+        &closed(&["render", scene, "-o", "-", "--format", "y4m"]),
+        1,
+        "standard output is closed",
+    );
+    expect(&closed(&["check", scene]), 1, "standard output is closed");
+    if Path::new("/dev/full").exists() {
+        let full = |args: &[&str]| {
+            Command::new(env!("CARGO_BIN_EXE_lapclone"))
+                .args(args)
+                .current_dir(world.root.path())
+                .stdout(std::fs::File::create("/dev/full").unwrap())
+                .stderr(Stdio::piped())
+                .output()
+                .unwrap()
+        };
+        expect(
+            &full(&["render", scene, "-o", "-", "--format", "y4m"]),
+            1,
+            "standard output",
+        );
+        expect(&full(&["check", scene]), 1, "writing to standard output");
+        expect(
+            &full(&["mesh", "mask.png"]),
+            1,
+            "writing to standard output",
+        );
+    }
+    // Standard output sent to /dev/null on purpose is a legitimate sink.
+    let null = Command::new(env!("CARGO_BIN_EXE_lapclone"))
+        .args(["render", scene, "-o", "-", "--format", "y4m"])
+        .current_dir(world.root.path())
+        .stdout(Stdio::null())
+        .output()
+        .unwrap();
+    expect(&null, 0, "rendered 3 frames");
+}
+
+#[test]
+fn no_command_creates_a_missing_parent_folder() {
+    let world = World::new();
+    let scene = world.scene("s.rhai", "");
+    let scene = scene.to_str().unwrap();
+    let before = world.names();
+    expect(
+        &world.run(&["test", scene, "--update", "--junit", "missing/j.xml"]),
+        1,
+        "missing/j.xml: the output folder missing does not exist",
+    );
+    expect(
+        &world.run(&["test", scene, "--update", "--out", "missing/out"]),
+        1,
+        "the output folder missing does not exist",
+    );
+    expect(
+        &world.run(&["test", scene, "--update", "--goldens", "missing/goldens"]),
+        1,
+        "the output folder missing does not exist",
+    );
+    assert_eq!(world.names(), before);
+}
+
+#[test]
+fn messages_say_what_is_wrong() {
+    let world = World::new();
+    std::fs::create_dir(world.path("plates")).unwrap();
+    for i in 1..=3 {
+        std::fs::copy(
+            world.path("bg.png"),
+            world.path(&format!("plates/plate_000{i}.png")),
+        )
+        .unwrap();
+    }
+    let plates = world.write(
+        "plates.rhai",
+        "canvas(#{ fps: 3, duration: 1, background: \"plates/plate_%04d.png\" });\n",
+    );
+    let plates = plates.to_str().unwrap();
+    let stderr = expect(
+        &world.run(&["preview", plates, "--t", "1e300", "-o", "p.png"]),
+        1,
+        "needs",
+    );
+    assert!(
+        !stderr.contains("frame 0 ") && !stderr.contains("plate_0000"),
+        "{stderr}"
+    );
+    expect(
+        &world.run(&["preview", plates, "--t", "100", "-o", "p.png"]),
+        1,
+        "frame 301 needs",
+    );
+    // A mask whose only piece is too small: the mask is named, no setting the command lacks.
+    image::GrayImage::from_fn(W, H, |x, y| {
+        image::Luma([if (x, y) == (5, 5) { 255 } else { 0 }])
+    })
+    .save(world.path("speck.png"))
+    .unwrap();
+    for output in [
+        world.run(&["mesh", "speck.png"]),
+        world.run(&[
+            "clone",
+            "--source",
+            "src.png",
+            "--mask",
+            "speck.png",
+            "--target",
+            "bg.png",
+            "--at",
+            "20,15",
+            "-o",
+            "o.png",
+        ]),
+    ] {
+        let stderr = expect(&output, 1, "mask speck.png: every piece");
+        assert!(!stderr.contains("lower min_piece_area"), "{stderr}");
+    }
+    // Already holding: the hint does not say to hold.
+    let held = world.write(
+        "held.rhai",
+        "canvas(40, 30, #{ background: \"bg.png\" });\n\
+         patch(\"p\", #{ source: \"plates/plate_%04d.png\", mask: \"mask.png\", source_start: 7, source_hold: true });\n",
+    );
+    let stderr = expect(
+        &world.run(&["check", held.to_str().unwrap()]),
+        1,
+        "plate_0007.png",
+    );
+    assert!(!stderr.contains("add `source_hold: true`"), "{stderr}");
+    // A pin and a drag far outside the patch are named.
+    let points = world.scene(
+        "points.rhai",
+        "p.pin([2, 2]);\np.drag([38, 28], 5).key(1, [30, 20]);\n",
+    );
+    let stderr = expect(
+        &world.run(&["check", points.to_str().unwrap()]),
+        0,
+        "the pin at [2, 2] lies",
+    );
+    assert!(stderr.contains("the drag grabs [38, 28]"), "{stderr}");
+    let inside = world.scene(
+        "inside.rhai",
+        "p.pin([15, 12]);\np.drag([20, 15], 5).key(1, [22, 16]);\n",
+    );
+    let stderr = expect(&world.run(&["check", inside.to_str().unwrap()]), 0, "");
+    assert!(!stderr.contains("outside the patch"), "{stderr}");
+}
+
+#[cfg(unix)]
+#[test]
+fn a_video_background_without_ffmpeg_names_ffmpeg_not_output_formats() {
+    let world = World::new();
+    std::fs::write(world.path("bg.mp4"), b"not a video").unwrap();
+    let scene = world.write(
+        "video.rhai",
+        "canvas(#{ fps: 3, duration: 1, background: \"bg.mp4\" });\n",
+    );
+    let output = Command::new(env!("CARGO_BIN_EXE_lapclone"))
+        .args(["check", scene.to_str().unwrap()])
+        .env("PATH", world.path("no-such-folder"))
+        .output()
+        .unwrap();
+    let stderr = expect(&output, 1, "reading video footage needs them");
+    assert!(!stderr.contains("--format"), "{stderr}");
+}
+
+#[test]
+fn more_hostile_scenes_fail_cleanly_or_work() {
+    let world = World::new();
+    std::fs::write(world.path("zero.png"), b"").unwrap();
+    let head = "canvas(40, 30, #{ fps: 3, duration: 1, background: \"bg.png\" });\n";
+    let long_line = format!("let x = 1{};\n", " + 1".repeat(200_000));
+    let big_literal = format!("let s = \"{}\";\n", "y".repeat(2 << 20));
+    let nested = format!("let a = {}1{};\n", "[".repeat(5000), "]".repeat(5000));
+    let table: Vec<(&str, String, i32, &str)> = vec![
+        ("negative_fps", "canvas(40, 30, #{ fps: -5 });\n".into(), 1, "fps"),
+        ("nan_fps", "canvas(40, 30, #{ fps: 0.0 / 0.0 });\n".into(), 1, "fps"),
+        ("huge_canvas", "canvas(1e10, 1);\n".into(), 1, "canvas width"),
+        ("zero_byte_background", "canvas(40, 30, #{ background: \"zero.png\" });\n".into(), 1, "zero.png"),
+        ("deep_arrays", format!("{head}{nested}"), 1, "nested_arrays.rhai:"),
+        ("long_line", format!("{head}{long_line}"), 1, "long_line.rhai:"),
+        ("big_literal", format!("{head}{big_literal}"), 1, "big_literal.rhai:"),
+        ("huge_time", format!("{head}let p = patch(\"p\", #{{ source: \"src.png\", mask: \"mask.png\" }});\np.at(1e300, [1, 1]);\n"), 0, ""),
+    ];
+    for (name, text, code, message) in &table {
+        let file = if *name == "deep_arrays" {
+            "nested_arrays"
+        } else {
+            name
+        };
+        let scene = world.write(&format!("{file}.rhai"), text);
+        let output = world.run(&["check", scene.to_str().unwrap()]);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(*code), "{name}: {stderr}");
+        assert!(
+            stderr.contains(message),
+            "{name}: no `{message}` in {stderr}"
+        );
+        assert!(
+            !stderr.contains("panicked") && !stderr.contains("overflowed"),
+            "{name}: {stderr}"
+        );
+    }
+}
+
+#[test]
+fn unicode_paths_render() {
+    let world = World::new();
+    let folder = world.path("szène 🎬 ünï");
+    std::fs::create_dir(&folder).unwrap();
+    std::fs::copy(world.path("bg.png"), folder.join("fond é.png")).unwrap();
+    std::fs::write(
+        folder.join("場面.rhai"),
+        "canvas(40, 30, #{ fps: 3, duration: 1, background: \"fond é.png\" });\n",
+    )
+    .unwrap();
+    let scene = folder.join("場面.rhai");
+    let out = folder.join("帧 ✓");
+    let output = Command::new(env!("CARGO_BIN_EXE_lapclone"))
+        .arg("render")
+        .arg(&scene)
+        .arg("-o")
+        .arg(&out)
+        .output()
+        .unwrap();
+    expect(&output, 0, "");
+    assert_eq!(sorted_names(&out).len(), 3);
+}
+
+#[test]
+fn the_repl_survives_loading_an_import_cycle() {
+    let world = World::new();
+    world.write("a.rhai", "import \"b\" as b;\n");
+    world.write("b.rhai", "import \"a\" as a;\n");
+    world.scene("cycle.rhai", "import \"a\" as a;\n");
+    world.scene("fine.rhai", "");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_lapclone"))
+        .args(["repl", "--preview"])
+        .arg(world.path("preview.png"))
+        .current_dir(world.root.path())
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    use std::io::Write as _;
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(b":load cycle.rhai\n:load fine.rhai\n:list\n")
+        .unwrap();
+    let output = child.wait_with_output().unwrap();
+    let all = format!(
+        "{}{}",
+        String::from_utf8_lossy(&output.stdout),
+        String::from_utf8_lossy(&output.stderr)
+    );
+    // Exit 1 only because a piped session reports its failed entry at the end.
+    assert_eq!(output.status.code(), Some(1), "{all}");
+    assert!(all.contains("1 failed entry"), "{all}");
+    assert!(
+        all.contains("import cycle: a.rhai → b.rhai → a.rhai"),
+        "{all}"
+    );
+    assert!(
+        all.contains("loaded") && all.contains("patch \"p\""),
+        "the session did not go on: {all}"
+    );
+    assert!(!all.contains("overflowed"), "{all}");
+}
