@@ -56,3 +56,4 @@ mod solve_update;
 mod test_cli;
 mod video_cli;
 mod video_encode;
+mod view_ws;
