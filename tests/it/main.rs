@@ -56,4 +56,5 @@ mod solve_update;
 mod test_cli;
 mod video_cli;
 mod video_encode;
+mod view_browser;
 mod view_ws;

@@ -20,7 +20,7 @@ use crate::files::asset;
 const WAIT: Duration = Duration::from_secs(60);
 
 /// The cat's face on the coffee, 600×400, keyed so a drag at t = 1.25 adds a key.
-fn cat_scene(dir: &Path) -> PathBuf {
+pub(super) fn cat_scene(dir: &Path) -> PathBuf {
     let text = format!(
         r#"canvas(600, 400, #{{ fps: 24, duration: 2, background: "{}" }});
 let cat = patch("cat", #{{ source: "{}", mask: "{}" }});
@@ -37,15 +37,15 @@ cat.scale(0, 0.42);
 }
 
 /// A `lapclone repl SCENE --view --port 0` whose stdin the test writes.
-struct ViewRepl {
+pub(super) struct ViewRepl {
     child: Child,
     stdin: Option<ChildStdin>,
     lines: Receiver<String>,
-    url: String,
+    pub(super) url: String,
 }
 
 impl ViewRepl {
-    fn start(dir: &Path, scene: &Path) -> ViewRepl {
+    pub(super) fn start(dir: &Path, scene: &Path) -> ViewRepl {
         let mut child = Command::new(env!("CARGO_BIN_EXE_lapclone"))
             .args(["repl", scene.to_str().unwrap(), "--view", "--port", "0"])
             .arg("--preview")
@@ -78,7 +78,7 @@ impl ViewRepl {
         repl
     }
 
-    fn wait_line(&self, found: impl Fn(&str) -> bool) -> String {
+    pub(super) fn wait_line(&self, found: impl Fn(&str) -> bool) -> String {
         loop {
             match self.lines.recv_timeout(WAIT) {
                 Ok(line) if found(&line) => return line,
@@ -89,7 +89,7 @@ impl ViewRepl {
         }
     }
 
-    fn type_line(&mut self, line: &str) {
+    pub(super) fn type_line(&mut self, line: &str) {
         let stdin = self.stdin.as_mut().unwrap();
         writeln!(stdin, "{line}").unwrap();
         stdin.flush().unwrap();
@@ -139,7 +139,7 @@ impl ViewRepl {
     }
 
     /// Closes stdin (the server ends with the input) and waits for the exit.
-    fn finish(mut self) -> std::process::ExitStatus {
+    pub(super) fn finish(mut self) -> std::process::ExitStatus {
         drop(self.stdin.take());
         self.child.wait().unwrap()
     }
@@ -226,7 +226,7 @@ impl Page {
     }
 }
 
-fn preview_png(dir: &Path, scene: &Path, t: f64) -> image::RgbaImage {
+pub(super) fn preview_png(dir: &Path, scene: &Path, t: f64) -> image::RgbaImage {
     let out = dir.join(format!("preview-{t}.png"));
     let status = Command::new(env!("CARGO_BIN_EXE_lapclone"))
         .args([

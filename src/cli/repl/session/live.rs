@@ -186,10 +186,7 @@ impl Session {
         self.from_view = false;
     }
 
-    fn as_page(
-        &mut self,
-        run: impl FnOnce(&mut Self) -> anyhow::Result<()>,
-    ) -> Result<(), String> {
+    fn as_page(&mut self, run: impl FnOnce(&mut Self) -> anyhow::Result<()>) -> Result<(), String> {
         self.from_view = true;
         let result = run(self);
         self.from_view = false;

@@ -13,6 +13,8 @@
   let playing = false, meshOn = false, scrubbing = false;
   // Pointer event → pixels painted, ms (read by the browser test and shown in the title).
   const timings = (window.lapcloneTimings = []);
+  // The last scene message, for tests that drive the page.
+  window.lapcloneScene = () => scene;
   let sentAt = 0;
 
   function send(message) {
