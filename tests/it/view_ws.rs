@@ -411,3 +411,102 @@ fn malformed(i: usize, seed: &mut u64) -> String {
     }
     text
 }
+
+#[test]
+fn each_page_edit_is_one_line_and_gives_the_scene_typing_it_gives() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = cat_scene(dir.path());
+    let mut repl = ViewRepl::start(dir.path(), &scene);
+    let mut page = repl.page();
+    repl.type_line(":t 0.5");
+    page.until(|v| v["type"] == "scene" && v["t"] == 0.5);
+    let edits = [
+        (
+            json!({"op": "at", "patch": "cat", "value": [300.126, 150]}),
+            "cat.at(0.5, [300.13, 150]);",
+        ),
+        (
+            json!({"op": "rotate", "patch": "cat", "value": 15}),
+            "cat.rotate(0.5, 15);",
+        ),
+        (
+            json!({"op": "scale", "patch": "cat", "value": 0.5}),
+            "cat.scale(0.5, 0.5);",
+        ),
+        (
+            json!({"op": "add_handle", "patch": "cat", "from": [250, 200], "radius": 60}),
+            "let h = cat.drag([250, 200], 60);",
+        ),
+        (
+            json!({"op": "handle_key", "patch": "cat", "handle": 0, "value": [262, 190]}),
+            "cat.handle(0).key(0.5, [262, 190]);",
+        ),
+        (
+            json!({"op": "add_pin", "patch": "cat", "at": [200, 150]}),
+            "cat.pin([200, 150]);",
+        ),
+        (
+            json!({"op": "add_handle", "patch": "cat", "from": [300, 250], "radius": 30}),
+            "let h2 = cat.drag([300, 250], 30);",
+        ),
+        (
+            json!({"op": "remove_handle", "patch": "cat", "handle": 1}),
+            "cat.remove_handle(1);",
+        ),
+        (
+            json!({"op": "remove_pin", "patch": "cat", "pin": 0}),
+            "cat.remove_pin(0);",
+        ),
+        (
+            json!({"op": "move_key", "patch": "cat", "track": "at", "from": 2, "to": 1.5}),
+            "cat.move_key(2, 1.5, \"at\");",
+        ),
+        (
+            json!({"op": "remove_key", "patch": "cat", "track": "scale", "t": 0}),
+            "cat.remove_key(0, \"scale\");",
+        ),
+    ];
+    for (edit, line) in &edits {
+        // The handle's target previews before it commits, as a drag would.
+        if edit["op"] == "handle_key" {
+            page.send(&json!({"type": "edit", "rev": page.rev(), "commit": false, "edit": edit}));
+            page.until_scene();
+        }
+        page.send(&json!({"type": "edit", "rev": page.rev(), "commit": true, "edit": edit}));
+        let reply = page.until(|v| v["type"] == "line");
+        assert_eq!(reply["text"], *line);
+    }
+    let from_page = dir.path().join("from_page.rhai");
+    repl.type_line(&format!(":save {}", from_page.display()));
+    repl.wait_line(|l| l.starts_with("saved "));
+    let frame = page.frame.clone();
+    assert!(repl.finish().success());
+    // The same lines typed into a fresh session give the same saved scene.
+    let typed = dir.path().join("typed.rhai");
+    let mut script: Vec<String> = vec![":t 0.5".into()];
+    script.extend(edits.iter().map(|(_, line)| line.to_string()));
+    script.push(format!(":save {}", typed.display()));
+    let out = Command::new(env!("CARGO_BIN_EXE_lapclone"))
+        .args(["repl", scene.to_str().unwrap(), "--preview"])
+        .arg(dir.path().join("typed.png"))
+        .arg("--script")
+        .arg(write_script(dir.path(), &script))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(
+        std::fs::read_to_string(&from_page).unwrap(),
+        std::fs::read_to_string(&typed).unwrap()
+    );
+    assert!(frame == preview_png(dir.path(), &typed, 0.5).as_raw()[..]);
+}
+
+fn write_script(dir: &Path, lines: &[String]) -> PathBuf {
+    let path = dir.join("typed_script.txt");
+    std::fs::write(&path, lines.join("\n") + "\n").unwrap();
+    path
+}
