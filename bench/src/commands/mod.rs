@@ -9,6 +9,7 @@ pub mod bench_opencv;
 pub mod bench_paper;
 pub mod bench_render;
 pub mod bench_solver;
+pub mod bench_view;
 pub mod child_run;
 
 pub use lapclone::cli::{describe, finite_f64, mesh_args, UsageError};
@@ -37,6 +38,9 @@ pub enum BenchCommand {
     /// scene to PNG files against an OpenCV loop and to MP4 against PNG, and a 6000×5000
     /// clone against seamlessClone, with its peak memory.
     Opencv(bench_opencv::OpencvBenchArgs),
+    /// The live view's drag on 1920×1080 scenes (the cat; the horse folding over itself):
+    /// pointer message in → changed pixels out, through the release `lapclone repl --view`.
+    View(bench_view::ViewBenchArgs),
 }
 
 /// Runs one benchmark.
@@ -50,5 +54,6 @@ pub fn run(which: BenchCommand) -> anyhow::Result<()> {
         BenchCommand::Clone(args) => bench_clone::run(args),
         BenchCommand::Paper(args) => bench_paper::run(args),
         BenchCommand::Opencv(args) => bench_opencv::run(args),
+        BenchCommand::View(args) => bench_view::run(args),
     }
 }
