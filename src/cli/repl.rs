@@ -84,6 +84,9 @@ pub fn run(args: ReplArgs) -> anyhow::Result<()> {
             failures += 1;
         }
     }
+    if args.view.watch {
+        crate::cli::view::watch(session.clone());
+    }
     if interactive {
         interactive_loop(&session, &args, cancel, words, &printer)
     } else {
@@ -121,9 +124,6 @@ fn start_view(
     println!("view: {}", server.url);
     if args.open {
         crate::cli::view::open_in_browser(&server.url);
-    }
-    if args.watch {
-        crate::cli::view::watch(session.clone());
     }
     Ok(())
 }

@@ -46,8 +46,13 @@ pub(super) struct ViewRepl {
 
 impl ViewRepl {
     pub(super) fn start(dir: &Path, scene: &Path) -> ViewRepl {
+        Self::start_with(dir, scene, &[])
+    }
+
+    fn start_with(dir: &Path, scene: &Path, extra: &[&str]) -> ViewRepl {
         let mut child = Command::new(env!("CARGO_BIN_EXE_lapclone"))
             .args(["repl", scene.to_str().unwrap(), "--view", "--port", "0"])
+            .args(extra)
             .arg("--preview")
             .arg(dir.join("preview.png"))
             .current_dir(dir)
@@ -509,4 +514,28 @@ fn write_script(dir: &Path, lines: &[String]) -> PathBuf {
     let path = dir.join("typed_script.txt");
     std::fs::write(&path, lines.join("\n") + "\n").unwrap();
     path
+}
+
+#[test]
+fn watch_reloads_a_changed_file_keeping_the_playhead_unless_edits_are_unsaved() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = cat_scene(dir.path());
+    let mut repl = ViewRepl::start_with(dir.path(), &scene, &["--watch"]);
+    let mut page = repl.page();
+    repl.type_line(":t 1");
+    page.until(|v| v["type"] == "scene" && v["t"] == 1.0);
+    let text = std::fs::read_to_string(&scene).unwrap();
+    std::fs::write(
+        &scene,
+        text.replace("cat.scale(0, 0.42);", "cat.scale(0, 0.5);"),
+    )
+    .unwrap();
+    repl.wait_line(|l| l.starts_with("loaded "));
+    page.until(|v| v["type"] == "scene" && v["patches"][0]["scale"] == 0.5);
+    assert_eq!(page.scene["t"], 1.0, "the playhead moved");
+    repl.type_line("cat.rotate(0, 10);");
+    page.until(|v| v["type"] == "scene" && v["patches"][0]["rotation"] == 10.0);
+    std::fs::write(&scene, text).unwrap();
+    repl.wait_line(|l| l.contains("not reloaded: the session has unsaved edits"));
+    assert!(repl.finish().success());
 }

@@ -14,35 +14,36 @@ const POLL: Duration = Duration::from_millis(500);
 
 type Stamp = Vec<(PathBuf, Option<(SystemTime, u64)>)>;
 
-/// Starts the watching thread.
+/// Starts the watching thread; the files as they are now are the baseline.
 pub fn watch(session: Arc<Mutex<Session>>) {
+    let mut last = stamp(&session);
     let spawned = std::thread::Builder::new()
         .name("view-watch".into())
-        .spawn(move || {
-            let mut last: Option<Stamp> = None;
-            loop {
-                std::thread::sleep(POLL);
-                let files = lock(&session).watched_files();
-                let now: Stamp = files
-                    .into_iter()
-                    .map(|f| {
-                        let meta = std::fs::metadata(&f).ok();
-                        let stamp = meta.and_then(|m| Some((m.modified().ok()?, m.len())));
-                        (f, stamp)
-                    })
-                    .collect();
-                let changed = last
-                    .as_ref()
-                    .is_some_and(|l| l != &now && same_files(l, &now));
-                last = Some(now);
-                if changed {
-                    lock(&session).watch_reload();
-                }
+        .spawn(move || loop {
+            std::thread::sleep(POLL);
+            let now = stamp(&session);
+            let changed = last != now && same_files(&last, &now);
+            last = now;
+            if changed {
+                lock(&session).watch_reload();
+                last = stamp(&session);
             }
         });
     if let Err(error) = spawned {
         eprintln!("warning: --watch is off: {error}");
     }
+}
+
+fn stamp(session: &Mutex<Session>) -> Stamp {
+    let files = lock(session).watched_files();
+    files
+        .into_iter()
+        .map(|f| {
+            let meta = std::fs::metadata(&f).ok();
+            let stamp = meta.and_then(|m| Some((m.modified().ok()?, m.len())));
+            (f, stamp)
+        })
+        .collect()
 }
 
 /// Whether two stamps list the same files (a `:load` of another file is no change on disk).
