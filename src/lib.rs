@@ -185,13 +185,14 @@ stage_modules!(
 // The CLI's files name library items as `lapclone::…`, as any other user would.
 extern crate self as lapclone;
 
-// The CLI's doc comments are clap's help texts, where `[…]` marks an optional part.
+// The CLI's doc comments are clap's help texts, where `[…]` marks an optional part. The CLI
+// is the program, not API: its modules share types among themselves without exporting them.
 #[cfg(all(feature = "cli", feature = "internals"))]
 #[doc(hidden)]
-#[allow(rustdoc::broken_intra_doc_links)]
+#[allow(rustdoc::broken_intra_doc_links, unnameable_types)]
 pub mod cli;
 #[cfg(all(feature = "cli", not(feature = "internals")))]
-#[allow(rustdoc::broken_intra_doc_links)]
+#[allow(rustdoc::broken_intra_doc_links, unnameable_types)]
 mod cli;
 
 /// The `lapclone` program: parses `std::env::args`, runs the subcommand, reports an error on

@@ -164,6 +164,7 @@ fn measure(settings: &Settings) -> Result<(Vec<Check>, Vec<Skipped>), String> {
     paper_checks(&mut checks)?;
     whole_process_checks(settings, &mut checks, &mut skipped)?;
     track_checks(settings, &mut checks, &mut skipped)?;
+    view_checks(settings, &mut checks, &mut skipped)?;
     Ok((checks, skipped))
 }
 
@@ -253,6 +254,50 @@ fn render_checks(settings: &Settings, checks: &mut Vec<Check>) -> Result<(), Str
         measured: number(&report, "/encode_speedup")?,
         bound: Bound::AtLeast(1.7),
     });
+    Ok(())
+}
+
+/// Issue #40: the live view's drag at 1920×1080, pointer message in → changed pixels out,
+/// through the release `lapclone repl --view` (skipped when that binary is not built).
+fn view_checks(
+    settings: &Settings,
+    checks: &mut Vec<Check>,
+    skipped: &mut Vec<Skipped>,
+) -> Result<(), String> {
+    let steps = settings.pick("50", "200");
+    let lapclone = Path::new(env!("CARGO_BIN_EXE_lapclone-bench"))
+        .with_file_name(format!("lapclone{}", std::env::consts::EXE_SUFFIX));
+    let report = if lapclone.is_file() {
+        Some(run_bench(&["view", "--steps", steps])?)
+    } else {
+        None
+    };
+    for (index, scene) in ["cat", "horse folding"].iter().enumerate() {
+        for (key, label, limit) in [
+            ("median_ms", "median", 8.0),
+            ("p95_ms", "95th percentile", 16.0),
+        ] {
+            let what = format!("live view drag, {scene}, 1920×1080, {label} of {steps} steps (ms)");
+            let bound = Bound::AtMost(limit);
+            match &report {
+                Some(report) => checks.push(Check {
+                    issue: 40,
+                    what,
+                    measured: number(report, &format!("/drags/{index}/{key}"))?,
+                    bound,
+                }),
+                None => skipped.push(Skipped {
+                    issue: 40,
+                    what,
+                    bound,
+                    reason: format!(
+                        "no {}: run `cargo build --release` first",
+                        lapclone.display()
+                    ),
+                }),
+            }
+        }
+    }
     Ok(())
 }
 

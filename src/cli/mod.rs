@@ -15,6 +15,7 @@ pub mod test_args;
 pub mod test_pending;
 pub mod test_report;
 pub mod track;
+pub mod view;
 
 /// An argument combination clap cannot reject by itself; exits with code 2.
 #[derive(Debug, thiserror::Error)]

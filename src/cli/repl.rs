@@ -1,8 +1,9 @@
-//! `lapclone repl [SCENE] [--script FILE]`: interactive scene editing. Takes lines from a
+//! `lapclone repl [SCENE] [--script FILE] [--view]`: interactive scene editing. Takes lines from a
 //! terminal (rustyline: history, completion, hints, multi-line input) or, when stdin is not
 //! a terminal or with `--script`, from a stream; each entry is Rhai run against the live
 //! scene or a `:command` (see docs/repl.md). Non-interactive sessions exit with code 1 when
-//! any entry failed.
+//! any entry failed. With `--view` a page in the browser follows the session and edits it
+//! too (see `crate::cli::view`).
 
 mod commands;
 mod completion;
@@ -28,7 +29,8 @@ use rustyline::{Config, Editor};
 use helper::ReplHelper;
 pub(crate) use preview::show_picture;
 use preview::{default_preview_path, Inline, Preview};
-use session::{Session, Step};
+pub(crate) use session::Session;
+use session::Step;
 use validator::InputValidator;
 
 #[derive(clap::Args, Debug)]
@@ -44,6 +46,8 @@ pub struct ReplArgs {
     /// History file (default: DATA_DIR/lapclone/history.txt).
     #[arg(long)]
     pub history: Option<PathBuf>,
+    #[command(flatten)]
+    pub view: crate::cli::view::ViewArgs,
 }
 
 /// Set when a non-interactive entry fails: the process then exits with code 1.
@@ -63,16 +67,28 @@ pub fn run(args: ReplArgs) -> anyhow::Result<()> {
         .is_none()
         .then(|| RemoveOnExit(preview_path.clone()));
     let preview = Preview::new(preview_path, interactive, Inline::detect(interactive));
-    let mut session = Session::new(cancel.clone(), preview, words.clone(), interactive);
+    let session = Arc::new(Mutex::new(Session::new(
+        cancel.clone(),
+        preview,
+        words.clone(),
+        interactive,
+    )));
+    let printer: crate::cli::view::Printer = Arc::new(Mutex::new(None));
+    if args.view.view {
+        start_view(&args.view, &session, interactive.then(|| printer.clone()))?;
+    }
     let mut failures = 0;
     if let Some(scene) = &args.scene {
-        if let Err(error) = session.load(scene) {
+        if let Err(error) = lock(&session).load(scene) {
             eprintln!("{}", super::describe(&error));
             failures += 1;
         }
     }
+    if args.view.watch {
+        crate::cli::view::watch(session.clone());
+    }
     if interactive {
-        interactive_loop(&mut session, &args, cancel, words)
+        interactive_loop(&session, &args, cancel, words, &printer)
     } else {
         let input: Box<dyn BufRead> = match &args.script {
             Some(path) => Box::new(std::io::BufReader::new(
@@ -81,12 +97,39 @@ pub fn run(args: ReplArgs) -> anyhow::Result<()> {
             )),
             None => Box::new(std::io::stdin().lock()),
         };
-        failures += script_loop(&mut session, input)?;
+        failures += script_loop(&session, input)?;
         if failures > 0 {
             return Err(EntriesFailed(failures).into());
         }
         Ok(())
     }
+}
+
+/// Starts the live view's server and prints its URL (with the token) before the prompt.
+fn start_view(
+    args: &crate::cli::view::ViewArgs,
+    session: &Arc<Mutex<Session>>,
+    printer: Option<crate::cli::view::Printer>,
+) -> anyhow::Result<()> {
+    let hub = Arc::new(crate::cli::view::Hub::default());
+    lock(session).attach_view(hub.clone(), printer);
+    let server = crate::cli::view::start(args.bind, args.port.unwrap_or(0), session.clone(), hub)?;
+    if args.bind.is_some_and(|ip| !ip.is_loopback()) {
+        eprintln!(
+            "warning: the live view listens on {}: anyone who can reach it and has the URL's \
+             token can edit this session",
+            server.addr
+        );
+    }
+    println!("view: {}", server.url);
+    if args.open {
+        crate::cli::view::open_in_browser(&server.url);
+    }
+    Ok(())
+}
+
+fn lock(session: &Mutex<Session>) -> std::sync::MutexGuard<'_, Session> {
+    crate::cli::view::lock(session)
 }
 
 /// Removes its file when dropped (a file that was never written is no error).
@@ -100,7 +143,7 @@ impl Drop for RemoveOnExit {
 
 /// Splits `input` into entries as the interactive validator would (unfinished Rhai goes on
 /// on the next line) and runs them; gives the number of failed entries.
-fn script_loop(session: &mut Session, input: Box<dyn BufRead>) -> anyhow::Result<usize> {
+fn script_loop(session: &Mutex<Session>, input: Box<dyn BufRead>) -> anyhow::Result<usize> {
     let validator = InputValidator::new();
     let mut failures = 0;
     let mut buffer = String::new();
@@ -117,23 +160,24 @@ fn script_loop(session: &mut Session, input: Box<dyn BufRead>) -> anyhow::Result
             continue;
         }
         let entry = std::mem::take(&mut buffer);
-        match session.entry(&entry) {
+        match lock(session).entry(&entry) {
             Step::Ok => {}
             Step::Failed => failures += 1,
             Step::Quit => return Ok(failures),
         }
     }
-    if !buffer.trim().is_empty() && session.entry(&buffer) == Step::Failed {
+    if !buffer.trim().is_empty() && lock(session).entry(&buffer) == Step::Failed {
         failures += 1;
     }
     Ok(failures)
 }
 
 fn interactive_loop(
-    session: &mut Session,
+    session: &Mutex<Session>,
     args: &ReplArgs,
     cancel: Arc<AtomicBool>,
     words: completion::SharedWords,
+    printer: &crate::cli::view::Printer,
 ) -> anyhow::Result<()> {
     let config = Config::builder()
         .auto_add_history(false)
@@ -149,6 +193,18 @@ fn interactive_loop(
         eprintln!("warning: Ctrl-C cannot cancel evaluations in this session");
     }
     editor.set_helper(Some(ReplHelper::new(words)));
+    if args.view.view {
+        // Lines a page's edits print go above the prompt instead of through it.
+        match editor.create_external_printer() {
+            Ok(mut external) => {
+                *crate::cli::view::lock(printer) = Some(Box::new(move |text: String| {
+                    use rustyline::ExternalPrinter as _;
+                    let _ = external.print(format!("{text}\n"));
+                }));
+            }
+            Err(error) => eprintln!("warning: page edits print through the prompt: {error}"),
+        }
+    }
     let history = args.history.clone().or_else(default_history_path);
     if let Some(path) = &history {
         let _ = editor.load_history(path);
@@ -160,7 +216,7 @@ fn interactive_loop(
                 if !line.trim().is_empty() {
                     let _ = editor.add_history_entry(line.as_str());
                 }
-                if session.entry(&line) == Step::Quit {
+                if lock(session).entry(&line) == Step::Quit {
                     break;
                 }
             }

@@ -244,6 +244,11 @@ impl Layer {
     }
 
     /// Canvas positions of the vertices in the last drawn frame.
+    /// The rest point a placement's position refers to (bounding-box centre).
+    pub fn pivot(&self) -> DVec2 {
+        self.pivot
+    }
+
     pub fn placed(&self) -> &[DVec2] {
         self.cloner.placed()
     }

@@ -123,6 +123,12 @@ impl Renderer {
         }
     }
 
+    /// Each patch's rest pivot, in scene order: the source point its `at` key places (the
+    /// centre of its bounding box), about which `scale` and `rotate` act.
+    pub fn pivots(&self) -> Vec<DVec2> {
+        self.layers.iter().map(Layer::pivot).collect()
+    }
+
     /// Whether each patch (scene order) has a deformation rig built.
     pub fn rigs_built(&self) -> Vec<bool> {
         self.layers.iter().map(Layer::has_rig).collect()

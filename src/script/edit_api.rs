@@ -1,6 +1,6 @@
 //! The scene language's editing calls, registered next to [`super::api`]: takes the shared
 //! draft and gives `remove_patch(...)` and, on `Patch` and `Handle` values, `remove_key`,
-//! `move_key`, `remove_handle`, `remove_pin`, `rename`, `to_front` and `to_back`. Every
+//! `move_key`, `handle`, `remove_handle`, `remove_pin`, `rename`, `to_front` and `to_back`. Every
 //! call is checked in full before it changes anything, so a refusal (a positioned runtime
 //! error that says what exists) leaves the scene as it was.
 
@@ -198,6 +198,27 @@ impl PatchRef {
         Ok(self.clone())
     }
 
+    /// The patch's handle at index `which`, as the value `drag` returned for it.
+    fn handle_at(&mut self, ctx: NativeCallContext, which: Dynamic) -> Fallible<HandleRef> {
+        let d = self.draft.lock();
+        let found = index_of(&d, self).and_then(|p| {
+            let h = index(&which, "handle", d.patches[p].handles.len()).map_err(|m| {
+                format!(
+                    "{m} on patch {:?}; {}",
+                    d.patches[p].name,
+                    handles_listed(&d.patches[p])
+                )
+            })?;
+            Ok(d.ids.handles[p][h])
+        });
+        let handle = found.map_err(|m| fail(&ctx, m))?;
+        Ok(HandleRef {
+            draft: self.draft.clone(),
+            patch: self.id,
+            handle,
+        })
+    }
+
     fn remove_handle(&mut self, ctx: NativeCallContext, which: Dynamic) -> Fallible<Self> {
         let this = self.clone();
         edit_draft(&self.draft, &ctx, |d| {
@@ -377,6 +398,10 @@ pub fn build_patch(b: &mut TypeBuilder<PatchRef>) {
     .with_fn(
         "remove_handle",
         |ctx: NativeCallContext, p: &mut PatchRef, h: Dynamic| p.remove_handle(ctx, h),
+    )
+    .with_fn(
+        "handle",
+        |ctx: NativeCallContext, p: &mut PatchRef, h: Dynamic| p.handle_at(ctx, h),
     )
     .with_fn(
         "remove_pin",

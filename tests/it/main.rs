@@ -65,3 +65,5 @@ mod track_cli;
 mod track_follow;
 mod video_cli;
 mod video_encode;
+mod view_browser;
+mod view_ws;

@@ -195,7 +195,7 @@ pub fn run(args: OpencvBenchArgs) -> anyhow::Result<()> {
 }
 
 /// `name` in the folder of the running program (target/release for a release build).
-fn beside_this_program(name: &str) -> anyhow::Result<PathBuf> {
+pub(crate) fn beside_this_program(name: &str) -> anyhow::Result<PathBuf> {
     let me = std::env::current_exe().context("cannot locate lapclone-bench itself")?;
     let folder = me.parent().context("lapclone-bench has no parent folder")?;
     Ok(folder.join(format!("{name}{}", std::env::consts::EXE_SUFFIX)))

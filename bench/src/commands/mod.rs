@@ -10,6 +10,7 @@ pub mod bench_paper;
 pub mod bench_render;
 pub mod bench_solver;
 pub mod bench_track;
+pub mod bench_view;
 pub mod child_run;
 
 pub use lapclone::cli::{describe, finite_f64, mesh_args, UsageError};
@@ -41,6 +42,9 @@ pub enum BenchCommand {
     /// Point tracking: 1920×1080 PNG footage against decoding alone and an OpenCV
     /// calcOpticalFlowPyrLK loop, and the tracked path's error beside OpenCV's.
     Track(bench_track::TrackBenchArgs),
+    /// The live view's drag on 1920×1080 scenes (the cat; the horse folding over itself):
+    /// pointer message in → changed pixels out, through the release `lapclone repl --view`.
+    View(bench_view::ViewBenchArgs),
 }
 
 /// Runs one benchmark.
@@ -55,5 +59,6 @@ pub fn run(which: BenchCommand) -> anyhow::Result<()> {
         BenchCommand::Paper(args) => bench_paper::run(args),
         BenchCommand::Opencv(args) => bench_opencv::run(args),
         BenchCommand::Track(args) => bench_track::run(args),
+        BenchCommand::View(args) => bench_view::run(args),
     }
 }

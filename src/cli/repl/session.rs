@@ -3,6 +3,8 @@
 //! earlier entries, an undo stack, and a renderer that re-renders and writes the preview
 //! after every change. A failed entry leaves scene and variables as they were.
 
+mod live;
+
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -66,6 +68,19 @@ pub struct Session {
     entries: u64,
     words: SharedWords,
     interactive: bool,
+    /// The live view's pages, when `--view` is on.
+    view: Option<Arc<crate::cli::view::Hub>>,
+    /// Prints above the prompt while a page's request runs.
+    printer: Option<crate::cli::view::Printer>,
+    /// Whether the entry running came from a page (its output goes through `printer` and
+    /// the preview file is left alone: the page is the preview).
+    from_view: bool,
+    /// Counts scene changes, so a page's edit made against an older scene is refused.
+    revision: u64,
+    /// Whether the renderer holds a page gesture's uncommitted preview.
+    previewing: bool,
+    /// How many of `edits` the loaded file holds (it was `:save`d over since the load).
+    saved_edits: usize,
 }
 
 impl Session {
@@ -104,6 +119,12 @@ impl Session {
             entries: 0,
             words,
             interactive,
+            view: None,
+            printer: None,
+            from_view: false,
+            revision: 0,
+            previewing: false,
+            saved_edits: 0,
         };
         session.refresh_words();
         session
@@ -111,14 +132,32 @@ impl Session {
 
     /// Runs one entry: a `:command` or Rhai source (possibly several lines).
     pub fn entry(&mut self, text: &str) -> Step {
+        match self.run_entry(text) {
+            Ok(step) => step,
+            Err(error) => {
+                eprintln!("{}", crate::cli::describe(&error));
+                Step::Failed
+            }
+        }
+    }
+
+    /// Runs one entry and gives its error instead of printing it.
+    fn run_entry(&mut self, text: &str) -> anyhow::Result<Step> {
+        if std::mem::take(&mut self.previewing) {
+            // A page gesture left its preview in the renderer: the entry starts from the
+            // committed scene.
+            if let (Ok(scene), Some(renderer)) = (self.current_scene(), self.renderer.as_mut()) {
+                let _ = renderer.set_scene(scene);
+            }
+        }
         self.cancel.store(false, Ordering::Relaxed);
         let trimmed = text.trim();
         if trimmed.is_empty() {
-            return Step::Ok;
+            return Ok(Step::Ok);
         }
         let result = if trimmed.starts_with(':') {
             match parse_command(trimmed) {
-                Ok(Command::Quit) => return Step::Quit,
+                Ok(Command::Quit) => return Ok(Step::Quit),
                 Ok(command) => self.command(command),
                 Err(usage) => Err(anyhow::anyhow!(usage)),
             }
@@ -126,13 +165,7 @@ impl Session {
             self.eval(text)
         };
         self.cancel.store(false, Ordering::Relaxed);
-        match result {
-            Ok(()) => Step::Ok,
-            Err(error) => {
-                eprintln!("{}", crate::cli::describe(&error));
-                Step::Failed
-            }
-        }
+        result.map(|()| Step::Ok)
     }
 
     /// Loads a scene file, replacing the live scene (the undo history is cleared).
@@ -168,11 +201,12 @@ impl Session {
         self.imports = import_statements(&text);
         self.base_text = Some(text);
         self.edits.clear();
+        self.saved_edits = 0;
         self.warned.clear();
         self.undo.clear();
         self.file = Some(file.clone());
         self.refresh_words();
-        println!("loaded {}", file.display());
+        self.say(format!("loaded {}", file.display()));
         self.warn();
         self.show_frame()
     }
@@ -319,13 +353,14 @@ impl Session {
         }
         .map_err(|e| positioned(loaded, e))?;
         if self.interactive && update.rebuilt + update.rigs_built > 0 {
-            println!(
+            self.say(format!(
                 "built {} layer(s), kept {} ({:.0} ms)",
                 update.rebuilt + update.rigs_built,
                 update.reused,
                 started.elapsed().as_secs_f64() * 1e3
-            );
+            ));
         }
+        self.revision += 1;
         self.last_update = Some(update);
         self.installed = Some(loaded.clone());
         Ok(())
@@ -349,6 +384,11 @@ impl Session {
                 None => render_error(error),
             });
         }
+        self.publish();
+        if self.from_view {
+            return Ok(());
+        }
+        let renderer = self.renderer.as_ref().context("no scene yet")?;
         self.preview.update(renderer)
     }
 
@@ -379,7 +419,8 @@ impl Session {
     fn undo(&mut self) -> anyhow::Result<()> {
         let snapshot = self.undo.pop().context("nothing to undo")?;
         self.restore(snapshot);
-        println!("undone ({} more)", self.undo.len());
+        self.revision += 1;
+        self.say(format!("undone ({} more)", self.undo.len()));
         if self.engine.draft().canvas.is_none() {
             self.renderer = None;
             return Ok(());
@@ -410,13 +451,16 @@ impl Session {
         let (text, form) = saved_text(&scene, self.base_text.as_deref(), &self.edits, path);
         lapclone::util::write_atomic(path, text.as_bytes())
             .with_context(|| format!("writing {}", path.display()))?;
+        if path.canonicalize().ok() == self.file {
+            self.saved_edits = self.edits.len();
+        }
         match form {
-            SaveForm::Script => println!("saved {}", path.display()),
-            SaveForm::Keys => println!(
+            SaveForm::Script => self.say(format!("saved {}", path.display())),
+            SaveForm::Keys => self.say(format!(
                 "saved {} (every key written out: the session's text does not rebuild this \
                  scene from that folder)",
                 path.display()
-            ),
+            )),
         }
         Ok(())
     }

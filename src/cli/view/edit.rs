@@ -1,0 +1,394 @@
+//! The live view's page messages: takes one text message from a page (JSON, bounded) and
+//! gives a checked [`Request`]; a scene edit in it becomes the readable Rhai line the
+//! session runs (`cat.at(1.25, [240, 180]);`), and the same edit can be applied to a
+//! [`Scene`] directly for the drag preview, with exactly the values the line writes.
+
+use glam::DVec2;
+use lapclone::scene::{rhai_string_literal, Easing, Scene};
+use serde::Deserialize;
+
+/// Largest text message a page may send, bytes.
+pub const MAX_MESSAGE_BYTES: usize = 16 * 1024;
+/// Largest coordinate, radius or time a page may send (anything a user controls has a bound).
+const MAX_MAGNITUDE: f64 = 1e6;
+/// Longest patch name a page may send.
+const MAX_NAME: usize = 256;
+
+/// One message from a page.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum Request {
+    /// Move the playhead (no history).
+    Seek { t: f64 },
+    /// Where a canvas point falls: the patch on top there and its source coordinates.
+    Locate { x: f64, y: f64 },
+    /// A scene edit made against revision `rev`: previewed while a gesture runs
+    /// (`commit: false`), run as one REPL line when it ends (`commit: true`).
+    Edit { rev: u64, commit: bool, edit: Edit },
+    /// Escape: drop the gesture's preview.
+    Cancel,
+    /// Ctrl+Z: `:undo`.
+    Undo,
+    /// Ctrl+S (after the page's confirmation): `:save` to the loaded file.
+    Save { rev: u64 },
+    /// This page wants the placed meshes with every scene message (overlay on).
+    Mesh { on: bool },
+}
+
+/// A keyframable patch track, as the scene functions name it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Track {
+    At,
+    Scale,
+    Rotate,
+    Depth,
+    Opacity,
+}
+
+impl Track {
+    fn name(self) -> &'static str {
+        match self {
+            Track::At => "at",
+            Track::Scale => "scale",
+            Track::Rotate => "rotate",
+            Track::Depth => "depth",
+            Track::Opacity => "opacity",
+        }
+    }
+}
+
+/// A scene edit from a page: which patch, which handle, which value. Keys go at the
+/// session's playhead, which the server supplies.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(tag = "op", rename_all = "snake_case", deny_unknown_fields)]
+pub enum Edit {
+    At {
+        patch: String,
+        value: [f64; 2],
+    },
+    Rotate {
+        patch: String,
+        value: f64,
+    },
+    Scale {
+        patch: String,
+        value: f64,
+    },
+    HandleKey {
+        patch: String,
+        handle: usize,
+        value: [f64; 2],
+    },
+    AddHandle {
+        patch: String,
+        from: [f64; 2],
+        radius: f64,
+    },
+    AddPin {
+        patch: String,
+        at: [f64; 2],
+    },
+    RemoveHandle {
+        patch: String,
+        handle: usize,
+    },
+    RemovePin {
+        patch: String,
+        pin: usize,
+    },
+    MoveKey {
+        patch: String,
+        track: Track,
+        from: f64,
+        to: f64,
+    },
+    RemoveKey {
+        patch: String,
+        track: Track,
+        t: f64,
+    },
+}
+
+/// Parses and bounds a page message; the error is shown in the page.
+pub fn parse_request(text: &str) -> Result<Request, String> {
+    if text.len() > MAX_MESSAGE_BYTES {
+        return Err(format!("message over {MAX_MESSAGE_BYTES} bytes"));
+    }
+    let request: Request =
+        serde_json::from_str(text).map_err(|e| format!("malformed message: {e}"))?;
+    match &request {
+        Request::Seek { t } => time(*t)?,
+        Request::Locate { x, y } => {
+            bounded(*x)?;
+            bounded(*y)?;
+        }
+        Request::Edit { edit, .. } => check_edit(edit)?,
+        _ => {}
+    }
+    Ok(request)
+}
+
+fn bounded(v: f64) -> Result<(), String> {
+    if v.is_finite() && v.abs() <= MAX_MAGNITUDE {
+        Ok(())
+    } else {
+        Err(format!(
+            "{v} is not a finite number within ±{MAX_MAGNITUDE}"
+        ))
+    }
+}
+
+fn time(t: f64) -> Result<(), String> {
+    bounded(t)?;
+    if t < 0.0 {
+        return Err(format!("time {t} is negative"));
+    }
+    Ok(())
+}
+
+fn positive(v: f64) -> Result<(), String> {
+    bounded(v)?;
+    if v <= 0.0 {
+        return Err(format!("{v} must be greater than 0"));
+    }
+    Ok(())
+}
+
+fn check_edit(edit: &Edit) -> Result<(), String> {
+    let patch = edit.patch();
+    if patch.is_empty() || patch.len() > MAX_NAME {
+        return Err("patch name empty or too long".into());
+    }
+    match edit {
+        Edit::At { value, .. } | Edit::HandleKey { value, .. } => {
+            value.iter().try_for_each(|v| bounded(*v))
+        }
+        Edit::AddPin { at: value, .. } => value.iter().try_for_each(|v| bounded(*v)),
+        Edit::Rotate { value, .. } => bounded(*value),
+        Edit::Scale { value, .. } => positive(*value),
+        Edit::AddHandle { from, radius, .. } => {
+            from.iter().try_for_each(|v| bounded(*v))?;
+            positive(*radius)
+        }
+        Edit::RemoveHandle { .. } | Edit::RemovePin { .. } => Ok(()),
+        Edit::MoveKey { from, to, .. } => time(*from).and(time(*to)),
+        Edit::RemoveKey { t, .. } => time(*t),
+    }
+}
+
+impl Edit {
+    /// The patch this edit is about.
+    pub fn patch(&self) -> &str {
+        match self {
+            Edit::At { patch, .. }
+            | Edit::Rotate { patch, .. }
+            | Edit::Scale { patch, .. }
+            | Edit::HandleKey { patch, .. }
+            | Edit::AddHandle { patch, .. }
+            | Edit::AddPin { patch, .. }
+            | Edit::RemoveHandle { patch, .. }
+            | Edit::RemovePin { patch, .. }
+            | Edit::MoveKey { patch, .. }
+            | Edit::RemoveKey { patch, .. } => patch,
+        }
+    }
+
+    /// The same edit with its values rounded as the line writes them (hundredths of a pixel
+    /// or degree, ten-thousandths of a scale), so a preview and its committed line agree.
+    pub fn rounded(&self) -> Edit {
+        let mut edit = self.clone();
+        let p2 = |v: &mut [f64; 2]| v.iter_mut().for_each(|x| *x = round(*x, 100.0));
+        match &mut edit {
+            Edit::At { value, .. } | Edit::HandleKey { value, .. } => p2(value),
+            Edit::AddPin { at, .. } => p2(at),
+            Edit::AddHandle { from, radius, .. } => {
+                p2(from);
+                *radius = round(*radius, 100.0).max(0.01);
+            }
+            Edit::Rotate { value, .. } => *value = round(*value, 100.0),
+            Edit::Scale { value, .. } => *value = round(*value, 10_000.0).max(0.0001),
+            _ => {}
+        }
+        edit
+    }
+
+    /// The Rhai line for this edit at playhead `t`; `patch` is how the session names the
+    /// patch (a variable holding it, else `get_patch("name")`); `handle_name` names a new
+    /// handle's variable.
+    pub fn line(&self, t: f64, patch: &str, handle_name: &str) -> String {
+        let t = num(t);
+        match self.rounded() {
+            Edit::At { value, .. } => format!("{patch}.at({t}, {});", point(value)),
+            Edit::Rotate { value, .. } => format!("{patch}.rotate({t}, {});", num(value)),
+            Edit::Scale { value, .. } => format!("{patch}.scale({t}, {});", num(value)),
+            Edit::HandleKey { handle, value, .. } => {
+                format!("{patch}.handle({handle}).key({t}, {});", point(value))
+            }
+            Edit::AddHandle { from, radius, .. } => format!(
+                "let {handle_name} = {patch}.drag({}, {});",
+                point(from),
+                num(radius)
+            ),
+            Edit::AddPin { at, .. } => format!("{patch}.pin({});", point(at)),
+            Edit::RemoveHandle { handle, .. } => format!("{patch}.remove_handle({handle});"),
+            Edit::RemovePin { pin, .. } => format!("{patch}.remove_pin({pin});"),
+            Edit::MoveKey {
+                track, from, to, ..
+            } => format!(
+                "{patch}.move_key({}, {}, \"{}\");",
+                num(from),
+                num(to),
+                track.name()
+            ),
+            Edit::RemoveKey { track, t, .. } => {
+                format!("{patch}.remove_key({}, \"{}\");", num(t), track.name())
+            }
+        }
+    }
+
+    /// Applies a key edit (at, rotate, scale, handle target) to `scene` as its line would,
+    /// for the preview of a gesture in progress. Other edits are not previewed.
+    pub fn apply_key(&self, scene: &mut Scene, t: f64) -> Result<(), String> {
+        let edit = self.rounded();
+        let patch = scene
+            .patches
+            .iter_mut()
+            .find(|p| p.name == edit.patch())
+            .ok_or_else(|| format!("no patch {:?}", edit.patch()))?;
+        let p = &mut patch.placement;
+        let linear = Easing::default();
+        let result = match edit {
+            Edit::At { value, .. } => p.position.push(t, DVec2::from(value), linear),
+            Edit::Rotate { value, .. } => p.rotation.push(t, value, linear),
+            Edit::Scale { value, .. } => p.scale.push(t, value, linear),
+            Edit::HandleKey { handle, value, .. } => {
+                let count = patch.handles.len();
+                let h = patch
+                    .handles
+                    .get_mut(handle)
+                    .ok_or_else(|| format!("no handle {handle}: the patch has {count}"))?;
+                h.to.push(t, DVec2::from(value), linear)
+            }
+            _ => return Err("this edit has no preview".into()),
+        };
+        result.map_err(|e| e.to_string())
+    }
+
+    /// Whether a gesture of this kind previews (the others only commit).
+    pub fn previews(&self) -> bool {
+        matches!(
+            self,
+            Edit::At { .. } | Edit::Rotate { .. } | Edit::Scale { .. } | Edit::HandleKey { .. }
+        )
+    }
+}
+
+/// How a line names patch `name` when no variable holds it.
+pub fn get_patch_call(name: &str) -> String {
+    format!("get_patch({})", rhai_string_literal(name))
+}
+
+fn round(v: f64, per: f64) -> f64 {
+    let r = (v * per).round() / per;
+    if r == 0.0 {
+        0.0
+    } else {
+        r
+    }
+}
+
+/// A number as Rhai reads it back exactly (integers without a fraction).
+fn num(v: f64) -> String {
+    format!("{v}")
+}
+
+fn point(v: [f64; 2]) -> String {
+    format!("[{}, {}]", num(v[0]), num(v[1]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn edit(json: &str) -> Edit {
+        match parse_request(&format!(
+            r#"{{"type":"edit","rev":1,"commit":true,"edit":{json}}}"#
+        )) {
+            Ok(Request::Edit { edit, .. }) => edit,
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn each_edit_kind_gives_its_line() {
+        let cases = [
+            (
+                r#"{"op":"at","patch":"cat","value":[240.004,180]}"#,
+                "cat.at(1.25, [240, 180]);",
+            ),
+            (
+                r#"{"op":"rotate","patch":"cat","value":-12.345}"#,
+                "cat.rotate(1.25, -12.35);",
+            ),
+            (
+                r#"{"op":"scale","patch":"cat","value":0.41234}"#,
+                "cat.scale(1.25, 0.4123);",
+            ),
+            (
+                r#"{"op":"handle_key","patch":"cat","handle":1,"value":[10.5,20]}"#,
+                "cat.handle(1).key(1.25, [10.5, 20]);",
+            ),
+            (
+                r#"{"op":"add_handle","patch":"cat","from":[118,298],"radius":70}"#,
+                "let h2 = cat.drag([118, 298], 70);",
+            ),
+            (
+                r#"{"op":"add_pin","patch":"cat","at":[5,6]}"#,
+                "cat.pin([5, 6]);",
+            ),
+            (
+                r#"{"op":"remove_handle","patch":"cat","handle":0}"#,
+                "cat.remove_handle(0);",
+            ),
+            (
+                r#"{"op":"remove_pin","patch":"cat","pin":2}"#,
+                "cat.remove_pin(2);",
+            ),
+            (
+                r#"{"op":"move_key","patch":"cat","track":"at","from":1,"to":1.5}"#,
+                "cat.move_key(1, 1.5, \"at\");",
+            ),
+            (
+                r#"{"op":"remove_key","patch":"cat","track":"scale","t":3}"#,
+                "cat.remove_key(3, \"scale\");",
+            ),
+        ];
+        for (json, line) in cases {
+            assert_eq!(edit(json).line(1.25, "cat", "h2"), line, "{json}");
+        }
+    }
+
+    #[test]
+    fn refuses_bad_values_and_unknown_fields() {
+        for text in [
+            r#"{"type":"seek","t":-1}"#,
+            r#"{"type":"seek","t":1e300}"#,
+            r#"{"type":"seek"}"#,
+            r#"{"type":"locate","x":1,"y":2,"z":3}"#,
+            r#"{"type":"edit","rev":1,"commit":true,"edit":{"op":"scale","patch":"cat","value":0}}"#,
+            r#"{"type":"edit","rev":1,"commit":true,"edit":{"op":"eval","patch":"cat"}}"#,
+            r#"{"type":"edit","rev":1,"commit":true,"edit":{"op":"at","patch":"","value":[1,2]}}"#,
+            r#"{"type":"edit","rev":1,"commit":true,"edit":{"op":"move_key","patch":"c","track":"x","from":1,"to":2}}"#,
+            "not json",
+        ] {
+            assert!(parse_request(text).is_err(), "{text}");
+        }
+        assert!(parse_request(&" ".repeat(MAX_MESSAGE_BYTES + 1)).is_err());
+    }
+
+    #[test]
+    fn names_are_rhai_string_literals() {
+        assert_eq!(get_patch_call("a \"b\""), r#"get_patch("a \"b\"")"#);
+    }
+}

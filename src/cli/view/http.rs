@@ -1,0 +1,307 @@
+//! The live view's fixed routes: takes a connection's request head (bounded in size and
+//! time) and gives either a response written back (the page, or an error status) or an
+//! accepted WebSocket. Every request must carry the session token; the WebSocket's `Host`
+//! and `Origin` must name this server, so another site open in the same browser can neither
+//! read the page nor drive the session.
+
+use std::io::{Read, Write};
+use std::net::TcpStream;
+use std::time::Duration;
+
+use tungstenite::handshake::derive_accept_key;
+use tungstenite::protocol::{Role, WebSocketConfig};
+use tungstenite::WebSocket;
+
+use super::edit::MAX_MESSAGE_BYTES;
+
+/// Largest request head read, bytes.
+const MAX_HEAD: usize = 8 * 1024;
+/// How long a client may take to send its request head.
+const HEAD_TIMEOUT: Duration = Duration::from_secs(5);
+
+/// What the server answers with: its token, the page, and the `host:port` names it goes by.
+pub struct Routes {
+    pub token: String,
+    pub page: String,
+    pub hosts: Vec<String>,
+}
+
+/// What a connection became.
+pub enum Accepted {
+    /// A response was written (the page, or an error); the connection is done.
+    Answered,
+    Socket(Box<WebSocket<TcpStream>>),
+}
+
+/// A request refused: its status line and the reason shown in the body.
+#[derive(Debug)]
+struct Refusal(&'static str, String);
+
+/// Reads one request from `stream` and answers it.
+pub fn accept(mut stream: TcpStream, routes: &Routes) -> std::io::Result<Accepted> {
+    stream.set_read_timeout(Some(HEAD_TIMEOUT))?;
+    let (head, rest) = match read_head(&mut stream) {
+        Ok(read) => read,
+        Err(refusal) => {
+            respond(
+                &mut stream,
+                refusal.0,
+                "text/plain",
+                refusal.1.as_bytes(),
+                &[],
+            )?;
+            return Ok(Accepted::Answered);
+        }
+    };
+    match route(&head, routes) {
+        Err(Refusal(status, body)) => {
+            respond(
+                &mut stream,
+                status,
+                "text/plain; charset=utf-8",
+                body.as_bytes(),
+                &[],
+            )?;
+            Ok(Accepted::Answered)
+        }
+        Ok(Route::Page) => {
+            let headers = [
+                ("Cache-Control", "no-store"),
+                ("Referrer-Policy", "no-referrer"),
+                ("X-Content-Type-Options", "nosniff"),
+                ("X-Frame-Options", "DENY"),
+                (
+                    "Content-Security-Policy",
+                    "default-src 'none'; script-src 'unsafe-inline'; style-src 'unsafe-inline'; \
+                     connect-src 'self'; img-src 'self' data:; frame-ancestors 'none'",
+                ),
+            ];
+            respond(
+                &mut stream,
+                "200 OK",
+                "text/html; charset=utf-8",
+                routes.page.as_bytes(),
+                &headers,
+            )?;
+            Ok(Accepted::Answered)
+        }
+        Ok(Route::Socket { key }) => {
+            let reply = format!(
+                "HTTP/1.1 101 Switching Protocols\r\nConnection: Upgrade\r\nUpgrade: websocket\r\n\
+                 Sec-WebSocket-Accept: {}\r\n\r\n",
+                derive_accept_key(key.as_bytes())
+            );
+            stream.write_all(reply.as_bytes())?;
+            let config = WebSocketConfig::default()
+                .max_message_size(Some(MAX_MESSAGE_BYTES))
+                .max_frame_size(Some(MAX_MESSAGE_BYTES));
+            let socket = WebSocket::from_partially_read(stream, rest, Role::Server, Some(config));
+            Ok(Accepted::Socket(Box::new(socket)))
+        }
+    }
+}
+
+/// The parts of a request head the routes look at.
+#[derive(Debug, Default)]
+pub struct Head {
+    pub method: String,
+    pub path: String,
+    pub query: String,
+    pub headers: Vec<(String, String)>,
+}
+
+impl Head {
+    fn header(&self, name: &str) -> Option<&str> {
+        self.headers
+            .iter()
+            .find(|(n, _)| n.eq_ignore_ascii_case(name))
+            .map(|(_, v)| v.as_str())
+    }
+}
+
+fn read_head(stream: &mut TcpStream) -> Result<(Head, Vec<u8>), Refusal> {
+    let mut buffer = Vec::with_capacity(1024);
+    let mut chunk = [0u8; 1024];
+    loop {
+        let n = stream
+            .read(&mut chunk)
+            .map_err(|e| Refusal("408 Request Timeout", e.to_string()))?;
+        if n == 0 {
+            return Err(Refusal("400 Bad Request", "connection closed".into()));
+        }
+        buffer.extend_from_slice(&chunk[..n]);
+        if let Some(end) = buffer.windows(4).position(|w| w == b"\r\n\r\n") {
+            let head = parse_head(&buffer[..end + 4])?;
+            return Ok((head, buffer[end + 4..].to_vec()));
+        }
+        if buffer.len() > MAX_HEAD {
+            return Err(Refusal(
+                "431 Request Header Fields Too Large",
+                "request head too large".into(),
+            ));
+        }
+    }
+}
+
+/// Parses a complete request head.
+fn parse_head(bytes: &[u8]) -> Result<Head, Refusal> {
+    let bad = |m: &str| Refusal("400 Bad Request", m.to_string());
+    let mut headers = [httparse::EMPTY_HEADER; 32];
+    let mut request = httparse::Request::new(&mut headers);
+    match request.parse(bytes) {
+        Ok(httparse::Status::Complete(_)) => {}
+        _ => return Err(bad("malformed request")),
+    }
+    let target = request.path.unwrap_or("");
+    let (path, query) = target.split_once('?').unwrap_or((target, ""));
+    Ok(Head {
+        method: request.method.unwrap_or("").to_string(),
+        path: path.to_string(),
+        query: query.to_string(),
+        headers: request
+            .headers
+            .iter()
+            .map(|h| {
+                (
+                    h.name.to_string(),
+                    String::from_utf8_lossy(h.value).into_owned(),
+                )
+            })
+            .collect(),
+    })
+}
+
+#[derive(Debug, PartialEq)]
+enum Route {
+    Page,
+    Socket { key: String },
+}
+
+fn route(head: &Head, routes: &Routes) -> Result<Route, Refusal> {
+    if head.method != "GET" {
+        return Err(Refusal("405 Method Not Allowed", "only GET".into()));
+    }
+    let host = head.header("Host").unwrap_or("");
+    if !routes.hosts.iter().any(|h| h.eq_ignore_ascii_case(host)) {
+        return Err(Refusal(
+            "403 Forbidden",
+            format!("unexpected Host {host:?}"),
+        ));
+    }
+    if !matches!(head.path.as_str(), "/" | "/ws") {
+        return Err(Refusal("404 Not Found", "no such page".into()));
+    }
+    let token = head
+        .query
+        .split('&')
+        .find_map(|pair| pair.strip_prefix("token="))
+        .unwrap_or("");
+    if !same_token(token, &routes.token) {
+        return Err(Refusal("403 Forbidden", "missing or wrong token".into()));
+    }
+    if head.path == "/" {
+        return Ok(Route::Page);
+    }
+    let origin = head.header("Origin").unwrap_or("");
+    if !routes
+        .hosts
+        .iter()
+        .any(|h| origin.eq_ignore_ascii_case(&format!("http://{h}")))
+    {
+        return Err(Refusal(
+            "403 Forbidden",
+            format!("foreign Origin {origin:?}"),
+        ));
+    }
+    let upgrade = head
+        .header("Upgrade")
+        .is_some_and(|v| v.eq_ignore_ascii_case("websocket"));
+    let key = head.header("Sec-WebSocket-Key").unwrap_or("");
+    if !upgrade || key.is_empty() || head.header("Sec-WebSocket-Version") != Some("13") {
+        return Err(Refusal("400 Bad Request", "not a WebSocket request".into()));
+    }
+    Ok(Route::Socket {
+        key: key.to_string(),
+    })
+}
+
+/// Compares tokens in time independent of where they first differ.
+fn same_token(given: &str, token: &str) -> bool {
+    given.len() == token.len()
+        && given
+            .bytes()
+            .zip(token.bytes())
+            .fold(0u8, |acc, (a, b)| acc | (a ^ b))
+            == 0
+}
+
+fn respond(
+    stream: &mut TcpStream,
+    status: &str,
+    content_type: &str,
+    body: &[u8],
+    headers: &[(&str, &str)],
+) -> std::io::Result<()> {
+    let mut head = format!(
+        "HTTP/1.1 {status}\r\nContent-Type: {content_type}\r\nContent-Length: {}\r\nConnection: close\r\n",
+        body.len()
+    );
+    for (name, value) in headers {
+        head.push_str(&format!("{name}: {value}\r\n"));
+    }
+    head.push_str("\r\n");
+    stream.write_all(head.as_bytes())?;
+    stream.write_all(body)?;
+    stream.flush()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn routes() -> Routes {
+        Routes {
+            token: "abc123".into(),
+            page: String::new(),
+            hosts: vec!["127.0.0.1:8000".into(), "localhost:8000".into()],
+        }
+    }
+
+    fn head(text: &str) -> Head {
+        parse_head(text.replace('\n', "\r\n").as_bytes()).unwrap()
+    }
+
+    const WS: &str = "Upgrade: websocket\nConnection: Upgrade\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\nSec-WebSocket-Version: 13\n";
+
+    #[test]
+    fn page_and_socket_need_token_host_and_origin() {
+        let r = routes();
+        assert_eq!(
+            route(
+                &head("GET /?token=abc123 HTTP/1.1\nHost: 127.0.0.1:8000\n\n"),
+                &r
+            )
+            .unwrap(),
+            Route::Page
+        );
+        for bad in [
+            "GET / HTTP/1.1\nHost: 127.0.0.1:8000\n\n",
+            "GET /?token=abc124 HTTP/1.1\nHost: 127.0.0.1:8000\n\n",
+            "GET /?token=abc12 HTTP/1.1\nHost: 127.0.0.1:8000\n\n",
+            "GET /?token=abc123 HTTP/1.1\nHost: evil.example:8000\n\n",
+            "POST /?token=abc123 HTTP/1.1\nHost: 127.0.0.1:8000\n\n",
+            "GET /etc/passwd?token=abc123 HTTP/1.1\nHost: 127.0.0.1:8000\n\n",
+        ] {
+            assert!(route(&head(bad), &r).is_err(), "{bad}");
+        }
+        let ok = format!("GET /ws?token=abc123 HTTP/1.1\nHost: localhost:8000\nOrigin: http://localhost:8000\n{WS}\n");
+        assert!(matches!(route(&head(&ok), &r), Ok(Route::Socket { .. })));
+        let foreign = ok.replace(
+            "Origin: http://localhost:8000",
+            "Origin: http://evil.example",
+        );
+        assert!(route(&head(&foreign), &r).unwrap_err().1.contains("Origin"));
+        let no_origin = ok.replace("Origin: http://localhost:8000\n", "");
+        assert!(route(&head(&no_origin), &r).is_err());
+    }
+}

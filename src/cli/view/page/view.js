@@ -1,0 +1,379 @@
+// lapclone live view: draws the frames and scene messages the server sends, and turns
+// pointer gestures into structured edits (which patch, which handle, which value). The
+// server writes the REPL line; this page never sends source code or paths.
+"use strict";
+(() => {
+  const $ = (id) => document.getElementById(id);
+  const frame = $("frame"), overlay = $("overlay");
+  const fctx = frame.getContext("2d"), octx = overlay.getContext("2d");
+  const token = new URLSearchParams(location.search).get("token") || "";
+  const TRACK_COLOURS = { at: "#f0c674", scale: "#81a2be", rotate: "#b294bb", depth: "#8abeb7", opacity: "#de935f" };
+  let ws = null, scene = null, located = null, gesture = null, selected = null;
+  let pendingEdit = null, inFlight = false, locating = false, nextLocate = null;
+  let playing = false, meshOn = false, scrubbing = false;
+  // Pointer event → pixels painted, ms (read by the browser test and shown in the title).
+  const timings = (window.lapcloneTimings = []);
+  // The last scene message, for tests that drive the page.
+  window.lapcloneScene = () => scene;
+  let sentAt = 0;
+
+  function send(message) {
+    if (ws && ws.readyState === 1) ws.send(JSON.stringify(message));
+  }
+  function notice(text, kind) {
+    const n = $("notice");
+    n.textContent = text;
+    n.className = kind || "";
+  }
+  function log(text) {
+    const l = $("log");
+    l.textContent += (l.textContent ? "\n" : "") + text;
+    l.scrollTop = l.scrollHeight;
+  }
+
+  function connect() {
+    ws = new WebSocket(`ws://${location.host}/ws?token=${encodeURIComponent(token)}`);
+    ws.binaryType = "arraybuffer";
+    ws.onopen = () => { $("conn").textContent = "live"; $("conn").className = "good"; };
+    ws.onclose = () => { $("conn").textContent = "disconnected (reload the page)"; $("conn").className = "bad"; };
+    ws.onmessage = (event) => (typeof event.data === "string" ? onText(JSON.parse(event.data)) : onFrame(event.data));
+  }
+
+  function onFrame(buffer) {
+    const h = new Uint32Array(buffer.slice(0, 28));
+    const [kind, width, height, x, y, w, hh] = h;
+    if (kind !== 1) return;
+    if (frame.width !== width || frame.height !== height) {
+      frame.width = overlay.width = width;
+      frame.height = overlay.height = height;
+    }
+    if (w > 0 && hh > 0) {
+      const pixels = new Uint8ClampedArray(buffer, 28, w * hh * 4);
+      fctx.putImageData(new ImageData(pixels, w, hh), x, y);
+    }
+    if (sentAt) {
+      timings.push(performance.now() - sentAt);
+      sentAt = 0;
+    }
+    inFlight = false;
+    flushEdit();
+    if (playing) requestAnimationFrame(playStep);
+  }
+
+  function onText(m) {
+    if (m.type === "scene") {
+      scene = m;
+      $("file").textContent = m.file || "(no file)";
+      $("scrub").max = m.duration;
+      if (!scrubbing) $("scrub").value = m.t;
+      $("clock").textContent = `t = ${+m.t.toFixed(4)} s · frame ${m.frame} / ${m.frames}`;
+      drawMarkers();
+      drawOverlay();
+    } else if (m.type === "located") {
+      located = m;
+      locating = false;
+      showCoords();
+      if (nextLocate) { const p = nextLocate; nextLocate = null; locate(p); }
+    } else if (m.type === "error") {
+      notice(m.message, "error");
+      inFlight = false;
+    } else if (m.type === "line") {
+      log(m.text);
+      notice("", "");
+    }
+  }
+
+  // --- geometry: a patch's placement (rest → canvas) and its inverse ---
+  function place(p, q) {
+    const r = (p.rotation * Math.PI) / 180, c = Math.cos(r), s = Math.sin(r);
+    const dx = q[0] - p.pivot[0], dy = q[1] - p.pivot[1];
+    return [p.at[0] + p.scale * (c * dx - s * dy), p.at[1] + p.scale * (s * dx + c * dy)];
+  }
+  function unplace(p, q) {
+    const r = (p.rotation * Math.PI) / 180, c = Math.cos(r), s = Math.sin(r);
+    const dx = (q[0] - p.at[0]) / p.scale, dy = (q[1] - p.at[1]) / p.scale;
+    return [p.pivot[0] + c * dx + s * dy, p.pivot[1] - s * dx + c * dy];
+  }
+  function canvasPoint(e) {
+    const r = overlay.getBoundingClientRect();
+    return [((e.clientX - r.left) * overlay.width) / r.width, ((e.clientY - r.top) * overlay.height) / r.height];
+  }
+  const screenScale = () => overlay.width / overlay.getBoundingClientRect().width;
+  const patchNamed = (name) => scene && scene.patches.find((p) => p.name === name);
+  const r2 = (v) => Math.round(v * 100) / 100;
+  const dist = (a, b) => Math.hypot(a[0] - b[0], a[1] - b[1]);
+
+  function drawOverlay() {
+    octx.clearRect(0, 0, overlay.width, overlay.height);
+    if (!scene) return;
+    const px = screenScale();
+    octx.lineWidth = 1.5 * px;
+    if (meshOn && scene.meshes) {
+      octx.strokeStyle = "rgba(120, 220, 255, 0.55)";
+      octx.beginPath();
+      for (const m of scene.meshes) {
+        const P = m.points, T = m.triangles;
+        for (let i = 0; i < T.length; i += 3) {
+          const a = T[i] * 2, b = T[i + 1] * 2, c = T[i + 2] * 2;
+          octx.moveTo(P[a], P[a + 1]); octx.lineTo(P[b], P[b + 1]); octx.lineTo(P[c], P[c + 1]); octx.closePath();
+        }
+      }
+      octx.stroke();
+    }
+    for (const p of scene.patches) {
+      const hot = (located && located.patch === p.name) || (gesture && gesture.patch === p.name);
+      if (hot && p.bbox) {
+        octx.setLineDash([4 * px, 4 * px]);
+        octx.strokeStyle = "rgba(255,255,255,0.7)";
+        octx.strokeRect(p.bbox[0], p.bbox[1], p.bbox[2] - p.bbox[0], p.bbox[3] - p.bbox[1]);
+        octx.setLineDash([]);
+      }
+      p.handles.forEach((h, i) => {
+        const grab = place(p, h.from), target = place(p, h.to);
+        const sel = selected && selected.kind === "handle" && selected.patch === p.name && selected.index === i;
+        octx.strokeStyle = sel ? "#fff" : "rgba(255, 200, 80, 0.9)";
+        octx.beginPath(); octx.arc(target[0], target[1], h.radius * p.scale, 0, 2 * Math.PI); octx.stroke();
+        octx.beginPath(); octx.moveTo(grab[0], grab[1]); octx.lineTo(target[0], target[1]); octx.stroke();
+        octx.fillStyle = "rgba(255, 200, 80, 0.9)";
+        octx.beginPath(); octx.arc(grab[0], grab[1], 3 * px, 0, 2 * Math.PI); octx.fill();
+        octx.fillStyle = sel ? "#fff" : "#ff5050";
+        octx.beginPath(); octx.arc(target[0], target[1], 5 * px, 0, 2 * Math.PI); octx.fill();
+      });
+      p.pins.forEach((pin, i) => {
+        const q = place(p, pin.at);
+        const sel = selected && selected.kind === "pin" && selected.patch === p.name && selected.index === i;
+        octx.fillStyle = sel ? "#fff" : "#50c8ff";
+        octx.fillRect(q[0] - 4 * px, q[1] - 4 * px, 8 * px, 8 * px);
+      });
+    }
+  }
+
+  function showCoords() {
+    if (!located) return;
+    let text = `canvas [${Math.round(located.x)}, ${Math.round(located.y)}]`;
+    if (located.patch !== null) {
+      text += ` · ${located.patch} source [${r2(located.source[0])}, ${r2(located.source[1])}]`;
+    }
+    $("coords").textContent = text;
+    drawOverlay();
+  }
+
+  function locate(p) {
+    if (locating) { nextLocate = p; return; }
+    locating = true;
+    send({ type: "locate", x: p[0], y: p[1] });
+  }
+
+  // --- what is under the pointer: a handle's target, a pin, or a patch ---
+  function pick(q) {
+    if (!scene) return null;
+    const near = 8 * screenScale();
+    for (const p of scene.patches) {
+      for (let i = 0; i < p.handles.length; i++) {
+        if (dist(place(p, p.handles[i].to), q) <= near) return { kind: "handle", patch: p.name, index: i };
+      }
+      for (let i = 0; i < p.pins.length; i++) {
+        if (dist(place(p, p.pins[i].at), q) <= near) return { kind: "pin", patch: p.name, index: i };
+      }
+    }
+    if (located && located.patch !== null && dist([located.x, located.y], q) < 2 * near) {
+      return { kind: "patch", patch: located.patch };
+    }
+    const order = scene.draw_order.slice().reverse();
+    for (const i of order) {
+      const b = scene.patches[i].bbox;
+      if (b && q[0] >= b[0] && q[0] <= b[2] && q[1] >= b[1] && q[1] <= b[3]) return { kind: "patch", patch: scene.patches[i].name };
+    }
+    return null;
+  }
+
+  function editFor(g, q) {
+    const p = patchNamed(g.patch);
+    if (!p) return null;
+    if (g.kind === "handle") return { op: "handle_key", patch: p.name, handle: g.index, value: unplace(g.base, q).map(r2) };
+    if (g.mode === "rotate") {
+      const a0 = Math.atan2(g.start[1] - g.base.at[1], g.start[0] - g.base.at[0]);
+      const a1 = Math.atan2(q[1] - g.base.at[1], q[0] - g.base.at[0]);
+      return { op: "rotate", patch: p.name, value: r2(g.base.rotation + ((a1 - a0) * 180) / Math.PI) };
+    }
+    if (g.mode === "scale") {
+      const d0 = Math.max(dist(g.start, g.base.at), 1);
+      return { op: "scale", patch: p.name, value: Math.max(0.0001, Math.round(((g.base.scale * dist(q, g.base.at)) / d0) * 1e4) / 1e4) };
+    }
+    return { op: "at", patch: p.name, value: [r2(g.base.at[0] + q[0] - g.start[0]), r2(g.base.at[1] + q[1] - g.start[1])] };
+  }
+
+  // One preview in flight at a time; the newest waiting one replaces older ones.
+  function queueEdit(edit) {
+    pendingEdit = edit;
+    flushEdit();
+  }
+  function flushEdit() {
+    if (inFlight || !pendingEdit || !scene) return;
+    sentAt = performance.now();
+    inFlight = true;
+    send({ type: "edit", rev: scene.rev, commit: false, edit: pendingEdit });
+    pendingEdit = null;
+  }
+
+  overlay.addEventListener("pointermove", (e) => {
+    const q = canvasPoint(e);
+    if (!gesture) { locate(q); return; }
+    if (dist(q, gesture.start) * (1 / screenScale()) > 2) gesture.moved = true;
+    if (gesture.moved && gesture.kind !== "add") {
+      gesture.last = editFor(gesture, q);
+      if (gesture.last) queueEdit(gesture.last);
+    }
+  });
+
+  overlay.addEventListener("pointerdown", (e) => {
+    if (!scene || e.button !== 0) return;
+    overlay.focus();
+    const q = canvasPoint(e);
+    const hit = pick(q);
+    if ((e.ctrlKey || e.metaKey) && hit && hit.kind === "patch") {
+      gesture = { kind: "add", patch: hit.patch, start: q, pin: e.shiftKey };
+      return;
+    }
+    if (!hit) { gesture = { kind: "none", start: q, shift: e.shiftKey }; return; }
+    const base = JSON.parse(JSON.stringify(patchNamed(hit.patch)));
+    const mode = e.shiftKey ? "rotate" : e.altKey ? "scale" : "move";
+    gesture = { kind: hit.kind, patch: hit.patch, index: hit.index, base, start: q, mode, moved: false, shift: e.shiftKey };
+    if (hit.kind !== "patch") { selected = hit; drawOverlay(); }
+    overlay.setPointerCapture(e.pointerId);
+  });
+
+  overlay.addEventListener("pointerup", (e) => {
+    const g = gesture;
+    gesture = null;
+    if (!g) return;
+    const q = canvasPoint(e);
+    if (g.kind === "add") {
+      const p = patchNamed(g.patch);
+      if (!p) return;
+      const at = located && located.patch === p.name ? located.source : unplace(p, q);
+      const edit = g.pin
+        ? { op: "add_pin", patch: p.name, at: at.map(r2) }
+        : { op: "add_handle", patch: p.name, from: at.map(r2), radius: r2(40 / p.scale) };
+      send({ type: "edit", rev: scene.rev, commit: true, edit });
+      return;
+    }
+    if (g.kind === "patch" && g.mode === "move" && !g.moved) { selected = null; drawOverlay(); }
+    if (!g.moved || g.kind === "pin") { copyPair(q, g.shift); return; }
+    const edit = editFor(g, q);
+    pendingEdit = null;
+    if (edit) send({ type: "edit", rev: scene.rev, commit: true, edit });
+  });
+
+  function copyPair(q, source) {
+    let pair = `[${Math.round(q[0])}, ${Math.round(q[1])}]`;
+    if (source && located && located.patch !== null) pair = `[${r2(located.source[0])}, ${r2(located.source[1])}]`;
+    const done = () => notice(`copied ${pair}`, "ok");
+    if (navigator.clipboard) navigator.clipboard.writeText(pair).then(done, () => notice(pair));
+    else notice(pair);
+  }
+
+  // --- timeline ---
+  function drawMarkers() {
+    const box = $("markers");
+    box.textContent = "";
+    if (!scene) return;
+    let row = 0;
+    for (const p of scene.patches) {
+      for (const [track, times] of Object.entries(p.keys)) {
+        if (!times.length) continue;
+        for (const t of times) {
+          const m = document.createElement("div");
+          m.className = "marker";
+          if (selected && selected.kind === "key" && selected.patch === p.name && selected.track === track && selected.t === t) m.classList.add("selected");
+          m.style.left = `${(100 * t) / scene.duration}%`;
+          m.style.top = `${row * 10 + 2}px`;
+          m.style.background = TRACK_COLOURS[track];
+          m.title = `${p.name} ${track} key at ${t} s (drag: move_key, Delete: remove_key)`;
+          m.addEventListener("pointerdown", (e) => markerDrag(e, m, p.name, track, t));
+          box.appendChild(m);
+        }
+        row++;
+      }
+    }
+    box.style.height = `${row * 10 + 4}px`;
+  }
+
+  function markerDrag(e, m, patch, track, t) {
+    e.preventDefault();
+    selected = { kind: "key", patch, track, t };
+    drawMarkers();
+    const box = $("markers").getBoundingClientRect();
+    const timeAt = (x) => {
+      const raw = Math.min(Math.max((x - box.left) / box.width, 0), 1) * scene.duration;
+      return Math.round(raw * scene.fps) / scene.fps;
+    };
+    let to = t;
+    const move = (ev) => { to = timeAt(ev.clientX); m.style.left = `${(100 * to) / scene.duration}%`; };
+    const up = () => {
+      window.removeEventListener("pointermove", move);
+      window.removeEventListener("pointerup", up);
+      if (Math.abs(to - t) > 1e-9) {
+        send({ type: "edit", rev: scene.rev, commit: true, edit: { op: "move_key", patch, track, from: t, to: +to.toFixed(6) } });
+      }
+    };
+    window.addEventListener("pointermove", move);
+    window.addEventListener("pointerup", up);
+  }
+
+  $("scrub").addEventListener("input", () => {
+    scrubbing = true;
+    send({ type: "seek", t: +$("scrub").value });
+  });
+  $("scrub").addEventListener("change", () => { scrubbing = false; });
+
+  let lastPlay = 0;
+  function playStep(now) {
+    if (!playing || !scene) return;
+    const wait = 1000 / scene.fps - (now - lastPlay);
+    if (wait > 1) { setTimeout(() => requestAnimationFrame(playStep), wait); return; }
+    lastPlay = now;
+    let t = scene.t + 1 / scene.fps;
+    if (t >= scene.duration - 1e-9) t = 0;
+    send({ type: "seek", t });
+  }
+  function togglePlay() {
+    playing = !playing;
+    $("play").textContent = playing ? "❚❚" : "▶";
+    if (playing) { lastPlay = 0; requestAnimationFrame(playStep); }
+  }
+  $("play").addEventListener("click", togglePlay);
+  $("mesh").addEventListener("change", () => { meshOn = $("mesh").checked; send({ type: "mesh", on: meshOn }); drawOverlay(); });
+
+  document.addEventListener("keydown", (e) => {
+    const mod = e.ctrlKey || e.metaKey;
+    if (e.key === "Escape" && gesture) {
+      gesture = null; pendingEdit = null;
+      send({ type: "cancel" });
+      notice("cancelled", "");
+    } else if (mod && e.key.toLowerCase() === "z") {
+      e.preventDefault();
+      send({ type: "undo" });
+    } else if (mod && e.key.toLowerCase() === "s") {
+      e.preventDefault();
+      if (!scene || !scene.file) notice("no scene file loaded: :save FILE in the terminal", "error");
+      else if (confirm(`Save the session to ${scene.file}?`)) send({ type: "save", rev: scene.rev });
+    } else if ((e.key === "Delete" || e.key === "Backspace") && selected && scene) {
+      const s = selected;
+      selected = null;
+      const edit = s.kind === "handle" ? { op: "remove_handle", patch: s.patch, handle: s.index }
+        : s.kind === "pin" ? { op: "remove_pin", patch: s.patch, pin: s.index }
+        : { op: "remove_key", patch: s.patch, track: s.track, t: s.t };
+      send({ type: "edit", rev: scene.rev, commit: true, edit });
+    } else if (e.key === " " && e.target === overlay) {
+      e.preventDefault();
+      togglePlay();
+    } else if (e.key.toLowerCase() === "m" && !mod && e.target === overlay) {
+      $("mesh").checked = !$("mesh").checked;
+      $("mesh").dispatchEvent(new Event("change"));
+    }
+  });
+  $("coords").addEventListener("click", () => located && copyPair([located.x, located.y], false));
+
+  connect();
+})();

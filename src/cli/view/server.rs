@@ -1,0 +1,189 @@
+//! The live view's server: takes the shared session, an address and a port, and gives a
+//! listening server (its URL carries a fresh random token) that serves the page and one
+//! WebSocket per page. Each page's messages are applied to the session in arrival order
+//! (the session's lock orders pages and typed lines); replies and frames go back through
+//! the [`Hub`]. Threads only: one accepting, one per connection.
+
+use std::net::{IpAddr, Ipv4Addr, SocketAddr, TcpListener, TcpStream};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+
+use anyhow::Context as _;
+use tungstenite::{Message, WebSocket};
+
+use super::edit::{parse_request, Request};
+use super::http::{accept, Accepted, Routes};
+use super::hub::{channel, Hub, Outgoing};
+use super::{error_message, lock};
+use crate::cli::repl::Session;
+
+/// Connections served at once; more are closed unanswered.
+const MAX_CONNECTIONS: usize = 32;
+/// How often a page's thread looks for frames to send while it waits for messages.
+const POLL: Duration = Duration::from_millis(5);
+
+const PAGE: &str = include_str!("page/index.html");
+const SCRIPT: &str = include_str!("page/view.js");
+const STYLE: &str = include_str!("page/view.css");
+
+/// A running view server.
+pub struct Server {
+    pub url: String,
+    pub addr: SocketAddr,
+}
+
+/// Binds `bind` (127.0.0.1 by default) on `port` (0: a free one) and serves the session.
+pub fn start(
+    bind: Option<IpAddr>,
+    port: u16,
+    session: Arc<Mutex<Session>>,
+    hub: Arc<Hub>,
+) -> anyhow::Result<Server> {
+    let ip = bind.unwrap_or(IpAddr::V4(Ipv4Addr::LOCALHOST));
+    let listener = TcpListener::bind((ip, port))
+        .with_context(|| format!("cannot listen on {ip} port {port}"))?;
+    let addr = listener
+        .local_addr()
+        .context("reading the view's address")?;
+    let token = new_token()?;
+    let mut hosts = vec![
+        format!("127.0.0.1:{}", addr.port()),
+        format!("localhost:{}", addr.port()),
+        format!("[::1]:{}", addr.port()),
+    ];
+    let shown = match ip {
+        IpAddr::V6(v6) => format!("[{v6}]:{}", addr.port()),
+        IpAddr::V4(v4) => format!("{v4}:{}", addr.port()),
+    };
+    if !hosts.contains(&shown) {
+        hosts.push(shown.clone());
+    }
+    let page = PAGE
+        .replace("/*STYLE*/", STYLE)
+        .replace("/*SCRIPT*/", SCRIPT);
+    let routes = Arc::new(Routes {
+        token: token.clone(),
+        page,
+        hosts,
+    });
+    let url = format!("http://{shown}/?token={token}");
+    std::thread::Builder::new()
+        .name("view-accept".into())
+        .spawn(move || serve(listener, routes, session, hub))
+        .context("starting the view server")?;
+    Ok(Server { url, addr })
+}
+
+/// 128 random bits from the operating system, as 32 hex digits.
+fn new_token() -> anyhow::Result<String> {
+    let mut bytes = [0u8; 16];
+    getrandom::fill(&mut bytes).map_err(|e| anyhow::anyhow!("no random token: {e}"))?;
+    Ok(bytes.iter().map(|b| format!("{b:02x}")).collect())
+}
+
+fn serve(listener: TcpListener, routes: Arc<Routes>, session: Arc<Mutex<Session>>, hub: Arc<Hub>) {
+    let open = Arc::new(AtomicUsize::new(0));
+    for stream in listener.incoming() {
+        let Ok(stream) = stream else { continue };
+        if open.load(Ordering::SeqCst) >= MAX_CONNECTIONS {
+            continue; // dropped: the connection closes
+        }
+        open.fetch_add(1, Ordering::SeqCst);
+        let (routes, session, hub, open) =
+            (routes.clone(), session.clone(), hub.clone(), open.clone());
+        let spawned = std::thread::Builder::new()
+            .name("view-page".into())
+            .spawn(move || {
+                if let Ok(Accepted::Socket(socket)) = accept(stream, &routes) {
+                    page_loop(*socket, &session, &hub);
+                }
+                open.fetch_sub(1, Ordering::SeqCst);
+            });
+        if spawned.is_err() {
+            eprintln!("warning: the view cannot serve another page");
+        }
+    }
+}
+
+/// Serves one page until it closes: its messages in, frames and replies out.
+fn page_loop(mut socket: WebSocket<TcpStream>, session: &Mutex<Session>, hub: &Hub) {
+    if socket.get_mut().set_read_timeout(Some(POLL)).is_err() {
+        return;
+    }
+    let _ = socket.get_mut().set_nodelay(true);
+    let (tx, rx) = channel();
+    let id = hub.connect(tx.clone());
+    loop {
+        match socket.read() {
+            Ok(Message::Text(text)) => handle(text.as_str(), id, session, hub, &|m| {
+                let _ = tx.send(Outgoing::Text(Arc::new(m)));
+            }),
+            Ok(Message::Binary(_)) => {
+                let _ = tx.send(Outgoing::Text(Arc::new(error_message(
+                    "binary messages are not accepted",
+                ))));
+            }
+            Ok(Message::Close(_)) => break,
+            Ok(_) => {}
+            Err(tungstenite::Error::Io(e))
+                if matches!(
+                    e.kind(),
+                    std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
+                ) => {}
+            Err(tungstenite::Error::Capacity(e)) => {
+                let _ = tx.send(Outgoing::Text(Arc::new(error_message(&format!(
+                    "refused: {e}"
+                )))));
+            }
+            Err(_) => break,
+        }
+        if !flush(&mut socket, &rx) {
+            break;
+        }
+    }
+    hub.disconnect(id);
+}
+
+/// Sends what is queued for this page; false once the page is gone.
+fn flush(socket: &mut WebSocket<TcpStream>, rx: &std::sync::mpsc::Receiver<Outgoing>) -> bool {
+    let mut sent = false;
+    while let Ok(message) = rx.try_recv() {
+        let message = match message {
+            Outgoing::Binary(bytes) => Message::Binary(bytes.as_ref().clone().into()),
+            Outgoing::Text(text) => Message::Text(text.as_str().into()),
+        };
+        if socket.write(message).is_err() {
+            return false;
+        }
+        sent = true;
+    }
+    !sent || socket.flush().is_ok()
+}
+
+/// Applies one page message to the session; `reply` answers this page only.
+fn handle(text: &str, id: u64, session: &Mutex<Session>, hub: &Hub, reply: &dyn Fn(String)) {
+    let request = match parse_request(text) {
+        Ok(request) => request,
+        Err(message) => return reply(error_message(&message)),
+    };
+    let mut session = lock(session);
+    let result = match request {
+        Request::Seek { t } => session.view_seek(t),
+        Request::Locate { x, y } => {
+            reply(session.view_locate(x, y));
+            Ok(())
+        }
+        Request::Edit { rev, commit, edit } => session.view_edit(rev, commit, &edit),
+        Request::Cancel => session.view_cancel(),
+        Request::Undo => session.view_undo(),
+        Request::Save { rev } => session.view_save(rev),
+        Request::Mesh { on } => {
+            hub.set_mesh(id, on);
+            session.view_publish()
+        }
+    };
+    if let Err(message) = result {
+        reply(error_message(&message));
+    }
+}

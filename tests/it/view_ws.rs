@@ -1,0 +1,541 @@
+//! `lapclone repl --view` driven as a page would drive it: a WebSocket client on port 0
+//! sends a drag and checks the frame update against `lapclone preview` of the `:save`d
+//! scene byte for byte; `:undo` restores the frame; a missing or wrong token, a foreign
+//! Origin and 1,000 malformed messages are refused with no change to the scene.
+
+use std::io::{BufRead, BufReader, Write};
+use std::net::TcpStream;
+use std::path::{Path, PathBuf};
+use std::process::{Child, ChildStdin, Command, Stdio};
+use std::sync::mpsc::{Receiver, RecvTimeoutError};
+use std::time::Duration;
+
+use serde_json::{json, Value};
+use tungstenite::client::IntoClientRequest;
+use tungstenite::stream::MaybeTlsStream;
+use tungstenite::{Message, WebSocket};
+
+use crate::files::asset;
+
+const WAIT: Duration = Duration::from_secs(60);
+
+/// The cat's face on the coffee, 600×400, keyed so a drag at t = 1.25 adds a key.
+pub(super) fn cat_scene(dir: &Path) -> PathBuf {
+    let text = format!(
+        r#"canvas(600, 400, #{{ fps: 24, duration: 2, background: "{}" }});
+let cat = patch("cat", #{{ source: "{}", mask: "{}" }});
+cat.at(0, [288, 147]).at(2, [320, 170]);
+cat.scale(0, 0.42);
+"#,
+        asset("coffee.png"),
+        asset("chelsea.png"),
+        asset("masks/chelsea_face.png")
+    );
+    let path = dir.join("cat.rhai");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// A `lapclone repl SCENE --view --port 0` whose stdin the test writes.
+pub(super) struct ViewRepl {
+    child: Child,
+    stdin: Option<ChildStdin>,
+    lines: Receiver<String>,
+    pub(super) url: String,
+}
+
+impl ViewRepl {
+    pub(super) fn start(dir: &Path, scene: &Path) -> ViewRepl {
+        Self::start_with(dir, scene, &[])
+    }
+
+    fn start_with(dir: &Path, scene: &Path, extra: &[&str]) -> ViewRepl {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_lapclone"))
+            .args(["repl", scene.to_str().unwrap(), "--view", "--port", "0"])
+            .args(extra)
+            .arg("--preview")
+            .arg(dir.join("preview.png"))
+            .current_dir(dir)
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::inherit())
+            .spawn()
+            .unwrap();
+        let stdout = child.stdout.take().unwrap();
+        let (tx, lines) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            for line in BufReader::new(stdout).lines().map_while(Result::ok) {
+                if tx.send(line).is_err() {
+                    break;
+                }
+            }
+        });
+        let stdin = child.stdin.take();
+        let mut repl = ViewRepl {
+            child,
+            stdin,
+            lines,
+            url: String::new(),
+        };
+        let first = repl.wait_line(|l| l.starts_with("view: "));
+        repl.url = first.trim_start_matches("view: ").to_string();
+        repl.wait_line(|l| l.starts_with("preview"));
+        repl
+    }
+
+    pub(super) fn wait_line(&self, found: impl Fn(&str) -> bool) -> String {
+        loop {
+            match self.lines.recv_timeout(WAIT) {
+                Ok(line) if found(&line) => return line,
+                Ok(_) => {}
+                Err(RecvTimeoutError::Timeout) => panic!("no such line from the REPL"),
+                Err(RecvTimeoutError::Disconnected) => panic!("the REPL ended"),
+            }
+        }
+    }
+
+    pub(super) fn type_line(&mut self, line: &str) {
+        let stdin = self.stdin.as_mut().unwrap();
+        writeln!(stdin, "{line}").unwrap();
+        stdin.flush().unwrap();
+    }
+
+    fn host(&self) -> String {
+        self.url
+            .trim_start_matches("http://")
+            .split('/')
+            .next()
+            .unwrap()
+            .to_string()
+    }
+
+    fn socket_url(&self) -> String {
+        self.url
+            .replacen("/?token=", "/ws?token=", 1)
+            .replacen("http://", "ws://", 1)
+    }
+
+    fn connect(&self, url: &str, origin: Option<&str>) -> Result<Page, tungstenite::Error> {
+        let mut request = url.into_client_request().unwrap();
+        if let Some(origin) = origin {
+            request
+                .headers_mut()
+                .insert("Origin", origin.parse().unwrap());
+        }
+        let (socket, _) = tungstenite::connect(request)?;
+        if let MaybeTlsStream::Plain(s) = socket.get_ref() {
+            s.set_read_timeout(Some(WAIT)).unwrap();
+        }
+        let mut page = Page {
+            socket,
+            frame: Vec::new(),
+            width: 0,
+            height: 0,
+            scene: Value::Null,
+            rects: Vec::new(),
+        };
+        page.until_scene();
+        Ok(page)
+    }
+
+    fn page(&self) -> Page {
+        let origin = format!("http://{}", self.host());
+        self.connect(&self.socket_url(), Some(&origin)).unwrap()
+    }
+
+    /// Closes stdin (the server ends with the input) and waits for the exit.
+    pub(super) fn finish(mut self) -> std::process::ExitStatus {
+        drop(self.stdin.take());
+        self.child.wait().unwrap()
+    }
+}
+
+/// A page's view of the session: the frame rebuilt from the updates, and the last scene
+/// message.
+struct Page {
+    socket: WebSocket<MaybeTlsStream<TcpStream>>,
+    frame: Vec<u8>,
+    width: u32,
+    height: u32,
+    scene: Value,
+    /// The rectangles of the frame updates since the last `until_scene`.
+    rects: Vec<[u32; 4]>,
+}
+
+impl Page {
+    fn send(&mut self, message: &Value) {
+        self.socket
+            .send(Message::Text(message.to_string().into()))
+            .unwrap();
+    }
+
+    fn send_text(&mut self, text: &str) {
+        self.socket.send(Message::Text(text.into())).unwrap();
+    }
+
+    /// Reads messages until a text one for which `done` holds; frames are applied.
+    fn until(&mut self, done: impl Fn(&Value) -> bool) -> Value {
+        loop {
+            match self.socket.read().unwrap() {
+                Message::Binary(bytes) => self.apply(&bytes),
+                Message::Text(text) => {
+                    let value: Value = serde_json::from_str(text.as_str()).unwrap();
+                    if value["type"] == "scene" {
+                        self.scene = value.clone();
+                    }
+                    if done(&value) {
+                        return value;
+                    }
+                    assert!(value["type"] != "error", "unexpected {value}");
+                }
+                _ => {}
+            }
+        }
+    }
+
+    fn until_scene(&mut self) -> Value {
+        self.rects.clear();
+        self.until(|v| v["type"] == "scene")
+    }
+
+    fn apply(&mut self, bytes: &[u8]) {
+        let u = |i: usize| u32::from_le_bytes(bytes[i * 4..i * 4 + 4].try_into().unwrap());
+        assert_eq!(u(0), 1, "frame message kind");
+        let (width, height, x, y, w, h) = (u(1), u(2), u(3), u(4), u(5), u(6));
+        assert_eq!(bytes.len(), 28 + (w * h * 4) as usize);
+        if (width, height) != (self.width, self.height) {
+            assert_eq!(
+                (x, y, w, h),
+                (0, 0, width, height),
+                "a new size comes whole"
+            );
+            self.frame = vec![0; (width * height * 4) as usize];
+            (self.width, self.height) = (width, height);
+        }
+        for j in 0..h {
+            let src = 28 + (j * w * 4) as usize;
+            let dst = (((y + j) * width + x) * 4) as usize;
+            self.frame[dst..dst + (w * 4) as usize]
+                .copy_from_slice(&bytes[src..src + (w * 4) as usize]);
+        }
+        self.rects.push([x, y, w, h]);
+    }
+
+    fn rev(&self) -> u64 {
+        self.scene["rev"].as_u64().unwrap()
+    }
+
+    fn cat_at(&self) -> [f64; 2] {
+        let at = &self.scene["patches"][0]["at"];
+        [at[0].as_f64().unwrap(), at[1].as_f64().unwrap()]
+    }
+}
+
+pub(super) fn preview_png(dir: &Path, scene: &Path, t: f64) -> image::RgbaImage {
+    let out = dir.join(format!("preview-{t}.png"));
+    let status = Command::new(env!("CARGO_BIN_EXE_lapclone"))
+        .args([
+            "preview",
+            scene.to_str().unwrap(),
+            "--t",
+            &t.to_string(),
+            "-o",
+        ])
+        .arg(&out)
+        .status()
+        .unwrap();
+    assert!(status.success());
+    image::open(&out).unwrap().to_rgba8()
+}
+
+#[test]
+fn a_drag_updates_the_frame_as_preview_renders_the_saved_scene_and_undo_restores_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = cat_scene(dir.path());
+    let mut repl = ViewRepl::start(dir.path(), &scene);
+    let mut page = repl.page();
+    repl.type_line(":t 1.25");
+    page.until(|v| v["type"] == "scene" && v["t"] == 1.25);
+    let before = page.frame.clone();
+    let [x, y] = page.cat_at().map(f64::round);
+    let rev = page.rev();
+    // The pointer moves: previews follow (no history), then the gesture ends.
+    for step in 1..=4 {
+        let value = [x + 10.0 * step as f64, y];
+        page.send(&json!({"type": "edit", "rev": rev, "commit": false, "edit": {"op": "at", "patch": "cat", "value": value}}));
+        page.until_scene();
+        assert_eq!(page.rev(), rev, "a preview is not a change of the scene");
+    }
+    page.send(&json!({"type": "edit", "rev": rev, "commit": true, "edit": {"op": "at", "patch": "cat", "value": [x + 40.0, y]}}));
+    let line = page.until(|v| v["type"] == "line");
+    let expected = format!("cat.at(1.25, [{}, {}]);", x + 40.0, y);
+    assert_eq!(line["text"], expected.as_str());
+    repl.wait_line(|l| l == format!("(view) {expected}"));
+    let saved = dir.path().join("saved.rhai");
+    repl.type_line(&format!(":save {}", saved.display()));
+    repl.wait_line(|l| l.starts_with("saved "));
+    // Every update was a rectangle, never more than the frame; the rebuilt frame is exactly
+    // what `lapclone preview` writes for the saved scene.
+    let reference = preview_png(dir.path(), &saved, 1.25);
+    assert_eq!((page.width, page.height), reference.dimensions());
+    assert!(
+        page.frame == reference.as_raw()[..],
+        "frame differs from lapclone preview"
+    );
+    assert!(page.frame != before, "the drag changed nothing");
+    // :undo from the page restores the frame byte for byte.
+    page.send(&json!({"type": "undo"}));
+    // The frame and scene message come before the line.
+    page.until(|v| v["type"] == "line" && v["text"] == ":undo");
+    assert!(page.frame == before, ":undo did not restore the frame");
+    assert!(repl.finish().success());
+}
+
+#[test]
+fn escape_leaves_no_trace_and_stale_edits_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = cat_scene(dir.path());
+    let repl = ViewRepl::start(dir.path(), &scene);
+    let mut page = repl.page();
+    let before = page.frame.clone();
+    let rev = page.rev();
+    let [x, y] = page.cat_at();
+    page.send(&json!({"type": "edit", "rev": rev, "commit": false, "edit": {"op": "rotate", "patch": "cat", "value": 30}}));
+    page.until_scene();
+    assert!(page.frame != before);
+    page.send(&json!({"type": "cancel"}));
+    page.until_scene();
+    assert!(page.frame == before, "cancel did not restore the frame");
+    let stale = json!({"type": "edit", "rev": rev + 7, "commit": true, "edit": {"op": "at", "patch": "cat", "value": [x + 5.0, y]}});
+    page.send(&stale);
+    let error = page.until(|v| v["type"] == "error");
+    assert!(
+        error["message"].as_str().unwrap().contains("stale"),
+        "{error}"
+    );
+    page.send(&json!({"type": "mesh", "on": false}));
+    page.until_scene();
+    assert_eq!(page.rev(), rev);
+    assert!(page.frame == before);
+    assert!(repl.finish().success());
+}
+
+#[test]
+fn wrong_tokens_foreign_origins_and_malformed_messages_change_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = cat_scene(dir.path());
+    let repl = ViewRepl::start(dir.path(), &scene);
+    let own = format!("http://{}", repl.host());
+    let url = repl.socket_url();
+    let (base, token) = url.split_once("?token=").unwrap();
+    let wrong: String = token.chars().rev().collect();
+    for (attempt, origin) in [
+        (base.to_string(), Some(own.as_str())),
+        (format!("{base}?token={wrong}"), Some(own.as_str())),
+        (format!("{base}?token="), Some(own.as_str())),
+        (url.clone(), Some("http://evil.example")),
+        (url.clone(), None),
+    ] {
+        match repl.connect(&attempt, origin) {
+            Err(tungstenite::Error::Http(response)) => assert_eq!(response.status(), 403),
+            Err(other) => panic!("{attempt}: {other}"),
+            Ok(_) => panic!("{attempt} with Origin {origin:?} was accepted"),
+        }
+    }
+    let mut page = repl.page();
+    let before = page.frame.clone();
+    let rev = page.rev();
+    let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+    for i in 0..1000 {
+        let text = malformed(i, &mut seed);
+        page.send_text(&text);
+        let reply = page.until(|v| v["type"] == "error");
+        assert!(reply["message"].is_string(), "{text}");
+    }
+    page.send(&json!({"type": "mesh", "on": false}));
+    page.until_scene();
+    assert_eq!(page.rev(), rev, "a malformed message changed the scene");
+    assert!(page.frame == before);
+    // Too large for the server: refused, and the session goes on.
+    page.send_text(&format!(
+        "{{\"type\":\"seek\",\"t\":1{}}}",
+        " ".repeat(20_000)
+    ));
+    let mut again = repl.page();
+    assert_eq!(again.rev(), rev);
+    again.send(&json!({"type": "seek", "t": 0.5}));
+    again.until(|v| v["type"] == "scene" && v["t"] == 0.5);
+    assert!(repl.finish().success());
+}
+
+fn next(seed: &mut u64) -> u64 {
+    *seed ^= *seed << 13;
+    *seed ^= *seed >> 7;
+    *seed ^= *seed << 17;
+    *seed
+}
+
+/// Message `i` of the malformed set: every tenth is random characters, the rest valid
+/// shapes with one part broken (unknown type or op, missing or extra field, wrong type,
+/// out-of-range or non-finite number, unknown patch, handle or key, code instead of values).
+fn malformed(i: usize, seed: &mut u64) -> String {
+    let r = next(seed);
+    if i % 10 == 0 {
+        let len = (r % 200) as usize;
+        return (0..len)
+            .map(|_| char::from_u32((next(seed) % 0x250) as u32).unwrap_or('?'))
+            .collect();
+    }
+    let n = (r >> 8) % 1000;
+    let cases = [
+        json!({"type": "eval", "code": "canvas(1, 1)"}),
+        json!({"type": "seek"}),
+        json!({"type": "seek", "t": -1.0 - n as f64}),
+        json!({"type": "seek", "t": "1"}),
+        json!({"type": "seek", "t": 1e300}),
+        json!({"type": "locate", "x": 1, "y": 2, "z": n}),
+        json!({"type": "edit", "rev": 0, "commit": true, "edit": {"op": "at", "patch": "cat", "value": [1, 2, 3]}}),
+        json!({"type": "edit", "rev": 1, "commit": true, "edit": {"op": "at", "patch": format!("dog{n}"), "value": [1, 2]}}),
+        json!({"type": "edit", "rev": 1, "commit": true, "edit": {"op": "load", "path": "/etc/passwd"}}),
+        json!({"type": "edit", "rev": 1, "commit": true, "edit": {"op": "scale", "patch": "cat", "value": -(n as f64)}}),
+        json!({"type": "edit", "rev": 1, "commit": true, "edit": {"op": "remove_handle", "patch": "cat", "handle": n}}),
+        json!({"type": "edit", "rev": 1, "commit": true, "edit": {"op": "remove_key", "patch": "cat", "track": "at", "t": 0.5 + n as f64}}),
+        json!({"type": "edit", "rev": 1, "commit": true, "edit": {"op": "move_key", "patch": "cat", "track": "colour", "from": 0, "to": 1}}),
+        json!({"type": "edit", "rev": 1, "commit": false, "edit": {"op": "add_pin", "patch": "cat", "at": [1, 2]}}),
+        json!({"type": "edit", "rev": 1, "commit": true, "edit": {"op": "at", "patch": "cat", "value": "cat.at(0, [0, 0])"}}),
+        json!({"type": "save", "rev": 1u64 << 40}),
+        json!({"type": "mesh", "on": "yes"}),
+        json!([1, 2, 3]),
+        json!("undo"),
+    ];
+    let mut text = cases[(r as usize / 7) % cases.len()].to_string();
+    if r % 3 == 0 {
+        // Truncated somewhere inside.
+        let cut = (next(seed) as usize) % text.len().max(1);
+        text.truncate(cut);
+    }
+    text
+}
+
+#[test]
+fn each_page_edit_is_one_line_and_gives_the_scene_typing_it_gives() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = cat_scene(dir.path());
+    let mut repl = ViewRepl::start(dir.path(), &scene);
+    let mut page = repl.page();
+    repl.type_line(":t 0.5");
+    page.until(|v| v["type"] == "scene" && v["t"] == 0.5);
+    let edits = [
+        (
+            json!({"op": "at", "patch": "cat", "value": [300.126, 150]}),
+            "cat.at(0.5, [300.13, 150]);",
+        ),
+        (
+            json!({"op": "rotate", "patch": "cat", "value": 15}),
+            "cat.rotate(0.5, 15);",
+        ),
+        (
+            json!({"op": "scale", "patch": "cat", "value": 0.5}),
+            "cat.scale(0.5, 0.5);",
+        ),
+        (
+            json!({"op": "add_handle", "patch": "cat", "from": [250, 200], "radius": 60}),
+            "let h = cat.drag([250, 200], 60);",
+        ),
+        (
+            json!({"op": "handle_key", "patch": "cat", "handle": 0, "value": [262, 190]}),
+            "cat.handle(0).key(0.5, [262, 190]);",
+        ),
+        (
+            json!({"op": "add_pin", "patch": "cat", "at": [200, 150]}),
+            "cat.pin([200, 150]);",
+        ),
+        (
+            json!({"op": "add_handle", "patch": "cat", "from": [300, 250], "radius": 30}),
+            "let h2 = cat.drag([300, 250], 30);",
+        ),
+        (
+            json!({"op": "remove_handle", "patch": "cat", "handle": 1}),
+            "cat.remove_handle(1);",
+        ),
+        (
+            json!({"op": "remove_pin", "patch": "cat", "pin": 0}),
+            "cat.remove_pin(0);",
+        ),
+        (
+            json!({"op": "move_key", "patch": "cat", "track": "at", "from": 2, "to": 1.5}),
+            "cat.move_key(2, 1.5, \"at\");",
+        ),
+        (
+            json!({"op": "remove_key", "patch": "cat", "track": "scale", "t": 0}),
+            "cat.remove_key(0, \"scale\");",
+        ),
+    ];
+    for (edit, line) in &edits {
+        // The handle's target previews before it commits, as a drag would.
+        if edit["op"] == "handle_key" {
+            page.send(&json!({"type": "edit", "rev": page.rev(), "commit": false, "edit": edit}));
+            page.until_scene();
+        }
+        page.send(&json!({"type": "edit", "rev": page.rev(), "commit": true, "edit": edit}));
+        let reply = page.until(|v| v["type"] == "line");
+        assert_eq!(reply["text"], *line);
+    }
+    let from_page = dir.path().join("from_page.rhai");
+    repl.type_line(&format!(":save {}", from_page.display()));
+    repl.wait_line(|l| l.starts_with("saved "));
+    let frame = page.frame.clone();
+    assert!(repl.finish().success());
+    // The same lines typed into a fresh session give the same saved scene.
+    let typed = dir.path().join("typed.rhai");
+    let mut script: Vec<String> = vec![":t 0.5".into()];
+    script.extend(edits.iter().map(|(_, line)| line.to_string()));
+    script.push(format!(":save {}", typed.display()));
+    let out = Command::new(env!("CARGO_BIN_EXE_lapclone"))
+        .args(["repl", scene.to_str().unwrap(), "--preview"])
+        .arg(dir.path().join("typed.png"))
+        .arg("--script")
+        .arg(write_script(dir.path(), &script))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(
+        std::fs::read_to_string(&from_page).unwrap(),
+        std::fs::read_to_string(&typed).unwrap()
+    );
+    assert!(frame == preview_png(dir.path(), &typed, 0.5).as_raw()[..]);
+}
+
+fn write_script(dir: &Path, lines: &[String]) -> PathBuf {
+    let path = dir.join("typed_script.txt");
+    std::fs::write(&path, lines.join("\n") + "\n").unwrap();
+    path
+}
+
+#[test]
+fn watch_reloads_a_changed_file_keeping_the_playhead_unless_edits_are_unsaved() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = cat_scene(dir.path());
+    let mut repl = ViewRepl::start_with(dir.path(), &scene, &["--watch"]);
+    let mut page = repl.page();
+    repl.type_line(":t 1");
+    page.until(|v| v["type"] == "scene" && v["t"] == 1.0);
+    let text = std::fs::read_to_string(&scene).unwrap();
+    std::fs::write(
+        &scene,
+        text.replace("cat.scale(0, 0.42);", "cat.scale(0, 0.5);"),
+    )
+    .unwrap();
+    repl.wait_line(|l| l.starts_with("loaded "));
+    page.until(|v| v["type"] == "scene" && v["patches"][0]["scale"] == 0.5);
+    assert_eq!(page.scene["t"], 1.0, "the playhead moved");
+    repl.type_line("cat.rotate(0, 10);");
+    page.until(|v| v["type"] == "scene" && v["patches"][0]["rotation"] == 10.0);
+    std::fs::write(&scene, text).unwrap();
+    repl.wait_line(|l| l.contains("not reloaded: the session has unsaved edits"));
+    assert!(repl.finish().success());
+}
