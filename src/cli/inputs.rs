@@ -7,7 +7,7 @@
 use std::path::{Path, PathBuf};
 
 use lapclone::animation::{Background, FootageSource, Pattern};
-use lapclone::output::foreign_frames;
+use lapclone::output::{foreign_frames, OutputKind};
 use lapclone::script::LoadedScene;
 use lapclone::util::same_file;
 
@@ -95,6 +95,22 @@ fn scene_inputs(loaded: &LoadedScene, imports: &[PathBuf]) -> Vec<Input> {
     inputs
 }
 
+/// Refuses a render's output (of `kind`) that is one of its scene's inputs: a file, or for
+/// a PNG folder a frame file that an input sequence shows. `render` and the REPL's
+/// `:render` both ask here.
+pub(crate) fn refuse_render_input(
+    kind: OutputKind,
+    output: &Path,
+    loaded: &LoadedScene,
+    imports: &[PathBuf],
+) -> anyhow::Result<()> {
+    if kind == OutputKind::PngFolder {
+        refuse_scene_input_frames(output, loaded, imports)
+    } else {
+        refuse_scene_input(output, loaded, imports)
+    }
+}
+
 /// Refuses a file output (`-o`) that is one of the scene's inputs.
 pub(crate) fn refuse_scene_input(
     output: &Path,
@@ -115,7 +131,7 @@ pub(crate) fn refuse_scene_input(
 
 /// Refuses a PNG frame folder holding frame files that are also the scene's inputs (a
 /// render would replace them, or `--force` remove them).
-pub(crate) fn refuse_scene_input_frames(
+fn refuse_scene_input_frames(
     folder: &Path,
     loaded: &LoadedScene,
     imports: &[PathBuf],

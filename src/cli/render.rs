@@ -194,11 +194,7 @@ pub fn run_render(args: RenderArgs) -> anyhow::Result<()> {
     for warning in renderer.point_warnings() {
         eprintln!("warning: {warning}");
     }
-    if kind == OutputKind::PngFolder {
-        super::inputs::refuse_scene_input_frames(&args.output, &loaded, &imports)?;
-    } else {
-        super::inputs::refuse_scene_input(&args.output, &loaded, &imports)?;
-    }
+    super::inputs::refuse_render_input(kind, &args.output, &loaded, &imports)?;
     let total = renderer.frame_count();
     let range = match args.frames {
         None => FrameRange {

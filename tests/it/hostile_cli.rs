@@ -791,3 +791,42 @@ fn the_repl_survives_loading_an_import_cycle() {
     );
     assert!(!all.contains("overflowed"), "{all}");
 }
+
+#[test]
+fn the_repl_refuses_to_render_over_its_own_inputs() {
+    let world = World::new();
+    world.write("lib.rhai", "fn width() { 40 }\n");
+    let scene = world.scene("victim.rhai", "import \"lib\" as lib;\n");
+    let (scene_before, lib_before) = (
+        std::fs::read(&scene).unwrap(),
+        std::fs::read(world.path("lib.rhai")).unwrap(),
+    );
+    let mut child = Command::new(env!("CARGO_BIN_EXE_lapclone"))
+        .args(["repl", "victim.rhai", "--preview"])
+        .arg(world.path("preview.png"))
+        .current_dir(world.root.path())
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    use std::io::Write as _;
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(b":gif victim.rhai\n:gif lib.rhai\n:gif out.gif\n")
+        .unwrap();
+    let output = child.wait_with_output().unwrap();
+    let all = format!(
+        "{}{}",
+        String::from_utf8_lossy(&output.stdout),
+        String::from_utf8_lossy(&output.stderr)
+    );
+    assert_eq!(output.status.code(), Some(1), "{all}");
+    assert!(all.contains("2 failed entries"), "{all}");
+    assert_eq!(all.matches("would replace an input").count(), 2, "{all}");
+    assert_eq!(std::fs::read(&scene).unwrap(), scene_before);
+    assert_eq!(std::fs::read(world.path("lib.rhai")).unwrap(), lib_before);
+    assert!(world.path("out.gif").is_file(), "{all}");
+}

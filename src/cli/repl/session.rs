@@ -497,6 +497,10 @@ impl Session {
         range: Option<FrameRange>,
     ) -> anyhow::Result<()> {
         let scene = self.current_scene()?;
+        if let Some(loaded) = &self.installed {
+            let imports = self.engine.module_files().files();
+            crate::cli::inputs::refuse_render_input(format.kind(), output, loaded, &imports)?;
+        }
         let started = Instant::now();
         let plan = SinkPlan::new(format.kind(), output, Default::default())?;
         let mut renderer = Renderer::new(scene).map_err(|e| anyhow::anyhow!("{e}"))?;
