@@ -830,3 +830,33 @@ fn the_repl_refuses_to_render_over_its_own_inputs() {
     assert_eq!(std::fs::read(world.path("lib.rhai")).unwrap(), lib_before);
     assert!(world.path("out.gif").is_file(), "{all}");
 }
+
+#[cfg(target_os = "linux")]
+#[test]
+fn a_repl_whose_output_fails_ends_with_exit_1_instead_of_a_panic() {
+    let world = World::new();
+    world.scene("fine.rhai", "");
+    let full = std::fs::OpenOptions::new()
+        .write(true)
+        .open("/dev/full")
+        .unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_lapclone"))
+        .args(["repl", "fine.rhai", "--preview"])
+        .arg(world.path("preview.png"))
+        .current_dir(world.root.path())
+        .env("RUST_BACKTRACE", "0")
+        .stdin(Stdio::piped())
+        .stdout(full)
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    use std::io::Write as _;
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(b"p.at(0, [21, 15]);\n:t 0.5\n")
+        .unwrap();
+    let output = child.wait_with_output().unwrap();
+    expect(&output, 1, "writing to standard output");
+}

@@ -240,7 +240,7 @@ impl Session {
             Command::Mesh => {
                 self.preview.overlay = !self.preview.overlay;
                 let state = if self.preview.overlay { "on" } else { "off" };
-                println!("mesh overlay {state}");
+                crate::cli::repl::print_line(format_args!("mesh overlay {state}"));
                 if self.renderer.is_some() {
                     self.show_frame()?;
                 }
@@ -285,9 +285,9 @@ impl Session {
         if !value.is_unit() {
             let shown = self.display(value);
             if self.interactive {
-                println!("=> {shown}");
+                crate::cli::repl::print_line(format_args!("=> {shown}"));
             } else {
-                println!("{shown}");
+                crate::cli::repl::print_line(&shown);
             }
         }
         Ok(())
@@ -529,12 +529,12 @@ impl Session {
             sink.push(number, renderer.frame())?;
         }
         let written = sink.finish()?;
-        println!(
+        crate::cli::repl::print_line(format_args!(
             "rendered {} frames to {} in {:.2} s",
             range.last - range.first + 1,
             written.display(),
             started.elapsed().as_secs_f64()
-        );
+        ));
         Ok(())
     }
 
