@@ -131,9 +131,9 @@ pub mod animation {
     pub use crate::golden::{GoldenSettings, Thresholds};
     pub use crate::pixels::footage::Pattern;
     pub use crate::scene::{
-        Background, Canvas as SceneCanvas, Easing, Footage, FootageSource, FrameState,
-        Handle as SceneHandle, HandleState, Interpolate, Key, KeyError, ModelError, Patch,
-        PatchState, Pin as ScenePin, Placement as ScenePlacement, Scene, Shape, Track,
+        Background, Canvas as SceneCanvas, Easing, Follow, FollowTarget, Footage, FootageSource,
+        FrameState, Handle as SceneHandle, HandleState, Interpolate, Key, KeyError, ModelError,
+        Patch, PatchState, Pin as ScenePin, Placement as ScenePlacement, Scene, Shape, Track,
     };
     /// Renamed [`SceneCanvas`].
     #[deprecated(note = "renamed `SceneCanvas`")]

@@ -333,7 +333,8 @@ pub(crate) fn default_jobs() -> usize {
     lapclone::util::available_cores()
 }
 
-fn progress_bar(frames: u64) -> ProgressBar {
+/// A frame counter on stderr when it is a terminal (hidden otherwise).
+pub(crate) fn progress_bar(frames: u64) -> ProgressBar {
     if !std::io::stderr().is_terminal() {
         return ProgressBar::hidden();
     }

@@ -2,11 +2,11 @@
 //! frame and tracking settings, and writes the track CSV (atomically), warning on stderr for
 //! each run of frames where a point was lost.
 
-use std::io::{IsTerminal, Write};
+use std::io::Write;
 use std::path::PathBuf;
 
+use super::render::progress_bar;
 use anyhow::Context;
-use indicatif::{ProgressBar, ProgressStyle};
 use lapclone::glam::DVec2;
 use lapclone::pixels::{Footage, FootageError, FootageReader, FootageSource};
 use lapclone::track::{
@@ -218,17 +218,4 @@ fn warn_lost(frames: &[TrackedFrame]) {
         }
         flush(&mut run);
     }
-}
-
-fn progress_bar(frames: u64) -> ProgressBar {
-    if !std::io::stderr().is_terminal() {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::new(frames);
-    if let Ok(style) =
-        ProgressStyle::with_template("{bar:40} {pos}/{len} frames  {per_sec}  eta {eta}")
-    {
-        bar.set_style(style);
-    }
-    bar
 }

@@ -327,14 +327,12 @@ impl PatchRef {
         ctx: &NativeCallContext,
         edit: impl FnOnce(&mut Patch) -> Result<R, String>,
     ) -> Fallible<R> {
-        let mut d = self.draft.lock();
-        let Some(index) = d.patch_index(self.id) else {
-            return Err(fail(ctx, "this patch no longer exists in the scene"));
-        };
-        let mut patch = d.patches[index].clone();
-        let result = edit(&mut patch).map_err(|m| fail(ctx, m))?;
-        d.patches[index] = patch;
-        Ok(result)
+        self.edit_in_place(ctx, |patch| {
+            let mut copy = patch.clone();
+            let result = edit(&mut copy)?;
+            *patch = copy;
+            Ok(result)
+        })
     }
 
     /// Applies `edit` to the patch itself, for edits that change it only once every check

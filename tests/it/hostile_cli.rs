@@ -69,6 +69,25 @@ impl World {
             .unwrap()
     }
 
+    /// `lapclone repl ARGS --preview …` in the world, fed `input`, its stdout to `stdout`.
+    fn repl(&self, args: &[&str], input: &[u8], stdout: Stdio) -> Output {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_lapclone"))
+            .arg("repl")
+            .args(args)
+            .arg("--preview")
+            .arg(self.path("preview.png"))
+            .current_dir(self.root.path())
+            .env("RUST_BACKTRACE", "0")
+            .stdin(Stdio::piped())
+            .stdout(stdout)
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        use std::io::Write as _;
+        child.stdin.take().unwrap().write_all(input).unwrap();
+        child.wait_with_output().unwrap()
+    }
+
     fn names(&self) -> Vec<String> {
         sorted_names(self.root.path())
     }
@@ -756,23 +775,11 @@ fn the_repl_survives_loading_an_import_cycle() {
     world.write("b.rhai", "import \"a\" as a;\n");
     world.scene("cycle.rhai", "import \"a\" as a;\n");
     world.scene("fine.rhai", "");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_lapclone"))
-        .args(["repl", "--preview"])
-        .arg(world.path("preview.png"))
-        .current_dir(world.root.path())
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    use std::io::Write as _;
-    child
-        .stdin
-        .take()
-        .unwrap()
-        .write_all(b":load cycle.rhai\n:load fine.rhai\n:list\n")
-        .unwrap();
-    let output = child.wait_with_output().unwrap();
+    let output = world.repl(
+        &[],
+        b":load cycle.rhai\n:load fine.rhai\n:list\n",
+        Stdio::piped(),
+    );
     let all = format!(
         "{}{}",
         String::from_utf8_lossy(&output.stdout),
@@ -801,23 +808,11 @@ fn the_repl_refuses_to_render_over_its_own_inputs() {
         std::fs::read(&scene).unwrap(),
         std::fs::read(world.path("lib.rhai")).unwrap(),
     );
-    let mut child = Command::new(env!("CARGO_BIN_EXE_lapclone"))
-        .args(["repl", "victim.rhai", "--preview"])
-        .arg(world.path("preview.png"))
-        .current_dir(world.root.path())
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    use std::io::Write as _;
-    child
-        .stdin
-        .take()
-        .unwrap()
-        .write_all(b":gif victim.rhai\n:gif lib.rhai\n:gif out.gif\n")
-        .unwrap();
-    let output = child.wait_with_output().unwrap();
+    let output = world.repl(
+        &["victim.rhai"],
+        b":gif victim.rhai\n:gif lib.rhai\n:gif out.gif\n",
+        Stdio::piped(),
+    );
     let all = format!(
         "{}{}",
         String::from_utf8_lossy(&output.stdout),
@@ -840,23 +835,10 @@ fn a_repl_whose_output_fails_ends_with_exit_1_instead_of_a_panic() {
         .write(true)
         .open("/dev/full")
         .unwrap();
-    let mut child = Command::new(env!("CARGO_BIN_EXE_lapclone"))
-        .args(["repl", "fine.rhai", "--preview"])
-        .arg(world.path("preview.png"))
-        .current_dir(world.root.path())
-        .env("RUST_BACKTRACE", "0")
-        .stdin(Stdio::piped())
-        .stdout(full)
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    use std::io::Write as _;
-    child
-        .stdin
-        .take()
-        .unwrap()
-        .write_all(b"p.at(0, [21, 15]);\n:t 0.5\n")
-        .unwrap();
-    let output = child.wait_with_output().unwrap();
+    let output = world.repl(
+        &["fine.rhai"],
+        b"p.at(0, [21, 15]);\n:t 0.5\n",
+        Stdio::from(full),
+    );
     expect(&output, 1, "writing to standard output");
 }
