@@ -81,6 +81,26 @@ pub fn say(line: impl std::fmt::Display) -> anyhow::Result<()> {
         .map_err(|e| anyhow::anyhow!("writing to standard output: {e}"))
 }
 
+/// The first failed write to standard output (closed, a full disk, a broken pipe).
+static STDOUT_FAILED: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+
+/// Prints a line to standard output where a command goes on after a failed write (the
+/// REPL, a review): the failure never panics, it is kept, and the command ends with it
+/// (exit 1) at its next check, so nothing is silently lost.
+pub(crate) fn print_line(line: impl std::fmt::Display) {
+    if let Err(error) = say(line) {
+        let _ = STDOUT_FAILED.set(describe(&error));
+    }
+}
+
+/// The kept failed write, as an error.
+pub(crate) fn stdout_failure() -> anyhow::Result<()> {
+    match STDOUT_FAILED.get() {
+        Some(message) => Err(anyhow::anyhow!("{message}")),
+        None => Ok(()),
+    }
+}
+
 /// The error and its causes as one line, `outer: cause: …`. The library's errors already
 /// end their message with their cause's, so a cause whose text the line holds is not
 /// repeated (anyhow's `{:#}` would print it twice).

@@ -98,7 +98,7 @@ pub fn run(args: ReplArgs) -> anyhow::Result<()> {
             None => Box::new(std::io::stdin().lock()),
         };
         failures += script_loop(&session, input)?;
-        stdout_failure()?;
+        super::stdout_failure()?;
         if failures > 0 {
             return Err(EntriesFailed(failures).into());
         }
@@ -122,7 +122,7 @@ fn start_view(
             server.addr
         );
     }
-    print_line(format_args!("view: {}", server.url));
+    super::print_line(format_args!("view: {}", server.url));
     if args.open {
         crate::cli::view::open_in_browser(&server.url);
     }
@@ -131,26 +131,6 @@ fn start_view(
 
 fn lock(session: &Mutex<Session>) -> std::sync::MutexGuard<'_, Session> {
     crate::cli::view::lock(session)
-}
-
-/// The first failed write to standard output (closed, a full disk, a broken pipe).
-static STDOUT_FAILED: std::sync::OnceLock<String> = std::sync::OnceLock::new();
-
-/// Prints a line of the session's to standard output. A failed write never panics: it is
-/// kept, and the session ends with it (exit 1) before its next entry, so nothing the
-/// session says is silently lost.
-pub(crate) fn print_line(line: impl std::fmt::Display) {
-    if let Err(error) = super::say(line) {
-        let _ = STDOUT_FAILED.set(super::describe(&error));
-    }
-}
-
-/// The kept failed write, as an error.
-fn stdout_failure() -> anyhow::Result<()> {
-    match STDOUT_FAILED.get() {
-        Some(message) => Err(anyhow::anyhow!("{message}")),
-        None => Ok(()),
-    }
 }
 
 /// Removes its file when dropped (a file that was never written is no error).
@@ -181,7 +161,7 @@ fn script_loop(session: &Mutex<Session>, input: Box<dyn BufRead>) -> anyhow::Res
             continue;
         }
         let entry = std::mem::take(&mut buffer);
-        stdout_failure()?;
+        super::stdout_failure()?;
         match lock(session).entry(&entry) {
             Step::Ok => {}
             Step::Failed => failures += 1,
@@ -231,7 +211,7 @@ fn interactive_loop(
     if let Some(path) = &history {
         let _ = editor.load_history(path);
     }
-    print_line(format_args!(
+    super::print_line(format_args!(
         "lapclone repl — :help for commands, Ctrl-D to quit"
     ));
     loop {
@@ -243,7 +223,7 @@ fn interactive_loop(
                 if lock(session).entry(&line) == Step::Quit {
                     break;
                 }
-                stdout_failure()?;
+                super::stdout_failure()?;
             }
             Err(ReadlineError::Interrupted) => continue,
             Err(ReadlineError::Eof) => break,

@@ -13,9 +13,14 @@ use super::test_args::{find_scenes, golden_dir, remove_if_present, write_file, T
 use super::test_report::scene_slug;
 
 pub fn run(args: &TestArgs, paths: &[PathBuf]) -> anyhow::Result<()> {
+    act(args, paths)?;
+    super::stdout_failure()
+}
+
+fn act(args: &TestArgs, paths: &[PathBuf]) -> anyhow::Result<()> {
     let pending = find_pending(args, paths)?;
     if pending.is_empty() {
-        println!("no pending frames under {}", list(paths));
+        super::print_line(format_args!("no pending frames under {}", list(paths)));
         return Ok(());
     }
     if args.review {
@@ -24,10 +29,10 @@ pub fn run(args: &TestArgs, paths: &[PathBuf]) -> anyhow::Result<()> {
     for file in &pending {
         if args.accept {
             accept(file)?;
-            println!("accepted {}", golden_of(file).display());
+            super::print_line(format_args!("accepted {}", golden_of(file).display()));
         } else {
             remove_if_present(file)?;
-            println!("rejected {}", file.display());
+            super::print_line(format_args!("rejected {}", file.display()));
         }
     }
     Ok(())
@@ -111,7 +116,12 @@ fn review(args: &TestArgs, pending: &[PathBuf]) -> anyhow::Result<()> {
     let mut lines = stdin.lock().lines();
     let (mut accepted, mut rejected, mut skipped) = (0, 0, 0);
     for (index, file) in pending.iter().enumerate() {
-        println!("[{}/{}] {}", index + 1, pending.len(), file.display());
+        super::print_line(format_args!(
+            "[{}/{}] {}",
+            index + 1,
+            pending.len(),
+            file.display()
+        ));
         show(args, file)?;
         let answer = loop {
             print!("accept, reject or skip? [a/r/s/q] ");
@@ -120,7 +130,7 @@ fn review(args: &TestArgs, pending: &[PathBuf]) -> anyhow::Result<()> {
                 break "q".to_string();
             };
             if !std::io::stdin().is_terminal() {
-                println!("{}", line.trim());
+                super::print_line(format_args!("{}", line.trim()));
             }
             let word = line.trim().to_lowercase();
             if ["a", "r", "s", "q"].contains(&word.as_str()) {
@@ -131,22 +141,24 @@ fn review(args: &TestArgs, pending: &[PathBuf]) -> anyhow::Result<()> {
             "a" => {
                 accept(file)?;
                 accepted += 1;
-                println!("accepted {}", golden_of(file).display());
+                super::print_line(format_args!("accepted {}", golden_of(file).display()));
             }
             "r" => {
                 remove_if_present(file)?;
                 rejected += 1;
-                println!("rejected {}", file.display());
+                super::print_line(format_args!("rejected {}", file.display()));
             }
             "s" => skipped += 1,
             _ => {
                 skipped += pending.len() - index;
-                println!();
+                super::print_line("");
                 break;
             }
         }
     }
-    println!("review: {accepted} accepted, {rejected} rejected, {skipped} skipped");
+    super::print_line(format_args!(
+        "review: {accepted} accepted, {rejected} rejected, {skipped} skipped"
+    ));
     Ok(())
 }
 
@@ -158,18 +170,18 @@ fn show(args: &TestArgs, file: &Path) -> anyhow::Result<()> {
         match GoldenFrame::load(&golden_path) {
             Ok(frame) => Some(frame),
             Err(error) => {
-                println!("  golden unreadable: {error}");
+                super::print_line(format_args!("  golden unreadable: {error}"));
                 None
             }
         }
     } else {
-        println!("  new: no golden {}", golden_path.display());
+        super::print_line(format_args!("  new: no golden {}", golden_path.display()));
         None
     };
     let thresholds = super::test_args::overrides(args, Thresholds::default());
     if let Some(expected) = &expected {
         match compare(expected, &actual, &thresholds) {
-            Ok(c) => println!(
+            Ok(c) => super::print_line(format_args!(
                 "  max {} @ ({}, {}, {}), {} px over {} ({:.3}%), PSNR {}, SSIM {:.4}",
                 c.figures.max.value,
                 c.figures.max.x,
@@ -182,8 +194,8 @@ fn show(args: &TestArgs, file: &Path) -> anyhow::Result<()> {
                     .psnr
                     .map_or_else(|| "inf".into(), |p| format!("{p:.2} dB")),
                 c.figures.ssim
-            ),
-            Err(mismatch) => println!("  {mismatch}"),
+            )),
+            Err(mismatch) => super::print_line(format_args!("  {mismatch}")),
         }
     }
     let sheet = triptych(expected.as_ref(), &actual, &thresholds);
@@ -191,7 +203,10 @@ fn show(args: &TestArgs, file: &Path) -> anyhow::Result<()> {
         let name = format!("{}.png", scene_slug(&file.with_extension("")));
         let path = args.out_dir().join("review").join(name);
         write_file(&path, &lapclone::golden::encode_rgba_png(&sheet))?;
-        println!("  expected | difference | actual: {}", path.display());
+        super::print_line(format_args!(
+            "  expected | difference | actual: {}",
+            path.display()
+        ));
     }
     Ok(())
 }

@@ -842,3 +842,22 @@ fn a_repl_whose_output_fails_ends_with_exit_1_instead_of_a_panic() {
     );
     expect(&output, 1, "writing to standard output");
 }
+
+#[cfg(target_os = "linux")]
+#[test]
+fn accepting_goldens_into_a_failing_output_is_exit_1_instead_of_a_panic() {
+    let world = World::new();
+    world.scene("fine.rhai", "");
+    let full = std::fs::OpenOptions::new()
+        .write(true)
+        .open("/dev/full")
+        .unwrap();
+    let output = Command::new(env!("CARGO_BIN_EXE_lapclone"))
+        .args(["test", "--accept", "fine.rhai"])
+        .current_dir(world.root.path())
+        .env("RUST_BACKTRACE", "0")
+        .stdout(full)
+        .output()
+        .unwrap();
+    expect(&output, 1, "writing to standard output");
+}

@@ -119,10 +119,10 @@ impl Preview {
             if self.overlay { ", mesh" } else { "" }
         );
         match self.inline {
-            Inline::None if self.interactive => crate::cli::repl::print_line(&line),
+            Inline::None if self.interactive => crate::cli::print_line(&line),
             Inline::None => {
                 if !self.announced {
-                    crate::cli::repl::print_line(format_args!("preview: {}", self.path.display()));
+                    crate::cli::print_line(format_args!("preview: {}", self.path.display()));
                 }
             }
             protocol => {
@@ -131,7 +131,7 @@ impl Preview {
                 } else {
                     print_inline(protocol, png);
                 }
-                crate::cli::repl::print_line(format_args!("{}", line.replacen("preview: ", "", 1)));
+                crate::cli::print_line(format_args!("{}", line.replacen("preview: ", "", 1)));
             }
         }
         self.announced = true;

@@ -240,7 +240,7 @@ impl Session {
             Command::Mesh => {
                 self.preview.overlay = !self.preview.overlay;
                 let state = if self.preview.overlay { "on" } else { "off" };
-                crate::cli::repl::print_line(format_args!("mesh overlay {state}"));
+                crate::cli::print_line(format_args!("mesh overlay {state}"));
                 if self.renderer.is_some() {
                     self.show_frame()?;
                 }
@@ -285,9 +285,9 @@ impl Session {
         if !value.is_unit() {
             let shown = self.display(value);
             if self.interactive {
-                crate::cli::repl::print_line(format_args!("=> {shown}"));
+                crate::cli::print_line(format_args!("=> {shown}"));
             } else {
-                crate::cli::repl::print_line(&shown);
+                crate::cli::print_line(&shown);
             }
         }
         Ok(())
@@ -529,7 +529,7 @@ impl Session {
             sink.push(number, renderer.frame())?;
         }
         let written = sink.finish()?;
-        crate::cli::repl::print_line(format_args!(
+        crate::cli::print_line(format_args!(
             "rendered {} frames to {} in {:.2} s",
             range.last - range.first + 1,
             written.display(),

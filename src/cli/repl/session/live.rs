@@ -28,9 +28,9 @@ impl Session {
         match (&self.printer, self.from_view) {
             (Some(printer), true) => match crate::cli::view::lock(printer).as_mut() {
                 Some(print) => print(text),
-                None => crate::cli::repl::print_line(&text),
+                None => crate::cli::print_line(&text),
             },
-            _ => crate::cli::repl::print_line(&text),
+            _ => crate::cli::print_line(&text),
         }
     }
 
