@@ -3,46 +3,9 @@
 //! REPL lists them as one entry, `:save` writes the `follow` call again instead of every key,
 //! and `check` warns about frames the track does not reach.
 
-use std::path::PathBuf;
 
-use glam::DVec2;
+use super::types::{Follow, FollowTarget, Patch};
 
-use super::track::Track;
-use super::types::Patch;
-
-/// What a `follow` call drives.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum FollowTarget {
-    /// The patch's placement (`at`, and `rotate` / `scale` when followed).
-    Patch,
-    /// The target of the patch's handle with this index.
-    Handle(usize),
-}
-
-/// One `follow` call: the file, its settings as written, and the tracks it set.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Follow {
-    /// The track file (resolved against the scene's folder).
-    pub file: PathBuf,
-    /// What it drives.
-    pub target: FollowTarget,
-    /// The point followed (from 1).
-    pub point: usize,
-    /// The offset added to the point.
-    pub offset: DVec2,
-    /// `rotate` as written (`None`: not written).
-    pub rotate: Option<bool>,
-    /// `scale` as written (`None`: not written).
-    pub scale: Option<bool>,
-    /// `from_frame` as written.
-    pub from_frame: Option<u64>,
-    /// The position keys it set.
-    pub at: Track<DVec2>,
-    /// The rotation keys it set, when it followed the rotation.
-    pub rotation: Option<Track<f64>>,
-    /// The scale keys it set, when it followed the scale.
-    pub scale_keys: Option<Track<f64>>,
-}
 
 impl Follow {
     /// Whether `patch`'s tracks still hold exactly the keys this call set.

@@ -11,10 +11,10 @@ mod types;
 mod warnings;
 
 pub use evaluate::{frame_time, FrameState, HandleState, PatchState};
-pub use follow::{Follow, FollowTarget};
 pub use to_rhai::rhai_string_literal;
 pub use track::{Easing, Interpolate, Key, KeyError, Track};
 pub use types::{
+    Follow, FollowTarget,
     check_polygons, Background, BoundaryData, BoundaryPlacement, Canvas, CloneMode, Footage,
     FootageSource, Handle, LaplacianKind, ModelError, Patch, Pin, Placement, Polygon, Scene, Shape,
     MAX_CANVAS_SIDE,

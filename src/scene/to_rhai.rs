@@ -9,7 +9,7 @@ use std::path::{Component, Path, PathBuf};
 
 use glam::DVec2;
 
-use super::follow::{Follow, FollowTarget};
+use super::types::{Follow, FollowTarget};
 use super::track::{Interpolate, Track};
 use super::types::{
     Background, Canvas, Footage, FootageSource, Handle, Patch, Pin, Polygon, Scene, Shape,

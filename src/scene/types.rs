@@ -153,7 +153,7 @@ pub struct Patch {
     /// Points held still while active.
     pub pins: Vec<Pin>,
     /// Tracks this patch's keys came from (`follow` calls), latest last.
-    pub follows: Vec<super::follow::Follow>,
+    pub follows: Vec<Follow>,
 }
 
 impl Patch {
@@ -362,4 +362,38 @@ pub fn check_polygons(polygons: &[Polygon]) -> Result<(), String> {
         }
     }
     Ok(())
+}
+
+/// What a `follow` call drives.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FollowTarget {
+    /// The patch's placement (`at`, and `rotate` / `scale` when followed).
+    Patch,
+    /// The target of the patch's handle with this index.
+    Handle(usize),
+}
+
+/// One `follow` call: the file, its settings as written, and the tracks it set.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Follow {
+    /// The track file (resolved against the scene's folder).
+    pub file: PathBuf,
+    /// What it drives.
+    pub target: FollowTarget,
+    /// The point followed (from 1).
+    pub point: usize,
+    /// The offset added to the point.
+    pub offset: DVec2,
+    /// `rotate` as written (`None`: not written).
+    pub rotate: Option<bool>,
+    /// `scale` as written (`None`: not written).
+    pub scale: Option<bool>,
+    /// `from_frame` as written.
+    pub from_frame: Option<u64>,
+    /// The position keys it set.
+    pub at: Track<DVec2>,
+    /// The rotation keys it set, when it followed the rotation.
+    pub rotation: Option<Track<f64>>,
+    /// The scale keys it set, when it followed the scale.
+    pub scale_keys: Option<Track<f64>>,
 }

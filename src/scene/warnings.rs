@@ -1,7 +1,7 @@
 //! Things a scene allows but a user probably did not mean: takes a [`Scene`] and gives
 //! warnings as sentences (today: keys after the scene's end, which no frame shows).
 
-use super::follow::{Follow, FollowTarget};
+use super::types::{Follow, FollowTarget};
 use super::track::{Interpolate, Track};
 use super::types::Scene;
 
