@@ -54,18 +54,6 @@ impl<'a> FrameRef<'a> {
         matches!(self.pixels, Pixels::Rgba16(_))
     }
 
-    pub fn to_owned_frame(self) -> Frame {
-        let data = match self.pixels {
-            Pixels::Rgba8(p) => FrameData::Rgba8(p.to_vec()),
-            Pixels::Rgba16(p) => FrameData::Rgba16(p.to_vec()),
-        };
-        Frame {
-            width: self.width,
-            height: self.height,
-            data,
-        }
-    }
-
     /// Writes the 8-bit RGBA form into `out` (16-bit samples rounded to the nearest 8-bit).
     pub fn write_rgba8(&self, out: &mut Vec<u8>) {
         out.clear();

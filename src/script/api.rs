@@ -499,19 +499,18 @@ impl HandleRef {
         Some((p, d.handle_index(p, self.handle)?))
     }
 
+    /// Applies `edit` to a copy of the handle and commits it only if it succeeds.
     pub(super) fn edit(
         &self,
         ctx: &NativeCallContext,
         edit: impl FnOnce(&mut Handle) -> Result<(), String>,
     ) -> Fallible<Self> {
-        let mut d = self.draft.lock();
-        let Some((p, h)) = self.indices(&d) else {
-            return Err(fail(ctx, "this handle no longer exists in the scene"));
-        };
-        let mut handle = d.patches[p].handles[h].clone();
-        edit(&mut handle).map_err(|m| fail(ctx, m))?;
-        d.patches[p].handles[h] = handle;
-        Ok(self.clone())
+        self.edit_in_place(ctx, |handle| {
+            let mut copy = handle.clone();
+            edit(&mut copy)?;
+            *handle = copy;
+            Ok(())
+        })
     }
 
     /// Applies `edit` to the handle itself, for edits that change it only once every check
@@ -675,38 +674,32 @@ impl CustomType for PinRef {
     }
 }
 
+/// A handle call taking a time, a value and an easing.
+type HandleKey = fn(&mut HandleRef, NativeCallContext, Dynamic, Dynamic, &str) -> Fallible<HandleRef>;
+
 impl CustomType for HandleRef {
     fn build(mut b: TypeBuilder<Self>) {
         b.with_name("Handle")
             .with_fn("to_string", |_: &mut HandleRef| "handle".to_string())
             .with_fn(
-                "key",
-                |ctx: NativeCallContext, h: &mut HandleRef, t: Dynamic, to: Dynamic| {
-                    h.key(ctx, t, to, "linear")
-                },
-            )
-            .with_fn(
-                "key",
-                |ctx: NativeCallContext, h: &mut HandleRef, t: Dynamic, to: Dynamic, e: &str| {
-                    h.key(ctx, t, to, e)
-                },
-            )
-            .with_fn(
                 "keys",
                 |ctx: NativeCallContext, h: &mut HandleRef, l: rhai::Array| h.keys(ctx, l),
-            )
-            .with_fn(
-                "rotate",
-                |ctx: NativeCallContext, h: &mut HandleRef, t: Dynamic, r: Dynamic| {
-                    h.rotate(ctx, t, r, "linear")
+            );
+        // `h.key(t, to [, easing])` and `h.rotate(t, degrees [, easing])`.
+        for (name, call) in [("key", HandleRef::key as HandleKey), ("rotate", HandleRef::rotate)] {
+            b.with_fn(
+                name,
+                move |ctx: NativeCallContext, h: &mut HandleRef, t: Dynamic, v: Dynamic| {
+                    call(h, ctx, t, v, "linear")
                 },
             )
             .with_fn(
-                "rotate",
-                |ctx: NativeCallContext, h: &mut HandleRef, t: Dynamic, r: Dynamic, e: &str| {
-                    h.rotate(ctx, t, r, e)
+                name,
+                move |ctx: NativeCallContext, h: &mut HandleRef, t: Dynamic, v: Dynamic, e: &str| {
+                    call(h, ctx, t, v, e)
                 },
             );
+        }
         super::edit_api::build_handle(&mut b);
     }
 }

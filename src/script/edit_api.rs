@@ -89,12 +89,7 @@ impl<'a> Tracks<'a> {
             Some(name) => format!("no {name:?} key"),
             None => "no key".to_string(),
         };
-        let keys = if times.is_empty() {
-            "it has no keys".to_string()
-        } else {
-            let listed: Vec<String> = times.iter().map(|t| t.to_string()).collect();
-            format!("its keys are at {}", listed.join(", "))
-        };
+        let keys = listed(times.iter().map(f64::to_string), "it has no keys", "its keys are at ");
         Err(format!("{what} at t = {t} on {owner}; {keys}"))
     }
 
@@ -202,13 +197,8 @@ impl PatchRef {
     fn handle_at(&mut self, ctx: NativeCallContext, which: Dynamic) -> Fallible<HandleRef> {
         let d = self.draft.lock();
         let found = index_of(&d, self).and_then(|p| {
-            let h = index(&which, "handle", d.patches[p].handles.len()).map_err(|m| {
-                format!(
-                    "{m} on patch {:?}; {}",
-                    d.patches[p].name,
-                    handles_listed(&d.patches[p])
-                )
-            })?;
+            let h = index(&which, "handle", d.patches[p].handles.len())
+                .map_err(|m| handles_listed(m, &d.patches[p]))?;
             Ok(d.ids.handles[p][h])
         });
         let handle = found.map_err(|m| fail(&ctx, m))?;
@@ -236,13 +226,8 @@ impl PatchRef {
                     }
                     h
                 }
-                None => index(&which, "handle", d.patches[p].handles.len()).map_err(|m| {
-                    format!(
-                        "{m} on patch {:?}; {}",
-                        d.patches[p].name,
-                        handles_listed(&d.patches[p])
-                    )
-                })?,
+                None => index(&which, "handle", d.patches[p].handles.len())
+                    .map_err(|m| handles_listed(m, &d.patches[p]))?,
             };
             d.patches[p].handles.remove(h);
             d.ids.handles[p].remove(h);
@@ -259,18 +244,10 @@ impl PatchRef {
         self.edit(&ctx, |p| {
             let i = if which.is_array() {
                 let at = values::point(&which, "pin point")?;
-                p.pins.iter().position(|pin| pin.at == at).ok_or_else(|| {
-                    format!(
-                        "no pin at [{}, {}] on patch {:?}; {}",
-                        at.x,
-                        at.y,
-                        p.name,
-                        pins_listed(p)
-                    )
-                })?
+                let found = p.pins.iter().position(|pin| pin.at == at);
+                found.ok_or_else(|| pins_listed(format!("no pin at [{}, {}]", at.x, at.y), p))?
             } else {
-                index(&which, "pin", p.pins.len())
-                    .map_err(|m| format!("{m} on patch {:?}; {}", p.name, pins_listed(p)))?
+                index(&which, "pin", p.pins.len()).map_err(|m| pins_listed(m, p))?
             };
             p.pins.remove(i);
             Ok(())
@@ -328,30 +305,29 @@ fn index(value: &Dynamic, what: &str, len: usize) -> Result<usize, String> {
         .ok_or_else(|| format!("no {what} {i}"))
 }
 
-fn handles_listed(p: &Patch) -> String {
-    if p.handles.is_empty() {
-        return "it has no handles".into();
-    }
-    let listed: Vec<String> = p
-        .handles
-        .iter()
-        .enumerate()
-        .map(|(i, h)| format!("{i} from [{}, {}]", h.from.x, h.from.y))
-        .collect();
-    format!("its handles: {}", listed.join(", "))
+/// `error` on patch `p`, followed by the handles it has.
+fn handles_listed(error: String, p: &Patch) -> String {
+    let each = p.handles.iter().enumerate();
+    let each = each.map(|(i, h)| format!("{i} from [{}, {}]", h.from.x, h.from.y));
+    let handles = listed(each, "it has no handles", "its handles: ");
+    format!("{error} on patch {:?}; {handles}", p.name)
 }
 
-fn pins_listed(p: &Patch) -> String {
-    if p.pins.is_empty() {
-        return "it has no pins".into();
+/// `error` on patch `p`, followed by the pins it has.
+fn pins_listed(error: String, p: &Patch) -> String {
+    let each = p.pins.iter().enumerate();
+    let each = each.map(|(i, pin)| format!("{i} at [{}, {}]", pin.at.x, pin.at.y));
+    let pins = listed(each, "it has no pins", "its pins: ");
+    format!("{error} on patch {:?}; {pins}", p.name)
+}
+
+/// `none` for no items, else `some` followed by the items separated by commas.
+fn listed(items: impl Iterator<Item = String>, none: &str, some: &str) -> String {
+    let items: Vec<String> = items.collect();
+    if items.is_empty() {
+        return none.into();
     }
-    let listed: Vec<String> = p
-        .pins
-        .iter()
-        .enumerate()
-        .map(|(i, pin)| format!("{i} at [{}, {}]", pin.at.x, pin.at.y))
-        .collect();
-    format!("its pins: {}", listed.join(", "))
+    format!("{some}{}", items.join(", "))
 }
 
 impl HandleRef {

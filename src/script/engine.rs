@@ -60,7 +60,6 @@ pub struct SceneEngine {
     engine: Engine,
     draft: SharedDraft,
     modules: ModuleFiles,
-    cancel: Arc<AtomicBool>,
     budget: MemoryBudget,
 }
 
@@ -121,17 +120,12 @@ impl SceneEngine {
             engine,
             draft,
             modules,
-            cancel: options.cancel.clone(),
             budget,
         }
     }
 
     pub fn engine(&self) -> &Engine {
         &self.engine
-    }
-
-    pub fn cancel_flag(&self) -> Arc<AtomicBool> {
-        self.cancel.clone()
     }
 
     pub fn module_files(&self) -> &ModuleFiles {
