@@ -172,35 +172,7 @@ fn drag(
     let rev = scene["rev"]
         .as_u64()
         .context("the scene message has no rev")?;
-    // Page point of canvas point (x, y): the canvas is shown scaled to fit the window.
-    let rect = browser.eval(
-        "(() => { const o = document.getElementById('overlay'), r = o.getBoundingClientRect();
-          return [r.left, r.top, r.width / o.width, r.height / o.height]; })()",
-    )?;
-    let r: Vec<f64> = rect
-        .as_array()
-        .into_iter()
-        .flatten()
-        .filter_map(Value::as_f64)
-        .collect();
-    anyhow::ensure!(r.len() == 4, "the page gave no canvas rectangle: {rect}");
-    let page = |p: [f64; 2]| (r[0] + p[0] * r[2], r[1] + p[1] * r[3]);
-
-    let (x, y) = page(point(&scene, 0)?);
-    browser.mouse("mouseMoved", x, y)?;
-    browser.mouse("mousePressed", x, y)?;
-    let started = Instant::now();
-    for i in 1..=steps {
-        let due = POINTER_PERIOD * i as u32;
-        if let Some(wait) = due.checked_sub(started.elapsed()) {
-            std::thread::sleep(wait);
-        }
-        let (x, y) = page(point(&scene, i)?);
-        browser.mouse("mouseMoved", x, y)?;
-    }
-    let dispatched = started.elapsed();
-    let (x, y) = page(point(&scene, steps)?);
-    browser.mouse("mouseReleased", x, y)?;
+    let dispatched = pointer_drag(&mut browser, steps, |i| point(&scene, i))?;
     // The commit's scene message comes after every preview's frame; then let the last
     // preview's paint be recorded.
     browser.wait_for(&format!("window.lapcloneScene().rev > {rev}"), PAGE_TIMEOUT)?;
@@ -212,6 +184,45 @@ fn drag(
     drop(browser);
     drop(server);
     summary(name, steps, dispatched, timings, &painted_at)
+}
+
+/// Presses at canvas point `point(0)`, moves through `point(1..=steps)` at 60 Hz (a move
+/// that falls behind goes at once) and releases; gives how long the moves took.
+fn pointer_drag(
+    browser: &mut Browser,
+    steps: usize,
+    point: impl Fn(usize) -> anyhow::Result<[f64; 2]>,
+) -> anyhow::Result<Duration> {
+    let r = canvas_on_page(browser)?;
+    let page = |i: usize| point(i).map(|p| (r[0] + p[0] * r[2], r[1] + p[1] * r[3]));
+    let (x, y) = page(0)?;
+    browser.mouse("mouseMoved", x, y)?;
+    browser.mouse("mousePressed", x, y)?;
+    let started = Instant::now();
+    for i in 1..=steps {
+        let due = POINTER_PERIOD * i as u32;
+        if let Some(wait) = due.checked_sub(started.elapsed()) {
+            std::thread::sleep(wait);
+        }
+        let (x, y) = page(i)?;
+        browser.mouse("mouseMoved", x, y)?;
+    }
+    let dispatched = started.elapsed();
+    let (x, y) = page(steps)?;
+    browser.mouse("mouseReleased", x, y)?;
+    Ok(dispatched)
+}
+
+/// Where the canvas is on the page: left, top and page pixels per canvas pixel across and
+/// down (the canvas is shown scaled to fit the window).
+fn canvas_on_page(browser: &mut Browser) -> anyhow::Result<[f64; 4]> {
+    let rect = browser.eval(
+        "(() => { const o = document.getElementById('overlay'), r = o.getBoundingClientRect();
+          return [r.left, r.top, r.width / o.width, r.height / o.height]; })()",
+    )?;
+    let r = numbers(&rect);
+    r.try_into()
+        .map_err(|_| anyhow::anyhow!("the page gave no canvas rectangle: {rect}"))
 }
 
 /// The figures of one drag from the page's timings and paint times (ms, page clock).
