@@ -165,6 +165,7 @@ fn measure(settings: &Settings) -> Result<(Vec<Check>, Vec<Skipped>), String> {
     whole_process_checks(settings, &mut checks, &mut skipped)?;
     track_checks(settings, &mut checks, &mut skipped)?;
     view_checks(settings, &mut checks, &mut skipped)?;
+    browser_checks(settings, &mut checks, &mut skipped)?;
     Ok((checks, skipped))
 }
 
@@ -294,6 +295,53 @@ fn view_checks(
                         "no {}: run `cargo build --release` first",
                         lapclone.display()
                     ),
+                }),
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Issue #40: the same drags in headless chromium, pointer events at 60 Hz: pointer event →
+/// pixels painted (the page's own timing) and previews painted per second (skipped without
+/// chromium or the release `lapclone`).
+fn browser_checks(
+    settings: &Settings,
+    checks: &mut Vec<Check>,
+    skipped: &mut Vec<Skipped>,
+) -> Result<(), String> {
+    let steps = settings.pick("50", "200");
+    let lapclone = Path::new(env!("CARGO_BIN_EXE_lapclone-bench"))
+        .with_file_name(format!("lapclone{}", std::env::consts::EXE_SUFFIX));
+    let report = if lapclone.is_file() {
+        run_bench(&["browser", "--steps", steps])?
+    } else {
+        let reason = format!(
+            "no {}: run `cargo build --release` first",
+            lapclone.display()
+        );
+        serde_json::json!({ "skipped": reason })
+    };
+    let reason = report.pointer("/skipped").and_then(Value::as_str);
+    for (index, scene) in ["cat", "horse folding"].iter().enumerate() {
+        for (key, label, bound) in [
+            ("median_ms", "median (ms)", Bound::AtMost(16.0)),
+            ("p95_ms", "p95 (ms)", Bound::AtMost(33.0)),
+            ("updates_per_s", "painted/s", Bound::AtLeast(50.0)),
+        ] {
+            let what = format!("chromium drag, {scene}, {steps} moves at 60 Hz, {label}");
+            match reason {
+                Some(reason) => skipped.push(Skipped {
+                    issue: 40,
+                    what,
+                    bound,
+                    reason: reason.to_string(),
+                }),
+                None => checks.push(Check {
+                    issue: 40,
+                    what,
+                    measured: number(&report, &format!("/drags/{index}/{key}"))?,
+                    bound,
                 }),
             }
         }

@@ -5,7 +5,11 @@
 //! - [`reference`](mod@reference): the pixel-grid Poisson membrane, MVC cloning, the quality metrics and
 //!   the paper's experiments and figures;
 //! - [`commands`]: `lapclone-bench mesh | factor | solver | deform | render | clone | paper |
-//!   opencv`, each printing a table or, with `--json`, one JSON document.
+//!   opencv | track | view | browser`, each printing a table or, with `--json`, one JSON
+//!   document;
+//! - [`cdp`]: the headless chromium client the `browser` benchmark and the live view's browser
+//!   test share.
 
+pub mod cdp;
 pub mod commands;
 pub mod reference;

@@ -149,11 +149,12 @@ impl PatchState {
         if !self.deformed_now {
             self.cloner.prepare_rigid(&pose.placement).map_err(to_py)?;
         } else {
-            if self.rig.is_none() {
-                let rig = DeformRig::new(self.cloner.mesh(), self.laplacian).map_err(to_py)?;
-                self.rig = Some(rig);
-            }
-            let rig = self.rig.as_mut().expect("built just above"); // invariant: set above
+            let rig = match &mut self.rig {
+                Some(rig) => rig,
+                slot => {
+                    slot.insert(DeformRig::new(self.cloner.mesh(), self.laplacian).map_err(to_py)?)
+                }
+            };
             rig.deform(&pose.handles, &pose.pins, &mut self.deformed)
                 .map_err(to_py)?;
             let d = &self.deformed;
@@ -178,18 +179,21 @@ impl PatchState {
             (c.width() as usize, c.height() as usize, c.depth())
                 == (layout.width, layout.height, depth)
         });
-        if !fits {
-            let canvas = Canvas::new(layout.width as u32, layout.height as u32, depth);
-            self.canvas = Some(canvas.map_err(to_py)?);
-        }
-        let canvas = self.canvas.as_mut().expect("made just above"); // invariant: set above
+        let canvas = match &mut self.canvas {
+            Some(canvas) if fits => canvas,
+            slot => {
+                let canvas = Canvas::new(layout.width as u32, layout.height as u32, depth);
+                slot.insert(canvas.map_err(to_py)?)
+            }
+        };
         arrays::load_rect(target, layout, bgr, canvas, rect)
     }
 
     /// The membrane solve and the raster on the canvas, and the samples of `rect` in the
     /// target's format.
     fn draw(&mut self, layout: &Layout, rect: Rect) -> PyResult<Vec<u8>> {
-        let canvas = self.canvas.as_mut().expect("loaded before drawing"); // invariant: load_target ran
+        // invariant: the clone calls `load_target`, which leaves a canvas, before every `draw`.
+        let canvas = self.canvas.as_mut().expect("loaded before drawing");
         let depth = self.deformed_now.then_some(&self.deformed.depth[..]);
         self.cloner.clone_prepared(canvas, depth).map_err(to_py)?;
         Ok(canvas.samples_in(layout.format(), rect.x0..rect.x1, rect.y0..rect.y1))

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use std::sync::Mutex;
 
 use lapclone::{Depth, Renderer};
-use pyo3::exceptions::{PyFileNotFoundError, PyIndexError};
+use pyo3::exceptions::{PyFileNotFoundError, PyIndexError, PyRuntimeError};
 use pyo3::prelude::*;
 
 use crate::arrays::{self, Dtype, Layout};
@@ -92,10 +92,13 @@ impl Scene {
             )));
         }
         let (samples, depth) = py.allow_threads(|| {
-            let mut renderer = self
-                .renderer
-                .lock()
-                .unwrap_or_else(|poisoned| poisoned.into_inner());
+            // A frame that panicked may have left the renderer's incremental state (its
+            // factor updates, its dirty rectangles) half-done: refuse rather than draw wrong.
+            let mut renderer = self.renderer.lock().map_err(|_| {
+                PyRuntimeError::new_err(
+                    "an earlier frame of this scene failed part-way: open the scene again",
+                )
+            })?;
             let format = renderer.output_format();
             let canvas = renderer.render_frame(i as u64).map_err(to_py)?;
             Ok::<_, PyErr>((canvas.samples(format), canvas.depth()))

@@ -18,7 +18,7 @@ use std::sync::mpsc::{channel, sync_channel, Receiver, Sender, SyncSender};
 use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 
-use crate::util::TempOutput;
+use crate::util::{lock, TempOutput};
 use super::gif_frame::{EncodedFrame, FrameEncoder};
 use super::gif_palette::{Palette, PaletteMap};
 use super::{FrameRef, OutputError};
@@ -171,11 +171,13 @@ impl GifWriter {
         }
         let path = self.path.clone();
         let io = |e| OutputError::io(&path, e);
-        let encoder = self.encoder.take().expect("encoder started"); // invariant: `start` created the encoder.
+        // invariant: `start` created the encoder.
+        let encoder = self.encoder.take().expect("encoder started");
         let mut file = encoder.into_inner()?;
         file.flush().map_err(io)?;
         drop(file);
-        let temp = self.temp.take().expect("temporary file present"); // invariant: only `finish` (which consumes self) takes the temporary file.
+        // invariant: only `finish` (which consumes self) takes the temporary file.
+        let temp = self.temp.take().expect("temporary file present");
         temp.commit().map_err(io)?;
         Ok(path)
     }
@@ -184,8 +186,10 @@ impl GifWriter {
     fn start(&mut self) -> Result<(), OutputError> {
         let samples: Vec<&[u8]> = self.warmup.iter().map(|f| f.as_slice()).collect();
         let palette = Palette::from_samples(&samples);
-        let (width, height) = self.size.expect("size known"); // invariant: `add` recorded the size before any frame reached the warm-up list.
-        let file = self.file.take().expect("file open"); // invariant: `create_with` opened the file and only `start` (run once) takes it.
+        // invariant: `add` recorded the size before any frame reached the warm-up list.
+        let (width, height) = self.size.expect("size known");
+        // invariant: `create_with` opened the file and only `start` (run once) takes it.
+        let file = self.file.take().expect("file open");
         let mut encoder =
             gif::Encoder::new(file, width as u16, height as u16, &palette.gif_table())?;
         encoder.set_repeat(gif::Repeat::Infinite)?;
@@ -236,7 +240,8 @@ impl GifWriter {
         };
         self.dispatched += 1;
         let fps = self.fps;
-        let pipeline = self.pipeline.as_mut().expect("started"); // invariant: dispatch runs after `start`
+        // invariant: dispatch runs after `start`
+        let pipeline = self.pipeline.as_mut().expect("started");
         match pipeline {
             Pipeline::Inline(encoder) => {
                 let done = run(encoder, job, fps);
@@ -308,7 +313,8 @@ impl GifWriter {
     }
 
     fn write_record(&mut self, frame: &gif::Frame<'_>) -> Result<(), OutputError> {
-        let encoder = self.encoder.as_mut().expect("encoder started"); // invariant: records exist only after `start` created the encoder.
+        // invariant: records exist only after `start` created the encoder.
+        let encoder = self.encoder.as_mut().expect("encoder started");
         Ok(encoder.write_lzw_pre_encoded_frame(frame)?)
     }
 
@@ -336,7 +342,7 @@ fn worker(
 ) {
     loop {
         let job = {
-            let receiver = receiver.lock().unwrap_or_else(|p| p.into_inner());
+            let receiver = lock(receiver);
             receiver.recv()
         };
         let Ok(job) = job else { return };

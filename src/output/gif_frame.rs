@@ -205,7 +205,8 @@ impl FrameEncoder {
         delay_cs: u16,
         dispose: gif::DisposalMethod,
     ) -> gif::Frame<'static> {
-        let dim = |v: usize| u16::try_from(v).expect("frame size checked"); // invariant: frames are at most u16::MAX wide and high (checked by the writer).
+        // invariant: frames are at most u16::MAX wide and high (checked by the writer).
+        let dim = |v: usize| u16::try_from(v).expect("frame size checked");
         let mut frame = gif::Frame {
             delay: delay_cs,
             dispose,

@@ -12,7 +12,7 @@ use std::sync::mpsc::{sync_channel, Receiver, SyncSender};
 use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 
-use crate::util::TempOutput;
+use crate::util::{lock, TempOutput};
 use super::encode::{FrameEncoder, PngCompression};
 use super::{Frame, OutputError};
 
@@ -81,7 +81,7 @@ impl Shared {
     }
 
     fn record(&self, error: OutputError) {
-        let mut slot = self.error.lock().unwrap_or_else(|p| p.into_inner());
+        let mut slot = lock(&self.error);
         slot.get_or_insert(error);
         self.failed.store(true, Ordering::Relaxed);
     }
@@ -189,7 +189,7 @@ impl PngSequenceWriter {
     }
 
     fn take_error(&self) -> OutputError {
-        let mut slot = self.shared.error.lock().unwrap_or_else(|p| p.into_inner());
+        let mut slot = lock(&self.shared.error);
         slot.take()
             .unwrap_or_else(|| OutputError::Worker("an earlier frame failed".into()))
     }
@@ -212,7 +212,7 @@ fn worker(
     let mut encoder = FrameEncoder::new(compression);
     loop {
         let job = {
-            let receiver = receiver.lock().unwrap_or_else(|p| p.into_inner());
+            let receiver = lock(receiver);
             receiver.recv()
         };
         let Ok(job) = job else { return };

@@ -4,158 +4,45 @@
 //! the canvas pixels read back from the page equal `lapclone preview` of the `:save`d
 //! scene. Skips, saying why, when chromium is not installed.
 
-use std::io::{BufRead, BufReader};
-use std::net::TcpStream;
-use std::path::PathBuf;
-use std::process::{Child, Command, Stdio};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use base64::Engine as _;
-use serde_json::{json, Value};
-use tungstenite::stream::MaybeTlsStream;
-use tungstenite::{Message, WebSocket};
 
 use super::view_ws::{cat_scene, preview_png, ViewRepl};
 
-fn chromium() -> Option<PathBuf> {
-    let path = std::env::var_os("PATH")?;
-    ["chromium", "chromium-browser"].iter().find_map(|name| {
-        std::env::split_paths(&path)
-            .map(|d| d.join(name))
-            .find(|p| p.is_file())
-    })
-}
+// The DevTools client the browser benchmark uses too: one copy, in the bench crate (which the
+// tests cannot depend on, as it depends on lapclone).
+#[path = "../../bench/src/cdp.rs"]
+mod cdp;
 
-/// A headless chromium and a DevTools connection to one page of it.
-struct Browser {
-    child: Child,
-    socket: WebSocket<MaybeTlsStream<TcpStream>>,
-    session: String,
-    next_id: u64,
-    _profile: tempfile::TempDir,
-}
+use cdp::{find_chromium, Browser};
 
-impl Browser {
-    fn launch(program: &PathBuf, url: &str) -> Browser {
-        let profile = tempfile::tempdir().unwrap();
-        let mut child = Command::new(program)
-            .args([
-                "--headless",
-                "--no-sandbox",
-                "--disable-gpu",
-                "--disable-background-networking",
-                "--disable-component-update",
-                "--disable-sync",
-                "--no-first-run",
-                "--window-size=1000,800",
-                "--remote-debugging-port=0",
-            ])
-            .arg(format!("--user-data-dir={}", profile.path().display()))
-            .arg("about:blank")
-            .stdout(Stdio::null())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap();
-        let stderr = BufReader::new(child.stderr.take().unwrap());
-        let endpoint = stderr
-            .lines()
-            .map_while(Result::ok)
-            .find_map(|l| {
-                l.split_once("DevTools listening on ")
-                    .map(|(_, u)| u.trim().to_string())
-            })
-            .expect("chromium printed no DevTools address");
-        let (socket, _) = tungstenite::connect(endpoint.as_str()).unwrap();
-        let mut browser = Browser {
-            child,
-            socket,
-            session: String::new(),
-            next_id: 0,
-            _profile: profile,
-        };
-        let target = browser.call("Target.createTarget", json!({ "url": url }));
-        let target_id = target["targetId"].as_str().unwrap().to_string();
-        let attached = browser.call(
-            "Target.attachToTarget",
-            json!({ "targetId": target_id, "flatten": true }),
-        );
-        browser.session = attached["sessionId"].as_str().unwrap().to_string();
-        browser
-    }
-
-    fn call(&mut self, method: &str, params: Value) -> Value {
-        self.next_id += 1;
-        let id = self.next_id;
-        let mut message = json!({ "id": id, "method": method, "params": params });
-        if !self.session.is_empty() {
-            message["sessionId"] = json!(self.session);
-        }
-        self.socket
-            .send(Message::Text(message.to_string().into()))
-            .unwrap();
-        loop {
-            if let Message::Text(text) = self.socket.read().unwrap() {
-                let reply: Value = serde_json::from_str(text.as_str()).unwrap();
-                if reply["id"] == id {
-                    assert!(reply.get("error").is_none(), "{method}: {reply}");
-                    return reply["result"].clone();
-                }
-            }
-        }
-    }
-
-    fn eval(&mut self, expression: &str) -> Value {
-        let result = self.call(
-            "Runtime.evaluate",
-            json!({ "expression": expression, "returnByValue": true }),
-        );
-        result["result"]["value"].clone()
-    }
-
-    /// Waits until `expression` is true in the page.
-    fn wait_for(&mut self, expression: &str) {
-        let started = Instant::now();
-        while self.eval(expression) != json!(true) {
-            assert!(
-                started.elapsed() < Duration::from_secs(60),
-                "page never had {expression}"
-            );
-            std::thread::sleep(Duration::from_millis(50));
-        }
-    }
-
-    fn mouse(&mut self, kind: &str, x: f64, y: f64) {
-        let buttons = if kind == "mouseReleased" { 0 } else { 1 };
-        self.call(
-            "Input.dispatchMouseEvent",
-            json!({ "type": kind, "x": x, "y": y, "button": "left", "buttons": buttons, "clickCount": 1 }),
-        );
-    }
-}
-
-impl Drop for Browser {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
-}
+const PAGE_TIMEOUT: Duration = Duration::from_secs(60);
 
 #[test]
 fn a_drag_in_chromium_becomes_one_line_and_the_canvas_shows_the_saved_scene() {
-    let Some(program) = chromium() else {
+    let Some(program) = find_chromium() else {
         println!("skipped: chromium is not installed (apt-get install chromium)");
         return;
     };
     let dir = tempfile::tempdir().unwrap();
     let scene = cat_scene(dir.path());
     let mut repl = ViewRepl::start(dir.path(), &scene);
-    let mut browser = Browser::launch(&program, &repl.url);
-    browser.wait_for("!!(window.lapcloneScene && window.lapcloneScene())");
+    let profile = tempfile::tempdir().unwrap();
+    let mut browser = Browser::launch(&program, profile.path(), (1000, 800), &repl.url).unwrap();
+    browser
+        .wait_for(
+            "!!(window.lapcloneScene && window.lapcloneScene())",
+            PAGE_TIMEOUT,
+        )
+        .unwrap();
     // Where canvas pixel (x, y) is on the page.
-    let rect = browser.eval(
-        "(() => { const r = document.getElementById('overlay').getBoundingClientRect();
+    let rect = browser
+        .eval(
+            "(() => { const r = document.getElementById('overlay').getBoundingClientRect();
           return [r.left, r.top, r.width / 600, r.height / 400]; })()",
-    );
+        )
+        .unwrap();
     let r: Vec<f64> = rect
         .as_array()
         .unwrap()
@@ -167,14 +54,21 @@ fn a_drag_in_chromium_becomes_one_line_and_the_canvas_shows_the_saved_scene() {
         "canvas not shown 1:1: {rect}"
     );
     let (x0, y0) = (r[0] + 288.0, r[1] + 147.0);
-    browser.mouse("mouseMoved", x0, y0);
-    browser.mouse("mousePressed", x0, y0);
+    browser.mouse("mouseMoved", x0, y0).unwrap();
+    browser.mouse("mousePressed", x0, y0).unwrap();
     for step in 1..=8 {
-        browser.mouse("mouseMoved", x0 + 5.0 * step as f64, y0);
+        browser
+            .mouse("mouseMoved", x0 + 5.0 * step as f64, y0)
+            .unwrap();
     }
-    browser.mouse("mouseReleased", x0 + 40.0, y0);
+    browser.mouse("mouseReleased", x0 + 40.0, y0).unwrap();
     repl.wait_line(|l| l == "(view) cat.at(0, [328, 147]);");
-    browser.wait_for("window.lapcloneScene().patches[0].at[0] === 328");
+    browser
+        .wait_for(
+            "window.lapcloneScene().patches[0].at[0] === 328",
+            PAGE_TIMEOUT,
+        )
+        .unwrap();
     let saved = dir.path().join("saved.rhai");
     repl.type_line(&format!(":save {}", saved.display()));
     repl.wait_line(|l| l.starts_with("saved "));
@@ -183,7 +77,8 @@ fn a_drag_in_chromium_becomes_one_line_and_the_canvas_shows_the_saved_scene() {
           const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
           let s = ''; for (let i = 0; i < d.length; i += 8192) s += String.fromCharCode.apply(null, d.subarray(i, i + 8192));
           return btoa(s); })()",
-    );
+        )
+        .unwrap();
     let pixels = base64::engine::general_purpose::STANDARD
         .decode(encoded.as_str().unwrap())
         .unwrap();
@@ -192,7 +87,7 @@ fn a_drag_in_chromium_becomes_one_line_and_the_canvas_shows_the_saved_scene() {
         pixels == reference.as_raw()[..],
         "the page's canvas differs from lapclone preview"
     );
-    let timings = browser.eval("window.lapcloneTimings.length");
+    let timings = browser.eval("window.lapcloneTimings.length").unwrap();
     assert!(
         timings.as_u64().unwrap() > 0,
         "no preview frame was painted during the drag"

@@ -7,7 +7,7 @@
 
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
+use std::process::{Child, Command, Stdio};
 use std::time::Instant;
 
 use anyhow::Context as _;
@@ -62,20 +62,14 @@ pub fn run(args: ViewBenchArgs) -> anyhow::Result<()> {
             &write(&dir, "cat", &cat_scene(&assets))?,
             "cat",
             args.steps,
-            |i, n| {
-                let s = i as f64 / n as f64;
-                json!({"op": "at", "patch": "cat", "value": [500.0 + 900.0 * s, 400.0 + 200.0 * s]})
-            },
+            |i, n| json!({"op": "at", "patch": "cat", "value": cat_at(i, n)}),
         )?;
         let horse = drag(
             &binary,
             &write(&dir, "horse", &horse_scene(&assets))?,
             "horse",
             args.steps,
-            |i, n| {
-                let s = i as f64 / n as f64;
-                json!({"op": "handle_key", "patch": "horse", "handle": 0, "value": [118.0 + 150.0 * s, 298.0 - 160.0 * s]})
-            },
+            |i, n| json!({"op": "handle_key", "patch": "horse", "handle": 0, "value": horse_target(i, n)}),
         )?;
         Ok::<_, anyhow::Error>(vec![cat, horse])
     })();
@@ -104,7 +98,7 @@ fn write(dir: &Path, name: &str, text: &str) -> anyhow::Result<PathBuf> {
     Ok(path)
 }
 
-fn cat_scene(assets: &Path) -> String {
+pub(crate) fn cat_scene(assets: &Path) -> String {
     format!(
         r#"canvas(1920, 1080, #{{ fps: 24, duration: 2, background: [0.45, 0.3, 0.2] }});
 let cat = patch("cat", #{{ source: "{a}/chelsea.png", mask: "{a}/masks/chelsea_face.png" }});
@@ -114,7 +108,7 @@ cat.at(0, [500, 400]);
     )
 }
 
-fn horse_scene(assets: &Path) -> String {
+pub(crate) fn horse_scene(assets: &Path) -> String {
     format!(
         r#"canvas(1920, 1080, #{{ fps: 24, duration: 2, background: [0.1, 0.15, 0.3] }});
 let horse = patch("horse", #{{ source: "{a}/horse_texture.png", mask: "{a}/horse_mask.png", density: 2 }});
@@ -128,6 +122,68 @@ horse.pin([30, 150]);
     )
 }
 
+/// The cat's drag: its `at` across the canvas, step `i` of `n`.
+pub(crate) fn cat_at(i: usize, n: usize) -> [f64; 2] {
+    let s = i as f64 / n as f64;
+    [500.0 + 900.0 * s, 400.0 + 200.0 * s]
+}
+
+/// The horse's drag: its depth handle's target (source coordinates), step `i` of `n`, so the
+/// hind leg folds over the belly.
+pub(crate) fn horse_target(i: usize, n: usize) -> [f64; 2] {
+    let s = i as f64 / n as f64;
+    [118.0 + 150.0 * s, 298.0 - 160.0 * s]
+}
+
+/// A running `lapclone repl SCENE --view --port 0`; dropping it ends the input, so the
+/// session and its server stop.
+pub(crate) struct ViewServer {
+    child: Child,
+    /// The page's address, with its token.
+    pub url: String,
+}
+
+impl ViewServer {
+    pub(crate) fn start(binary: &Path, scene: &Path) -> anyhow::Result<ViewServer> {
+        let mut child = Command::new(binary)
+            .args([
+                "repl",
+                &scene.display().to_string(),
+                "--view",
+                "--port",
+                "0",
+            ])
+            .arg("--preview")
+            .arg(scene.with_extension("png"))
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::inherit())
+            .spawn()
+            .with_context(|| format!("cannot run {}", binary.display()))?;
+        let stdout = child.stdout.take().context("no stdout")?;
+        let mut lines = BufReader::new(stdout).lines();
+        let url = lines
+            .by_ref()
+            .map_while(Result::ok)
+            .find_map(|l| l.strip_prefix("view: ").map(str::to_string));
+        // The REPL goes on printing (the page's lines); keep its pipe drained.
+        std::thread::spawn(move || lines.map_while(Result::ok).for_each(drop));
+        let mut server = ViewServer {
+            child,
+            url: String::new(),
+        };
+        server.url = url.context("lapclone printed no view URL")?;
+        Ok(server)
+    }
+}
+
+impl Drop for ViewServer {
+    fn drop(&mut self) {
+        drop(self.child.stdin.take());
+        let _ = self.child.wait();
+    }
+}
+
 /// One scripted drag against a fresh `lapclone repl SCENE --view`.
 fn drag(
     binary: &Path,
@@ -136,28 +192,8 @@ fn drag(
     steps: usize,
     edit: impl Fn(usize, usize) -> Value,
 ) -> anyhow::Result<Drag> {
-    let mut child = Command::new(binary)
-        .args([
-            "repl",
-            &scene.display().to_string(),
-            "--view",
-            "--port",
-            "0",
-        ])
-        .arg("--preview")
-        .arg(scene.with_extension("png"))
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::inherit())
-        .spawn()
-        .with_context(|| format!("cannot run {}", binary.display()))?;
-    let stdout = child.stdout.take().context("no stdout")?;
-    let mut lines = BufReader::new(stdout).lines();
-    let url = lines
-        .by_ref()
-        .map_while(Result::ok)
-        .find_map(|l| l.strip_prefix("view: ").map(str::to_string))
-        .context("lapclone printed no view URL")?;
+    let server = ViewServer::start(binary, scene)?;
+    let url = &server.url;
     let host = url
         .trim_start_matches("http://")
         .split('/')
@@ -186,18 +222,23 @@ fn drag(
     }
     socket.send(Message::Text(json!({"type": "cancel"}).to_string().into()))?;
     drop(socket);
-    drop(child.stdin.take());
-    let _ = child.wait();
-    times.sort_by(f64::total_cmp);
-    let at = |q: f64| times[((times.len() as f64 - 1.0) * q).round() as usize];
+    drop(server);
+    let (median_ms, p95_ms, max_ms) = spread(&mut times);
     Ok(Drag {
         scene: name,
         steps,
-        median_ms: at(0.5),
-        p95_ms: at(0.95),
-        max_ms: times[times.len() - 1],
+        median_ms,
+        p95_ms,
+        max_ms,
         mean_update_bytes: bytes as f64 / steps as f64,
     })
+}
+
+/// Median, 95th percentile and maximum of `times` (not empty), which it sorts.
+pub(crate) fn spread(times: &mut [f64]) -> (f64, f64, f64) {
+    times.sort_by(f64::total_cmp);
+    let at = |q: f64| times[((times.len() as f64 - 1.0) * q).round() as usize];
+    (at(0.5), at(0.95), at(1.0))
 }
 
 type Socket = tungstenite::WebSocket<tungstenite::stream::MaybeTlsStream<std::net::TcpStream>>;

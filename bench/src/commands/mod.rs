@@ -2,6 +2,7 @@
 //! release build), printing a table or JSON. The argument helpers are the `lapclone` CLI's
 //! own, so shared flags parse and fail alike.
 
+pub mod bench_browser;
 pub mod bench_clone;
 pub mod bench_deform;
 pub mod bench_mesh;
@@ -45,6 +46,9 @@ pub enum BenchCommand {
     /// The live view's drag on 1920×1080 scenes (the cat; the horse folding over itself):
     /// pointer message in → changed pixels out, through the release `lapclone repl --view`.
     View(bench_view::ViewBenchArgs),
+    /// The live view's drag in headless chromium on the same scenes, pointer events at 60 Hz:
+    /// pointer event → pixels painted (the page's own timing) and updates painted per second.
+    Browser(bench_browser::BrowserBenchArgs),
 }
 
 /// Runs one benchmark.
@@ -60,5 +64,6 @@ pub fn run(which: BenchCommand) -> anyhow::Result<()> {
         BenchCommand::Opencv(args) => bench_opencv::run(args),
         BenchCommand::Track(args) => bench_track::run(args),
         BenchCommand::View(args) => bench_view::run(args),
+        BenchCommand::Browser(args) => bench_browser::run(args),
     }
 }

@@ -11,11 +11,14 @@
   let ws = null, scene = null, located = null, gesture = null, selected = null;
   let pendingEdit = null, inFlight = false, locating = false, nextLocate = null;
   let playing = false, meshOn = false, scrubbing = false;
-  // Pointer event → pixels painted, ms (read by the browser test and shown in the title).
+  // Pointer event → pixels painted, ms, per preview: from the earliest pointer event the
+  // preview answers to the end of the browser frame that paints it (read by the browser test
+  // and benchmark), and when each was painted (performance.now(), for updates per second).
   const timings = (window.lapcloneTimings = []);
+  const paintedAt = (window.lapclonePaintedAt = []);
   // The last scene message, for tests that drive the page.
   window.lapcloneScene = () => scene;
-  let sentAt = 0;
+  let pointerAt = 0, sentAt = 0;
 
   function send(message) {
     if (ws && ws.readyState === 1) ws.send(JSON.stringify(message));
@@ -52,8 +55,15 @@
       fctx.putImageData(new ImageData(pixels, w, hh), x, y);
     }
     if (sentAt) {
-      timings.push(performance.now() - sentAt);
+      // requestAnimationFrame runs just before the frame's paint; a task queued from it runs
+      // once that paint is done.
+      const from = sentAt;
       sentAt = 0;
+      requestAnimationFrame(() => setTimeout(() => {
+        const now = performance.now();
+        timings.push(now - from);
+        paintedAt.push(now);
+      }, 0));
     }
     inFlight = false;
     flushEdit();
@@ -77,6 +87,7 @@
     } else if (m.type === "error") {
       notice(m.message, "error");
       inFlight = false;
+      sentAt = 0;
     } else if (m.type === "line") {
       log(m.text);
       notice("", "");
@@ -210,7 +221,8 @@
   }
   function flushEdit() {
     if (inFlight || !pendingEdit || !scene) return;
-    sentAt = performance.now();
+    sentAt = pointerAt || performance.now();
+    pointerAt = 0;
     inFlight = true;
     send({ type: "edit", rev: scene.rev, commit: false, edit: pendingEdit });
     pendingEdit = null;
@@ -222,7 +234,10 @@
     if (dist(q, gesture.start) * (1 / screenScale()) > 2) gesture.moved = true;
     if (gesture.moved && gesture.kind !== "add") {
       gesture.last = editFor(gesture, q);
-      if (gesture.last) queueEdit(gesture.last);
+      if (gesture.last) {
+        if (!pointerAt) pointerAt = e.timeStamp;
+        queueEdit(gesture.last);
+      }
     }
   });
 
@@ -262,6 +277,7 @@
     if (!g.moved || g.kind === "pin") { copyPair(q, g.shift); return; }
     const edit = editFor(g, q);
     pendingEdit = null;
+    pointerAt = 0;
     if (edit) send({ type: "edit", rev: scene.rev, commit: true, edit });
   });
 
@@ -348,7 +364,7 @@
   document.addEventListener("keydown", (e) => {
     const mod = e.ctrlKey || e.metaKey;
     if (e.key === "Escape" && gesture) {
-      gesture = null; pendingEdit = null;
+      gesture = null; pendingEdit = null; pointerAt = 0;
       send({ type: "cancel" });
       notice("cancelled", "");
     } else if (mod && e.key.toLowerCase() === "z") {

@@ -1,0 +1,263 @@
+//! `lapclone-bench browser`: the live view's drag as a user sees it — takes the release
+//! `lapclone` and Debian's `chromium`, starts `lapclone repl SCENE --view` on the two
+//! 1920×1080 scenes of `lapclone-bench view` (the cat moved across the canvas; the horse's
+//! depth handle dragged so the leg folds over its belly), opens the page in headless chromium
+//! and drags with dispatched pointer events paced at 60 Hz, as a mouse reports. Gives, from
+//! the page's own timings (`window.lapcloneTimings`: pointer event → the frame showing the
+//! answer painted), the median, 95th percentile and the updates painted per second during
+//! the drag (table or JSON). Without chromium it reports the drags as skipped, saying why.
+
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use anyhow::Context as _;
+use serde_json::{json, Value};
+
+use super::bench_view::{cat_at, cat_scene, horse_scene, horse_target, spread, ViewServer};
+use crate::cdp::{find_chromium, Browser};
+
+#[derive(clap::Args, Debug)]
+pub struct BrowserBenchArgs {
+    /// Pointer steps per drag (dispatched at 60 Hz).
+    #[arg(long, default_value_t = 200)]
+    pub steps: usize,
+    /// Folder holding the bundled photos.
+    #[arg(long, default_value = "assets")]
+    pub assets: PathBuf,
+    /// The `lapclone` binary (default: the one beside this program).
+    #[arg(long)]
+    pub lapclone: Option<PathBuf>,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// The pointer's report rate: a mouse's events reach a page once per 60 Hz display frame.
+const POINTER_PERIOD: Duration = Duration::from_nanos(16_666_667);
+
+/// The browser window: a full-HD screen (the 1920×1080 canvas is shown scaled to fit).
+const WINDOW: (u32, u32) = (1920, 1080);
+
+/// How long the page may take to connect, draw and commit.
+const PAGE_TIMEOUT: Duration = Duration::from_secs(60);
+
+#[derive(serde::Serialize)]
+struct Drag {
+    scene: &'static str,
+    steps: usize,
+    /// Pointer events dispatched per second (60 unless the browser held the dispatch back).
+    pointer_hz: f64,
+    /// Previews painted during the drag.
+    painted: usize,
+    median_ms: f64,
+    p95_ms: f64,
+    max_ms: f64,
+    /// Previews painted per second, from the first pointer event answered to the last paint.
+    updates_per_s: f64,
+}
+
+pub fn run(args: BrowserBenchArgs) -> anyhow::Result<()> {
+    if args.steps < 2 {
+        return Err(super::UsageError("--steps must be at least 2".into()).into());
+    }
+    let report = match find_chromium() {
+        Some(chromium) => json!({ "drags": drags(&args, &chromium)?, "skipped": null }),
+        None => json!({
+            "drags": [],
+            "skipped": "chromium is not installed (apt-get install chromium)",
+        }),
+    };
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+        return Ok(());
+    }
+    if let Some(reason) = report["skipped"].as_str() {
+        println!("live view drag in chromium: skipped: {reason}");
+        return Ok(());
+    }
+    println!("live view drag in headless chromium, pointer event → pixels painted (1920×1080):");
+    for d in report["drags"].as_array().into_iter().flatten() {
+        println!(
+            "  {:<6} {} steps at {:.0} Hz: median {:.1} ms, p95 {:.1} ms, max {:.1} ms, {:.1} updates/s ({} painted)   (targets ≤ 16, ≤ 33 ms, ≥ 50/s)",
+            d["scene"].as_str().unwrap_or(""),
+            d["steps"],
+            d["pointer_hz"].as_f64().unwrap_or(f64::NAN),
+            d["median_ms"].as_f64().unwrap_or(f64::NAN),
+            d["p95_ms"].as_f64().unwrap_or(f64::NAN),
+            d["max_ms"].as_f64().unwrap_or(f64::NAN),
+            d["updates_per_s"].as_f64().unwrap_or(f64::NAN),
+            d["painted"],
+        );
+    }
+    Ok(())
+}
+
+/// Both drags, each against a fresh server and browser.
+fn drags(args: &BrowserBenchArgs, chromium: &Path) -> anyhow::Result<Vec<Drag>> {
+    let binary = match &args.lapclone {
+        Some(path) => path.clone(),
+        None => super::bench_opencv::beside_this_program("lapclone")?,
+    };
+    let assets = args
+        .assets
+        .canonicalize()
+        .context("cannot find the assets folder")?;
+    let dir = std::env::temp_dir().join(format!("lapclone-bench-browser-{}", std::process::id()));
+    std::fs::create_dir_all(&dir)?;
+    let result = (|| {
+        let steps = args.steps;
+        let cat = drag(
+            &binary,
+            chromium,
+            &dir,
+            "cat",
+            &cat_scene(&assets),
+            steps,
+            |_, i| Ok(cat_at(i, steps)),
+        )?;
+        let horse = drag(
+            &binary,
+            chromium,
+            &dir,
+            "horse",
+            &horse_scene(&assets),
+            steps,
+            |scene, i| place(&scene["patches"][0], horse_target(i, steps)),
+        )?;
+        Ok::<_, anyhow::Error>(vec![cat, horse])
+    })();
+    let _ = std::fs::remove_dir_all(&dir);
+    result
+}
+
+/// Canvas point of a patch's source point `q`, from the page's scene message (the page's
+/// own placement: pivot, rotation, scale, then `at`).
+fn place(patch: &Value, q: [f64; 2]) -> anyhow::Result<[f64; 2]> {
+    let number = |key: &str| {
+        patch
+            .pointer(key)
+            .and_then(Value::as_f64)
+            .with_context(|| format!("the scene message has no {key}"))
+    };
+    let (sin, cos) = number("/rotation")?.to_radians().sin_cos();
+    let scale = number("/scale")?;
+    let (dx, dy) = (q[0] - number("/pivot/0")?, q[1] - number("/pivot/1")?);
+    Ok([
+        number("/at/0")? + scale * (cos * dx - sin * dy),
+        number("/at/1")? + scale * (sin * dx + cos * dy),
+    ])
+}
+
+/// One 60 Hz drag through the page: pressed at canvas point `point(scene, 0)`, moved through
+/// `point(scene, 1..=steps)`, released at the last one.
+fn drag(
+    binary: &Path,
+    chromium: &Path,
+    dir: &Path,
+    name: &'static str,
+    scene_text: &str,
+    steps: usize,
+    point: impl Fn(&Value, usize) -> anyhow::Result<[f64; 2]>,
+) -> anyhow::Result<Drag> {
+    let scene_path = dir.join(format!("{name}.rhai"));
+    std::fs::write(&scene_path, scene_text)?;
+    let server = ViewServer::start(binary, &scene_path)?;
+    let profile = dir.join(format!("profile-{name}"));
+    let mut browser = Browser::launch(chromium, &profile, WINDOW, &server.url)?;
+    browser.wait_for(
+        "!!(window.lapcloneScene && window.lapcloneScene()) && document.getElementById('frame').width === 1920",
+        PAGE_TIMEOUT,
+    )?;
+    let scene = browser.eval("window.lapcloneScene()")?;
+    let rev = scene["rev"]
+        .as_u64()
+        .context("the scene message has no rev")?;
+    let dispatched = pointer_drag(&mut browser, steps, |i| point(&scene, i))?;
+    // The commit's scene message comes after every preview's frame; then let the last
+    // preview's paint be recorded.
+    browser.wait_for(&format!("window.lapcloneScene().rev > {rev}"), PAGE_TIMEOUT)?;
+    browser.eval(
+        "new Promise(r => requestAnimationFrame(() => requestAnimationFrame(() => setTimeout(r, 0))))",
+    )?;
+    let timings = numbers(&browser.eval("window.lapcloneTimings")?);
+    let painted_at = numbers(&browser.eval("window.lapclonePaintedAt")?);
+    drop(browser);
+    drop(server);
+    summary(name, steps, dispatched, timings, &painted_at)
+}
+
+/// Presses at canvas point `point(0)`, moves through `point(1..=steps)` at 60 Hz (a move
+/// that falls behind goes at once) and releases; gives how long the moves took.
+fn pointer_drag(
+    browser: &mut Browser,
+    steps: usize,
+    point: impl Fn(usize) -> anyhow::Result<[f64; 2]>,
+) -> anyhow::Result<Duration> {
+    let r = canvas_on_page(browser)?;
+    let page = |i: usize| point(i).map(|p| (r[0] + p[0] * r[2], r[1] + p[1] * r[3]));
+    let (x, y) = page(0)?;
+    browser.mouse("mouseMoved", x, y)?;
+    browser.mouse("mousePressed", x, y)?;
+    let started = Instant::now();
+    for i in 1..=steps {
+        let due = POINTER_PERIOD * i as u32;
+        if let Some(wait) = due.checked_sub(started.elapsed()) {
+            std::thread::sleep(wait);
+        }
+        let (x, y) = page(i)?;
+        browser.mouse("mouseMoved", x, y)?;
+    }
+    let dispatched = started.elapsed();
+    let (x, y) = page(steps)?;
+    browser.mouse("mouseReleased", x, y)?;
+    Ok(dispatched)
+}
+
+/// Where the canvas is on the page: left, top and page pixels per canvas pixel across and
+/// down (the canvas is shown scaled to fit the window).
+fn canvas_on_page(browser: &mut Browser) -> anyhow::Result<[f64; 4]> {
+    let rect = browser.eval(
+        "(() => { const o = document.getElementById('overlay'), r = o.getBoundingClientRect();
+          return [r.left, r.top, r.width / o.width, r.height / o.height]; })()",
+    )?;
+    let r = numbers(&rect);
+    r.try_into()
+        .map_err(|_| anyhow::anyhow!("the page gave no canvas rectangle: {rect}"))
+}
+
+/// The figures of one drag from the page's timings and paint times (ms, page clock).
+fn summary(
+    name: &'static str,
+    steps: usize,
+    dispatched: Duration,
+    mut timings: Vec<f64>,
+    painted_at: &[f64],
+) -> anyhow::Result<Drag> {
+    anyhow::ensure!(
+        !timings.is_empty() && timings.len() == painted_at.len(),
+        "the page recorded no preview painted during the {name} drag"
+    );
+    // From the first pointer event answered (the first paint less its latency) to the last paint.
+    let span = painted_at[painted_at.len() - 1] - (painted_at[0] - timings[0]);
+    let painted = timings.len();
+    let (median_ms, p95_ms, max_ms) = spread(&mut timings);
+    Ok(Drag {
+        scene: name,
+        steps,
+        pointer_hz: steps as f64 / dispatched.as_secs_f64(),
+        painted,
+        median_ms,
+        p95_ms,
+        max_ms,
+        updates_per_s: painted as f64 / (span / 1e3),
+    })
+}
+
+fn numbers(value: &Value) -> Vec<f64> {
+    value
+        .as_array()
+        .into_iter()
+        .flatten()
+        .filter_map(Value::as_f64)
+        .collect()
+}
