@@ -465,7 +465,9 @@ fn follow_checks(
     skipped: &mut Vec<Skipped>,
 ) -> Result<(), String> {
     let (runs, frames) = settings.pick(("3", "48"), ("5", "96"));
-    let what = format!("render following a track ÷ keys written out, {frames} frames, median of {runs} (×)");
+    let what = format!(
+        "render following a track ÷ keys written out, {frames} frames, median of {runs} (×)"
+    );
     let bound = Bound::AtMost(1.0);
     let lapclone = Path::new(env!("CARGO_BIN_EXE_lapclone-bench"))
         .with_file_name(format!("lapclone{}", std::env::consts::EXE_SUFFIX));
@@ -474,13 +476,18 @@ fn follow_checks(
             issue: 41,
             what,
             bound,
-            reason: format!("no {}: run `cargo build --release` first", lapclone.display()),
+            reason: format!(
+                "no {}: run `cargo build --release` first",
+                lapclone.display()
+            ),
         });
         return Ok(());
     }
     let report = run_bench(&["follow", "--runs", runs, "--frames", frames])?;
     if report.pointer("/identical_frames").and_then(Value::as_bool) != Some(true) {
-        return Err("bench follow: the followed scene's frames differ from the written-out keys'".into());
+        return Err(
+            "bench follow: the followed scene's frames differ from the written-out keys'".into(),
+        );
     }
     checks.push(Check {
         issue: 41,

@@ -119,7 +119,10 @@ fn measure(
     std::fs::write(dir.join("track.csv"), track_csv(&rows))?;
     let followed = dir.join("followed.rhai");
     let written = dir.join("written_out.rhai");
-    std::fs::write(&followed, scene(root, args.frames, "cat.follow(\"track.csv\");\n"))?;
+    std::fs::write(
+        &followed,
+        scene(root, args.frames, "cat.follow(\"track.csv\");\n"),
+    )?;
     std::fs::write(&written, scene(root, args.frames, &written_keys(&rows)))?;
     let render = |name: &'static str, scene: &Path| -> anyhow::Result<f64> {
         let out = dir.join(name);
