@@ -108,7 +108,7 @@ fn from_bytes(image: &image::DynamicImage, threshold: f32) -> Option<Vec<bool>> 
     let every_value: Vec<u8> = (0..=255u8)
         .flat_map(|v| std::iter::repeat_n(v, channels))
         .collect();
-    let table: Vec<bool> = match channels {
+    let flags: Vec<bool> = match channels {
         1 => {
             let all = image::GrayImage::from_raw(256, 1, every_value)?;
             let floats = image::DynamicImage::ImageLuma8(all).to_luma32f();
@@ -122,17 +122,15 @@ fn from_bytes(image: &image::DynamicImage, threshold: f32) -> Option<Vec<bool>> 
             all.to_rgba32f().pixels().map(|p| p.0[3] >= threshold).collect()
         }
     };
-    // The byte read per pixel: grey, or the last channel (alpha).
+    let table: [bool; 256] = flags.try_into().ok()?;
     let pixels = image.width() as usize * image.height() as usize;
-    let bytes = image.as_bytes().get(channels - 1..)?;
-    Some(
-        bytes
-            .iter()
-            .step_by(channels)
-            .take(pixels)
-            .map(|&b| table[usize::from(b)])
-            .collect(),
-    )
+    let bytes = image.as_bytes();
+    if channels == 1 {
+        return Some(bytes.get(..pixels)?.iter().map(|&b| table[usize::from(b)]).collect());
+    }
+    // The byte read per pixel: the last channel (alpha).
+    let alpha = bytes.get(channels - 1..)?.iter().step_by(channels);
+    Some(alpha.take(pixels).map(|&b| table[usize::from(b)]).collect())
 }
 
 /// A width × height grid of inside/outside pixels. Pixel (x, y) covers [x, x+1] × [y, y+1].
