@@ -164,6 +164,7 @@ fn measure(settings: &Settings) -> Result<(Vec<Check>, Vec<Skipped>), String> {
     paper_checks(&mut checks)?;
     whole_process_checks(settings, &mut checks, &mut skipped)?;
     track_checks(settings, &mut checks, &mut skipped)?;
+    follow_checks(settings, &mut checks, &mut skipped)?;
     view_checks(settings, &mut checks, &mut skipped)?;
     browser_checks(settings, &mut checks, &mut skipped)?;
     Ok((checks, skipped))
@@ -501,6 +502,47 @@ fn track_checks(
             }),
         }
     }
+    Ok(())
+}
+
+/// Issue #41: a 1920×1080 scene following a track against the same scene with the keys
+/// written out, whole `lapclone render` processes (skipped when that binary is not built).
+fn follow_checks(
+    settings: &Settings,
+    checks: &mut Vec<Check>,
+    skipped: &mut Vec<Skipped>,
+) -> Result<(), String> {
+    let (runs, frames) = settings.pick(("3", "48"), ("5", "96"));
+    let what = format!(
+        "render following a track ÷ keys written out, {frames} frames, median of {runs} (×)"
+    );
+    let bound = Bound::AtMost(1.0);
+    let lapclone = Path::new(env!("CARGO_BIN_EXE_lapclone-bench"))
+        .with_file_name(format!("lapclone{}", std::env::consts::EXE_SUFFIX));
+    if !lapclone.is_file() {
+        skipped.push(Skipped {
+            issue: 41,
+            what,
+            bound,
+            reason: format!(
+                "no {}: run `cargo build --release` first",
+                lapclone.display()
+            ),
+        });
+        return Ok(());
+    }
+    let report = run_bench(&["follow", "--runs", runs, "--frames", frames])?;
+    if report.pointer("/identical_frames").and_then(Value::as_bool) != Some(true) {
+        return Err(
+            "bench follow: the followed scene's frames differ from the written-out keys'".into(),
+        );
+    }
+    checks.push(Check {
+        issue: 41,
+        what,
+        measured: number(&report, "/follow_over_keys")?,
+        bound,
+    });
     Ok(())
 }
 

@@ -81,6 +81,58 @@ pub(crate) fn crack_edge_count(mask: &BitMask) -> usize {
         .sum()
 }
 
+/// The inside flags through the image's float conversion: the definition.
+fn from_floats(image: &image::DynamicImage, threshold: f32) -> Vec<bool> {
+    if image.color().has_alpha() {
+        let rgba = image.to_rgba32f();
+        rgba.pixels().map(|p| p.0[3] >= threshold).collect()
+    } else {
+        let luma = image.to_luma32f();
+        luma.pixels().map(|p| p.0[0] >= threshold).collect()
+    }
+}
+
+/// The inside flags of an 8-bit grey, grey + alpha or RGBA image straight from its bytes,
+/// through a table of the 256 byte values (`None` for other layouts). The table is made by
+/// running a 256 × 1 image of the same layout holding every byte value through the general
+/// path's own float conversion, so the flags are the same; what is skipped is converting the
+/// whole image to floats first.
+fn from_bytes(image: &image::DynamicImage, threshold: f32) -> Option<Vec<bool>> {
+    use image::DynamicImage::{ImageLuma8, ImageLumaA8, ImageRgba8};
+    let channels = match image {
+        ImageLuma8(_) => 1,
+        ImageLumaA8(_) => 2,
+        ImageRgba8(_) => 4,
+        _ => return None,
+    };
+    let every_value: Vec<u8> = (0..=255u8)
+        .flat_map(|v| std::iter::repeat_n(v, channels))
+        .collect();
+    let flags: Vec<bool> = match channels {
+        1 => {
+            let all = image::GrayImage::from_raw(256, 1, every_value)?;
+            let floats = image::DynamicImage::ImageLuma8(all).to_luma32f();
+            floats.pixels().map(|p| p.0[0] >= threshold).collect()
+        }
+        _ => {
+            let all = match channels {
+                2 => image::DynamicImage::ImageLumaA8(image::GrayAlphaImage::from_raw(256, 1, every_value)?),
+                _ => image::DynamicImage::ImageRgba8(image::RgbaImage::from_raw(256, 1, every_value)?),
+            };
+            all.to_rgba32f().pixels().map(|p| p.0[3] >= threshold).collect()
+        }
+    };
+    let table: [bool; 256] = flags.try_into().ok()?;
+    let pixels = image.width() as usize * image.height() as usize;
+    let bytes = image.as_bytes();
+    if channels == 1 {
+        return Some(bytes.get(..pixels)?.iter().map(|&b| table[usize::from(b)]).collect());
+    }
+    // The byte read per pixel: the last channel (alpha).
+    let alpha = bytes.get(channels - 1..)?.iter().step_by(channels);
+    Some(alpha.take(pixels).map(|&b| table[usize::from(b)]).collect())
+}
+
 /// A width × height grid of inside/outside pixels. Pixel (x, y) covers [x, x+1] × [y, y+1].
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct BitMask {
@@ -120,13 +172,7 @@ impl BitMask {
     /// `threshold` (both in [0, 1]).
     pub fn from_image(image: &image::DynamicImage, threshold: f32) -> Self {
         let (width, height) = (image.width() as usize, image.height() as usize);
-        let inside = if image.color().has_alpha() {
-            let rgba = image.to_rgba32f();
-            rgba.pixels().map(|p| p.0[3] >= threshold).collect()
-        } else {
-            let luma = image.to_luma32f();
-            luma.pixels().map(|p| p.0[0] >= threshold).collect()
-        };
+        let inside = from_bytes(image, threshold).unwrap_or_else(|| from_floats(image, threshold));
         Self {
             width,
             height,
@@ -259,6 +305,41 @@ mod tests {
         let mask = BitMask::from_image(&image::DynamicImage::ImageRgba8(img), 0.5);
         assert!(!mask.get(0, 0));
         assert!(mask.get(1, 0));
+    }
+
+    #[test]
+    fn the_byte_table_gives_the_float_conversion_s_flags() {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut byte = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 24) as u8
+        };
+        let mut images = Vec::new();
+        // Every byte value, then random ones, in each 8-bit layout the table serves.
+        let grey: Vec<u8> = (0..=255u8).chain((0..700).map(|_| byte())).collect();
+        let n = grey.len() as u32;
+        images.push(image::DynamicImage::ImageLuma8(
+            image::GrayImage::from_raw(n, 1, grey.clone()).unwrap(),
+        ));
+        let pairs = grey.iter().flat_map(|&a| [byte(), a]).collect();
+        images.push(image::DynamicImage::ImageLumaA8(
+            image::GrayAlphaImage::from_raw(n, 1, pairs).unwrap(),
+        ));
+        let quads = grey.iter().flat_map(|&a| [byte(), byte(), byte(), a]).collect();
+        images.push(image::DynamicImage::ImageRgba8(
+            image::RgbaImage::from_raw(n, 1, quads).unwrap(),
+        ));
+        for image in &images {
+            for threshold in [0.0, 0.25, 0.5, 127.5 / 255.0, 128.0 / 255.0, 1.0, 1.5] {
+                let table = from_bytes(image, threshold).expect("an 8-bit layout");
+                assert_eq!(table, from_floats(image, threshold), "{:?} at {threshold}", image.color());
+                assert_eq!(BitMask::from_image(image, threshold).inside, table);
+            }
+        }
+        let rgb = image::DynamicImage::ImageRgb8(image::RgbImage::new(2, 2));
+        assert!(from_bytes(&rgb, 0.5).is_none());
     }
 
     #[test]

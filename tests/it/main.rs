@@ -63,6 +63,7 @@ mod solve_update;
 mod test_cli;
 mod track_cli;
 mod track_follow;
+mod track_video;
 mod video_cli;
 mod video_encode;
 mod view_browser;

@@ -204,7 +204,7 @@ pub(crate) fn beside_this_program(name: &str) -> anyhow::Result<PathBuf> {
 /// A warning when a file under `src/` is newer than the binary: the figures would then be
 /// of code that is no longer the tree's. (Manifests are left out: cargo may find nothing to
 /// rebuild after their change, and the warning would then never go away.)
-fn stale_binary(binary: &Path, root: &Path) -> Option<String> {
+pub(crate) fn stale_binary(binary: &Path, root: &Path) -> Option<String> {
     let built = std::fs::metadata(binary).and_then(|m| m.modified()).ok()?;
     let mut newest = None;
     newest_file(&root.join("src"), &mut newest);

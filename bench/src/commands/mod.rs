@@ -5,6 +5,7 @@
 pub mod bench_browser;
 pub mod bench_clone;
 pub mod bench_deform;
+pub mod bench_follow;
 pub mod bench_mesh;
 pub mod bench_opencv;
 pub mod bench_paper;
@@ -43,6 +44,9 @@ pub enum BenchCommand {
     /// Point tracking: 1920×1080 PNG footage against decoding alone and an OpenCV
     /// calcOpticalFlowPyrLK loop, and the tracked path's error beside OpenCV's.
     Track(bench_track::TrackBenchArgs),
+    /// A 1920×1080 scene following a track against the same scene with its keys written
+    /// out: whole `lapclone render` processes, interleaved.
+    Follow(bench_follow::FollowBenchArgs),
     /// The live view's drag on 1920×1080 scenes (the cat; the horse folding over itself):
     /// pointer message in → changed pixels out, through the release `lapclone repl --view`.
     View(bench_view::ViewBenchArgs),
@@ -63,6 +67,7 @@ pub fn run(which: BenchCommand) -> anyhow::Result<()> {
         BenchCommand::Paper(args) => bench_paper::run(args),
         BenchCommand::Opencv(args) => bench_opencv::run(args),
         BenchCommand::Track(args) => bench_track::run(args),
+        BenchCommand::Follow(args) => bench_follow::run(args),
         BenchCommand::View(args) => bench_view::run(args),
         BenchCommand::Browser(args) => bench_browser::run(args),
     }
