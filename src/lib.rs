@@ -87,20 +87,21 @@ pub use mesh::{
     BitMask, BoundaryLoop, BoundaryPlacement, LoopKind, Mesh, MeshError, MeshOptions, MeshResult,
     MeshStats, Polygon, SanityError, MASK_THRESHOLD,
 };
-pub use pixels::{
-    Canvas, CanvasPixels, ColorKind, Depth, FloatImage, FootageError, PixelError, PixelFormat,
-    PixelRect,
-};
 pub use output::{
     render_scene, FrameRange, OutputError, OutputKind, PngCompression, RenderOptions,
     RenderProgress, Rendered, SinkSettings,
+};
+pub use pixels::{
+    Canvas, CanvasPixels, ColorKind, Depth, FloatImage, FootageError, PixelError, PixelFormat,
+    PixelRect,
 };
 pub use raster::{RasterError, RasterStats};
 pub use render::{FrameStats, RenderError, Renderer, SceneUpdate};
 /// The scene language's engine: [`SceneError::position`] is its [`rhai::Position`].
 pub use rhai;
 pub use script::{
-    load_scene, load_scene_and_imports, set_allocation_probe, ErrorKind as SceneErrorKind, LoadedScene, SceneError,
+    load_scene, load_scene_and_imports, set_allocation_probe, ErrorKind as SceneErrorKind,
+    LoadedScene, SceneError,
 };
 pub use solve::{FactorMethod, LaplacianKind, PenaltyOptions, SolveError, SwitchStats};
 

@@ -340,7 +340,10 @@ fn check_arguments(args: &CloneArgs) -> anyhow::Result<()> {
             .map_err(|e| UsageError(format!("--density: {e}")))?;
     }
     check_output_folder(&args.output)?;
-    Ok(lapclone::output::refuse_input(&args.output, &[&args.source, &args.mask, &args.target])?)
+    Ok(lapclone::output::refuse_input(
+        &args.output,
+        &[&args.source, &args.mask, &args.target],
+    )?)
 }
 
 /// Fails before any work when the output's folder does not exist.

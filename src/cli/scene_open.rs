@@ -15,9 +15,7 @@ use lapclone::RenderProgress;
 
 /// Parses, validates and builds the renderer (meshes and factors every patch); every error
 /// comes back positioned at the scene call it is about.
-pub(crate) fn load_renderer(
-    scene: &Path,
-) -> anyhow::Result<(LoadedScene, Vec<PathBuf>, Renderer)> {
+pub(crate) fn load_renderer(scene: &Path) -> anyhow::Result<(LoadedScene, Vec<PathBuf>, Renderer)> {
     let (loaded, imports) = load_scene_and_imports(scene).map_err(|e| anyhow::anyhow!("{e}"))?;
     let renderer = lapclone::build_renderer(&loaded).map_err(|e| anyhow::anyhow!("{e}"))?;
     Ok((loaded, imports, renderer))

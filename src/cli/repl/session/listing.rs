@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use lapclone::scene::{Background, Scene, Shape};
+use lapclone::scene::{Background, Canvas as SceneCanvas, Patch, Scene, Shape};
 use lapclone::script::Draft;
 
 use super::Session;
@@ -54,64 +54,11 @@ impl Session {
         let draft = self.engine.draft();
         let mut out = String::new();
         match &draft.canvas {
-            Some(c) => {
-                let background = match &c.background {
-                    Background::Image(path) => short(path),
-                    Background::Colour(rgba) => format!("colour {rgba:?}"),
-                    Background::Footage(f) => format!("footage {}", f.describe()),
-                };
-                out.push_str(&format!(
-                    "canvas {}×{}, {} fps, {} s ({} frames), background {background}\n",
-                    c.width,
-                    c.height,
-                    c.fps,
-                    c.duration,
-                    c.frame_count()
-                ));
-            }
+            Some(c) => out.push_str(&canvas_line(c)),
             None => out.push_str("no canvas yet\n"),
         }
         for patch in &draft.patches {
-            let shape = match &patch.shape {
-                Shape::Mask(path) => format!("mask {}", short(path)),
-                Shape::Polygons(p) => format!("{} polygon(s)", p.len()),
-            };
-            out.push_str(&format!(
-                "patch \"{}\": source {}, {shape}, {:?}, {:?}, feather {}, boundary data {}, \
-                 boundary {}\n",
-                patch.name,
-                short(&patch.source),
-                patch.laplacian,
-                patch.mode,
-                patch.feather,
-                patch.boundary_data.name(),
-                patch.boundary.name()
-            ));
-            let p = &patch.placement;
-            out.push_str(&format!(
-                "  keys: position {}, scale {}, rotation {}, depth {}, opacity {}\n",
-                p.position.keys().len(),
-                p.scale.keys().len(),
-                p.rotation.keys().len(),
-                p.depth.keys().len(),
-                p.opacity.keys().len()
-            ));
-            for (i, h) in patch.handles.iter().enumerate() {
-                out.push_str(&format!(
-                    "  handle {i}: from [{}, {}], radius {}, {} key(s)\n",
-                    h.from.x,
-                    h.from.y,
-                    h.radius,
-                    h.to.keys().len()
-                ));
-            }
-            for (i, pin) in patch.pins.iter().enumerate() {
-                let end = pin.end.map_or("end".to_string(), |e| format!("{e} s"));
-                out.push_str(&format!(
-                    "  pin {i}: at [{}, {}], {} s to {end}\n",
-                    pin.at.x, pin.at.y, pin.start
-                ));
-            }
+            out.push_str(&patch_lines(patch));
         }
         out.push_str(&layer_order(&draft, self.time));
         let names: Vec<&str> = self.scope.iter_raw().map(|(name, _, _)| name).collect();
@@ -120,6 +67,68 @@ impl Session {
         }
         out
     }
+}
+
+/// `canvas 600×400, 24 fps, 3 s (72 frames), background coffee.png`.
+fn canvas_line(c: &SceneCanvas) -> String {
+    let background = match &c.background {
+        Background::Image(path) => short(path),
+        Background::Colour(rgba) => format!("colour {rgba:?}"),
+        Background::Footage(f) => format!("footage {}", f.describe()),
+    };
+    format!(
+        "canvas {}×{}, {} fps, {} s ({} frames), background {background}\n",
+        c.width,
+        c.height,
+        c.fps,
+        c.duration,
+        c.frame_count()
+    )
+}
+
+/// A patch's `:list` lines: its settings, its key counts, its handles and pins.
+fn patch_lines(patch: &Patch) -> String {
+    let shape = match &patch.shape {
+        Shape::Mask(path) => format!("mask {}", short(path)),
+        Shape::Polygons(p) => format!("{} polygon(s)", p.len()),
+    };
+    let mut out = format!(
+        "patch \"{}\": source {}, {shape}, {:?}, {:?}, feather {}, boundary data {}, \
+         boundary {}\n",
+        patch.name,
+        short(&patch.source),
+        patch.laplacian,
+        patch.mode,
+        patch.feather,
+        patch.boundary_data.name(),
+        patch.boundary.name()
+    );
+    let p = &patch.placement;
+    out.push_str(&format!(
+        "  keys: position {}, scale {}, rotation {}, depth {}, opacity {}\n",
+        p.position.keys().len(),
+        p.scale.keys().len(),
+        p.rotation.keys().len(),
+        p.depth.keys().len(),
+        p.opacity.keys().len()
+    ));
+    for (i, h) in patch.handles.iter().enumerate() {
+        out.push_str(&format!(
+            "  handle {i}: from [{}, {}], radius {}, {} key(s)\n",
+            h.from.x,
+            h.from.y,
+            h.radius,
+            h.to.keys().len()
+        ));
+    }
+    for (i, pin) in patch.pins.iter().enumerate() {
+        let end = pin.end.map_or("end".to_string(), |e| format!("{e} s"));
+        out.push_str(&format!(
+            "  pin {i}: at [{}, {}], {} s to {end}\n",
+            pin.at.x, pin.at.y, pin.start
+        ));
+    }
+    out
 }
 
 /// `layers at t = 1.5 s, back to front: horse, cat (opacity 0.5)`.
