@@ -49,7 +49,7 @@ def test_render_writes_what_lapclone_render_writes(cli, tmp_path, name, format):
     got_files, want_files = files_of(got), files_of(want)
     assert len(got_files) >= 1
     if format is None and name in ("frames", "shot.png"):
-        assert sorted(got_files) == [f"frame_{i}.png" for i in range(1, 5)]
+        assert sorted(got_files) == [f"frame_{i:04d}.png" for i in range(1, 5)]
     assert got_files == want_files
 
 
