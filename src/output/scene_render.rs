@@ -73,9 +73,7 @@ pub fn render_scene(
     let plan = SinkPlan::new(kind, path, options.settings)?;
     let total = renderer.frame_count();
     let range = options.frames.unwrap_or(FrameRange::all(total));
-    if range.last > total || range.first == 0 || range.first > range.last {
-        return Err(OutputError::FramesOutOfRange { range, total });
-    }
+    range.check(total)?;
     let jobs = match options.jobs {
         0 => crate::util::available_cores(),
         jobs => jobs,
@@ -88,8 +86,9 @@ pub fn render_scene(
     })
 }
 
-/// Renders the frames of `range` into an opened sink and finishes it; a failure or a
-/// raised `cancel` abandons the sink, so nothing appears. Renderer errors come back as
+/// Renders the frames of `range` (which must lie in the scene, [`FrameRange::check`]) into
+/// an opened sink and finishes it; a failure or a raised `cancel` abandons the sink, so
+/// nothing appears. Renderer errors come back as
 /// [`OutputError::Render`], a cancel as [`OutputError::Interrupted`] (also when a writer
 /// refused because it saw the cancel) or [`OutputError::InterruptedFinishing`].
 pub fn render_frames(
@@ -99,6 +98,10 @@ pub fn render_frames(
     cancel: &AtomicBool,
     progress: &mut dyn RenderProgress,
 ) -> Result<Rendered, OutputError> {
+    if let Err(error) = range.check(renderer.frame_count()) {
+        sink.abandon();
+        return Err(error);
+    }
     if let Some(note) = sink.note() {
         progress.note(note);
     }

@@ -45,14 +45,28 @@ impl FrameRange {
         }
     }
 
-    /// How many frames it holds.
+    /// How many frames it holds (0 when `last` is before `first`).
     pub fn len(&self) -> u64 {
-        self.last - self.first + 1
+        match self.last.checked_sub(self.first) {
+            Some(span) => span.saturating_add(1),
+            None => 0,
+        }
     }
 
-    /// Never: a range holds at least its first frame.
+    /// Refuses a range that is empty, starts at 0 or ends past a scene's `total` frames.
+    pub fn check(&self, total: u64) -> Result<(), OutputError> {
+        if self.first == 0 || self.is_empty() || self.last > total {
+            return Err(OutputError::FramesOutOfRange {
+                range: *self,
+                total,
+            });
+        }
+        Ok(())
+    }
+
+    /// Whether it holds no frame (`last` before `first`).
     pub fn is_empty(&self) -> bool {
-        false
+        self.len() == 0
     }
 }
 
