@@ -21,6 +21,10 @@
 //! 5. **Images**: [`FloatImage`] (sources and targets, any 8/16-bit PNG or JPEG) and
 //!    [`Canvas`] (the premultiplied frame being composited) with their [`PixelFormat`];
 //!    [`Canvas::to_rgba8_image`] hands a frame to the `image` crate. Errors: [`PixelError`].
+//! 6. **Output**: [`render_scene`] writes a loaded scene's frames to a path as `lapclone
+//!    render` does (a PNG folder, GIF, APNG, Y4M, or MP4/WebM/MOV through ffmpeg; the
+//!    [`OutputKind`] the path names, or the one [`RenderOptions`] give), reporting to a
+//!    [`RenderProgress`]. Errors: [`OutputError`].
 //!
 //! Points are [`glam`] vectors, re-exported so callers use the same version.
 //!
@@ -83,6 +87,10 @@ pub use mesh::{
     BitMask, BoundaryLoop, BoundaryPlacement, LoopKind, Mesh, MeshError, MeshOptions, MeshResult,
     MeshStats, Polygon, SanityError, MASK_THRESHOLD,
 };
+pub use output::{
+    render_scene, FrameRange, OutputError, OutputKind, PngCompression, RenderOptions,
+    RenderProgress, Rendered, SinkSettings,
+};
 pub use pixels::{
     Canvas, CanvasPixels, ColorKind, Depth, FloatImage, FootageError, PixelError, PixelFormat,
     PixelRect,
@@ -92,7 +100,8 @@ pub use render::{FrameStats, RenderError, Renderer, SceneUpdate};
 /// The scene language's engine: [`SceneError::position`] is its [`rhai::Position`].
 pub use rhai;
 pub use script::{
-    load_scene, set_allocation_probe, ErrorKind as SceneErrorKind, LoadedScene, SceneError,
+    load_scene, load_scene_and_imports, set_allocation_probe, ErrorKind as SceneErrorKind,
+    LoadedScene, SceneError,
 };
 pub use solve::{FactorMethod, LaplacianKind, PenaltyOptions, SolveError, SwitchStats};
 

@@ -167,6 +167,28 @@ class Scene:
         """``frame(index)``."""
     def __iter__(self) -> Iterator[Image]:
         """Every frame in order."""
+    def render(
+        self, path: Union[str, PathLike[str]], format: Optional[str] = None
+    ) -> str:
+        """Renders every frame to ``path`` as ``lapclone render -o path [--format format]``
+        does, byte for byte, and returns the path written. The GIL is released while it
+        renders.
+
+        ``format``: ``"png"`` (a folder of ``frame_NNNN.png``), ``"gif"``, ``"apng"``,
+        ``"y4m"`` (YUV4MPEG2 4:4:4), or ``"mp4"``, ``"webm"``, ``"mov"`` (through ffmpeg,
+        which must be on ``PATH``). Without it, the path's extension names the format
+        (``.gif``, ``.apng``, ``.y4m``, ``.mp4``, ``.webm``, ``.mov``; no extension, or
+        ``.png``: a folder of frames).
+
+        The output appears whole or not at all (a temporary file or folder beside it,
+        renamed at the end). A PNG folder holding frame files of another render is refused.
+
+        Raises ``ValueError`` for an unknown format or extension and for an output that is
+        one of the scene's inputs (the scene, its imports, images, plates, videos);
+        ``FileNotFoundError`` when the output's folder does not exist;
+        ``IsADirectoryError`` when a file format names a folder; ``SceneError`` for an error
+        in the scene; ``OSError`` when writing fails (ffmpeg missing or failing, a full disk).
+        """
 
 def mesh(
     mask: Mask, *, density: float = 3.0

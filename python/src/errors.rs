@@ -1,8 +1,13 @@
 //! lapclone's errors as Python exceptions: takes the library's typed errors and gives
 //! `ValueError` with lapclone's message, `FileNotFoundError` for a missing file, and
-//! `lapclone.SceneError` (with `file`, `line` and `column`) for a scene file's errors.
+//! `lapclone.SceneError` (with `file`, `line` and `column`) for a scene file's errors; an
+//! output's errors as `ValueError` (bad format, an output that is an input),
+//! `FileNotFoundError` (missing folder) or `OSError` (the write failed).
 
-use pyo3::exceptions::PyValueError;
+use lapclone::OutputError;
+use pyo3::exceptions::{
+    PyFileNotFoundError, PyIsADirectoryError, PyNotADirectoryError, PyOSError, PyValueError,
+};
 use pyo3::prelude::*;
 
 pyo3::create_exception!(
@@ -44,4 +49,40 @@ pub fn scene_error(py: Python<'_>, error: &lapclone::SceneError) -> PyResult<PyE
         value.setattr(name, attribute)?;
     }
     Ok(err)
+}
+
+/// An output error as the Python exception that says what kind of failure it is; the
+/// message is lapclone's, with its causes.
+pub fn output_error(py: Python<'_>, error: OutputError) -> PyErr {
+    let message = with_causes(&error);
+    match error {
+        OutputError::Scene(scene) => scene_error(py, &scene).unwrap_or_else(|e| e),
+        OutputError::UnknownFormat(_)
+        | OutputError::UnknownExtension { .. }
+        | OutputError::StdoutNeedsY4m
+        | OutputError::FramesOutOfRange { .. }
+        | OutputError::ReplacesInput { .. }
+        | OutputError::TooManyFrames(_) => PyValueError::new_err(message),
+        OutputError::MissingFolder { exists: false, .. } => PyFileNotFoundError::new_err(message),
+        OutputError::MissingFolder { exists: true, .. } | OutputError::NotAFrameFolder(_) => {
+            PyNotADirectoryError::new_err(message)
+        }
+        OutputError::IsAFolder { .. } => PyIsADirectoryError::new_err(message),
+        _ => PyOSError::new_err(message),
+    }
+}
+
+/// `error: cause: …`, each cause once (lapclone's messages often end with their cause's).
+fn with_causes(error: &dyn std::error::Error) -> String {
+    let mut line = error.to_string();
+    let mut cause = error.source();
+    while let Some(next) = cause {
+        let text = next.to_string();
+        if !line.contains(&text) {
+            line.push_str(": ");
+            line.push_str(&text);
+        }
+        cause = next.source();
+    }
+    line
 }

@@ -1,27 +1,32 @@
 //! `lapclone.Scene`: takes a `.rhai` scene file, opens it as `lapclone render` does (errors
 //! become `lapclone.SceneError` with the file, line and column, or `FileNotFoundError`) and
 //! gives its frames as arrays: H×W×4 RGBA (or BGRA), `uint8`, or `uint16` for a 16-bit
-//! canvas, the samples `lapclone render` writes to its PNG frames.
+//! canvas, the samples `lapclone render` writes to its PNG frames; `.render(path, format)`
+//! writes them to files through the library's output stage, as `lapclone render` does.
 
 use std::path::PathBuf;
 use std::sync::Mutex;
 
-use lapclone::{Depth, Renderer};
+use lapclone::{Depth, LoadedScene, OutputKind, RenderOptions, Renderer};
 use pyo3::exceptions::{PyFileNotFoundError, PyIndexError, PyRuntimeError};
 use pyo3::prelude::*;
 
 use crate::arrays::{self, Dtype, Layout};
-use crate::errors::{scene_error, to_py};
+use crate::errors::{output_error, scene_error, to_py};
 
 /// Scene(path, *, bgr=False)
 ///
 /// A `.rhai` scene file, opened as `lapclone render` opens it: `len()`, `.fps`, `.size`,
-/// `.frame(i)` (an H×W×4 RGBA array, BGRA with `bgr=True`), indexing and iteration.
+/// `.frame(i)` (an H×W×4 RGBA array, BGRA with `bgr=True`), indexing, iteration and
+/// `.render(path, format=None)` (files, as `lapclone render -o path` writes them).
 /// FileNotFoundError for a missing file, lapclone.SceneError (file, line, column) for an
 /// error in it.
 #[pyclass(module = "lapclone", frozen)]
 pub struct Scene {
     renderer: Mutex<Renderer>,
+    loaded: LoadedScene,
+    /// The module files the scene imported: inputs an output must not replace.
+    imports: Vec<PathBuf>,
     path: PathBuf,
     frames: u64,
     fps: f64,
@@ -42,8 +47,12 @@ impl Scene {
                 path.display().to_string(),
             )));
         }
-        let opened = py.allow_threads(|| lapclone::open_scene(&path));
-        let (loaded, renderer) = match opened {
+        let opened = py.allow_threads(|| {
+            let (loaded, imports) = lapclone::load_scene_and_imports(&path)?;
+            let renderer = lapclone::build_renderer(&loaded)?;
+            Ok::<_, lapclone::SceneError>((loaded, imports, renderer))
+        });
+        let (loaded, imports, renderer) = match opened {
             Ok(opened) => opened,
             Err(error) => return Err(scene_error(py, &error)?),
         };
@@ -54,6 +63,8 @@ impl Scene {
             width: canvas.width,
             height: canvas.height,
             renderer: Mutex::new(renderer),
+            loaded,
+            imports,
             path,
             bgr,
         })
@@ -92,13 +103,7 @@ impl Scene {
             )));
         }
         let (samples, depth) = py.allow_threads(|| {
-            // A frame that panicked may have left the renderer's incremental state (its
-            // factor updates, its dirty rectangles) half-done: refuse rather than draw wrong.
-            let mut renderer = self.renderer.lock().map_err(|_| {
-                PyRuntimeError::new_err(
-                    "an earlier frame of this scene failed part-way: open the scene again",
-                )
-            })?;
+            let mut renderer = self.renderer()?;
             let format = renderer.output_format();
             let canvas = renderer.render_frame(i as u64).map_err(to_py)?;
             Ok::<_, PyErr>((canvas.samples(format), canvas.depth()))
@@ -113,6 +118,38 @@ impl Scene {
             },
         };
         arrays::new_array(py, samples, &layout, self.bgr)
+    }
+
+    /// Renders every frame to `path` as `lapclone render -o path [--format format]` does,
+    /// byte for byte, and returns the path written. `format` is "png" (a folder of
+    /// frame_NNNN.png), "gif", "apng", "y4m", "mp4", "webm" or "mov" (the last three through
+    /// ffmpeg); without it, the path's extension names the format (no extension, or .png: a
+    /// folder). The GIL is released while it renders.
+    #[pyo3(signature = (path, format=None))]
+    fn render(&self, py: Python<'_>, path: PathBuf, format: Option<&str>) -> PyResult<String> {
+        let format = format
+            .map(OutputKind::from_name)
+            .transpose()
+            .map_err(|e| output_error(py, e))?;
+        let options = RenderOptions {
+            format,
+            ..RenderOptions::default()
+        };
+        let rendered = py.allow_threads(|| {
+            let mut renderer = self.renderer()?;
+            Ok::<_, PyErr>(lapclone::render_scene(
+                &self.loaded,
+                &self.imports,
+                &mut renderer,
+                &path,
+                &options,
+                &mut (),
+            ))
+        })?;
+        match rendered {
+            Ok(rendered) => Ok(rendered.path.display().to_string()),
+            Err(error) => Err(output_error(py, error)),
+        }
     }
 
     fn __getitem__<'py>(&self, py: Python<'py>, index: i64) -> PyResult<Bound<'py, PyAny>> {
@@ -143,6 +180,18 @@ impl Scene {
 pub struct SceneFrames {
     scene: Py<Scene>,
     next: u64,
+}
+
+impl Scene {
+    /// The scene's renderer. A frame that panicked may have left its incremental state (its
+    /// factor updates, its dirty rectangles) half-done: refuse rather than draw wrong.
+    fn renderer(&self) -> PyResult<std::sync::MutexGuard<'_, Renderer>> {
+        self.renderer.lock().map_err(|_| {
+            PyRuntimeError::new_err(
+                "an earlier frame of this scene failed part-way: open the scene again",
+            )
+        })
+    }
 }
 
 #[pymethods]

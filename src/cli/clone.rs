@@ -340,26 +340,15 @@ fn check_arguments(args: &CloneArgs) -> anyhow::Result<()> {
             .map_err(|e| UsageError(format!("--density: {e}")))?;
     }
     check_output_folder(&args.output)?;
-    super::inputs::refuse_input(&args.output, &[&args.source, &args.mask, &args.target])
+    Ok(lapclone::output::refuse_input(
+        &args.output,
+        &[&args.source, &args.mask, &args.target],
+    )?)
 }
 
 /// Fails before any work when the output's folder does not exist.
 pub fn check_output_folder(output: &Path) -> anyhow::Result<()> {
-    match output.parent() {
-        Some(dir) if !dir.as_os_str().is_empty() && !dir.is_dir() => {
-            let problem = if dir.exists() {
-                "is not a folder"
-            } else {
-                "does not exist"
-            };
-            anyhow::bail!(
-                "{}: the output folder {} {problem}",
-                output.display(),
-                dir.display()
-            )
-        }
-        _ => Ok(()),
-    }
+    Ok(lapclone::output::check_output_folder(output)?)
 }
 
 fn laplacian_kind(arg: LaplacianArg) -> LaplacianKind {

@@ -47,7 +47,7 @@ pub fn run(args: MeshArgs) -> anyhow::Result<()> {
         return Err(UsageError(format!("--threshold must be in [0, 1], got {threshold}")).into());
     }
     for output in args.output.iter().chain(&args.laplacian_out) {
-        super::inputs::refuse_input(output, &[&args.mask])?;
+        lapclone::output::refuse_input(output, &[&args.mask])?;
     }
     let mask = BitMask::load(&args.mask, threshold as f32)?;
     let started = Instant::now();

@@ -4,12 +4,15 @@
 
 use clap::{Parser, Subcommand};
 
+pub mod check;
 pub mod clone;
-mod inputs;
 pub mod mesh;
 pub mod mesh_args;
+pub mod preview;
 pub mod render;
+pub mod render_args;
 pub mod repl;
+mod scene_open;
 pub mod test;
 pub mod test_args;
 pub mod test_pending;
@@ -138,9 +141,9 @@ pub enum Command {
     /// Render a Rhai scene into frames (PNG sequence, GIF, APNG, Y4M, or MP4/WebM/MOV through ffmpeg).
     Render(render::RenderArgs),
     /// Render one frame of a scene.
-    Preview(render::PreviewArgs),
+    Preview(preview::PreviewArgs),
     /// Parse, evaluate and validate a scene without rendering it.
-    Check(render::CheckArgs),
+    Check(check::CheckArgs),
     /// Edit a scene interactively.
     Repl(repl::ReplArgs),
     /// Compare scenes' frames with their golden frames (accept, reject, review changes).
@@ -154,8 +157,8 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Mesh(args) => mesh::run(args),
         Command::Clone(args) => clone::run(args),
         Command::Render(args) => render::run_render(args),
-        Command::Preview(args) => render::run_preview(args),
-        Command::Check(args) => render::run_check(args),
+        Command::Preview(args) => preview::run_preview(args),
+        Command::Check(args) => check::run_check(args),
         Command::Repl(args) => repl::run(args),
         Command::Test(args) => test::run(args),
         Command::Track(args) => track::run(args),

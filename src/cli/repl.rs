@@ -85,7 +85,11 @@ pub fn run(args: ReplArgs) -> anyhow::Result<()> {
         }
     }
     if args.view.watch {
-        crate::cli::view::watch(session.clone());
+        let (watched, reloaded) = (session.clone(), session.clone());
+        crate::cli::view::watch(
+            move || lock(&watched).watched_files(),
+            move || lock(&reloaded).watch_reload(),
+        );
     }
     if interactive {
         interactive_loop(&session, &args, cancel, words, &printer)

@@ -139,6 +139,22 @@ fn check_scene(job: &Job, scene: &Path) -> SceneResult {
             return result;
         }
     };
+    check_frames(job, scene, &loaded, &mut renderer, frames, &mut result);
+    result.seconds = started.elapsed().as_secs_f64();
+    result
+}
+
+/// Renders and compares `frames` (numbers from 1) into `result`; a render error ends the
+/// scene's checks.
+fn check_frames(
+    job: &Job,
+    scene: &Path,
+    loaded: &lapclone::script::LoadedScene,
+    renderer: &mut Renderer,
+    frames: Vec<u64>,
+    result: &mut SceneResult,
+) {
+    let total = renderer.frame_count();
     let dir = golden_dir(scene, job.args.goldens.as_deref());
     let digits = frame_digits(total);
     let format = renderer.output_format();
@@ -147,7 +163,7 @@ fn check_scene(job: &Job, scene: &Path) -> SceneResult {
         let canvas = match renderer.render_frame(number - 1) {
             Ok(canvas) => canvas,
             Err(error) => {
-                let error = positioned(&loaded, error);
+                let error = positioned(loaded, error);
                 result.failure = Some(SceneFailure {
                     message: format!("frame {number}: {}", super::describe(&error)),
                     loads: true,
@@ -172,8 +188,6 @@ fn check_scene(job: &Job, scene: &Path) -> SceneResult {
         frame.seconds = frame_started.elapsed().as_secs_f64();
         result.frames.push(frame);
     }
-    result.seconds = started.elapsed().as_secs_f64();
-    result
 }
 
 fn load(scene: &Path) -> anyhow::Result<(lapclone::script::LoadedScene, Renderer)> {

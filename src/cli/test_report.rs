@@ -86,7 +86,6 @@ pub fn finish(
     _reporter: &Reporter,
 ) -> anyhow::Result<()> {
     let counts = count(results);
-    let bad = counts.failed + counts.new + counts.errors;
     let shown: Vec<(&SceneResult, &FrameResult)> = results
         .iter()
         .flat_map(|r| r.frames.iter().map(move |f| (r, f)))
@@ -103,20 +102,7 @@ pub fn finish(
         super::test_args::write_file(path, xml.as_bytes())?;
     }
     let summary = summary_line(&counts, seconds);
-    let pending = results
-        .iter()
-        .flat_map(|r| &r.frames)
-        .filter(|f| f.pending_written.is_some())
-        .count();
-    let mut notes = Vec::new();
-    if let Some(dir) = report.filter(|_| !shown.is_empty()) {
-        notes.push(format!("report: {}", dir.join("index.html").display()));
-    }
-    if pending > 0 {
-        notes.push(format!(
-            "{pending} pending frame(s): lapclone test --review (or --accept / --reject)"
-        ));
-    }
+    let notes = notes(report.filter(|_| !shown.is_empty()), results);
     if args.json {
         eprintln!("{summary}");
         notes.iter().for_each(|n| eprintln!("{n}"));
@@ -126,6 +112,31 @@ pub fn finish(
             super::say(note)?;
         }
     }
+    verdict(&counts)
+}
+
+/// The notes after the summary: where the report is, and what to do with pending frames.
+fn notes(report: Option<std::path::PathBuf>, results: &[SceneResult]) -> Vec<String> {
+    let pending = results
+        .iter()
+        .flat_map(|r| &r.frames)
+        .filter(|f| f.pending_written.is_some())
+        .count();
+    let mut notes = Vec::new();
+    if let Some(dir) = report {
+        notes.push(format!("report: {}", dir.join("index.html").display()));
+    }
+    if pending > 0 {
+        notes.push(format!(
+            "{pending} pending frame(s): lapclone test --review (or --accept / --reject)"
+        ));
+    }
+    notes
+}
+
+/// The run's outcome: a usage error when a scene could not be checked, a failure when a
+/// frame failed, had no golden or did not render.
+fn verdict(counts: &Counts) -> anyhow::Result<()> {
     if counts.load_errors > 0 {
         return Err(UsageError(format!(
             "{} scene(s) could not be checked (see the ERROR lines)",
@@ -133,7 +144,7 @@ pub fn finish(
         ))
         .into());
     }
-    if bad > 0 {
+    if counts.failed + counts.new + counts.errors > 0 {
         anyhow::bail!(
             "{} frame(s) failed, {} had no golden, {} scene(s) failed to render",
             counts.failed,

@@ -85,6 +85,37 @@ pub fn triangulate_loops(
         });
     }
     let input_count = points.len();
+    let mut cdt = constrained_triangulation(&points, &edges)?;
+    let additional = (max_vertices - input_count).min(refinement_budget(loops, input_count));
+    let mut parameters = RefinementParameters::<f64>::new()
+        .with_angle_limit(AngleLimit::from_deg(min_angle_deg))
+        .exclude_outer_faces(true)
+        .with_max_additional_vertices(additional);
+    if let Some(area) = max_area {
+        parameters = parameters.with_max_allowed_area(area);
+    }
+    if keep_boundary {
+        parameters = parameters.keep_constraint_edges();
+    }
+    let result = cdt.refine(parameters);
+    let mut excluded = vec![false; cdt.num_all_faces()];
+    for face in &result.excluded_faces {
+        excluded[face.index()] = true;
+    }
+    let mesh = extract_mesh(&cdt, &excluded);
+    Ok(Triangulated {
+        mesh,
+        refinement_complete: result.refinement_complete,
+    })
+}
+
+/// The constrained Delaunay triangulation of `points` with the boundary `edges`; crossing
+/// edges and merged vertices are errors.
+fn constrained_triangulation(
+    points: &[DVec2],
+    edges: &[[usize; 2]],
+) -> Result<ConstrainedDelaunayTriangulation<Point2<f64>>, MeshError> {
+    let input_count = points.len();
     let spade_points: Vec<Point2<f64>> = points.iter().map(|p| Point2::new(p.x, p.y)).collect();
     // Delaunay first, constraints after: the boundary edges are (nearly) all Delaunay edges
     // already, so adding them is a walk of one step each, while spade's constraint-aware
@@ -111,27 +142,7 @@ pub fn triangulate_loops(
             "spade merged boundary vertices".into(),
         ));
     }
-    let additional = (max_vertices - input_count).min(refinement_budget(loops, input_count));
-    let mut parameters = RefinementParameters::<f64>::new()
-        .with_angle_limit(AngleLimit::from_deg(min_angle_deg))
-        .exclude_outer_faces(true)
-        .with_max_additional_vertices(additional);
-    if let Some(area) = max_area {
-        parameters = parameters.with_max_allowed_area(area);
-    }
-    if keep_boundary {
-        parameters = parameters.keep_constraint_edges();
-    }
-    let result = cdt.refine(parameters);
-    let mut excluded = vec![false; cdt.num_all_faces()];
-    for face in &result.excluded_faces {
-        excluded[face.index()] = true;
-    }
-    let mesh = extract_mesh(&cdt, &excluded);
-    Ok(Triangulated {
-        mesh,
-        refinement_complete: result.refinement_complete,
-    })
+    Ok(cdt)
 }
 
 /// Exact-position deduplication; drops zero-length edges.

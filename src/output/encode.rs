@@ -13,9 +13,12 @@ use super::{Frame, FrameRef, OutputError, Pixels};
 /// PNG compression effort; `Fast` is the default for frame sequences.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum PngCompression {
+    /// Fast deflate; a sequence's unchanged rows reuse the frame before's bands.
     #[default]
     Fast,
+    /// The encoder's default effort.
     Default,
+    /// The smallest files.
     Best,
 }
 

@@ -8,16 +8,24 @@
 
 use std::path::Path;
 
+use super::OutputError;
+
 /// What `lapclone render` writes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum OutputKind {
     /// A folder of `frame_NNNN.png`.
     PngFolder,
+    /// An animated GIF.
     Gif,
+    /// An animated PNG.
     Apng,
+    /// H.264 through ffmpeg.
     Mp4,
+    /// VP9 through ffmpeg.
     Webm,
+    /// H.264, or ProRes 4444 for a transparent canvas, through ffmpeg.
     Mov,
+    /// YUV4MPEG2 4:4:4, written without ffmpeg (`-`: standard output).
     Y4m,
 }
 
@@ -42,6 +50,40 @@ impl OutputKind {
         })
     }
 
+    /// The format a name stands for: `png` (a folder of frames), `gif`, `apng`, `mp4`,
+    /// `webm`, `mov`, `y4m` (the names `lapclone render --format` takes).
+    pub fn from_name(name: &str) -> Result<OutputKind, OutputError> {
+        Ok(match name.to_ascii_lowercase().as_str() {
+            "png" => OutputKind::PngFolder,
+            "gif" => OutputKind::Gif,
+            "apng" => OutputKind::Apng,
+            "mp4" => OutputKind::Mp4,
+            "webm" => OutputKind::Webm,
+            "mov" => OutputKind::Mov,
+            "y4m" => OutputKind::Y4m,
+            _ => return Err(OutputError::UnknownFormat(name.to_string())),
+        })
+    }
+
+    /// The output's format: `format` when given (the path is then just a name), else the
+    /// one `path` names. `-` (standard output) must be Y4M.
+    pub fn resolve(path: &Path, format: Option<OutputKind>) -> Result<OutputKind, OutputError> {
+        let kind = match (format, OutputKind::from_path(path)) {
+            (Some(format), _) => format,
+            (None, Ok(named)) => named,
+            (None, Err(extension)) => {
+                return Err(OutputError::UnknownExtension {
+                    path: path.to_path_buf(),
+                    extension,
+                })
+            }
+        };
+        if path.as_os_str() == "-" && kind != OutputKind::Y4m {
+            return Err(OutputError::StdoutNeedsY4m);
+        }
+        Ok(kind)
+    }
+
     /// Whether it is written through ffmpeg.
     pub fn needs_ffmpeg(self) -> bool {
         matches!(self, OutputKind::Mp4 | OutputKind::Webm | OutputKind::Mov)
@@ -62,5 +104,20 @@ mod tests {
         assert_eq!(kind("frames"), Ok(OutputKind::PngFolder));
         assert_eq!(kind("-"), Ok(OutputKind::Y4m));
         assert_eq!(kind("cat.jpg"), Err("jpg".to_string()));
+    }
+
+    #[test]
+    fn names_and_paths_resolve_to_formats() {
+        assert_eq!(OutputKind::from_name("GIF").ok(), Some(OutputKind::Gif));
+        assert_eq!(OutputKind::from_name("png").ok(), Some(OutputKind::PngFolder));
+        assert!(matches!(
+            OutputKind::from_name("jpeg"),
+            Err(OutputError::UnknownFormat(name)) if name == "jpeg"
+        ));
+        let resolve = |p: &str, f| OutputKind::resolve(Path::new(p), f);
+        assert_eq!(resolve("a.mp4", Some(OutputKind::Y4m)).ok(), Some(OutputKind::Y4m));
+        assert_eq!(resolve("a.apng", None).ok(), Some(OutputKind::Apng));
+        assert!(matches!(resolve("a.bmp", None), Err(OutputError::UnknownExtension { .. })));
+        assert!(matches!(resolve("-", Some(OutputKind::Gif)), Err(OutputError::StdoutNeedsY4m)));
     }
 }

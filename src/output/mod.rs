@@ -2,7 +2,9 @@
 //! sequence (`DIR/frame_0001.png …`, encoded in parallel), an animated GIF, an animated
 //! PNG, a YUV4MPEG2 stream, or an MP4/WebM/MOV through an ffmpeg process; plus the format an
 //! output path names ([`OutputKind::from_path`]). Every file appears whole or not at all
-//! (temporary file + rename).
+//! (temporary file + rename). On top of the writers, a [`SinkPlan`] / [`FrameSink`] picks
+//! the writer for a path and a renderer, and [`render_scene`] renders a loaded scene to a
+//! path (refusing an output that is one of the scene's inputs).
 
 mod apng;
 mod encode;
@@ -12,7 +14,11 @@ mod frame;
 mod gif;
 mod gif_frame;
 mod gif_palette;
+mod inputs;
 mod png_sequence;
+mod scene_render;
+mod sink;
+mod staging;
 mod y4m;
 mod yuv;
 
@@ -27,12 +33,16 @@ pub use gif_palette::{Palette, PaletteMap};
 pub use png_sequence::{
     foreign_frames, frame_digits, frame_file_name, write_png_file, PngSequenceWriter,
 };
+pub use inputs::{refuse_input, refuse_render_input, refuse_scene_input};
+pub use scene_render::{render_frames, render_scene, RenderOptions, RenderProgress, Rendered};
+pub use sink::{check_output_folder, FrameRange, FrameSink, SinkPlan, SinkSettings};
 pub use y4m::{fps_fraction, Y4mWriter};
 pub use yuv::{frame_to_yuv420, rgb_to_ycbcr, yuv420_len, yuv420_size};
 
 use std::path::{Path, PathBuf};
 
 impl OutputError {
+    /// An I/O failure on `path`.
     pub fn io(path: &Path, source: std::io::Error) -> Self {
         OutputError::Io {
             path: path.to_path_buf(),
@@ -41,30 +51,164 @@ impl OutputError {
     }
 }
 
+/// Why an output was refused or failed. Messages name the path; the causes (I/O errors)
+/// are their `source`s.
 #[derive(Debug, thiserror::Error)]
 pub enum OutputError {
+    /// Reading or writing `path` failed.
     #[error("{}: {source}", path.display())]
     Io {
+        /// The file.
         path: PathBuf,
+        /// Why.
         #[source]
         source: std::io::Error,
     },
+    /// The PNG encoder failed.
     #[error("PNG encoding failed: {0}")]
     Png(#[from] png::EncodingError),
+    /// The GIF encoder failed.
     #[error("GIF encoding failed: {0}")]
     Gif(#[from] ::gif::EncodingError),
+    /// A frame whose size or samples do not fit the output.
     #[error("bad frame: {0}")]
     BadFrame(String),
+    /// A frame folder that does not exist.
     #[error("output folder {} does not exist", .0.display())]
     NotAFolder(PathBuf),
+    /// An encoder thread failed.
     #[error("{0}")]
     Worker(String),
+    /// A video format without an `ffmpeg` on `PATH`.
     #[error("{}", crate::util::FFMPEG_MISSING)]
     NoFfmpeg,
+    /// ffmpeg failed; the last lines it wrote.
     #[error("ffmpeg failed writing {}; it said:\n  {stderr}", path.display())]
-    Ffmpeg { path: PathBuf, stderr: String },
+    Ffmpeg {
+        /// The video.
+        path: PathBuf,
+        /// ffmpeg's last lines on stderr.
+        stderr: String,
+    },
+    /// A writer stopped because the cancel flag was raised.
     #[error("cancelled")]
     Cancelled,
+    /// The output's parent folder is missing (`exists` false) or not a folder.
+    #[error("{}: the output folder {} {}", output.display(), folder.display(), if *exists { "is not a folder" } else { "does not exist" })]
+    MissingFolder {
+        /// The output path.
+        output: PathBuf,
+        /// Its parent folder.
+        folder: PathBuf,
+        /// Whether something that is not a folder is there.
+        exists: bool,
+    },
+    /// A file output names an existing folder.
+    #[error("{} is a folder; name a file for {kind:?} output", path.display())]
+    IsAFolder {
+        /// The output path.
+        path: PathBuf,
+        /// The format asked for.
+        kind: OutputKind,
+    },
+    /// A PNG frame folder's path is a file.
+    #[error("{} exists and is not a folder; name a folder for PNG frames", .0.display())]
+    NotAFrameFolder(PathBuf),
+    /// A PNG frame folder holds frame files of another render (and `force` is off).
+    #[error("{} holds {count} frame files of another render (e.g. {example}); use --force to remove them, or another folder", folder.display())]
+    ForeignFrames {
+        /// The folder.
+        folder: PathBuf,
+        /// How many such files.
+        count: usize,
+        /// One of their names.
+        example: String,
+    },
+    /// The output would replace one of the inputs.
+    #[error("{}: the output would replace an input of this command ({input}); write it elsewhere", output.display())]
+    ReplacesInput {
+        /// The output path (or the frame file in a PNG folder).
+        output: PathBuf,
+        /// The input: its path or footage pattern.
+        input: String,
+    },
+    /// The output path's extension names no format.
+    #[error("{}: unknown output extension `.{extension}` (use .gif, .apng, .mp4, .webm, .mov, .y4m, a folder name without an extension, or a format)", path.display())]
+    UnknownExtension {
+        /// The output path.
+        path: PathBuf,
+        /// Its extension.
+        extension: String,
+    },
+    /// A format name that is none of png, gif, apng, mp4, webm, mov, y4m.
+    #[error("unknown output format `{0}` (use png, gif, apng, mp4, webm, mov or y4m)")]
+    UnknownFormat(String),
+    /// `-` (standard output) for a format other than Y4M.
+    #[error("- (standard output) needs the y4m format")]
+    StdoutNeedsY4m,
+    /// Frames asked for beyond the scene's end.
+    #[error("frames {}..{}: the scene has {total} frames", range.first, range.last)]
+    FramesOutOfRange {
+        /// The range asked for.
+        range: FrameRange,
+        /// The scene's frame count.
+        total: u64,
+    },
+    /// More frames than an APNG holds.
+    #[error("too many frames for an APNG")]
+    TooManyFrames(#[source] std::num::TryFromIntError),
+    /// Listing a frame folder failed.
+    #[error("reading {}", path.display())]
+    ReadingFolder {
+        /// The folder.
+        path: PathBuf,
+        /// Why.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The temporary folder beside the output could not be made.
+    #[error("creating a folder beside {}", beside.display())]
+    CreatingFolder {
+        /// The output.
+        beside: PathBuf,
+        /// Why.
+        #[source]
+        source: std::io::Error,
+    },
+    /// Moving the finished frames into the destination failed.
+    #[error("moving the frames to {}", dest.display())]
+    Moving {
+        /// The destination folder.
+        dest: PathBuf,
+        /// Why.
+        #[source]
+        source: std::io::Error,
+    },
+    /// Removing another render's frame file (with `force`) failed.
+    #[error("removing {}", path.display())]
+    Removing {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The renderer failed on a frame (not positioned; [`render_scene`] gives
+    /// [`OutputError::Scene`] instead).
+    #[error(transparent)]
+    Render(#[from] crate::render::RenderError),
+    /// An error about the scene, positioned at the call it is about.
+    #[error(transparent)]
+    Scene(#[from] crate::script::SceneError),
+    /// The render was cancelled after `after` frames of the range were written.
+    #[error("interrupted: stopped after frame {after}")]
+    Interrupted {
+        /// The last frame number pushed (one before the range's first when none was).
+        after: u64,
+    },
+    /// The render was cancelled while the writers finished the last frames.
+    #[error("interrupted: stopped while writing the last frames")]
+    InterruptedFinishing,
 }
 
 /// Whole `unit`s per frame (e.g. 100 for centiseconds), rounded from the exact frame times

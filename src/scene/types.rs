@@ -270,8 +270,8 @@ impl Scene {
 }
 
 impl Patch {
-    /// Checks the patch's settings and keys.
-    pub fn sanity_check(&self) -> Result<(), ModelError> {
+    /// Checks the placement's and the handles' tracks and rest values.
+    fn check_tracks(&self) -> Result<(), ModelError> {
         let fail = |what: String| ModelError::Patch {
             patch: self.name.clone(),
             what,
@@ -281,23 +281,6 @@ impl Patch {
             track: track.to_string(),
             error,
         };
-        if self.name.is_empty() {
-            return Err(fail("empty name".into()));
-        }
-        if let Some(d) = self.density {
-            if !(d.is_finite() && d > 0.0) {
-                return Err(fail(format!("density {d} must be finite and > 0")));
-            }
-        }
-        if !(self.feather.is_finite() && self.feather >= 0.0) {
-            return Err(fail(format!(
-                "feather {} must be finite and ≥ 0",
-                self.feather
-            )));
-        }
-        if let Shape::Polygons(polygons) = &self.shape {
-            check_polygons(polygons).map_err(fail)?;
-        }
         let p = &self.placement;
         p.position.sanity_check().map_err(|e| key("position", e))?;
         p.scale.sanity_check().map_err(|e| key("scale", e))?;
@@ -329,6 +312,33 @@ impl Patch {
                 .sanity_check()
                 .map_err(|e| key(&format!("handle {i} rotation"), e))?;
         }
+        Ok(())
+    }
+
+    /// Checks the patch's settings and keys.
+    pub fn sanity_check(&self) -> Result<(), ModelError> {
+        let fail = |what: String| ModelError::Patch {
+            patch: self.name.clone(),
+            what,
+        };
+        if self.name.is_empty() {
+            return Err(fail("empty name".into()));
+        }
+        if let Some(d) = self.density {
+            if !(d.is_finite() && d > 0.0) {
+                return Err(fail(format!("density {d} must be finite and > 0")));
+            }
+        }
+        if !(self.feather.is_finite() && self.feather >= 0.0) {
+            return Err(fail(format!(
+                "feather {} must be finite and ≥ 0",
+                self.feather
+            )));
+        }
+        if let Shape::Polygons(polygons) = &self.shape {
+            check_polygons(polygons).map_err(fail)?;
+        }
+        self.check_tracks()?;
         for (i, pin) in self.pins.iter().enumerate() {
             let window_ok = pin.start.is_finite()
                 && pin.start >= 0.0

@@ -75,6 +75,27 @@ pub struct SymbolicFactor {
     pub(crate) supernodes: SupernodePartition,
 }
 
+/// faer's symbolic parameters for `method` (`Auto` picks by the matrix size `n`).
+fn cholesky_params(n: usize, method: FactorMethod) -> CholeskySymbolicParams<'static> {
+        let method = match method {
+            FactorMethod::Auto if n >= SUPERNODAL_MIN_VERTICES => AUTO_SUPERNODAL,
+            FactorMethod::Auto => FactorMethod::Simplicial,
+            chosen => chosen,
+        };
+        let supernodal = method != FactorMethod::Simplicial;
+        // `None` keeps fundamental supernodes, whose columns are exactly the simplicial ones.
+        let relax = (method == FactorMethod::SupernodalRelaxed).then_some(RELAXED_SUPERNODES);
+        CholeskySymbolicParams {
+            supernodal_flop_ratio_threshold: if supernodal {
+                SupernodalThreshold::FORCE_SUPERNODAL
+            } else {
+                SupernodalThreshold::FORCE_SIMPLICIAL
+            },
+            supernodal_params: SymbolicSupernodalParams { relax },
+            ..Default::default()
+        }
+}
+
 impl SymbolicFactor {
     /// AMD ordering plus symbolic factorisation of `a`'s pattern ([`FactorMethod::Auto`]).
     pub fn analyse(a: &SymmetricCsc) -> Result<Self, SolveError> {
@@ -97,23 +118,7 @@ impl SymbolicFactor {
             .collect::<Result<_, _>>()?;
         // SAFETY-free: the pattern was validated by `sanity_check` (sorted, in range).
         let pattern = SymbolicSparseColMatRef::new_checked(a.n, a.n, &a_col_ptr, None, &a_row_idx);
-        let method = match method {
-            FactorMethod::Auto if a.n >= SUPERNODAL_MIN_VERTICES => AUTO_SUPERNODAL,
-            FactorMethod::Auto => FactorMethod::Simplicial,
-            chosen => chosen,
-        };
-        let supernodal = method != FactorMethod::Simplicial;
-        // `None` keeps fundamental supernodes, whose columns are exactly the simplicial ones.
-        let relax = (method == FactorMethod::SupernodalRelaxed).then_some(RELAXED_SUPERNODES);
-        let params = CholeskySymbolicParams {
-            supernodal_flop_ratio_threshold: if supernodal {
-                SupernodalThreshold::FORCE_SUPERNODAL
-            } else {
-                SupernodalThreshold::FORCE_SIMPLICIAL
-            },
-            supernodal_params: SymbolicSupernodalParams { relax },
-            ..Default::default()
-        };
+        let params = cholesky_params(a.n, method);
         let faer =
             factorize_symbolic_cholesky(pattern, Side::Lower, SymmetricOrdering::Amd, params)
                 .map_err(|e| SolveError::Symbolic(format!("{e:?}")))?;

@@ -79,13 +79,7 @@ pub fn rank1_diagonal(
         let rows = &row_idx[start + 1..end];
         let vals = &mut values[start + 1..end];
         if j == p {
-            // First column, w = e_p: l̄_ip = l_ip (1 − γ) = l_ip d_p / d̄_p. Written as the
-            // ratio, because 1 − γ cancels catastrophically when σ ≫ d_p (a penalty update).
-            let ratio = d / d_bar;
-            for (&i, l) in rows.iter().zip(vals.iter_mut()) {
-                w[i as usize] = -*l;
-                *l *= ratio;
-            }
+            first_column(rows, vals, w, d / d_bar);
         } else {
             column_step(rows, vals, w, wj, gamma);
         }
@@ -93,6 +87,16 @@ pub fn rank1_diagonal(
             Some(&parent) => j = parent as usize,
             None => return Rank1Outcome::Done { amplification },
         }
+    }
+}
+
+/// The first column, where w = e_p: l̄_ip = l_ip (1 − γ) = l_ip d_p / d̄_p, written as the
+/// ratio d_p / d̄_p because 1 − γ cancels catastrophically when σ ≫ d_p (a penalty update).
+#[inline(always)]
+fn first_column(rows: &[u32], vals: &mut [f64], w: &mut [f64], ratio: f64) {
+    for (&i, l) in rows.iter().zip(vals.iter_mut()) {
+        w[i as usize] = -*l;
+        *l *= ratio;
     }
 }
 

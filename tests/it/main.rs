@@ -37,6 +37,7 @@ mod mesh_shapes;
 mod numeric_faults;
 mod output_apng;
 mod output_gif;
+mod output_render_scene;
 mod output_writers;
 mod pixels_formats;
 mod program_lookup;

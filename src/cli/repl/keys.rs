@@ -49,14 +49,20 @@ pub fn key_table(patch: &Patch) -> String {
     if rows.is_empty() {
         return out;
     }
+    write_table(&mut out, &rows);
+    out
+}
+
+/// `rows` under a header, each column as wide as its widest cell.
+fn write_table(out: &mut String, rows: &[[String; 4]]) {
     let header = ["track", "t", "value", "easing"].map(String::from);
     let mut widths = [0usize; 4];
-    for row in std::iter::once(&header).chain(&rows) {
+    for row in std::iter::once(&header).chain(rows) {
         for (w, cell) in widths.iter_mut().zip(row) {
             *w = (*w).max(cell.chars().count());
         }
     }
-    for row in std::iter::once(&header).chain(&rows) {
+    for row in std::iter::once(&header).chain(rows) {
         let _ = writeln!(
             out,
             "  {:<a$}  {:>b$}  {:<c$}  {}",
@@ -69,7 +75,6 @@ pub fn key_table(patch: &Patch) -> String {
             c = widths[2]
         );
     }
-    out
 }
 
 fn track_rows<T: Interpolate>(

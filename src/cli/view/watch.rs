@@ -1,32 +1,32 @@
-//! `--watch`: takes the shared session and gives a thread that polls the loaded scene file
-//! and the modules its `import` lines name (twice a second, by modification time and size)
-//! and reloads the scene when one changes — only when the session has no unsaved edits;
-//! otherwise it says why not. The playhead is kept.
+//! `--watch`: takes two callbacks, one giving the files to watch (the loaded scene file and
+//! the modules its `import` lines name) and one reloading the scene, and gives a thread
+//! that polls those files (twice a second, by modification time and size) and calls the
+//! reload when one changes. What a reload does (refuse over unsaved edits, keep the
+//! playhead) is the caller's: this file knows no session.
 
 use std::path::PathBuf;
-use std::sync::{Arc, Mutex};
 use std::time::{Duration, SystemTime};
-
-use super::lock;
-use crate::cli::repl::Session;
 
 const POLL: Duration = Duration::from_millis(500);
 
 type Stamp = Vec<(PathBuf, Option<(SystemTime, u64)>)>;
 
 /// Starts the watching thread; the files as they are now are the baseline.
-pub fn watch(session: Arc<Mutex<Session>>) {
-    let mut last = stamp(&session);
+pub fn watch(
+    files: impl Fn() -> Vec<PathBuf> + Send + 'static,
+    reload: impl Fn() + Send + 'static,
+) {
+    let mut last = stamp(&files);
     let spawned = std::thread::Builder::new()
         .name("view-watch".into())
         .spawn(move || loop {
             std::thread::sleep(POLL);
-            let now = stamp(&session);
+            let now = stamp(&files);
             let changed = last != now && same_files(&last, &now);
             last = now;
             if changed {
-                lock(&session).watch_reload();
-                last = stamp(&session);
+                reload();
+                last = stamp(&files);
             }
         });
     if let Err(error) = spawned {
@@ -34,9 +34,8 @@ pub fn watch(session: Arc<Mutex<Session>>) {
     }
 }
 
-fn stamp(session: &Mutex<Session>) -> Stamp {
-    let files = lock(session).watched_files();
-    files
+fn stamp(files: &impl Fn() -> Vec<PathBuf>) -> Stamp {
+    files()
         .into_iter()
         .map(|f| {
             let meta = std::fs::metadata(&f).ok();

@@ -1,15 +1,16 @@
 //! The files a command reads, and the refusal of an output that is one of them: takes a
 //! loaded scene (with its imports) or a command's input paths and an output path, and
 //! gives an error naming the input when writing the output would replace it. Files are
-//! compared by identity (links and hard links followed, `lapclone::util::same_file`), so
-//! `-o` cannot reach an input through another spelling of its path.
+//! compared by identity (links and hard links followed, `util::same_file`), so an output
+//! path cannot reach an input through another spelling of it.
 
 use std::path::{Path, PathBuf};
 
-use lapclone::animation::{Background, FootageSource, Pattern};
-use lapclone::output::{foreign_frames, OutputKind};
-use lapclone::script::LoadedScene;
-use lapclone::util::same_file;
+use super::{foreign_frames, OutputError, OutputKind};
+use crate::pixels::footage::Pattern;
+use crate::scene::{Background, Footage, FootageSource, Shape};
+use crate::script::LoadedScene;
+use crate::util::same_file;
 
 /// Something a render reads: a file, or the files of a numbered sequence it shows.
 enum Input {
@@ -70,7 +71,7 @@ fn scene_inputs(loaded: &LoadedScene, imports: &[PathBuf]) -> Vec<Input> {
         .chain(imports.iter().cloned())
         .map(Input::File)
         .collect();
-    let footage = |f: &lapclone::animation::Footage| match &f.source {
+    let footage = |f: &Footage| match &f.source {
         FootageSource::Sequence { pattern, start } => Input::Sequence {
             pattern: pattern.clone(),
             first: *start,
@@ -88,7 +89,7 @@ fn scene_inputs(loaded: &LoadedScene, imports: &[PathBuf]) -> Vec<Input> {
         if let Some(f) = &patch.footage {
             inputs.push(footage(f));
         }
-        if let lapclone::animation::Shape::Mask(mask) = &patch.shape {
+        if let Shape::Mask(mask) = &patch.shape {
             inputs.push(Input::File(mask.clone()));
         }
     }
@@ -98,12 +99,12 @@ fn scene_inputs(loaded: &LoadedScene, imports: &[PathBuf]) -> Vec<Input> {
 /// Refuses a render's output (of `kind`) that is one of its scene's inputs: a file, or for
 /// a PNG folder a frame file that an input sequence shows. `render` and the REPL's
 /// `:render` both ask here.
-pub(crate) fn refuse_render_input(
+pub fn refuse_render_input(
     kind: OutputKind,
     output: &Path,
     loaded: &LoadedScene,
     imports: &[PathBuf],
-) -> anyhow::Result<()> {
+) -> Result<(), OutputError> {
     if kind == OutputKind::PngFolder {
         refuse_scene_input_frames(output, loaded, imports)
     } else {
@@ -112,11 +113,11 @@ pub(crate) fn refuse_render_input(
 }
 
 /// Refuses a file output (`-o`) that is one of the scene's inputs.
-pub(crate) fn refuse_scene_input(
+pub fn refuse_scene_input(
     output: &Path,
     loaded: &LoadedScene,
     imports: &[PathBuf],
-) -> anyhow::Result<()> {
+) -> Result<(), OutputError> {
     if output.as_os_str() == "-" || !output.exists() {
         return Ok(());
     }
@@ -135,7 +136,7 @@ fn refuse_scene_input_frames(
     folder: &Path,
     loaded: &LoadedScene,
     imports: &[PathBuf],
-) -> anyhow::Result<()> {
+) -> Result<(), OutputError> {
     if !folder.is_dir() {
         return Ok(());
     }
@@ -150,16 +151,16 @@ fn refuse_scene_input_frames(
 }
 
 /// Refuses an output that is one of `inputs` (a command's input files).
-pub(crate) fn refuse_input(output: &Path, inputs: &[&Path]) -> anyhow::Result<()> {
+pub fn refuse_input(output: &Path, inputs: &[&Path]) -> Result<(), OutputError> {
     match inputs.iter().find(|input| same_file(input, output)) {
         Some(input) => Err(overwrite(output, &input.display().to_string())),
         None => Ok(()),
     }
 }
 
-fn overwrite(output: &Path, input: &str) -> anyhow::Error {
-    anyhow::anyhow!(
-        "{}: the output would replace an input of this command ({input}); write it elsewhere",
-        output.display()
-    )
+fn overwrite(output: &Path, input: &str) -> OutputError {
+    OutputError::ReplacesInput {
+        output: output.to_path_buf(),
+        input: input.to_string(),
+    }
 }

@@ -1,0 +1,38 @@
+//! `lapclone check`: takes a scene file, parses, evaluates, validates and builds it, and
+//! prints a one-line summary (or the positioned error with a caret) and its warnings.
+
+use std::path::PathBuf;
+
+use super::scene_open::load_renderer;
+
+#[derive(clap::Args, Debug)]
+pub struct CheckArgs {
+    /// Scene file (.rhai).
+    pub scene: PathBuf,
+}
+
+pub fn run_check(args: CheckArgs) -> anyhow::Result<()> {
+    let (loaded, _, renderer) = load_renderer(&args.scene)?;
+    let c = &loaded.scene.canvas;
+    let handles: usize = loaded.scene.patches.iter().map(|p| p.handles.len()).sum();
+    let pins: usize = loaded.scene.patches.iter().map(|p| p.pins.len()).sum();
+    let vertices: usize = renderer.vertex_counts().iter().sum();
+    super::say(format_args!(
+        "{}: ok — {}×{}, {} fps, {} s ({} frames), {} patches ({vertices} mesh vertices), {handles} handles, {pins} pins",
+        args.scene.display(),
+        c.width,
+        c.height,
+        c.fps,
+        c.duration,
+        c.frame_count(),
+        loaded.scene.patches.len(),
+    ))?;
+    for warning in loaded
+        .warnings()
+        .into_iter()
+        .chain(renderer.point_warnings())
+    {
+        eprintln!("warning: {warning}");
+    }
+    Ok(())
+}

@@ -1,0 +1,154 @@
+//! `lapclone render`'s arguments: takes the command line and gives [`RenderArgs`] (scene,
+//! output, frames, format, jobs, force, PNG compression, quality), the `A..B` frame range
+//! parser the REPL and `track` share, and the output format those arguments name.
+
+use std::path::PathBuf;
+
+use clap::ValueEnum;
+use lapclone::output::{OutputError, OutputKind, PngCompression, SinkSettings};
+use lapclone::FrameRange;
+
+use crate::cli::UsageError;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum OutputFormat {
+    /// A folder of frame_NNNN.png.
+    Png,
+    Gif,
+    Apng,
+    /// H.264 (through ffmpeg).
+    Mp4,
+    /// VP9 (through ffmpeg).
+    Webm,
+    /// H.264, or ProRes 4444 with alpha for a transparent canvas (through ffmpeg).
+    Mov,
+    /// YUV4MPEG2, 4:4:4 (written without ffmpeg; `-o -` for standard output).
+    Y4m,
+}
+
+impl OutputFormat {
+    pub(crate) fn kind(self) -> OutputKind {
+        match self {
+            OutputFormat::Png => OutputKind::PngFolder,
+            OutputFormat::Gif => OutputKind::Gif,
+            OutputFormat::Apng => OutputKind::Apng,
+            OutputFormat::Mp4 => OutputKind::Mp4,
+            OutputFormat::Webm => OutputKind::Webm,
+            OutputFormat::Mov => OutputKind::Mov,
+            OutputFormat::Y4m => OutputKind::Y4m,
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum CompressionArg {
+    #[default]
+    Fast,
+    Default,
+    Best,
+}
+
+pub fn frame_range(text: &str) -> Result<FrameRange, String> {
+    let (a, b) = text
+        .split_once("..")
+        .ok_or_else(|| format!("`{text}` is not a frame range A..B"))?;
+    let parse = |s: &str| {
+        s.trim()
+            .parse::<u64>()
+            .map_err(|_| format!("`{s}` is not a frame number"))
+    };
+    let (first, last) = (parse(a)?, parse(b)?);
+    if first == 0 || last < first {
+        return Err(format!("frame range `{text}` must have 1 ≤ A ≤ B"));
+    }
+    Ok(FrameRange { first, last })
+}
+
+#[derive(clap::Args, Debug)]
+pub struct RenderArgs {
+    /// Scene file (.rhai).
+    pub scene: PathBuf,
+    /// Output: a folder for frame_NNNN.png (a name without an extension, or ending in .png),
+    /// or a file whose extension names the format (.gif, .apng, .mp4, .webm, .mov, .y4m);
+    /// `-` writes Y4M to standard output.
+    #[arg(
+        short = 'o',
+        long = "output",
+        default_value = "frames",
+        allow_hyphen_values = true
+    )]
+    pub output: PathBuf,
+    /// Inclusive frame numbers to render, e.g. 1..24 (default: all).
+    #[arg(long, value_parser = frame_range, allow_hyphen_values = true)]
+    pub frames: Option<FrameRange>,
+    /// Output format (default: the one the output's extension names).
+    #[arg(long, value_enum)]
+    pub format: Option<OutputFormat>,
+    /// Encoder threads: PNG frames, and the conversion of video frames (default: available
+    /// cores).
+    #[arg(long, allow_hyphen_values = true)]
+    pub jobs: Option<usize>,
+    /// Remove frame files of an earlier render from the PNG output folder (without it,
+    /// such a folder is refused).
+    #[arg(long)]
+    pub force: bool,
+    /// PNG deflate effort for frame folders: fast (default; unchanged rows reuse the frame before's bands), default, or best (smaller files).
+    #[arg(long, value_enum, default_value = "fast")]
+    pub png_compression: CompressionArg,
+    /// Constant quality for MP4/WebM/MOV (lower is better; H.264 default 20, VP9 default 32).
+    #[arg(long, visible_alias = "quality", value_parser = clap::value_parser!(u32).range(0..=63))]
+    pub crf: Option<u32>,
+}
+
+impl RenderArgs {
+    /// The output format: `--format`, else the one `-o`'s extension names.
+    pub(crate) fn output_kind(&self) -> anyhow::Result<OutputKind> {
+        let kind = match OutputKind::resolve(&self.output, self.format.map(OutputFormat::kind)) {
+            Ok(kind) => kind,
+            Err(OutputError::UnknownExtension { extension, .. }) => {
+                return Err(UsageError(format!(
+                    "-o {}: unknown output extension `.{extension}` (use .gif, .apng, .mp4, .webm, .mov, .y4m, a folder name without an extension, or --format)",
+                    self.output.display()
+                ))
+                .into())
+            }
+            Err(OutputError::StdoutNeedsY4m) => {
+                return Err(UsageError("-o - (standard output) needs --format y4m".into()).into())
+            }
+            Err(other) => return Err(other.into()),
+        };
+        if self.output.as_os_str() == "-" && !super::stdout_is_open() {
+            anyhow::bail!("-o -: standard output is closed");
+        }
+        if kind.needs_ffmpeg() && lapclone::util::find_program("ffmpeg").is_none() {
+            anyhow::bail!("{}", lapclone::util::FFMPEG_MISSING);
+        }
+        Ok(kind)
+    }
+
+    /// Force, PNG compression and quality.
+    pub(crate) fn sink_settings(&self) -> SinkSettings {
+        SinkSettings {
+            force: self.force,
+            png_compression: match self.png_compression {
+                CompressionArg::Fast => PngCompression::Fast,
+                CompressionArg::Default => PngCompression::Default,
+                CompressionArg::Best => PngCompression::Best,
+            },
+            crf: self.crf,
+        }
+    }
+
+    /// The frames to render of a scene with `total` frames; beyond its end is a usage error.
+    pub(crate) fn range(&self, total: u64) -> anyhow::Result<FrameRange> {
+        match self.frames {
+            None => Ok(FrameRange::all(total)),
+            Some(r) if r.last > total => Err(UsageError(format!(
+                "--frames {}..{}: the scene has {total} frames",
+                r.first, r.last
+            ))
+            .into()),
+            Some(r) => Ok(r),
+        }
+    }
+}

@@ -1,0 +1,32 @@
+//! `:save`: takes a path and writes the live scene there (see `repl/save.rs` for the two
+//! forms the text takes).
+
+use std::path::Path;
+
+use anyhow::Context as _;
+
+use super::Session;
+use crate::cli::repl::save::{saved_text, SaveForm};
+
+impl Session {
+    /// Writes the live scene (see `save.rs` for the two forms it takes).
+    pub(super) fn save(&mut self, path: &Path) -> anyhow::Result<()> {
+        let scene = self.current_scene()?;
+        crate::cli::clone::check_output_folder(path)?;
+        let (text, form) = saved_text(&scene, self.base_text.as_deref(), &self.edits, path);
+        lapclone::util::write_atomic(path, text.as_bytes())
+            .with_context(|| format!("writing {}", path.display()))?;
+        if path.canonicalize().ok() == self.file {
+            self.saved_edits = self.edits.len();
+        }
+        match form {
+            SaveForm::Script => self.say(format!("saved {}", path.display())),
+            SaveForm::Keys => self.say(format!(
+                "saved {} (every key written out: the session's text does not rebuild this \
+                 scene from that folder)",
+                path.display()
+            )),
+        }
+        Ok(())
+    }
+}
