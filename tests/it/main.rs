@@ -66,4 +66,5 @@ mod track_follow;
 mod video_cli;
 mod video_encode;
 mod view_browser;
+mod view_open;
 mod view_ws;
