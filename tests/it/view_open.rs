@@ -16,7 +16,14 @@ fn open_session(dir: &Path, env: &[(&str, &std::ffi::OsStr)]) -> Output {
     std::fs::write(&input, ":t 0.5\n").unwrap();
     let mut command = Command::new(env!("CARGO_BIN_EXE_lapclone"));
     command
-        .args(["repl", scene.to_str().unwrap(), "--view", "--port", "0", "--open"])
+        .args([
+            "repl",
+            scene.to_str().unwrap(),
+            "--view",
+            "--port",
+            "0",
+            "--open",
+        ])
         .arg("--preview")
         .arg(dir.join("preview.png"))
         .current_dir(dir)
@@ -56,7 +63,11 @@ fn open_runs_the_browser_program_with_the_url_and_its_token() {
     let link = dir.path().join("browser");
     std::os::unix::fs::symlink(&stand_in, &link).unwrap();
     let out = open_session(dir.path(), &[("BROWSER", link.as_os_str())]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let url = printed_url(&out);
     let token = url.split_once("?token=").unwrap().1;
     assert_eq!(token.len(), 32, "{url}");
@@ -64,7 +75,10 @@ fn open_runs_the_browser_program_with_the_url_and_its_token() {
     // The stand-in runs on its own: wait for what it wrote.
     let started = Instant::now();
     while !args.exists() {
-        assert!(started.elapsed() < Duration::from_secs(60), "the browser program never ran");
+        assert!(
+            started.elapsed() < Duration::from_secs(60),
+            "the browser program never ran"
+        );
         std::thread::sleep(Duration::from_millis(20));
     }
     assert_eq!(std::fs::read_to_string(&args).unwrap(), format!("{url}\n"));

@@ -566,7 +566,7 @@ fn watch_reloads_a_changed_file_keeping_the_playhead_unless_edits_are_unsaved() 
 }
 
 /// The cat scene with a drag handle on its face, keyed so it pulls at t = 1.
-fn handle_scene(dir: &Path) -> PathBuf {
+pub(super) fn handle_scene(dir: &Path) -> PathBuf {
     let path = cat_scene(dir);
     let mut text = std::fs::read_to_string(&path).unwrap();
     text.push_str("let h = cat.drag([225, 175], 30);\nh.key(0, [225, 175]).key(1, [250, 160]);\n");

@@ -369,7 +369,8 @@
     };
     let to = t;
     const move = (ev) => { to = timeAt(ev.clientX); m.style.left = `${(100 * to) / scene.duration}%`; };
-    const up = () => {
+    const up = (ev) => {
+      move(ev);
       window.removeEventListener("pointermove", move);
       window.removeEventListener("pointerup", up);
       if (Math.abs(to - t) > 1e-9) {
