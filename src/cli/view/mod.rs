@@ -53,6 +53,9 @@ pub fn lock<T>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {
 /// prints page lines and hands them over) and the prompt's loop.
 pub type Printer = Arc<Terminal>;
 
+/// Prints one line above the prompt.
+pub type PrintFn = Box<dyn FnMut(String) + Send>;
+
 /// Lines a page ran that wait for the prompt's history, at most this many.
 const MAX_WAITING_LINES: usize = 1000;
 
@@ -61,12 +64,12 @@ const MAX_WAITING_LINES: usize = 1000;
 /// history cannot change under a prompt that is up, so they join before the next one).
 #[derive(Default)]
 pub struct Terminal {
-    print: Mutex<Option<Box<dyn FnMut(String) + Send>>>,
+    print: Mutex<Option<PrintFn>>,
     history: Mutex<VecDeque<String>>,
 }
 
 impl Terminal {
-    pub fn set_print(&self, print: Box<dyn FnMut(String) + Send>) {
+    pub fn set_print(&self, print: PrintFn) {
         *lock(&self.print) = Some(print);
     }
 
