@@ -174,6 +174,17 @@ impl Browser {
         )
         .map(drop)
     }
+
+    /// Presses and releases `key` (its DOM name, and its Windows virtual key code).
+    pub fn key(&mut self, key: &str, code: u32) -> Result<(), CdpError> {
+        for kind in ["keyDown", "keyUp"] {
+            self.call(
+                "Input.dispatchKeyEvent",
+                json!({ "type": kind, "key": key, "code": key, "windowsVirtualKeyCode": code }),
+            )?;
+        }
+        Ok(())
+    }
 }
 
 impl Drop for Browser {

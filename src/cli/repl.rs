@@ -23,7 +23,7 @@ use std::sync::{Arc, Mutex};
 
 use anyhow::Context as _;
 use rustyline::error::ReadlineError;
-use rustyline::history::FileHistory;
+use rustyline::history::{FileHistory, History};
 use rustyline::{Config, Editor};
 
 use helper::ReplHelper;
@@ -73,7 +73,7 @@ pub fn run(args: ReplArgs) -> anyhow::Result<()> {
         words.clone(),
         interactive,
     )));
-    let printer: crate::cli::view::Printer = Arc::new(Mutex::new(None));
+    let printer: crate::cli::view::Printer = Arc::default();
     if args.view.view {
         start_view(&args.view, &session, interactive.then(|| printer.clone()))?;
     }
@@ -203,7 +203,7 @@ fn interactive_loop(
         // Lines a page's edits print go above the prompt instead of through it.
         match editor.create_external_printer() {
             Ok(mut external) => {
-                *crate::cli::view::lock(printer) = Some(Box::new(move |text: String| {
+                printer.set_print(Box::new(move |text: String| {
                     use rustyline::ExternalPrinter as _;
                     let _ = external.print(format!("{text}\n"));
                 }));
@@ -219,6 +219,7 @@ fn interactive_loop(
         "lapclone repl — :help for commands, Ctrl-D to quit"
     ));
     loop {
+        add_page_lines(printer, editor.history_mut());
         match editor.readline("lapclone> ") {
             Ok(line) => {
                 if !line.trim().is_empty() {
@@ -234,10 +235,18 @@ fn interactive_loop(
             Err(error) => return Err(error).context("reading input"),
         }
     }
+    add_page_lines(printer, editor.history_mut());
     if let Some(path) = &history {
         save_history(&mut editor, path);
     }
     Ok(())
+}
+
+/// The lines pages ran since the last prompt join the history, as typed lines do.
+fn add_page_lines(printer: &crate::cli::view::Printer, history: &mut impl History) {
+    for line in printer.take_history() {
+        let _ = history.add_owned(line);
+    }
 }
 
 /// DATA_DIR/lapclone/history.txt, creating the folder (none if there is no data folder).
@@ -256,5 +265,32 @@ fn default_history_path() -> Option<PathBuf> {
 fn save_history(editor: &mut Editor<ReplHelper, FileHistory>, path: &std::path::Path) {
     if let Err(error) = editor.save_history(path) {
         eprintln!("warning: cannot write history {}: {error}", path.display());
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rustyline::history::SearchDirection;
+
+    #[test]
+    fn lines_pages_ran_join_the_history_in_order_once() {
+        let printer: crate::cli::view::Printer = Arc::default();
+        let mut history = FileHistory::new();
+        history.add("cat.at(0, [1, 2]);").unwrap();
+        printer.remember("cat.rotate(0.5, 10);");
+        printer.remember(":undo");
+        add_page_lines(&printer, &mut history);
+        add_page_lines(&printer, &mut history);
+        let entries: Vec<String> = (0..history.len())
+            .map(|i| {
+                let found = history.get(i, SearchDirection::Forward).unwrap().unwrap();
+                found.entry.into_owned()
+            })
+            .collect();
+        assert_eq!(
+            entries,
+            ["cat.at(0, [1, 2]);", "cat.rotate(0.5, 10);", ":undo"]
+        );
     }
 }

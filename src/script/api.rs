@@ -543,6 +543,14 @@ impl HandleRef {
         })
     }
 
+    /// `radius(r)`: the radius of influence, > 0, for the whole shot (it is not keyed).
+    fn set_radius(&mut self, ctx: NativeCallContext, radius: Dynamic) -> Fallible<Self> {
+        self.edit_in_place(&ctx, |h| {
+            h.radius = values::positive(&radius, "drag radius")?;
+            Ok(())
+        })
+    }
+
     /// `keys([#{ t, at, rotate, ease }, ...])`.
     fn keys(&mut self, ctx: NativeCallContext, list: rhai::Array) -> Fallible<Self> {
         self.edit(&ctx, |h| {
@@ -698,6 +706,10 @@ impl CustomType for HandleRef {
                 move |ctx: NativeCallContext, h: &mut HandleRef, t: Dynamic, v: Dynamic, e: &str| {
                     call(h, ctx, t, v, e)
                 },
+            )
+            .with_fn(
+                "radius",
+                |ctx: NativeCallContext, h: &mut HandleRef, r: Dynamic| h.set_radius(ctx, r),
             );
         }
         super::edit_api::build_handle(&mut b);

@@ -68,4 +68,5 @@ mod track_video;
 mod video_cli;
 mod video_encode;
 mod view_browser;
+mod view_open;
 mod view_ws;

@@ -197,6 +197,20 @@ b.at(0, [36, 26]).depth(0, 1); b.at(0.5, [20, 20]);",
 }
 
 #[test]
+fn a_handle_radius_set_later_renders_like_the_radius_written_in_drag() {
+    let keys = "h.key(0, [160, 70]).key(1, [166, 64]);";
+    let set = base() + "let h = a.drag([160, 70], 10); " + keys + " h.radius(14.5);";
+    let by_index = base() + "let h = a.drag([160, 70], 10); " + keys + " a.handle(0).radius(14.5);";
+    let written = base() + "let h = a.drag([160, 70], 14.5); " + keys;
+    assert_eq!(load(&set), load(&written));
+    assert_eq!(load(&by_index), load(&written));
+    assert_eq!(load(&set).patches[0].handles[0].radius, 14.5);
+    assert!(render(&set) == render(&written));
+    // The radius changes what the drag pulls: the frames differ from the first radius's.
+    assert!(render(&set) != render(&(base() + "let h = a.drag([160, 70], 10); " + keys)));
+}
+
+#[test]
 fn rename_reorder_remove_and_move_keys() {
     let scene = load(
         &(base()
@@ -274,6 +288,9 @@ fn bad_arguments_are_positioned_errors_that_change_nothing() {
         "no pin at [1, 2] on patch \"a\"; its pins: 0 at [170, 62]",
     );
     refused("a.remove_pin(\"x\")", "index");
+    refused("h.radius(0)", "drag radius must be > 0, got 0");
+    refused("h.radius(-3)", "drag radius must be > 0");
+    refused("h.radius(\"big\")", "drag radius");
     refused("a.rename(\"b\")", "a patch named \"b\" already exists");
     refused("a.rename(\"\")", "must not be empty");
 }

@@ -8,7 +8,7 @@ use std::time::Duration;
 
 use base64::Engine as _;
 
-use super::view_ws::{cat_scene, preview_png, ViewRepl};
+use super::view_ws::{cat_scene, handle_scene, preview_png, ViewRepl};
 
 // The DevTools client the browser benchmark uses too: one copy, in the bench crate (which the
 // tests cannot depend on, as it depends on lapclone).
@@ -91,6 +91,130 @@ fn a_drag_in_chromium_becomes_one_line_and_the_canvas_shows_the_saved_scene() {
     assert!(
         timings.as_u64().unwrap() > 0,
         "no preview frame was painted during the drag"
+    );
+    drop(browser);
+    assert!(repl.finish().success());
+}
+
+fn wait_for(browser: &mut Browser, expression: &str) {
+    browser.wait_for(expression, PAGE_TIMEOUT).unwrap();
+}
+
+/// A pointer drag from (x0, y0) to (x1, y1) in `steps` moves.
+fn drag(browser: &mut Browser, (x0, y0): (f64, f64), (x1, y1): (f64, f64), steps: u32) {
+    browser.mouse("mouseMoved", x0, y0).unwrap();
+    browser.mouse("mousePressed", x0, y0).unwrap();
+    for step in 1..=steps {
+        let f = step as f64 / steps as f64;
+        browser
+            .mouse("mouseMoved", x0 + (x1 - x0) * f, y0 + (y1 - y0) * f)
+            .unwrap();
+    }
+    browser.mouse("mouseReleased", x1, y1).unwrap();
+}
+
+/// Numbers the page's expression gives as an array.
+fn numbers(browser: &mut Browser, expression: &str) -> Vec<f64> {
+    let value = browser.eval(expression).unwrap();
+    value
+        .as_array()
+        .unwrap_or_else(|| panic!("{expression}: {value}"))
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect()
+}
+
+/// Where the handle's target of the cat is on the page, the screen radius of its circle
+/// and the patch's scale (from the page's last scene message).
+const HANDLE_ON_PAGE: &str = "(() => {
+  const r = document.getElementById('overlay').getBoundingClientRect();
+  const p = window.lapcloneScene().patches[0], h = p.handles[0];
+  const a = p.rotation * Math.PI / 180, c = Math.cos(a), s = Math.sin(a);
+  const dx = h.to[0] - p.pivot[0], dy = h.to[1] - p.pivot[1];
+  return [r.left + p.at[0] + p.scale * (c * dx - s * dy), r.top + p.at[1] + p.scale * (s * dx + c * dy),
+          h.radius * p.scale, p.scale];
+})()";
+
+#[test]
+fn in_chromium_a_circle_drag_sets_the_radius_and_handle_keys_and_deletes_are_lines() {
+    let Some(program) = find_chromium() else {
+        println!("skipped: chromium is not installed (apt-get install chromium)");
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let scene = handle_scene(dir.path());
+    let mut text = std::fs::read_to_string(&scene).unwrap();
+    text.push_str("cat.pin([200, 150]);\n");
+    std::fs::write(&scene, text).unwrap();
+    let repl = ViewRepl::start(dir.path(), &scene);
+    let profile = tempfile::tempdir().unwrap();
+    let mut browser = Browser::launch(&program, profile.path(), (1000, 800), &repl.url).unwrap();
+    wait_for(
+        &mut browser,
+        "!!(window.lapcloneScene && window.lapcloneScene())",
+    );
+    // The circle's right edge, dragged 20 px further out: the radius follows.
+    let h = numbers(&mut browser, HANDLE_ON_PAGE);
+    let (tx, ty, edge, scale) = (h[0], h[1], h[2], h[3]);
+    drag(&mut browser, (tx + edge, ty), (tx + edge + 20.0, ty), 5);
+    let line = repl.wait_line(|l| l.starts_with("(view) cat.handle(0).radius("));
+    let radius: f64 = line
+        .trim_start_matches("(view) cat.handle(0).radius(")
+        .trim_end_matches(");")
+        .parse()
+        .unwrap();
+    let expected = (edge + 20.0) / scale;
+    assert!(
+        (radius - expected).abs() <= 0.011,
+        "{line}: expected {expected}"
+    );
+    wait_for(
+        &mut browser,
+        &format!("window.lapcloneScene().patches[0].handles[0].radius === {radius}"),
+    );
+    assert!(
+        browser
+            .eval("window.lapcloneTimings.length")
+            .unwrap()
+            .as_u64()
+            .unwrap()
+            > 0,
+        "the circle drag previewed nothing"
+    );
+    // The handle's key marker at t = 1, dragged to three quarters of the 2 s timeline.
+    let marker = numbers(&mut browser,
+        "(() => { const m = [...document.querySelectorAll('.marker.handle')]
+            .find((m) => JSON.parse(m.dataset.key).t === 1);
+          const r = m.getBoundingClientRect(), b = document.getElementById('markers').getBoundingClientRect();
+          return [r.left + r.width / 2, r.top + r.height / 2, b.left, b.width]; })()",
+    );
+    let to = marker[2] + marker[3] * 0.75;
+    drag(&mut browser, (marker[0], marker[1]), (to, marker[1]), 4);
+    wait_for(
+        &mut browser,
+        "window.lapcloneScene().patches[0].handles[0].keys.at[1] === 1.5",
+    );
+    repl.wait_line(|l| l == "(view) cat.handle(0).move_key(1, 1.5, \"at\");");
+    // Click the handle's target, then Delete; the same for the pin.
+    let h = numbers(&mut browser, HANDLE_ON_PAGE);
+    drag(&mut browser, (h[0], h[1]), (h[0], h[1]), 0);
+    browser.key("Delete", 46).unwrap();
+    repl.wait_line(|l| l == "(view) cat.remove_handle(0);");
+    wait_for(
+        &mut browser,
+        "window.lapcloneScene().patches[0].handles.length === 0",
+    );
+    let pin = numbers(&mut browser,
+        "(() => { const r = document.getElementById('overlay').getBoundingClientRect();
+          const p = window.lapcloneScene().patches[0], q = p.pins[0].at;
+          return [r.left + p.at[0] + p.scale * (q[0] - p.pivot[0]), r.top + p.at[1] + p.scale * (q[1] - p.pivot[1])]; })()",
+    );
+    drag(&mut browser, (pin[0], pin[1]), (pin[0], pin[1]), 0);
+    browser.key("Delete", 46).unwrap();
+    repl.wait_line(|l| l == "(view) cat.remove_pin(0);");
+    wait_for(
+        &mut browser,
+        "window.lapcloneScene().patches[0].pins.length === 0",
     );
     drop(browser);
     assert!(repl.finish().success());

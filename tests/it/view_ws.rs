@@ -447,6 +447,22 @@ fn each_page_edit_is_one_line_and_gives_the_scene_typing_it_gives() {
             "cat.handle(0).key(0.5, [262, 190]);",
         ),
         (
+            json!({"op": "handle_radius", "patch": "cat", "handle": 0, "value": 75.004}),
+            "cat.handle(0).radius(75);",
+        ),
+        (
+            json!({"op": "move_key", "patch": "cat", "handle": 0, "track": "at", "from": 0.5, "to": 1}),
+            "cat.handle(0).move_key(0.5, 1, \"at\");",
+        ),
+        (
+            json!({"op": "handle_key", "patch": "cat", "handle": 0, "value": [258, 186]}),
+            "cat.handle(0).key(0.5, [258, 186]);",
+        ),
+        (
+            json!({"op": "remove_key", "patch": "cat", "handle": 0, "track": "at", "t": 1}),
+            "cat.handle(0).remove_key(1, \"at\");",
+        ),
+        (
             json!({"op": "add_pin", "patch": "cat", "at": [200, 150]}),
             "cat.pin([200, 150]);",
         ),
@@ -471,16 +487,25 @@ fn each_page_edit_is_one_line_and_gives_the_scene_typing_it_gives() {
             "cat.remove_key(0, \"scale\");",
         ),
     ];
+    let mut handle_keys = Vec::new();
     for (edit, line) in &edits {
-        // The handle's target previews before it commits, as a drag would.
-        if edit["op"] == "handle_key" {
+        // A handle's target and radius preview before they commit, as a drag would.
+        if edit["op"] == "handle_key" || edit["op"] == "handle_radius" {
             page.send(&json!({"type": "edit", "rev": page.rev(), "commit": false, "edit": edit}));
             page.until_scene();
         }
         page.send(&json!({"type": "edit", "rev": page.rev(), "commit": true, "edit": edit}));
         let reply = page.until(|v| v["type"] == "line");
         assert_eq!(reply["text"], *line);
+        // The scene message came before the line.
+        if let Some(handle) = page.scene["patches"][0]["handles"].get(0) {
+            handle_keys.push(handle["keys"]["at"].clone());
+        }
     }
+    // The scene messages carry the handle's keys for its markers, as the lines left them.
+    assert!(handle_keys.contains(&json!([0.5, 1.0])), "{handle_keys:?}");
+    assert_eq!(handle_keys.last(), Some(&json!([0.5])));
+    assert_eq!(page.scene["patches"][0]["handles"][0]["radius"], 75.0);
     let from_page = dir.path().join("from_page.rhai");
     repl.type_line(&format!(":save {}", from_page.display()));
     repl.wait_line(|l| l.starts_with("saved "));
@@ -537,5 +562,132 @@ fn watch_reloads_a_changed_file_keeping_the_playhead_unless_edits_are_unsaved() 
     page.until(|v| v["type"] == "scene" && v["patches"][0]["rotation"] == 10.0);
     std::fs::write(&scene, text).unwrap();
     repl.wait_line(|l| l.contains("not reloaded: the session has unsaved edits"));
+    assert!(repl.finish().success());
+}
+
+/// The cat scene with a drag handle on its face, keyed so it pulls at t = 1.
+pub(super) fn handle_scene(dir: &Path) -> PathBuf {
+    let path = cat_scene(dir);
+    let mut text = std::fs::read_to_string(&path).unwrap();
+    text.push_str("let h = cat.drag([225, 175], 30);\nh.key(0, [225, 175]).key(1, [250, 160]);\n");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+#[test]
+fn a_circle_drag_changes_the_radius_live_and_commits_one_line_preview_agrees_with() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = handle_scene(dir.path());
+    let mut repl = ViewRepl::start(dir.path(), &scene);
+    let mut page = repl.page();
+    repl.type_line(":t 1");
+    page.until(|v| v["type"] == "scene" && v["t"] == 1.0);
+    let before = page.frame.clone();
+    let rev = page.rev();
+    let mut frames = Vec::new();
+    // The pointer moves the circle's edge out: the clone follows every move, uncommitted.
+    for radius in [40.0, 55.5, 70.123] {
+        let edit = json!({"op": "handle_radius", "patch": "cat", "handle": 0, "value": radius});
+        page.send(&json!({"type": "edit", "rev": rev, "commit": false, "edit": edit}));
+        page.until_scene();
+        assert_eq!(page.rev(), rev, "a preview is not a change of the scene");
+        assert_eq!(
+            page.scene["patches"][0]["handles"][0]["radius"],
+            (radius * 100.0_f64).round() / 100.0
+        );
+        frames.push(page.frame.clone());
+    }
+    assert!(
+        frames[0] != before && frames[1] != frames[0],
+        "the radius changed nothing"
+    );
+    let edit = json!({"op": "handle_radius", "patch": "cat", "handle": 0, "value": 70.123});
+    page.send(&json!({"type": "edit", "rev": rev, "commit": true, "edit": edit}));
+    let line = page.until(|v| v["type"] == "line");
+    assert_eq!(line["text"], "cat.handle(0).radius(70.12);");
+    repl.wait_line(|l| l == "(view) cat.handle(0).radius(70.12);");
+    assert!(
+        page.frame == frames[2],
+        "the committed frame is not the last previewed one"
+    );
+    let saved = dir.path().join("saved.rhai");
+    repl.type_line(&format!(":save {}", saved.display()));
+    repl.wait_line(|l| l.starts_with("saved "));
+    assert!(page.frame == preview_png(dir.path(), &saved, 1.0).as_raw()[..]);
+    assert!(repl.finish().success());
+    // Typing the line gives the same scene.
+    let typed = dir.path().join("typed.rhai");
+    let script = [
+        "cat.handle(0).radius(70.12);".to_string(),
+        format!(":save {}", typed.display()),
+    ];
+    let out = Command::new(env!("CARGO_BIN_EXE_lapclone"))
+        .args(["repl", scene.to_str().unwrap(), "--preview"])
+        .arg(dir.path().join("typed.png"))
+        .arg("--script")
+        .arg(write_script(dir.path(), &script))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(
+        std::fs::read_to_string(&saved).unwrap(),
+        std::fs::read_to_string(&typed).unwrap()
+    );
+}
+
+#[test]
+fn the_scene_message_carries_a_followed_tracks_path() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut track = String::from("frame,x,y\n");
+    let points: Vec<[f64; 2]> = (0..48)
+        .map(|k| [280.25 + 1.5 * k as f64, 150.5 - 0.75 * k as f64])
+        .collect();
+    for (k, [x, y]) in points.iter().enumerate() {
+        track.push_str(&format!("{},{x},{y}\n", k + 1));
+    }
+    std::fs::write(dir.path().join("track.csv"), track).unwrap();
+    let scene = handle_scene(dir.path());
+    let mut text = std::fs::read_to_string(&scene).unwrap();
+    text.push_str(
+        "cat.follow(\"track.csv\", #{ offset: [5, -3] });\nh.follow(\"track.csv\", #{ offset: [-60, 30] });\n",
+    );
+    std::fs::write(&scene, text).unwrap();
+    let mut repl = ViewRepl::start(dir.path(), &scene);
+    let mut page = repl.page();
+    repl.type_line(":t 0.2");
+    page.until(|v| v["type"] == "scene" && v["t"] == 0.2);
+    let patch = page.scene["patches"][0].clone();
+    let path = |offset: [f64; 2]| -> Value {
+        points
+            .iter()
+            .map(|p| json!([p[0] + offset[0], p[1] + offset[1]]))
+            .collect()
+    };
+    let follow = &patch["follow"];
+    assert_eq!(follow["file"], "track.csv");
+    assert_eq!(follow["keys"], 48);
+    assert_eq!(follow["path"], path([5.0, -3.0]));
+    // Frame 5 (t = 4/24 ≤ 0.2 < 5/24) is the current one.
+    assert_eq!(follow["current"], 4);
+    let handle = &patch["handles"][0]["follow"];
+    assert_eq!(handle["path"], path([-60.0, 30.0]));
+    assert_eq!(handle["current"], 4);
+    // A key of the page's own replaces the followed keys: the patch no longer follows.
+    let rev = page.rev();
+    page.send(&json!({"type": "edit", "rev": rev, "commit": true, "edit": {"op": "at", "patch": "cat", "value": [300, 160]}}));
+    page.until(|v| v["type"] == "line");
+    assert_eq!(page.scene["patches"][0]["follow"], Value::Null);
+    assert_eq!(page.scene["patches"][0]["handles"][0]["follow"]["keys"], 48);
+    // :undo puts the followed keys back, and with them the path.
+    repl.type_line(":undo");
+    page.until(|v| v["type"] == "scene" && !v["patches"][0]["follow"].is_null());
+    assert_eq!(
+        page.scene["patches"][0]["follow"]["path"],
+        path([5.0, -3.0])
+    );
     assert!(repl.finish().success());
 }

@@ -267,6 +267,7 @@ mod tests {
             "to_front",
             "to_back",
             "opacity",
+            "radius",
         ] {
             assert!(names.iter().any(|n| n == call), "{call}");
         }

@@ -4,7 +4,7 @@
 //! [`Scene`] directly for the drag preview, with exactly the values the line writes.
 
 use glam::DVec2;
-use lapclone::scene::{rhai_string_literal, Easing, Scene};
+use lapclone::scene::{rhai_string_literal, Easing, Handle, Patch, Scene};
 use serde::Deserialize;
 
 /// Largest text message a page may send, bytes.
@@ -35,7 +35,8 @@ pub enum Request {
     Mesh { on: bool },
 }
 
-/// A keyframable patch track, as the scene functions name it.
+/// A keyframable track, as the scene functions name it: a patch has all five, a handle
+/// `at` (its target) and `rotate`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Track {
@@ -47,6 +48,11 @@ pub enum Track {
 }
 
 impl Track {
+    /// Whether a handle has this track.
+    fn on_handle(self) -> bool {
+        matches!(self, Track::At | Track::Rotate)
+    }
+
     fn name(self) -> &'static str {
         match self {
             Track::At => "at",
@@ -80,6 +86,11 @@ pub enum Edit {
         handle: usize,
         value: [f64; 2],
     },
+    HandleRadius {
+        patch: String,
+        handle: usize,
+        value: f64,
+    },
     AddHandle {
         patch: String,
         from: [f64; 2],
@@ -97,14 +108,19 @@ pub enum Edit {
         patch: String,
         pin: usize,
     },
+    /// A key of the patch's track, or of its handle's when `handle` is given.
     MoveKey {
         patch: String,
+        #[serde(default)]
+        handle: Option<usize>,
         track: Track,
         from: f64,
         to: f64,
     },
     RemoveKey {
         patch: String,
+        #[serde(default)]
+        handle: Option<usize>,
         track: Track,
         t: f64,
     },
@@ -166,15 +182,40 @@ fn check_edit(edit: &Edit) -> Result<(), String> {
         }
         Edit::AddPin { at: value, .. } => value.iter().try_for_each(|v| bounded(*v)),
         Edit::Rotate { value, .. } => bounded(*value),
-        Edit::Scale { value, .. } => positive(*value),
+        Edit::Scale { value, .. } | Edit::HandleRadius { value, .. } => positive(*value),
         Edit::AddHandle { from, radius, .. } => {
             from.iter().try_for_each(|v| bounded(*v))?;
             positive(*radius)
         }
         Edit::RemoveHandle { .. } | Edit::RemovePin { .. } => Ok(()),
-        Edit::MoveKey { from, to, .. } => time(*from).and(time(*to)),
-        Edit::RemoveKey { t, .. } => time(*t),
+        Edit::MoveKey {
+            from,
+            to,
+            handle,
+            track,
+            ..
+        } => {
+            handle_track(*handle, *track)?;
+            time(*from).and(time(*to))
+        }
+        Edit::RemoveKey {
+            t, handle, track, ..
+        } => {
+            handle_track(*handle, *track)?;
+            time(*t)
+        }
     }
+}
+
+/// A handle's key edit names one of the handle's tracks.
+fn handle_track(handle: Option<usize>, track: Track) -> Result<(), String> {
+    if handle.is_some() && !track.on_handle() {
+        return Err(format!(
+            "a handle has no {:?} track; tracks: at, rotate",
+            track.name()
+        ));
+    }
+    Ok(())
 }
 
 impl Edit {
@@ -185,6 +226,7 @@ impl Edit {
             | Edit::Rotate { patch, .. }
             | Edit::Scale { patch, .. }
             | Edit::HandleKey { patch, .. }
+            | Edit::HandleRadius { patch, .. }
             | Edit::AddHandle { patch, .. }
             | Edit::AddPin { patch, .. }
             | Edit::RemoveHandle { patch, .. }
@@ -207,6 +249,7 @@ impl Edit {
                 *radius = round(*radius, 100.0).max(0.01);
             }
             Edit::Rotate { value, .. } => *value = round(*value, 100.0),
+            Edit::HandleRadius { value, .. } => *value = round(*value, 100.0).max(0.01),
             Edit::Scale { value, .. } => *value = round(*value, 10_000.0).max(0.0001),
             _ => {}
         }
@@ -225,6 +268,9 @@ impl Edit {
             Edit::HandleKey { handle, value, .. } => {
                 format!("{patch}.handle({handle}).key({t}, {});", point(value))
             }
+            Edit::HandleRadius { handle, value, .. } => {
+                format!("{patch}.handle({handle}).radius({});", num(value))
+            }
             Edit::AddHandle { from, radius, .. } => format!(
                 "let {handle_name} = {patch}.drag({}, {});",
                 point(from),
@@ -234,21 +280,32 @@ impl Edit {
             Edit::RemoveHandle { handle, .. } => format!("{patch}.remove_handle({handle});"),
             Edit::RemovePin { pin, .. } => format!("{patch}.remove_pin({pin});"),
             Edit::MoveKey {
-                track, from, to, ..
+                handle,
+                track,
+                from,
+                to,
+                ..
             } => format!(
-                "{patch}.move_key({}, {}, \"{}\");",
+                "{}.move_key({}, {}, \"{}\");",
+                owner(patch, handle),
                 num(from),
                 num(to),
                 track.name()
             ),
-            Edit::RemoveKey { track, t, .. } => {
-                format!("{patch}.remove_key({}, \"{}\");", num(t), track.name())
-            }
+            Edit::RemoveKey {
+                handle, track, t, ..
+            } => format!(
+                "{}.remove_key({}, \"{}\");",
+                owner(patch, handle),
+                num(t),
+                track.name()
+            ),
         }
     }
 
-    /// Applies a key edit (at, rotate, scale, handle target) to `scene` as its line would,
-    /// for the preview of a gesture in progress. Other edits are not previewed.
+    /// Applies a gesture's edit (at, rotate, scale, a handle's target or radius) to `scene`
+    /// as its line would, for the preview of a gesture in progress. Other edits are not
+    /// previewed.
     pub fn apply_key(&self, scene: &mut Scene, t: f64) -> Result<(), String> {
         let edit = self.rounded();
         let patch = scene
@@ -263,12 +320,13 @@ impl Edit {
             Edit::Rotate { value, .. } => p.rotation.push(t, value, linear),
             Edit::Scale { value, .. } => p.scale.push(t, value, linear),
             Edit::HandleKey { handle, value, .. } => {
-                let count = patch.handles.len();
-                let h = patch
-                    .handles
-                    .get_mut(handle)
-                    .ok_or_else(|| format!("no handle {handle}: the patch has {count}"))?;
-                h.to.push(t, DVec2::from(value), linear)
+                handle_of(patch, handle)?
+                    .to
+                    .push(t, DVec2::from(value), linear)
+            }
+            Edit::HandleRadius { handle, value, .. } => {
+                handle_of(patch, handle)?.radius = value;
+                Ok(())
             }
             _ => return Err("this edit has no preview".into()),
         };
@@ -279,8 +337,28 @@ impl Edit {
     pub fn previews(&self) -> bool {
         matches!(
             self,
-            Edit::At { .. } | Edit::Rotate { .. } | Edit::Scale { .. } | Edit::HandleKey { .. }
+            Edit::At { .. }
+                | Edit::Rotate { .. }
+                | Edit::Scale { .. }
+                | Edit::HandleKey { .. }
+                | Edit::HandleRadius { .. }
         )
+    }
+}
+
+fn handle_of(patch: &mut Patch, handle: usize) -> Result<&mut Handle, String> {
+    let count = patch.handles.len();
+    patch
+        .handles
+        .get_mut(handle)
+        .ok_or_else(|| format!("no handle {handle}: the patch has {count}"))
+}
+
+/// How a key edit's line names the owner of the track: the patch or one of its handles.
+fn owner(patch: &str, handle: Option<usize>) -> String {
+    match handle {
+        Some(h) => format!("{patch}.handle({h})"),
+        None => patch.to_string(),
     }
 }
 
@@ -363,6 +441,18 @@ mod tests {
                 r#"{"op":"remove_key","patch":"cat","track":"scale","t":3}"#,
                 "cat.remove_key(3, \"scale\");",
             ),
+            (
+                r#"{"op":"handle_radius","patch":"cat","handle":1,"value":55.555}"#,
+                "cat.handle(1).radius(55.56);",
+            ),
+            (
+                r#"{"op":"move_key","patch":"cat","handle":0,"track":"at","from":1,"to":1.5}"#,
+                "cat.handle(0).move_key(1, 1.5, \"at\");",
+            ),
+            (
+                r#"{"op":"remove_key","patch":"cat","handle":2,"track":"rotate","t":0.5}"#,
+                "cat.handle(2).remove_key(0.5, \"rotate\");",
+            ),
         ];
         for (json, line) in cases {
             assert_eq!(edit(json).line(1.25, "cat", "h2"), line, "{json}");
@@ -380,6 +470,9 @@ mod tests {
             r#"{"type":"edit","rev":1,"commit":true,"edit":{"op":"eval","patch":"cat"}}"#,
             r#"{"type":"edit","rev":1,"commit":true,"edit":{"op":"at","patch":"","value":[1,2]}}"#,
             r#"{"type":"edit","rev":1,"commit":true,"edit":{"op":"move_key","patch":"c","track":"x","from":1,"to":2}}"#,
+            r#"{"type":"edit","rev":1,"commit":true,"edit":{"op":"remove_key","patch":"c","handle":0,"track":"scale","t":1}}"#,
+            r#"{"type":"edit","rev":1,"commit":true,"edit":{"op":"handle_radius","patch":"c","handle":0,"value":0}}"#,
+            r#"{"type":"edit","rev":1,"commit":true,"edit":{"op":"handle_radius","patch":"c","handle":-1,"value":3}}"#,
             "not json",
         ] {
             assert!(parse_request(text).is_err(), "{text}");

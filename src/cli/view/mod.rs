@@ -6,15 +6,18 @@
 mod edit;
 mod http;
 mod hub;
+mod open;
 mod scene;
 mod server;
 mod watch;
 
+use std::collections::VecDeque;
 use std::net::IpAddr;
 use std::sync::{Arc, Mutex, MutexGuard};
 
 pub use edit::{get_patch_call, Edit};
 pub use hub::{Hub, SceneText};
+pub use open::open_in_browser;
 pub use scene::Playhead;
 pub use scene::{locate, scene_message};
 pub use server::start;
@@ -46,26 +49,53 @@ pub fn lock<T>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {
     mutex.lock().unwrap_or_else(|p| p.into_inner())
 }
 
-/// Where lines printed for the view go while a prompt is up (rustyline's external printer).
-pub type Printer = Arc<Mutex<Option<Box<dyn FnMut(String) + Send>>>>;
+/// The terminal's side of the view while a prompt is up: shared by the session (which
+/// prints page lines and hands them over) and the prompt's loop.
+pub type Printer = Arc<Terminal>;
 
-/// Opens `url` in the default browser with the desktop's opener program.
-pub fn open_in_browser(url: &str) {
-    let opener = if cfg!(target_os = "macos") {
-        "open"
-    } else if cfg!(windows) {
-        "explorer"
-    } else {
-        "xdg-open"
-    };
-    let spawned = std::process::Command::new(opener)
-        .arg(url)
-        .stdin(std::process::Stdio::null())
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::null())
-        .spawn();
-    if let Err(error) = spawned {
-        eprintln!("warning: cannot open a browser ({opener}: {error}); open the URL above");
+/// Prints one line above the prompt.
+pub type PrintFn = Box<dyn FnMut(String) + Send>;
+
+/// Lines a page ran that wait for the prompt's history, at most this many.
+const MAX_WAITING_LINES: usize = 1000;
+
+/// Where lines printed for the view go while a prompt is up (rustyline's external
+/// printer), and the lines pages ran, waiting to join the prompt's history (rustyline's
+/// history cannot change under a prompt that is up, so they join before the next one).
+#[derive(Default)]
+pub struct Terminal {
+    print: Mutex<Option<PrintFn>>,
+    history: Mutex<VecDeque<String>>,
+}
+
+impl Terminal {
+    pub fn set_print(&self, print: PrintFn) {
+        *lock(&self.print) = Some(print);
+    }
+
+    /// Prints `text` above the prompt; gives it back when there is no printer.
+    pub fn print(&self, text: String) -> Option<String> {
+        match lock(&self.print).as_mut() {
+            Some(print) => {
+                print(text);
+                None
+            }
+            None => Some(text),
+        }
+    }
+
+    /// Keeps a line a page ran for the history (the oldest go past the bound).
+    pub fn remember(&self, line: &str) {
+        let mut waiting = lock(&self.history);
+        if waiting.len() == MAX_WAITING_LINES {
+            waiting.pop_front();
+        }
+        waiting.push_back(line.to_string());
+    }
+
+    /// The lines waiting for the history, oldest first; none wait afterwards.
+    pub fn take_history(&self) -> Vec<String> {
+        lock(&self.history).drain(..).collect()
     }
 }
 

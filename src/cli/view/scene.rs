@@ -1,12 +1,12 @@
 //! The scene message a page draws its overlays and timeline from: takes the renderer (its
 //! scene, placed meshes and pivots) and the session's playhead and revision, and gives JSON
-//! — each patch's placement at the playhead, key times per track, handles, pins and, for
-//! pages with the mesh overlay on, the placed meshes. Also where a canvas point falls: the
+//! — each patch's placement at the playhead, key times per track, handles, pins, the path
+//! of a followed track and, for pages with the mesh overlay on, the placed meshes. Also where a canvas point falls: the
 //! patch drawn on top there and the source (rest) point under it.
 
 use glam::DVec2;
 use lapclone::render::Renderer;
-use lapclone::scene::{Patch, PatchState, Track};
+use lapclone::scene::{Follow, FollowTarget, Patch, PatchState, Track};
 use serde_json::{json, Value};
 
 /// The session facts a scene message carries besides the renderer's.
@@ -29,7 +29,7 @@ pub fn scene_message(renderer: &Renderer, head: &Playhead, mesh: bool) -> String
         .iter()
         .zip(&state.patches)
         .zip(pivots.iter().zip(&meshes))
-        .map(|((patch, s), (&pivot, placed))| patch_json(patch, s, pivot, placed.placed))
+        .map(|((patch, s), (&pivot, placed))| patch_json(patch, s, pivot, placed.placed, head.time))
         .collect();
     let frame = (head.time * canvas.fps + 1e-9).floor() as u64 + 1;
     let mut message = json!({
@@ -61,7 +61,7 @@ pub fn scene_message(renderer: &Renderer, head: &Playhead, mesh: bool) -> String
     message.to_string()
 }
 
-fn patch_json(patch: &Patch, s: &PatchState, pivot: DVec2, placed: &[DVec2]) -> Value {
+fn patch_json(patch: &Patch, s: &PatchState, pivot: DVec2, placed: &[DVec2], t: f64) -> Value {
     let at = s.position.unwrap_or(pivot);
     let bbox = placed.iter().fold(None, |b: Option<[f64; 4]>, p| {
         Some(match b {
@@ -74,8 +74,15 @@ fn patch_json(patch: &Patch, s: &PatchState, pivot: DVec2, placed: &[DVec2]) -> 
         .handles
         .iter()
         .zip(&s.handles)
-        .map(|(h, hs)| {
-            json!({ "from": xy(h.from), "to": xy(hs.to), "radius": h.radius, "keys": times(&h.to) })
+        .enumerate()
+        .map(|(i, (h, hs))| {
+            json!({
+                "from": xy(h.from),
+                "to": xy(hs.to),
+                "radius": h.radius,
+                "keys": { "at": times(&h.to), "rotate": times(&h.rotation) },
+                "follow": follow_json(patch, FollowTarget::Handle(i), t),
+            })
         })
         .collect();
     let pins: Vec<Value> = patch
@@ -101,6 +108,28 @@ fn patch_json(patch: &Patch, s: &PatchState, pivot: DVec2, placed: &[DVec2]) -> 
         },
         "handles": handles,
         "pins": pins,
+        "follow": follow_json(patch, FollowTarget::Patch, t),
+    })
+}
+
+/// The path of the track `target` follows, if its keys are still in place: the file, the
+/// followed positions (canvas points for a patch, source points for a handle's target, as
+/// the handle's `to` is) and the index of the last one at or before the playhead `t`.
+fn follow_json(patch: &Patch, target: FollowTarget, t: f64) -> Value {
+    let Some(follow) = patch.intact_follows(target).last() else {
+        return Value::Null;
+    };
+    let keys = follow.at.keys();
+    let path: Vec<[f64; 2]> = keys
+        .iter()
+        .map(|k| [r2(k.value.x), r2(k.value.y)])
+        .collect();
+    let current = keys.iter().rposition(|k| k.time <= t + 1e-9).unwrap_or(0);
+    json!({
+        "file": Follow::file_name(follow),
+        "keys": keys.len(),
+        "path": path,
+        "current": current,
     })
 }
 

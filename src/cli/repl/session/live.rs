@@ -16,7 +16,7 @@ use crate::cli::view::{get_patch_call, locate, scene_message, Edit, Hub, Printer
 
 impl Session {
     /// Sends every frame and scene change to `hub`; lines printed for page edits go to
-    /// `printer` while a prompt is up.
+    /// `printer` while a prompt is up, and the lines pages run join its history.
     pub fn attach_view(&mut self, hub: Arc<Hub>, printer: Option<Printer>) {
         self.view = Some(hub);
         self.printer = printer;
@@ -25,12 +25,12 @@ impl Session {
     /// Prints a line of the session's own: through the prompt's printer while a page's
     /// request runs, so the prompt stays intact.
     pub(super) fn say(&self, text: String) {
-        match (&self.printer, self.from_view) {
-            (Some(printer), true) => match crate::cli::view::lock(printer).as_mut() {
-                Some(print) => print(text),
-                None => crate::cli::print_line(&text),
-            },
-            _ => crate::cli::print_line(&text),
+        let unprinted = match (&self.printer, self.from_view) {
+            (Some(printer), true) => printer.print(text),
+            _ => Some(text),
+        };
+        if let Some(text) = unprinted {
+            crate::cli::print_line(&text);
         }
     }
 
@@ -163,6 +163,9 @@ impl Session {
         self.from_view = false;
         match result {
             Ok(Step::Ok | Step::Quit) => {
+                if let Some(printer) = &self.printer {
+                    printer.remember(line);
+                }
                 if let Some(hub) = &self.view {
                     hub.broadcast(serde_json::json!({ "type": "line", "text": line }).to_string());
                 }

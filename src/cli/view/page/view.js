@@ -132,6 +132,10 @@
       octx.stroke();
     }
     for (const p of scene.patches) {
+      if (p.follow) drawPath(p.follow, (q) => q, px);
+      p.handles.forEach((h) => { if (h.follow) drawPath(h.follow, (q) => place(p, q), px); });
+    }
+    for (const p of scene.patches) {
       const hot = (located && located.patch === p.name) || (gesture && gesture.patch === p.name);
       if (hot && p.bbox) {
         octx.setLineDash([4 * px, 4 * px]);
@@ -142,8 +146,11 @@
       p.handles.forEach((h, i) => {
         const grab = place(p, h.from), target = place(p, h.to);
         const sel = selected && selected.kind === "handle" && selected.patch === p.name && selected.index === i;
+        const sizing = gesture && gesture.kind === "radius" && gesture.patch === p.name && gesture.index === i;
         octx.strokeStyle = sel ? "#fff" : "rgba(255, 200, 80, 0.9)";
+        if (sizing) octx.lineWidth = 3 * px;
         octx.beginPath(); octx.arc(target[0], target[1], h.radius * p.scale, 0, 2 * Math.PI); octx.stroke();
+        octx.lineWidth = 1.5 * px;
         octx.beginPath(); octx.moveTo(grab[0], grab[1]); octx.lineTo(target[0], target[1]); octx.stroke();
         octx.fillStyle = "rgba(255, 200, 80, 0.9)";
         octx.beginPath(); octx.arc(grab[0], grab[1], 3 * px, 0, 2 * Math.PI); octx.fill();
@@ -157,6 +164,22 @@
         octx.fillRect(q[0] - 4 * px, q[1] - 4 * px, 8 * px, 8 * px);
       });
     }
+  }
+
+  // A followed track's path: its positions over the shot, the current frame's ringed.
+  function drawPath(f, toCanvas, px) {
+    const pts = f.path.map(toCanvas);
+    if (!pts.length) return;
+    octx.strokeStyle = "rgba(140, 255, 140, 0.85)";
+    octx.setLineDash([6 * px, 3 * px]);
+    octx.beginPath();
+    pts.forEach((q, i) => (i ? octx.lineTo(q[0], q[1]) : octx.moveTo(q[0], q[1])));
+    octx.stroke();
+    octx.setLineDash([]);
+    octx.fillStyle = "rgba(140, 255, 140, 0.85)";
+    for (const q of pts) octx.fillRect(q[0] - 1.5 * px, q[1] - 1.5 * px, 3 * px, 3 * px);
+    const c = pts[Math.min(f.current, pts.length - 1)];
+    octx.beginPath(); octx.arc(c[0], c[1], 6 * px, 0, 2 * Math.PI); octx.stroke();
   }
 
   function showCoords() {
@@ -187,6 +210,13 @@
         if (dist(place(p, p.pins[i].at), q) <= near) return { kind: "pin", patch: p.name, index: i };
       }
     }
+    // A handle's circle of influence, grabbed at its edge.
+    for (const p of scene.patches) {
+      for (let i = 0; i < p.handles.length; i++) {
+        const h = p.handles[i];
+        if (Math.abs(dist(place(p, h.to), q) - h.radius * p.scale) <= near / 2 + 2) return { kind: "radius", patch: p.name, index: i };
+      }
+    }
     if (located && located.patch !== null && dist([located.x, located.y], q) < 2 * near) {
       return { kind: "patch", patch: located.patch };
     }
@@ -202,6 +232,10 @@
     const p = patchNamed(g.patch);
     if (!p) return null;
     if (g.kind === "handle") return { op: "handle_key", patch: p.name, handle: g.index, value: unplace(g.base, q).map(r2) };
+    if (g.kind === "radius") {
+      const centre = place(g.base, g.base.handles[g.index].to);
+      return { op: "handle_radius", patch: p.name, handle: g.index, value: Math.max(0.01, r2(dist(q, centre) / g.base.scale)) };
+    }
     if (g.mode === "rotate") {
       const a0 = Math.atan2(g.start[1] - g.base.at[1], g.start[0] - g.base.at[0]);
       const a1 = Math.atan2(q[1] - g.base.at[1], q[0] - g.base.at[0]);
@@ -230,7 +264,12 @@
 
   overlay.addEventListener("pointermove", (e) => {
     const q = canvasPoint(e);
-    if (!gesture) { locate(q); return; }
+    if (!gesture) {
+      const hit = pick(q);
+      overlay.style.cursor = !hit || hit.kind === "patch" ? "" : hit.kind === "radius" ? "ew-resize" : "move";
+      locate(q);
+      return;
+    }
     if (dist(q, gesture.start) * (1 / screenScale()) > 2) gesture.moved = true;
     if (gesture.moved && gesture.kind !== "add") {
       gesture.last = editFor(gesture, q);
@@ -254,7 +293,7 @@
     const base = JSON.parse(JSON.stringify(patchNamed(hit.patch)));
     const mode = e.shiftKey ? "rotate" : e.altKey ? "scale" : "move";
     gesture = { kind: hit.kind, patch: hit.patch, index: hit.index, base, start: q, mode, moved: false, shift: e.shiftKey };
-    if (hit.kind !== "patch") { selected = hit; drawOverlay(); }
+    if (hit.kind === "handle" || hit.kind === "pin") { selected = hit; drawOverlay(); }
     overlay.setPointerCapture(e.pointerId);
   });
 
@@ -274,7 +313,11 @@
       return;
     }
     if (g.kind === "patch" && g.mode === "move" && !g.moved) { selected = null; drawOverlay(); }
-    if (!g.moved || g.kind === "pin") { copyPair(q, g.shift); return; }
+    if (!g.moved || g.kind === "pin") {
+      if (g.kind === "radius") drawOverlay();
+      else copyPair(q, g.shift);
+      return;
+    }
     const edit = editFor(g, q);
     pendingEdit = null;
     pointerAt = 0;
@@ -295,29 +338,45 @@
     box.textContent = "";
     if (!scene) return;
     let row = 0;
-    for (const p of scene.patches) {
-      for (const [track, times] of Object.entries(p.keys)) {
+    // One row per keyed track: the patch's, then each handle's (`handle` null: the patch).
+    const rows = (owner, keys, handle) => {
+      for (const [track, times] of Object.entries(keys)) {
         if (!times.length) continue;
         for (const t of times) {
+          const key = { kind: "key", patch: owner.name, handle, track, t };
           const m = document.createElement("div");
-          m.className = "marker";
-          if (selected && selected.kind === "key" && selected.patch === p.name && selected.track === track && selected.t === t) m.classList.add("selected");
+          m.className = handle === null ? "marker" : "marker handle";
+          if (sameKey(selected, key)) m.classList.add("selected");
           m.style.left = `${(100 * t) / scene.duration}%`;
           m.style.top = `${row * 10 + 2}px`;
           m.style.background = TRACK_COLOURS[track];
-          m.title = `${p.name} ${track} key at ${t} s (drag: move_key, Delete: remove_key)`;
-          m.addEventListener("pointerdown", (e) => markerDrag(e, m, p.name, track, t));
+          const what = handle === null ? `${owner.name} ${track}` : `${owner.name} handle ${handle} ${track}`;
+          m.title = `${what} key at ${t} s (drag: move_key, Delete: remove_key)`;
+          m.dataset.key = JSON.stringify(key);
+          m.addEventListener("pointerdown", (e) => markerDrag(e, m, key));
           box.appendChild(m);
         }
         row++;
       }
+    };
+    for (const p of scene.patches) {
+      rows(p, p.keys, null);
+      p.handles.forEach((h, i) => rows(p, h.keys, i));
     }
     box.style.height = `${row * 10 + 4}px`;
   }
+  const sameKey = (a, b) => a && a.kind === "key" && a.patch === b.patch && a.handle === b.handle && a.track === b.track && a.t === b.t;
+  // A key edit on the patch's track, or its handle's.
+  function keyEdit(key, fields) {
+    const edit = { patch: key.patch, track: key.track, ...fields };
+    if (key.handle !== null) edit.handle = key.handle;
+    return edit;
+  }
 
-  function markerDrag(e, m, patch, track, t) {
+  function markerDrag(e, m, key) {
     e.preventDefault();
-    selected = { kind: "key", patch, track, t };
+    const t = key.t;
+    selected = key;
     drawMarkers();
     const box = $("markers").getBoundingClientRect();
     const timeAt = (x) => {
@@ -326,11 +385,12 @@
     };
     let to = t;
     const move = (ev) => { to = timeAt(ev.clientX); m.style.left = `${(100 * to) / scene.duration}%`; };
-    const up = () => {
+    const up = (ev) => {
+      move(ev);
       window.removeEventListener("pointermove", move);
       window.removeEventListener("pointerup", up);
       if (Math.abs(to - t) > 1e-9) {
-        send({ type: "edit", rev: scene.rev, commit: true, edit: { op: "move_key", patch, track, from: t, to: +to.toFixed(6) } });
+        send({ type: "edit", rev: scene.rev, commit: true, edit: keyEdit(key, { op: "move_key", from: t, to: +to.toFixed(6) }) });
       }
     };
     window.addEventListener("pointermove", move);
@@ -379,7 +439,7 @@
       selected = null;
       const edit = s.kind === "handle" ? { op: "remove_handle", patch: s.patch, handle: s.index }
         : s.kind === "pin" ? { op: "remove_pin", patch: s.patch, pin: s.index }
-        : { op: "remove_key", patch: s.patch, track: s.track, t: s.t };
+        : keyEdit(s, { op: "remove_key", t: s.t });
       send({ type: "edit", rev: scene.rev, commit: true, edit });
     } else if (e.key === " " && e.target === overlay) {
       e.preventDefault();
