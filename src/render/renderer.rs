@@ -55,10 +55,30 @@ pub struct FrameStats {
     pub total_ms: f64,
 }
 
+/// Where the last frame may differ from its background: outside `rect` it equals the
+/// background `background` names. Two frames with the same `background` differ at most inside
+/// the union of their rectangles, so a viewer compares only there.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct DrawnRegion {
+    /// Names the background canvas: a new number whenever any renderer builds or replaces
+    /// one (a new scene's background, a footage plate), never reused within a process.
+    pub background: u64,
+    /// The bounding rectangle of what the frame's layers drew into (empty: none drew).
+    pub rect: PixelRect,
+}
+
+/// The number naming the next background canvas (see [`DrawnRegion::background`]).
+fn next_background_id() -> u64 {
+    static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
+}
+
 /// A scene with everything built once per patch. See the module doc.
 pub struct Renderer {
     scene: Scene,
     background: Canvas,
+    /// Names `background` (see [`DrawnRegion`]).
+    background_id: u64,
     frame: Canvas,
     layers: Vec<Layer>,
     state: FrameState,
@@ -71,6 +91,8 @@ pub struct Renderer {
     below: Option<Canvas>,
     /// Background footage, and the scene frame whose plate `background` holds.
     plates: Option<(FootageReader, u64)>,
+    /// Threads each layer's draw shades on (see [`set_raster_threads`](Self::set_raster_threads)).
+    raster_threads: usize,
 }
 
 impl Renderer {
@@ -93,6 +115,7 @@ impl Renderer {
         Ok(Self {
             scene,
             background,
+            background_id: next_background_id(),
             frame,
             layers,
             state: FrameState::default(),
@@ -101,7 +124,18 @@ impl Renderer {
             dirty_valid: true,
             below: None,
             plates,
+            raster_threads: 1,
         })
+    }
+
+    /// Shades each layer's draw on `threads` threads (the caller's and scoped ones; 1 by
+    /// default, so a scene render's other cores encode frames): for an interactive view,
+    /// where nothing else waits for the cores. The frames are the same for any count.
+    pub fn set_raster_threads(&mut self, threads: usize) {
+        self.raster_threads = threads.max(1);
+        for layer in &mut self.layers {
+            layer.set_raster_threads(self.raster_threads);
+        }
     }
 
     /// The scene being rendered.
@@ -255,6 +289,7 @@ impl Renderer {
             })?;
             let (width, height) = (self.scene.canvas.width, self.scene.canvas.height);
             self.background = canvas_over(plate, width, height)?;
+            self.background_id = next_background_id();
             *held = index;
             self.dirty_valid = false;
         }
@@ -283,6 +318,31 @@ impl Renderer {
     /// The last rendered frame.
     pub fn frame(&self) -> &Canvas {
         &self.frame
+    }
+
+    /// Where the last frame may differ from its background; `None` when that is not known
+    /// (a frame failed midway).
+    pub fn drawn_region(&self) -> Option<DrawnRegion> {
+        if !self.dirty_valid {
+            return None;
+        }
+        let rect = self
+            .dirty
+            .iter()
+            .filter(|r| !r.is_empty())
+            .fold(None, |union: Option<PixelRect>, r| {
+                Some(union.map_or(*r, |u| PixelRect {
+                    x0: u.x0.min(r.x0),
+                    y0: u.y0.min(r.y0),
+                    x1: u.x1.max(r.x1),
+                    y1: u.y1.max(r.y1),
+                }))
+            })
+            .unwrap_or_default();
+        Some(DrawnRegion {
+            background: self.background_id,
+            rect,
+        })
     }
 
     /// Timings of the last frame rendered.

@@ -55,9 +55,7 @@ impl Session {
                 .wants_mesh()
                 .then(|| scene_message(renderer, &head, true)),
         };
-        let frame = renderer.frame();
-        let (width, height) = (frame.width(), frame.height());
-        hub.publish(width, height, frame.to_rgba8_image().into_raw(), scene);
+        hub.publish(renderer.frame(), renderer.drawn_region(), scene);
     }
 
     /// Publishes again (a page changed what it wants to be sent).
@@ -119,6 +117,8 @@ impl Session {
         edit.apply_key(&mut scene, self.time)?;
         let renderer = self.renderer.as_mut().ok_or("no scene to preview")?;
         renderer.set_scene(scene).map_err(|e| e.to_string())?;
+        // A drag waits for each frame: its raster may take every core.
+        renderer.set_raster_threads(lapclone::util::available_cores());
         self.previewing = true;
         self.as_page(|s| s.show_frame())
     }
