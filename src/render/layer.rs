@@ -134,11 +134,6 @@ impl Layer {
         Ok(())
     }
 
-    /// Shades this layer's draws on `threads` threads (the pixels are the same for any count).
-    pub fn set_raster_threads(&mut self, threads: usize) {
-        self.cloner.set_raster_threads(threads);
-    }
-
     /// Factorisations of this layer's cloning Laplacian so far.
     pub fn factorisations(&self) -> usize {
         self.cloner.factorisations()

@@ -91,8 +91,6 @@ pub struct Renderer {
     below: Option<Canvas>,
     /// Background footage, and the scene frame whose plate `background` holds.
     plates: Option<(FootageReader, u64)>,
-    /// Threads each layer's draw shades on (see [`set_raster_threads`](Self::set_raster_threads)).
-    raster_threads: usize,
 }
 
 impl Renderer {
@@ -124,18 +122,7 @@ impl Renderer {
             dirty_valid: true,
             below: None,
             plates,
-            raster_threads: 1,
         })
-    }
-
-    /// Shades each layer's draw on `threads` threads (the caller's and scoped ones; 1 by
-    /// default, so a scene render's other cores encode frames): for an interactive view,
-    /// where nothing else waits for the cores. The frames are the same for any count.
-    pub fn set_raster_threads(&mut self, threads: usize) {
-        self.raster_threads = threads.max(1);
-        for layer in &mut self.layers {
-            layer.set_raster_threads(self.raster_threads);
-        }
     }
 
     /// The scene being rendered.

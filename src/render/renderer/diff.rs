@@ -53,7 +53,7 @@ impl Renderer {
             .map(Some)
             .collect();
         for (patch, planned) in scene.patches.iter().zip(plan) {
-            let mut layer = match planned {
+            let layer = match planned {
                 Planned::Keep { index, rig } => {
                     update.reused += 1;
                     update.rigs_built += usize::from(rig.is_some());
@@ -66,7 +66,6 @@ impl Renderer {
                     *layer
                 }
             };
-            layer.set_raster_threads(self.raster_threads);
             self.layers.push(layer);
         }
         update.dropped = old.iter().filter(|l| l.is_some()).count();

@@ -117,8 +117,6 @@ impl Session {
         edit.apply_key(&mut scene, self.time)?;
         let renderer = self.renderer.as_mut().ok_or("no scene to preview")?;
         renderer.set_scene(scene).map_err(|e| e.to_string())?;
-        // A drag waits for each frame: its raster may take every core.
-        renderer.set_raster_threads(lapclone::util::available_cores());
         self.previewing = true;
         self.as_page(|s| s.show_frame())
     }
