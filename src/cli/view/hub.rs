@@ -8,7 +8,8 @@
 use std::sync::mpsc::{Receiver, Sender};
 use std::sync::{Arc, Mutex};
 
-use lapclone::{Canvas, CanvasPixels, DrawnRegion, PixelFormat, PixelRect};
+use lapclone::pixels::{Canvas, CanvasPixels, PixelFormat, PixelRect};
+use lapclone::render::DrawnRegion;
 
 use super::lock;
 
