@@ -96,7 +96,7 @@ pub use pixels::{
     PixelRect,
 };
 pub use raster::{RasterError, RasterStats};
-pub use render::{FrameStats, RenderError, Renderer, SceneUpdate};
+pub use render::{DrawnRegion, FrameStats, RenderError, Renderer, SceneUpdate};
 /// The scene language's engine: [`SceneError::position`] is its [`rhai::Position`].
 pub use rhai;
 pub use script::{

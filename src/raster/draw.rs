@@ -146,16 +146,38 @@ impl Frame<'_> {
             scratch.centres = coverage;
             return totals;
         }
-        // Each strip of the silhouette shades the target rows it holds from its own mask.
-        let mut totals = (0, 0);
-        for strip in scratch.silhouette.strips() {
-            let rows = self.target.intersect(&strip.rect());
-            if !rows.is_empty() {
-                let (h, w) = self.shade_rows(scratch, strip.coverage(), rows, canvas);
-                totals = (totals.0 + h, totals.1 + w);
+        // Each strip of the silhouette shades the target rows it holds from its own mask;
+        // threads split the target's rows, whatever the strips.
+        let scratch = &*scratch;
+        self.in_parts(self.target, canvas, |part, canvas| {
+            let mut totals = (0, 0);
+            for strip in scratch.silhouette.strips() {
+                let rows = part.intersect(&strip.rect());
+                if !rows.is_empty() {
+                    let canvas = &mut canvas[(rows.y0 - part.y0) as usize * self.width..];
+                    let input = self.input(scratch, strip.coverage());
+                    let (h, w) = shade_and_composite(&input, rows, canvas, self.width);
+                    totals = (totals.0 + h, totals.1 + w);
+                }
             }
+            totals
+        })
+    }
+
+    fn input<'a, C>(
+        &'a self,
+        scratch: &'a RasterScratch,
+        (coverage, coverage_stride, coverage_origin): (&'a [C], usize, (i32, i32)),
+    ) -> ShadeInput<'a, C> {
+        ShadeInput {
+            setups: &scratch.setups,
+            ids: &scratch.ids,
+            ids_rect: self.work,
+            coverage,
+            coverage_stride,
+            coverage_origin,
+            source: self.patch.source,
         }
-        totals
     }
 
     /// Shades the whole target with `coverage` laid out like the work rectangle.
@@ -175,26 +197,32 @@ impl Frame<'_> {
     fn shade_rows<T: Texel + Send, C: CoverageTexel + Sync>(
         &self,
         scratch: &RasterScratch,
-        (coverage, coverage_stride, coverage_origin): (&[C], usize, (i32, i32)),
+        coverage: (&[C], usize, (i32, i32)),
         rows: PixelRect,
         canvas: &mut [[T; 4]],
     ) -> (usize, usize) {
-        let input = ShadeInput {
-            setups: &scratch.setups,
-            ids: &scratch.ids,
-            ids_rect: self.work,
-            coverage,
-            coverage_stride,
-            coverage_origin,
-            source: self.patch.source,
-        };
-        let mut canvas_rows = &mut canvas[rows.y0 as usize * self.width..];
+        let input = self.input(scratch, coverage);
+        self.in_parts(rows, canvas, |part, canvas| {
+            shade_and_composite(&input, part, canvas, self.width)
+        })
+    }
+
+    /// Runs `shade` over `rows` of the canvas split into row ranges, one per thread (the
+    /// caller's last); `shade` gets a range and the canvas from that range's first row on,
+    /// and gives (centre hits, pixels written), summed here. Rows shade independently, so
+    /// the pixels are the same for any split.
+    fn in_parts<T: Texel + Send>(
+        &self,
+        rows: PixelRect,
+        canvas: &mut [[T; 4]],
+        shade: impl Fn(PixelRect, &mut [[T; 4]]) -> (usize, usize) + Sync,
+    ) -> (usize, usize) {
+        let mut canvas_rows = &mut canvas[rows.y0.max(0) as usize * self.width..];
         let height = rows.height();
         let parts = self.threads.min(height / MIN_ROWS_PER_THREAD).max(1);
         if parts == 1 {
-            return shade_and_composite(&input, rows, canvas_rows, self.width);
+            return shade(rows, canvas_rows);
         }
-        // Rows shade independently: each part takes its own rows of the canvas.
         let per_part = height.div_ceil(parts) as i32;
         std::thread::scope(|scope| {
             let mut parts = Vec::new();
@@ -209,14 +237,12 @@ impl Frame<'_> {
             }
             // invariant: `rows` is not empty (parts ≥ 1), so there is a last part.
             let (last_rows, last) = parts.pop().expect("a part");
-            let (input, width) = (&input, self.width);
+            let shade = &shade;
             let spawned: Vec<_> = parts
                 .into_iter()
-                .map(|(part_rows, part)| {
-                    scope.spawn(move || shade_and_composite(input, part_rows, part, width))
-                })
+                .map(|(part_rows, part)| scope.spawn(move || shade(part_rows, part)))
                 .collect();
-            let mine = shade_and_composite(input, last_rows, last, width);
+            let mine = shade(last_rows, last);
             spawned.into_iter().fold(mine, |(h, w), handle| {
                 // invariant: shading does not panic on validated input; a panic is a bug
                 // to surface, not to hide.

@@ -17,4 +17,4 @@ mod point_warnings;
 mod renderer;
 
 pub use error::RenderError;
-pub use renderer::{FrameStats, PlacedMesh, Renderer, SceneUpdate};
+pub use renderer::{DrawnRegion, FrameStats, PlacedMesh, Renderer, SceneUpdate};

@@ -55,10 +55,30 @@ pub struct FrameStats {
     pub total_ms: f64,
 }
 
+/// Where the last frame may differ from its background: outside `rect` it equals the
+/// background `background` names. Two frames with the same `background` differ at most inside
+/// the union of their rectangles, so a viewer compares only there.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct DrawnRegion {
+    /// Names the background canvas: a new number whenever any renderer builds or replaces
+    /// one (a new scene's background, a footage plate), never reused within a process.
+    pub background: u64,
+    /// The bounding rectangle of what the frame's layers drew into (empty: none drew).
+    pub rect: PixelRect,
+}
+
+/// The number naming the next background canvas (see [`DrawnRegion::background`]).
+fn next_background_id() -> u64 {
+    static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
+}
+
 /// A scene with everything built once per patch. See the module doc.
 pub struct Renderer {
     scene: Scene,
     background: Canvas,
+    /// Names `background` (see [`DrawnRegion`]).
+    background_id: u64,
     frame: Canvas,
     layers: Vec<Layer>,
     state: FrameState,
@@ -93,6 +113,7 @@ impl Renderer {
         Ok(Self {
             scene,
             background,
+            background_id: next_background_id(),
             frame,
             layers,
             state: FrameState::default(),
@@ -255,6 +276,7 @@ impl Renderer {
             })?;
             let (width, height) = (self.scene.canvas.width, self.scene.canvas.height);
             self.background = canvas_over(plate, width, height)?;
+            self.background_id = next_background_id();
             *held = index;
             self.dirty_valid = false;
         }
@@ -283,6 +305,31 @@ impl Renderer {
     /// The last rendered frame.
     pub fn frame(&self) -> &Canvas {
         &self.frame
+    }
+
+    /// Where the last frame may differ from its background; `None` when that is not known
+    /// (a frame failed midway).
+    pub fn drawn_region(&self) -> Option<DrawnRegion> {
+        if !self.dirty_valid {
+            return None;
+        }
+        let rect = self
+            .dirty
+            .iter()
+            .filter(|r| !r.is_empty())
+            .fold(None, |union: Option<PixelRect>, r| {
+                Some(union.map_or(*r, |u| PixelRect {
+                    x0: u.x0.min(r.x0),
+                    y0: u.y0.min(r.y0),
+                    x1: u.x1.max(r.x1),
+                    y1: u.y1.max(r.y1),
+                }))
+            })
+            .unwrap_or_default();
+        Some(DrawnRegion {
+            background: self.background_id,
+            rect,
+        })
     }
 
     /// Timings of the last frame rendered.

@@ -592,7 +592,9 @@ fn a_wrong_membrane_is_an_error_and_leaves_the_canvas_as_it_was() {
 }
 
 /// Shading on several threads (row ranges) gives exactly the one-thread pixels, with
-/// anti-aliasing, pixel-centre coverage and a feather, and over a canvas edge.
+/// anti-aliasing, pixel-centre coverage and a feather, over a canvas edge, and on a patch
+/// large enough for several silhouette strips (threads split rows across strips), with and
+/// without depth.
 #[test]
 fn threads_shade_the_same_pixels() {
     let source = raster_meshes::pattern_image(300, 300);
@@ -600,16 +602,27 @@ fn threads_shade_the_same_pixels() {
     let membrane: Vec<[f32; 3]> = (0..mesh.positions.len())
         .map(|i| [(i % 7) as f32 * 0.01, -0.02, 0.03])
         .collect();
-    let placed: Vec<DVec2> = mesh
+    let depth: Vec<f32> = mesh
         .positions
         .iter()
-        .map(|p| DVec2::new(p.x * 0.97 + 0.3 * p.y.sin(), p.y + 0.2))
+        .map(|p| (p.x * 0.05).sin() as f32)
         .collect();
-    for (anti_alias, feather) in [(true, 0.0), (false, 0.0), (true, 3.5), (false, 2.0)] {
+    let cases = [(true, 0.0), (false, 0.0), (true, 3.5), (false, 2.0)];
+    for (scale, (anti_alias, feather), with_depth) in [1.0, 1.7]
+        .into_iter()
+        .flat_map(|s| cases.into_iter().map(move |c| (s, c)))
+        .flat_map(|(s, c)| [false, true].into_iter().map(move |d| (s, c, d)))
+    {
+        let placed: Vec<DVec2> = mesh
+            .positions
+            .iter()
+            .map(|p| DVec2::new(p.x * 0.97 + 0.3 * p.y.sin(), p.y + 0.2) * scale)
+            .collect();
+        let (width, height) = if scale > 1.0 { (520, 460) } else { (280, 300) };
         let canvases: Vec<Canvas> = [1, 2, 3]
             .into_iter()
             .map(|threads| {
-                let mut canvas = opaque_canvas(280, 300, 0.4);
+                let mut canvas = opaque_canvas(width, height, 0.4);
                 let options = RasterOptions {
                     anti_alias,
                     feather,
@@ -621,7 +634,7 @@ fn threads_shade_the_same_pixels() {
                     &placed,
                     &mesh.triangles,
                     &membrane,
-                    None,
+                    with_depth.then_some(&depth[..]),
                     &mesh.loops,
                     &source,
                     options,
@@ -629,7 +642,7 @@ fn threads_shade_the_same_pixels() {
                 canvas
             })
             .collect();
-        let background = opaque_canvas(280, 300, 0.4);
+        let background = opaque_canvas(width, height, 0.4);
         assert!(
             canvases[0].pixels() != background.pixels(),
             "the patch drew"
@@ -637,7 +650,7 @@ fn threads_shade_the_same_pixels() {
         for canvas in &canvases[1..] {
             assert!(
                 canvas.pixels() == canvases[0].pixels(),
-                "AA {anti_alias}, feather {feather}"
+                "scale {scale}, AA {anti_alias}, feather {feather}, depth {with_depth}"
             );
         }
     }

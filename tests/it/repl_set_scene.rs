@@ -179,3 +179,74 @@ fn placed_meshes_follow_the_last_frame() {
         );
     }
 }
+
+/// `Renderer::drawn_region`, what the live view compares: every frame of the demo scenes
+/// (deformation with folds, several layers, translucent layers) equals the background outside
+/// its drawn rectangle, and the background's number holds while the background does — across
+/// frames and an edit that keeps it — and changes with it.
+#[test]
+fn drawn_region_bounds_where_a_frame_differs_from_its_background() {
+    let scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    for name in ["horse_gallop", "two_layers", "ring_slide"] {
+        let (loaded, mut renderer) =
+            lapclone::open_scene(&scenes.join(format!("{name}.rhai"))).unwrap();
+        let mut bare = loaded.scene.clone();
+        bare.patches.clear();
+        let background = Renderer::new(bare)
+            .unwrap()
+            .render_frame(0)
+            .unwrap()
+            .clone();
+        let mut numbers = Vec::new();
+        for frame in (0..renderer.frame_count()).step_by(5) {
+            let canvas = renderer.render_frame(frame).unwrap().clone();
+            let region = renderer.drawn_region().unwrap();
+            assert!(
+                !region.rect.is_empty(),
+                "{name} frame {frame}: nothing drawn"
+            );
+            let outside = differing_pixels(&canvas, &background)
+                .into_iter()
+                .filter(|&(x, y)| {
+                    let r = region.rect;
+                    !(r.x0 <= x && x < r.x1 && r.y0 <= y && y < r.y1)
+                })
+                .count();
+            assert_eq!(
+                outside, 0,
+                "{name} frame {frame}: pixels changed outside {region:?}"
+            );
+            numbers.push(region.background);
+        }
+        numbers.dedup();
+        assert_eq!(numbers.len(), 1, "{name}: the background's number changed");
+        // An edit that keeps the background keeps its number; a new background gets another.
+        let mut edited = loaded.scene.clone();
+        edited.patches.truncate(1);
+        renderer.set_scene(edited.clone()).unwrap();
+        renderer.render_frame(0).unwrap();
+        assert_eq!(
+            renderer.drawn_region().unwrap().background,
+            numbers[0],
+            "{name}"
+        );
+        edited.canvas.background = Background::Colour([0.5, 0.1, 0.1, 1.0]);
+        renderer.set_scene(edited).unwrap();
+        renderer.render_frame(0).unwrap();
+        assert_ne!(
+            renderer.drawn_region().unwrap().background,
+            numbers[0],
+            "{name}"
+        );
+    }
+}
+
+/// The (x, y) of every pixel where two canvases of one size differ.
+fn differing_pixels(a: &lapclone::Canvas, b: &lapclone::Canvas) -> Vec<(i32, i32)> {
+    let (a, b) = (a.to_rgba8_image(), b.to_rgba8_image());
+    a.enumerate_pixels()
+        .zip(b.pixels())
+        .filter(|((_, _, p), q)| p != q)
+        .map(|((x, y, _), _)| (x as i32, y as i32))
+        .collect()
+}

@@ -2,9 +2,14 @@
 //! with it) from the session and gives the connected pages binary frame updates — only the
 //! rectangle where the 8-bit RGBA frame changed since the last one, or the whole frame to a
 //! page that just connected — plus JSON text messages, in the order they were published.
+//! Between two frames over the same background only the union of their drawn regions can
+//! differ, so only that part is converted and compared.
 
 use std::sync::mpsc::{Receiver, Sender};
 use std::sync::{Arc, Mutex};
+
+use lapclone::pixels::{Canvas, CanvasPixels, PixelFormat, PixelRect};
+use lapclone::render::DrawnRegion;
 
 use super::lock;
 
@@ -36,9 +41,18 @@ pub struct SceneText {
 struct State {
     clients: Vec<Client>,
     next_id: u64,
-    /// The last published frame: width, height and RGBA8 bytes.
-    frame: Option<(u32, u32, Vec<u8>)>,
+    /// The last published frame.
+    frame: Option<Published>,
     scene: Option<(Arc<String>, Option<Arc<String>>)>,
+}
+
+/// The last published frame: its size, RGBA8 bytes and where it may differ from its
+/// background.
+struct Published {
+    width: u32,
+    height: u32,
+    rgba: Vec<u8>,
+    region: Option<DrawnRegion>,
 }
 
 /// The pages connected to one session.
@@ -53,7 +67,13 @@ impl Hub {
         let mut state = lock(&self.state);
         state.next_id += 1;
         let id = state.next_id;
-        if let Some((w, h, rgba)) = &state.frame {
+        if let Some(Published {
+            width: w,
+            height: h,
+            rgba,
+            ..
+        }) = &state.frame
+        {
             let message = frame_message(*w, *h, rgba, [0, 0, *w, *h]);
             let _ = tx.send(Outgoing::Binary(Arc::new(message)));
         }
@@ -84,15 +104,33 @@ impl Hub {
         }
     }
 
-    /// Sends every page what changed in `rgba` (a `width`×`height` RGBA8 frame), then `scene`.
-    pub fn publish(&self, width: u32, height: u32, rgba: Vec<u8>, scene: SceneText) {
+    /// Sends every page what changed in `frame` (rounded to 8-bit RGBA) since the last one,
+    /// then `scene`. `region` is where `frame` may differ from its background
+    /// ([`Renderer::drawn_region`](lapclone::Renderer::drawn_region)).
+    pub fn publish(&self, frame: &Canvas, region: Option<DrawnRegion>, scene: SceneText) {
         let mut state = lock(&self.state);
-        let rect = match &state.frame {
-            Some((w, h, last)) if *w == width && *h == height => changed_rect(width, last, &rgba),
-            _ => Some([0, 0, width, height]),
+        let rect = state
+            .frame
+            .as_mut()
+            .and_then(|last| last.update(frame, region));
+        let rect = match rect {
+            Some(rect) => rect,
+            None => {
+                let (width, height) = (frame.width(), frame.height());
+                let rgba = frame.to_rgba8_image().into_raw();
+                state.frame = Some(Published {
+                    width,
+                    height,
+                    rgba,
+                    region,
+                });
+                Some([0, 0, width, height])
+            }
         };
         let rect = rect.unwrap_or([0, 0, 0, 0]);
-        let frame = Arc::new(frame_message(width, height, &rgba, rect));
+        // invariant: both arms above leave a published frame.
+        let last = state.frame.as_ref().expect("a published frame");
+        let frame = Arc::new(frame_message(last.width, last.height, &last.rgba, rect));
         let plain = Arc::new(scene.plain);
         let with_mesh = scene.with_mesh.map(Arc::new);
         state.clients.retain(|c| {
@@ -103,7 +141,6 @@ impl Hub {
             c.tx.send(Outgoing::Binary(frame.clone())).is_ok()
                 && c.tx.send(Outgoing::Text(text)).is_ok()
         });
-        state.frame = Some((width, height, rgba));
         state.scene = Some((plain, with_mesh));
     }
 
@@ -116,35 +153,86 @@ impl Hub {
     }
 }
 
+impl Published {
+    /// Takes in `frame` when it has this frame's size, comparing only the union of the two
+    /// drawn regions when both are known over the same background, else the whole frame.
+    /// Gives the changed rectangle (`None` inside: nothing changed), or `None` when the size
+    /// differs and the whole frame must be taken instead.
+    fn update(&mut self, frame: &Canvas, region: Option<DrawnRegion>) -> Option<Option<[u32; 4]>> {
+        if (frame.width(), frame.height()) != (self.width, self.height) {
+            return None;
+        }
+        let whole = PixelRect {
+            x0: 0,
+            y0: 0,
+            x1: self.width.min(i32::MAX as u32) as i32,
+            y1: self.height.min(i32::MAX as u32) as i32,
+        };
+        let union = match (self.region, region) {
+            (Some(old), Some(new)) if old.background == new.background => [old.rect, new.rect]
+                .into_iter()
+                .map(|r| r.intersect(&whole))
+                .filter(|r| !r.is_empty())
+                .reduce(|a, b| PixelRect {
+                    x0: a.x0.min(b.x0),
+                    y0: a.y0.min(b.y0),
+                    x1: a.x1.max(b.x1),
+                    y1: a.y1.max(b.y1),
+                }),
+            _ => Some(whole),
+        };
+        self.region = region;
+        let Some(union) = union else {
+            return Some(None);
+        };
+        let (x0, w) = (union.x0 as usize, union.width());
+        let row = self.width as usize * 4;
+        // Rows are compared where they are: only the union's columns of each row.
+        let (mut top, mut bottom, mut left, mut right) = (usize::MAX, 0, usize::MAX, 0);
+        let mut converted: Vec<u8>;
+        for y in union.y0 as usize..union.y1 as usize {
+            let new_row = match frame.pixels() {
+                CanvasPixels::Eight(p) => p[y * self.width as usize + x0..][..w].as_flattened(),
+                CanvasPixels::Sixteen(_) => {
+                    let (x, y) = (x0 as u32, y as u32);
+                    converted = frame.samples_in(PixelFormat::RGBA8, x..x + w as u32, y..y + 1);
+                    &converted[..]
+                }
+            };
+            let old_row = &mut self.rgba[y * row + x0 * 4..][..w * 4];
+            if *old_row == *new_row {
+                continue;
+            }
+            // invariant: the rows differ, so a first and a last difference exist.
+            let first = old_row
+                .iter()
+                .zip(new_row)
+                .position(|(a, b)| a != b)
+                .expect("a difference");
+            let last = old_row
+                .iter()
+                .zip(new_row)
+                .rposition(|(a, b)| a != b)
+                .expect("a difference");
+            (top, bottom) = (top.min(y), y);
+            (left, right) = (left.min(first / 4), right.max(last / 4));
+            old_row.copy_from_slice(new_row);
+        }
+        Some((top <= bottom).then(|| {
+            let x = (x0 + left) as u32;
+            [
+                x,
+                top as u32,
+                (right - left + 1) as u32,
+                (bottom - top + 1) as u32,
+            ]
+        }))
+    }
+}
+
 /// A channel for one page's messages.
 pub fn channel() -> (Sender<Outgoing>, Receiver<Outgoing>) {
     std::sync::mpsc::channel()
-}
-
-/// The smallest rectangle `[x, y, w, h]` holding every pixel that differs, if any does.
-pub fn changed_rect(width: u32, old: &[u8], new: &[u8]) -> Option<[u32; 4]> {
-    let row = width as usize * 4;
-    let rows: Vec<usize> = (0..new.len() / row.max(1))
-        .filter(|&y| old[y * row..(y + 1) * row] != new[y * row..(y + 1) * row])
-        .collect();
-    let (&top, &bottom) = (rows.first()?, rows.last()?);
-    let (mut left, mut right) = (width as usize, 0);
-    for y in top..=bottom {
-        let (a, b) = (&old[y * row..(y + 1) * row], &new[y * row..(y + 1) * row]);
-        let differs = |x: &usize| a[x * 4..x * 4 + 4] != b[x * 4..x * 4 + 4];
-        if let Some(x) = (0..left).find(differs) {
-            left = x;
-        }
-        if let Some(x) = (right..width as usize).rev().find(differs) {
-            right = x;
-        }
-    }
-    Some([
-        left as u32,
-        top as u32,
-        (right - left + 1) as u32,
-        (bottom - top + 1) as u32,
-    ])
 }
 
 /// The binary frame message for `rect` of the `width`×`height` frame `rgba`.
@@ -166,14 +254,71 @@ pub fn frame_message(width: u32, height: u32, rgba: &[u8], rect: [u32; 4]) -> Ve
 mod tests {
     use super::*;
 
+    fn canvas(pixels: &[(usize, [u8; 4])]) -> Canvas {
+        let mut rgba = vec![[10, 20, 30, 255]; 6 * 5];
+        for &(i, p) in pixels {
+            rgba[i] = p;
+        }
+        Canvas::from_rgba8(6, 5, rgba).unwrap()
+    }
+
+    fn region(background: u64, x0: i32, y0: i32, x1: i32, y1: i32) -> Option<DrawnRegion> {
+        let rect = PixelRect { x0, y0, x1, y1 };
+        Some(DrawnRegion { background, rect })
+    }
+
+    fn scene() -> SceneText {
+        SceneText {
+            plain: "{}".into(),
+            with_mesh: None,
+        }
+    }
+
+    /// The rectangle of a frame message.
+    fn rect_of(message: &Outgoing) -> [u32; 4] {
+        let Outgoing::Binary(m) = message else {
+            panic!("not a frame: {message:?}");
+        };
+        let word = |k: usize| u32::from_le_bytes(m[4 * k..4 * k + 4].try_into().unwrap());
+        [word(3), word(4), word(5), word(6)]
+    }
+
     #[test]
-    fn changed_rect_bounds_every_difference() {
-        let old = vec![0u8; 5 * 4 * 4];
-        let mut new = old.clone();
-        assert_eq!(changed_rect(5, &old, &new), None);
-        new[(5 + 3) * 4] = 9; // (3, 1)
-        new[(2 * 5 + 1) * 4 + 2] = 9; // (1, 2)
-        assert_eq!(changed_rect(5, &old, &new), Some([1, 1, 3, 2]));
+    fn updates_bound_the_changes_inside_the_drawn_regions() {
+        let hub = Hub::default();
+        let (tx, rx) = channel();
+        hub.connect(tx);
+        // A first frame goes whole; then only what changed inside old ∪ new drawn regions.
+        hub.publish(
+            &canvas(&[(7, [1, 2, 3, 4])]),
+            region(1, 1, 1, 2, 2),
+            scene(),
+        );
+        assert_eq!(rect_of(&rx.recv().unwrap()), [0, 0, 6, 5]);
+        rx.recv().unwrap();
+        // The pixel at (1, 1) is background again; (4, 3) and (3, 2) were drawn.
+        let next = canvas(&[(6 * 3 + 4, [9, 9, 9, 9]), (6 * 2 + 3, [8, 8, 8, 8])]);
+        hub.publish(&next, region(1, 3, 2, 5, 4), scene());
+        assert_eq!(rect_of(&rx.recv().unwrap()), [1, 1, 4, 3]);
+        rx.recv().unwrap();
+        // The same frame again: nothing changed.
+        hub.publish(&next, region(1, 3, 2, 5, 4), scene());
+        assert_eq!(rect_of(&rx.recv().unwrap()), [0, 0, 0, 0]);
+        rx.recv().unwrap();
+        // Another background, or an unknown region: the whole frame is compared.
+        let other = canvas(&[(0, [0, 0, 0, 0]), (6 * 3 + 4, [9, 9, 9, 9])]);
+        hub.publish(&other, region(2, 4, 3, 5, 4), scene());
+        assert_eq!(rect_of(&rx.recv().unwrap()), [0, 0, 4, 3]);
+        rx.recv().unwrap();
+        hub.publish(&canvas(&[]), None, scene());
+        assert_eq!(rect_of(&rx.recv().unwrap()), [0, 0, 5, 4]);
+        // A page that connects now is sent the frame last published, whole.
+        let (tx, late) = channel();
+        hub.connect(tx);
+        let Outgoing::Binary(m) = late.recv().unwrap() else {
+            panic!("no frame");
+        };
+        assert_eq!(&m[FRAME_HEADER..], canvas(&[]).samples(PixelFormat::RGBA8));
     }
 
     #[test]

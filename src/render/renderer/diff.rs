@@ -72,6 +72,7 @@ impl Renderer {
         if let Some((background, plates)) = background {
             self.frame = background.clone();
             self.background = background;
+            self.background_id = super::next_background_id();
             self.plates = plates;
             self.dirty.clear();
             self.dirty_valid = true;
@@ -84,11 +85,16 @@ impl Renderer {
     /// Does all fallible work without touching `self`.
     fn plan_layers(&self, patches: &[Patch]) -> Result<Vec<Planned>, RenderError> {
         let kept = self.match_layers(patches);
-        let mut sources: HashMap<PathBuf, FloatImage> = self
-            .layers
-            .iter()
-            .map(|l| (l.settings_source().to_path_buf(), l.source().clone()))
-            .collect();
+        // Sources the kept layers already decoded, for new layers that share them (copied
+        // only when a layer is to be built: an edit during a drag builds none).
+        let mut sources: HashMap<PathBuf, FloatImage> = match kept.contains(&None) {
+            true => self
+                .layers
+                .iter()
+                .map(|l| (l.settings_source().to_path_buf(), l.source().clone()))
+                .collect(),
+            false => HashMap::new(),
+        };
         let mut plan = Vec::with_capacity(patches.len());
         for (patch, kept) in patches.iter().zip(kept) {
             plan.push(match kept {

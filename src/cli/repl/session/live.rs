@@ -55,9 +55,7 @@ impl Session {
                 .wants_mesh()
                 .then(|| scene_message(renderer, &head, true)),
         };
-        let frame = renderer.frame();
-        let (width, height) = (frame.width(), frame.height());
-        hub.publish(width, height, frame.to_rgba8_image().into_raw(), scene);
+        hub.publish(renderer.frame(), renderer.drawn_region(), scene);
     }
 
     /// Publishes again (a page changed what it wants to be sent).
