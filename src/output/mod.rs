@@ -13,6 +13,7 @@ mod gif;
 mod gif_frame;
 mod gif_palette;
 mod png_sequence;
+mod pool;
 mod y4m;
 mod yuv;
 
