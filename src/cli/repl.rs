@@ -26,6 +26,8 @@ use rustyline::error::ReadlineError;
 use rustyline::history::{FileHistory, History};
 use rustyline::{Config, Editor};
 
+use crate::util::lock;
+
 use helper::ReplHelper;
 pub(crate) use preview::show_picture;
 use preview::{default_preview_path, Inline, Preview};
@@ -131,10 +133,6 @@ fn start_view(
         crate::cli::view::open_in_browser(&server.url);
     }
     Ok(())
-}
-
-fn lock(session: &Mutex<Session>) -> std::sync::MutexGuard<'_, Session> {
-    crate::cli::view::lock(session)
 }
 
 /// Removes its file when dropped (a file that was never written is no error).

@@ -14,13 +14,13 @@ use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
-use std::sync::mpsc::{channel, sync_channel, Receiver, Sender, SyncSender};
-use std::sync::{Arc, Mutex};
-use std::thread::JoinHandle;
+use std::sync::mpsc::{channel, Receiver};
+use std::sync::Arc;
 
-use crate::util::{lock, TempOutput};
+use crate::util::TempOutput;
 use super::gif_frame::{EncodedFrame, FrameEncoder};
 use super::gif_palette::{Palette, PaletteMap};
+use super::pool::WorkerPool;
 use super::{FrameRef, OutputError};
 
 /// Frames sampled for the palette (fewer if the animation is shorter).
@@ -66,9 +66,8 @@ struct Done {
 enum Pipeline {
     Inline(FrameEncoder),
     Threads {
-        sender: Option<SyncSender<Job>>,
+        pool: WorkerPool<Job, ()>,
         results: Receiver<Done>,
-        workers: Vec<JoinHandle<()>>,
     },
 }
 
@@ -210,26 +209,15 @@ impl GifWriter {
                 height,
             ));
         }
-        let (sender, receiver) = sync_channel::<Job>(jobs);
-        let (done_sender, results) = channel::<Done>();
-        let receiver = Arc::new(Mutex::new(receiver));
-        let workers = (0..jobs)
-            .map(|_| {
-                let receiver = receiver.clone();
-                let done = done_sender.clone();
-                let palette = palette.clone();
-                std::thread::spawn(move || {
-                    let map = PaletteMap::new(palette, dither);
-                    let encoder = FrameEncoder::new(map, width, height);
-                    worker(&receiver, &done, encoder, fps)
-                })
-            })
-            .collect();
-        Pipeline::Threads {
-            sender: Some(sender),
-            results,
-            workers,
-        }
+        let (done, results) = channel::<Done>();
+        let pool = WorkerPool::new(jobs, move || {
+            let map = PaletteMap::new(palette.clone(), dither);
+            let mut encoder = FrameEncoder::new(map, width, height);
+            let done = done.clone();
+            // A closed result channel means the writer is gone: skip what is left.
+            move |job| done.send(run(&mut encoder, job, fps)).map_err(|_| ())
+        });
+        Pipeline::Threads { pool, results }
     }
 
     fn dispatch(&mut self, current: Rgba) -> Result<(), OutputError> {
@@ -247,15 +235,9 @@ impl GifWriter {
                 let done = run(encoder, job, fps);
                 self.accept(done)
             }
-            Pipeline::Threads {
-                sender, results, ..
-            } => {
-                let lost = || OutputError::Worker("a GIF encoder thread stopped".into());
-                sender
-                    .as_ref()
-                    .ok_or_else(lost)?
-                    .send(job)
-                    .map_err(|_| lost())?;
+            Pipeline::Threads { pool, results } => {
+                pool.send(job)
+                    .map_err(|_| OutputError::Worker("a GIF encoder thread stopped".into()))?;
                 let finished: Vec<Done> = results.try_iter().collect();
                 finished.into_iter().try_for_each(|done| self.accept(done))
             }
@@ -264,32 +246,18 @@ impl GifWriter {
 
     /// Waits for every dispatched frame and stops the workers.
     fn drain(&mut self) -> Result<(), OutputError> {
-        if let Some(Pipeline::Threads { sender, .. }) = self.pipeline.as_mut() {
-            *sender = None;
+        let Some(Pipeline::Threads { pool, results }) = self.pipeline.as_mut() else {
+            return Ok(());
+        };
+        // The result channel is unbounded, so the workers finish the queue without waiting;
+        // once they have ended, every result there will be is in the channel.
+        pool.stop(|| ());
+        let finished: Vec<Done> = results.try_iter().collect();
+        finished.into_iter().try_for_each(|done| self.accept(done))?;
+        if self.written < self.dispatched {
+            return Err(OutputError::Worker("a GIF encoder thread panicked".into()));
         }
-        while self.written < self.dispatched {
-            let Some(Pipeline::Threads { results, .. }) = self.pipeline.as_ref() else {
-                break;
-            };
-            let done = results
-                .recv()
-                .map_err(|_| OutputError::Worker("a GIF encoder thread panicked".into()))?;
-            self.accept(done)?;
-        }
-        self.join();
         Ok(())
-    }
-
-    fn join(&mut self) {
-        if let Some(Pipeline::Threads {
-            sender, workers, ..
-        }) = self.pipeline.as_mut()
-        {
-            *sender = None;
-            for worker in workers.drain(..) {
-                let _ = worker.join();
-            }
-        }
     }
 
     /// Takes an encoded frame; writes every frame now complete in order, holding the last
@@ -324,30 +292,6 @@ impl GifWriter {
             if self.pool.len() < 2 * self.options.jobs + 2 {
                 self.pool.push(buffer);
             }
-        }
-    }
-}
-
-impl Drop for GifWriter {
-    fn drop(&mut self) {
-        self.join();
-    }
-}
-
-fn worker(
-    receiver: &Mutex<Receiver<Job>>,
-    done: &Sender<Done>,
-    mut encoder: FrameEncoder,
-    fps: f64,
-) {
-    loop {
-        let job = {
-            let receiver = lock(receiver);
-            receiver.recv()
-        };
-        let Ok(job) = job else { return };
-        if done.send(run(&mut encoder, job, fps)).is_err() {
-            return;
         }
     }
 }

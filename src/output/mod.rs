@@ -16,6 +16,7 @@ mod gif_frame;
 mod gif_palette;
 mod inputs;
 mod png_sequence;
+mod pool;
 mod scene_render;
 mod sink;
 mod staging;

@@ -8,12 +8,12 @@
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::mpsc::{sync_channel, Receiver, SyncSender};
-use std::sync::{Arc, Mutex};
-use std::thread::JoinHandle;
+use std::sync::mpsc::{sync_channel, Receiver};
+use std::sync::Arc;
 
-use crate::util::{lock, TempOutput};
+use crate::util::TempOutput;
 use super::encode::{FrameEncoder, PngCompression};
+use super::pool::WorkerPool;
 use super::{Frame, OutputError};
 
 /// `frame_` + the number zero-padded to `digits`.
@@ -68,33 +68,13 @@ struct Job {
     frame: Frame,
 }
 
-/// State shared by the workers: the first error, and the cancel flag.
-struct Shared {
-    error: Mutex<Option<OutputError>>,
-    failed: AtomicBool,
-    cancel: Arc<AtomicBool>,
-}
-
-impl Shared {
-    fn stop(&self) -> bool {
-        self.failed.load(Ordering::Relaxed) || self.cancel.load(Ordering::Relaxed)
-    }
-
-    fn record(&self, error: OutputError) {
-        let mut slot = lock(&self.error);
-        slot.get_or_insert(error);
-        self.failed.store(true, Ordering::Relaxed);
-    }
-}
-
 /// A pool of PNG encoders writing numbered frames into a folder.
 pub struct PngSequenceWriter {
     dir: PathBuf,
     digits: usize,
-    sender: Option<SyncSender<Job>>,
+    pool: WorkerPool<Job, OutputError>,
     spare: Receiver<Frame>,
-    workers: Vec<JoinHandle<()>>,
-    shared: Arc<Shared>,
+    cancel: Arc<AtomicBool>,
     written: Vec<PathBuf>,
 }
 
@@ -112,29 +92,29 @@ impl PngSequenceWriter {
             return Err(OutputError::NotAFolder(dir.to_path_buf()));
         }
         let jobs = jobs.max(1);
-        let (sender, receiver) = sync_channel::<Job>(jobs);
         let (spare_sender, spare) = sync_channel::<Frame>(2 * jobs + 2);
-        let receiver = Arc::new(Mutex::new(receiver));
-        let shared = Arc::new(Shared {
-            error: Mutex::new(None),
-            failed: AtomicBool::new(false),
-            cancel,
+        let stop = cancel.clone();
+        let pool = WorkerPool::new(jobs, move || {
+            // Each worker compares a frame with the one it encoded before (a few frames
+            // earlier), reusing the bands of unchanged rows.
+            let mut encoder = FrameEncoder::new(compression);
+            let (stop, spare_sender) = (stop.clone(), spare_sender.clone());
+            move |job: Job| {
+                if stop.load(Ordering::Relaxed) {
+                    return Ok(()); // drain the queue without writing
+                }
+                if let Some(frame) = write_png_file(&job.path, job.frame, &mut encoder)? {
+                    let _ = spare_sender.try_send(frame);
+                }
+                Ok(())
+            }
         });
-        let workers = (0..jobs)
-            .map(|_| {
-                let receiver = receiver.clone();
-                let shared = shared.clone();
-                let spare_sender = spare_sender.clone();
-                std::thread::spawn(move || worker(&receiver, &shared, &spare_sender, compression))
-            })
-            .collect();
         Ok(PngSequenceWriter {
             dir: dir.to_path_buf(),
             digits: frame_digits(last_number),
-            sender: Some(sender),
+            pool,
             spare,
-            workers,
-            shared,
+            cancel,
             written: Vec::new(),
         })
     }
@@ -152,79 +132,35 @@ impl PngSequenceWriter {
     /// or the cancel flag is raised.
     pub fn submit(&mut self, number: u64, frame: Frame) -> Result<(), OutputError> {
         frame.as_ref()?;
-        if self.shared.cancel.load(Ordering::Relaxed) {
+        if self.cancel.load(Ordering::Relaxed) {
             return Err(OutputError::Cancelled);
         }
-        if self.shared.failed.load(Ordering::Relaxed) {
+        if self.pool.failed() {
             return Err(self.take_error());
         }
         let path = self.path_for(number);
         self.written.push(path.clone());
-        let sender = self.sender.as_ref().ok_or(OutputError::Cancelled)?;
-        sender
+        self.pool
             .send(Job { path, frame })
             .map_err(|_| OutputError::Cancelled)
     }
 
     /// Waits for every queued frame; gives the paths written, in submission order.
     pub fn finish(mut self) -> Result<Vec<PathBuf>, OutputError> {
-        self.join();
-        if self.shared.failed.load(Ordering::Relaxed) {
+        self.pool
+            .stop(|| OutputError::Worker("a PNG encoder thread panicked".into()));
+        if self.pool.failed() {
             return Err(self.take_error());
         }
-        if self.shared.cancel.load(Ordering::Relaxed) {
+        if self.cancel.load(Ordering::Relaxed) {
             return Err(OutputError::Cancelled);
         }
         Ok(std::mem::take(&mut self.written))
     }
 
-    fn join(&mut self) {
-        self.sender = None;
-        for worker in self.workers.drain(..) {
-            if worker.join().is_err() {
-                self.shared
-                    .record(OutputError::Worker("a PNG encoder thread panicked".into()));
-            }
-        }
-    }
-
     fn take_error(&self) -> OutputError {
-        let mut slot = lock(&self.shared.error);
-        slot.take()
+        self.pool
+            .take_error()
             .unwrap_or_else(|| OutputError::Worker("an earlier frame failed".into()))
-    }
-}
-
-impl Drop for PngSequenceWriter {
-    fn drop(&mut self) {
-        self.join();
-    }
-}
-
-fn worker(
-    receiver: &Mutex<Receiver<Job>>,
-    shared: &Shared,
-    spare: &SyncSender<Frame>,
-    compression: PngCompression,
-) {
-    // Each worker compares a frame with the one it encoded before (a few frames earlier),
-    // reusing the bands of unchanged rows.
-    let mut encoder = FrameEncoder::new(compression);
-    loop {
-        let job = {
-            let receiver = lock(receiver);
-            receiver.recv()
-        };
-        let Ok(job) = job else { return };
-        if shared.stop() {
-            continue; // drain the queue without writing
-        }
-        match write_png_file(&job.path, job.frame, &mut encoder) {
-            Ok(Some(frame)) => {
-                let _ = spare.try_send(frame);
-            }
-            Ok(None) => {}
-            Err(e) => shared.record(e),
-        }
     }
 }

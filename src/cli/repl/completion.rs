@@ -177,7 +177,7 @@ impl Completer for ReplCompleter {
             Completion::Command => Ok((0, pairs(command_candidates(before)))),
             Completion::Path => self.files.complete(line, pos, ctx),
             Completion::Word { start, in_string } => {
-                let words = self.words.lock().unwrap_or_else(|p| p.into_inner());
+                let words = crate::util::lock(&self.words);
                 let found = word_candidates(&before[start..], in_string, &words);
                 if found.is_empty() && in_string {
                     drop(words);

@@ -245,6 +245,6 @@ impl Session {
                 .collect(),
             functions,
         };
-        *self.words.lock().unwrap_or_else(|p| p.into_inner()) = words;
+        *crate::util::lock(&self.words) = words;
     }
 }

@@ -13,7 +13,7 @@ mod watch;
 
 use std::collections::VecDeque;
 use std::net::IpAddr;
-use std::sync::{Arc, Mutex, MutexGuard};
+use std::sync::{Arc, Mutex};
 
 pub use edit::{get_patch_call, Edit};
 pub use hub::{Hub, SceneText};
@@ -44,10 +44,7 @@ pub struct ViewArgs {
     pub watch: bool,
 }
 
-/// A mutex whose holder panicked still guards consistent data here (each change is whole).
-pub fn lock<T>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {
-    mutex.lock().unwrap_or_else(|p| p.into_inner())
-}
+pub(crate) use crate::util::lock;
 
 /// The terminal's side of the view while a prompt is up: shared by the session (which
 /// prints page lines and hands them over) and the prompt's loop.
