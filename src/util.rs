@@ -10,7 +10,7 @@ use std::sync::{Mutex, MutexGuard};
 
 /// Locks `mutex`, also when a panicking thread poisoned it: every user here keeps its data
 /// whole under the lock (a queue position, a finished entry, a hand-off state).
-pub(crate) fn lock<T>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {
+pub(crate) fn lock<T: ?Sized>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {
     mutex
         .lock()
         .unwrap_or_else(|poisoned| poisoned.into_inner())

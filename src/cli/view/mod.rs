@@ -20,7 +20,7 @@ pub use hub::{Hub, SceneText};
 pub use open::open_in_browser;
 pub use scene::Playhead;
 pub use scene::{locate, scene_message};
-pub use server::start;
+pub use server::{start, LiveSession};
 pub use watch::watch;
 
 /// `--view` and its options, part of `lapclone repl`'s arguments.

@@ -12,11 +12,10 @@ use std::time::Duration;
 use anyhow::Context as _;
 use tungstenite::{Message, WebSocket};
 
-use super::edit::{parse_request, Request};
+use super::edit::{parse_request, Edit, Request};
 use super::http::{accept, Accepted, Routes};
 use super::hub::{channel, Hub, Outgoing};
 use super::{error_message, lock};
-use crate::cli::repl::Session;
 
 /// Connections served at once; more are closed unanswered.
 const MAX_CONNECTIONS: usize = 32;
@@ -33,11 +32,30 @@ pub struct Server {
     pub addr: SocketAddr,
 }
 
+/// What a page may ask of the session it edits. The REPL's session implements it, so the view
+/// never names the REPL that starts it.
+pub trait LiveSession: Send {
+    /// Publishes again (a page changed what it wants to be sent).
+    fn view_publish(&mut self) -> Result<(), String>;
+    /// Moves the playhead (no history).
+    fn view_seek(&mut self, t: f64) -> Result<(), String>;
+    /// The `located` reply for canvas point (x, y).
+    fn view_locate(&self, x: f64, y: f64) -> String;
+    /// Previews (`commit` false) or commits a page edit made against revision `rev`.
+    fn view_edit(&mut self, rev: u64, commit: bool, edit: &Edit) -> Result<(), String>;
+    /// Escape: back to the committed scene's frame.
+    fn view_cancel(&mut self) -> Result<(), String>;
+    /// Ctrl+Z in a page.
+    fn view_undo(&mut self) -> Result<(), String>;
+    /// Ctrl+S in a page (confirmed there): `:save` to the loaded file.
+    fn view_save(&mut self, rev: u64) -> Result<(), String>;
+}
+
 /// Binds `bind` (127.0.0.1 by default) on `port` (0: a free one) and serves the session.
 pub fn start(
     bind: Option<IpAddr>,
     port: u16,
-    session: Arc<Mutex<Session>>,
+    session: Arc<Mutex<dyn LiveSession>>,
     hub: Arc<Hub>,
 ) -> anyhow::Result<Server> {
     let ip = bind.unwrap_or(IpAddr::V4(Ipv4Addr::LOCALHOST));
@@ -82,7 +100,12 @@ fn new_token() -> anyhow::Result<String> {
     Ok(bytes.iter().map(|b| format!("{b:02x}")).collect())
 }
 
-fn serve(listener: TcpListener, routes: Arc<Routes>, session: Arc<Mutex<Session>>, hub: Arc<Hub>) {
+fn serve(
+    listener: TcpListener,
+    routes: Arc<Routes>,
+    session: Arc<Mutex<dyn LiveSession>>,
+    hub: Arc<Hub>,
+) {
     let open = Arc::new(AtomicUsize::new(0));
     for stream in listener.incoming() {
         let Ok(stream) = stream else { continue };
@@ -107,7 +130,7 @@ fn serve(listener: TcpListener, routes: Arc<Routes>, session: Arc<Mutex<Session>
 }
 
 /// Serves one page until it closes: its messages in, frames and replies out.
-fn page_loop(mut socket: WebSocket<TcpStream>, session: &Mutex<Session>, hub: &Hub) {
+fn page_loop(mut socket: WebSocket<TcpStream>, session: &Mutex<dyn LiveSession>, hub: &Hub) {
     if socket.get_mut().set_read_timeout(Some(POLL)).is_err() {
         return;
     }
@@ -162,7 +185,13 @@ fn flush(socket: &mut WebSocket<TcpStream>, rx: &std::sync::mpsc::Receiver<Outgo
 }
 
 /// Applies one page message to the session; `reply` answers this page only.
-fn handle(text: &str, id: u64, session: &Mutex<Session>, hub: &Hub, reply: &dyn Fn(String)) {
+fn handle(
+    text: &str,
+    id: u64,
+    session: &Mutex<dyn LiveSession>,
+    hub: &Hub,
+    reply: &dyn Fn(String),
+) {
     let request = match parse_request(text) {
         Ok(request) => request,
         Err(message) => return reply(error_message(&message)),

@@ -12,7 +12,9 @@ use lapclone::script::ScriptOptions;
 use rhai::Scope;
 
 use super::{Session, Step};
-use crate::cli::view::{get_patch_call, locate, scene_message, Edit, Hub, Printer, SceneText};
+use crate::cli::view::{
+    get_patch_call, locate, scene_message, Edit, Hub, LiveSession, Printer, SceneText,
+};
 
 impl Session {
     /// Sends every frame and scene change to `hub`; lines printed for page edits go to
@@ -56,100 +58,6 @@ impl Session {
                 .then(|| scene_message(renderer, &head, true)),
         };
         hub.publish(renderer.frame(), renderer.drawn_region(), scene);
-    }
-
-    /// Publishes again (a page changed what it wants to be sent).
-    pub fn view_publish(&mut self) -> Result<(), String> {
-        self.publish();
-        Ok(())
-    }
-
-    /// Moves the playhead (no history).
-    pub fn view_seek(&mut self, t: f64) -> Result<(), String> {
-        self.time = t;
-        self.as_page(|s| s.show_frame())
-    }
-
-    /// The `located` reply for canvas point (x, y).
-    pub fn view_locate(&self, x: f64, y: f64) -> String {
-        let found = self
-            .renderer
-            .as_ref()
-            .and_then(|r| locate(r, self.time, DVec2::new(x, y)));
-        let (patch, source) = match found {
-            Some((name, p)) => (Some(name), Some([p.x, p.y])),
-            None => (None, None),
-        };
-        serde_json::json!({ "type": "located", "x": x, "y": y, "patch": patch, "source": source })
-            .to_string()
-    }
-
-    /// Previews (`commit` false) or commits a page edit made against revision `rev`.
-    pub fn view_edit(&mut self, rev: u64, commit: bool, edit: &Edit) -> Result<(), String> {
-        if rev != self.revision {
-            self.publish();
-            return Err(format!(
-                "stale edit: the scene changed since (revision {rev}, now {}); try again",
-                self.revision
-            ));
-        }
-        if self
-            .engine
-            .draft()
-            .patches
-            .iter()
-            .all(|p| p.name != edit.patch())
-        {
-            return Err(format!("no patch {:?}", edit.patch()));
-        }
-        if commit {
-            let line = edit.line(
-                self.time,
-                &self.receiver(edit.patch()),
-                &self.new_handle_name(),
-            );
-            return self.view_line(&line);
-        }
-        if !edit.previews() {
-            return Err("this edit has no preview".into());
-        }
-        let mut scene = self.current_scene().map_err(|e| e.to_string())?;
-        edit.apply_key(&mut scene, self.time)?;
-        let renderer = self.renderer.as_mut().ok_or("no scene to preview")?;
-        renderer.set_scene(scene).map_err(|e| e.to_string())?;
-        self.previewing = true;
-        self.as_page(|s| s.show_frame())
-    }
-
-    /// Escape: back to the committed scene's frame.
-    pub fn view_cancel(&mut self) -> Result<(), String> {
-        if !std::mem::take(&mut self.previewing) {
-            return Ok(());
-        }
-        let scene = self.current_scene().map_err(|e| e.to_string())?;
-        if let Some(renderer) = self.renderer.as_mut() {
-            renderer.set_scene(scene).map_err(|e| e.to_string())?;
-        }
-        self.as_page(|s| s.show_frame())
-    }
-
-    /// Ctrl+Z in a page.
-    pub fn view_undo(&mut self) -> Result<(), String> {
-        self.view_cancel()?;
-        self.view_line(":undo")
-    }
-
-    /// Ctrl+S in a page (confirmed there): `:save` to the loaded file.
-    pub fn view_save(&mut self, rev: u64) -> Result<(), String> {
-        if rev != self.revision {
-            return Err("stale save: the scene changed since; try again".into());
-        }
-        let file = self
-            .file
-            .clone()
-            .ok_or("no scene file loaded: use :save FILE in the terminal")?;
-        self.say_from_view(format!("(view) :save {}", file.display()));
-        self.as_page(|s| s.save(&file))
     }
 
     /// Runs `line` as an entry, printing it first as the page's.
@@ -270,5 +178,101 @@ impl Session {
             })
             .find(|n| !taken(n))
             .unwrap_or_else(|| "h".into())
+    }
+}
+
+impl LiveSession for Session {
+    /// Publishes again (a page changed what it wants to be sent).
+    fn view_publish(&mut self) -> Result<(), String> {
+        self.publish();
+        Ok(())
+    }
+
+    /// Moves the playhead (no history).
+    fn view_seek(&mut self, t: f64) -> Result<(), String> {
+        self.time = t;
+        self.as_page(|s| s.show_frame())
+    }
+
+    /// The `located` reply for canvas point (x, y).
+    fn view_locate(&self, x: f64, y: f64) -> String {
+        let found = self
+            .renderer
+            .as_ref()
+            .and_then(|r| locate(r, self.time, DVec2::new(x, y)));
+        let (patch, source) = match found {
+            Some((name, p)) => (Some(name), Some([p.x, p.y])),
+            None => (None, None),
+        };
+        serde_json::json!({ "type": "located", "x": x, "y": y, "patch": patch, "source": source })
+            .to_string()
+    }
+
+    /// Previews (`commit` false) or commits a page edit made against revision `rev`.
+    fn view_edit(&mut self, rev: u64, commit: bool, edit: &Edit) -> Result<(), String> {
+        if rev != self.revision {
+            self.publish();
+            return Err(format!(
+                "stale edit: the scene changed since (revision {rev}, now {}); try again",
+                self.revision
+            ));
+        }
+        if self
+            .engine
+            .draft()
+            .patches
+            .iter()
+            .all(|p| p.name != edit.patch())
+        {
+            return Err(format!("no patch {:?}", edit.patch()));
+        }
+        if commit {
+            let line = edit.line(
+                self.time,
+                &self.receiver(edit.patch()),
+                &self.new_handle_name(),
+            );
+            return self.view_line(&line);
+        }
+        if !edit.previews() {
+            return Err("this edit has no preview".into());
+        }
+        let mut scene = self.current_scene().map_err(|e| e.to_string())?;
+        edit.apply_key(&mut scene, self.time)?;
+        let renderer = self.renderer.as_mut().ok_or("no scene to preview")?;
+        renderer.set_scene(scene).map_err(|e| e.to_string())?;
+        self.previewing = true;
+        self.as_page(|s| s.show_frame())
+    }
+
+    /// Escape: back to the committed scene's frame.
+    fn view_cancel(&mut self) -> Result<(), String> {
+        if !std::mem::take(&mut self.previewing) {
+            return Ok(());
+        }
+        let scene = self.current_scene().map_err(|e| e.to_string())?;
+        if let Some(renderer) = self.renderer.as_mut() {
+            renderer.set_scene(scene).map_err(|e| e.to_string())?;
+        }
+        self.as_page(|s| s.show_frame())
+    }
+
+    /// Ctrl+Z in a page.
+    fn view_undo(&mut self) -> Result<(), String> {
+        self.view_cancel()?;
+        self.view_line(":undo")
+    }
+
+    /// Ctrl+S in a page (confirmed there): `:save` to the loaded file.
+    fn view_save(&mut self, rev: u64) -> Result<(), String> {
+        if rev != self.revision {
+            return Err("stale save: the scene changed since; try again".into());
+        }
+        let file = self
+            .file
+            .clone()
+            .ok_or("no scene file loaded: use :save FILE in the terminal")?;
+        self.say_from_view(format!("(view) :save {}", file.display()));
+        self.as_page(|s| s.save(&file))
     }
 }
