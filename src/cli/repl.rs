@@ -183,32 +183,7 @@ fn interactive_loop(
     words: completion::SharedWords,
     printer: &crate::cli::view::Printer,
 ) -> anyhow::Result<()> {
-    let config = Config::builder()
-        .auto_add_history(false)
-        .completion_type(rustyline::CompletionType::List)
-        .build();
-    let mut editor: Editor<ReplHelper, FileHistory> =
-        Editor::with_config(config).context("starting the line editor")?;
-    // Ctrl-C while an entry runs raises the cancel flag (the engine and render loops check
-    // it); at the prompt rustyline reads it as a key and we clear the line. Installed after
-    // the editor: rustyline takes SIGINT for itself when it is created.
-    let flag = cancel.clone();
-    if ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed)).is_err() {
-        eprintln!("warning: Ctrl-C cannot cancel evaluations in this session");
-    }
-    editor.set_helper(Some(ReplHelper::new(words)));
-    if args.view.view {
-        // Lines a page's edits print go above the prompt instead of through it.
-        match editor.create_external_printer() {
-            Ok(mut external) => {
-                printer.set_print(Box::new(move |text: String| {
-                    use rustyline::ExternalPrinter as _;
-                    let _ = external.print(format!("{text}\n"));
-                }));
-            }
-            Err(error) => eprintln!("warning: page edits print through the prompt: {error}"),
-        }
-    }
+    let mut editor = line_editor(args, cancel, words, printer)?;
     let history = args.history.clone().or_else(default_history_path);
     if let Some(path) = &history {
         let _ = editor.load_history(path);
@@ -238,6 +213,43 @@ fn interactive_loop(
         save_history(&mut editor, path);
     }
     Ok(())
+}
+
+/// The prompt's line editor: completion from `words`, Ctrl-C raising `cancel` while an entry
+/// runs, and (with a view) page lines printed above the prompt.
+fn line_editor(
+    args: &ReplArgs,
+    cancel: Arc<AtomicBool>,
+    words: completion::SharedWords,
+    printer: &crate::cli::view::Printer,
+) -> anyhow::Result<Editor<ReplHelper, FileHistory>> {
+    let config = Config::builder()
+        .auto_add_history(false)
+        .completion_type(rustyline::CompletionType::List)
+        .build();
+    let mut editor: Editor<ReplHelper, FileHistory> =
+        Editor::with_config(config).context("starting the line editor")?;
+    // Ctrl-C while an entry runs raises the cancel flag (the engine and render loops check
+    // it); at the prompt rustyline reads it as a key and we clear the line. Installed after
+    // the editor: rustyline takes SIGINT for itself when it is created.
+    let flag = cancel.clone();
+    if ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed)).is_err() {
+        eprintln!("warning: Ctrl-C cannot cancel evaluations in this session");
+    }
+    editor.set_helper(Some(ReplHelper::new(words)));
+    if args.view.view {
+        // Lines a page's edits print go above the prompt instead of through it.
+        match editor.create_external_printer() {
+            Ok(mut external) => {
+                printer.set_print(Box::new(move |text: String| {
+                    use rustyline::ExternalPrinter as _;
+                    let _ = external.print(format!("{text}\n"));
+                }));
+            }
+            Err(error) => eprintln!("warning: page edits print through the prompt: {error}"),
+        }
+    }
+    Ok(editor)
 }
 
 /// The lines pages ran since the last prompt join the history, as typed lines do.

@@ -85,8 +85,19 @@ pub fn draw_mesh_overlay(
     let mut pixmap = upscaled_background(background, width, height)
         .ok_or(OverlayError::BadSize { width, height })?;
     let to_px = |p: DVec2| ((p.x as f32) * scale, (p.y as f32) * scale);
-    let transform = Transform::identity();
+    draw_wire(&mut pixmap, positions, triangles, style, &to_px);
+    draw_loops(&mut pixmap, positions, loops, style, &to_px);
+    draw_handles(&mut pixmap, handles, style, &to_px);
+    Ok(to_rgba(&pixmap))
+}
 
+fn draw_wire(
+    pixmap: &mut Pixmap,
+    positions: &[DVec2],
+    triangles: &[[u32; 3]],
+    style: &OverlayStyle,
+    to_px: &dyn Fn(DVec2) -> (f32, f32),
+) {
     let mut wire = PathBuilder::new();
     for &(a, b) in &unique_edges(triangles) {
         let (pa, pb) = (to_px(positions[a as usize]), to_px(positions[b as usize]));
@@ -94,14 +105,18 @@ pub fn draw_mesh_overlay(
         wire.line_to(pb.0, pb.1);
     }
     if let Some(path) = wire.finish() {
-        pixmap.stroke_path(
-            &path,
-            &paint(style.wire),
-            &stroke(style.wire_width),
-            transform,
-            None,
-        );
+        let (paint, stroke) = (paint(style.wire), stroke(style.wire_width));
+        pixmap.stroke_path(&path, &paint, &stroke, Transform::identity(), None);
     }
+}
+
+fn draw_loops(
+    pixmap: &mut Pixmap,
+    positions: &[DVec2],
+    loops: &[BoundaryLoop],
+    style: &OverlayStyle,
+    to_px: &dyn Fn(DVec2) -> (f32, f32),
+) {
     for lp in loops {
         let mut builder = PathBuilder::new();
         for (i, &v) in lp.vertices.iter().enumerate() {
@@ -119,17 +134,10 @@ pub fn draw_mesh_overlay(
             style.hole
         };
         if let Some(path) = builder.finish() {
-            pixmap.stroke_path(
-                &path,
-                &paint(colour),
-                &stroke(style.loop_width),
-                transform,
-                None,
-            );
+            let (paint, stroke) = (paint(colour), stroke(style.loop_width));
+            pixmap.stroke_path(&path, &paint, &stroke, Transform::identity(), None);
         }
     }
-    draw_handles(&mut pixmap, handles, style, &to_px);
-    Ok(to_rgba(&pixmap))
 }
 
 fn draw_handles(

@@ -181,13 +181,19 @@ fn in_chromium_a_circle_drag_sets_the_radius_and_handle_keys_and_deletes_are_lin
             > 0,
         "the circle drag previewed nothing"
     );
-    // The handle's key marker at t = 1, dragged to three quarters of the 2 s timeline.
-    let marker = numbers(&mut browser,
-        "(() => { const m = [...document.querySelectorAll('.marker.handle')]
+    // The handle's key marker at t = 1, dragged to three quarters of the 2 s timeline; found
+    // once the page's log shows the radius line, as that line moves the timeline down.
+    wait_for(
+        &mut browser,
+        "document.getElementById('log').textContent.includes('radius(')",
+    );
+    const MARKER: &str = "(() => { const m = [...document.querySelectorAll('.marker.handle')]
             .find((m) => JSON.parse(m.dataset.key).t === 1);
           const r = m.getBoundingClientRect(), b = document.getElementById('markers').getBoundingClientRect();
-          return [r.left + r.width / 2, r.top + r.height / 2, b.left, b.width]; })()",
-    );
+          const x = r.left + r.width / 2, y = r.top + r.height / 2;
+          return [x, y, b.left, b.width, document.elementFromPoint(x, y) === m ? 1 : 0]; })()";
+    wait_for(&mut browser, &format!("{MARKER}[4] === 1"));
+    let marker = numbers(&mut browser, MARKER);
     let to = marker[2] + marker[3] * 0.75;
     drag(&mut browser, (marker[0], marker[1]), (to, marker[1]), 4);
     wait_for(

@@ -93,7 +93,8 @@ fn track_rows<T: Interpolate>(
     }
 }
 
-/// `at: follows track.csv (96 keys)`, plus `rotate` and `scale` when the track drives them.
+/// `at: follows track.csv (96 keys)`, plus `rotate` and `scale` when the track drives them,
+/// then the path the track gives: where it starts and ends, and when.
 fn follow_line(name: &str, f: &Follow) -> String {
     let mut also = String::new();
     if f.rotation.is_some() {
@@ -102,11 +103,21 @@ fn follow_line(name: &str, f: &Follow) -> String {
     if f.scale_keys.is_some() {
         also.push_str(", scale");
     }
-    format!(
+    let mut line = format!(
         "{name}{also}: follows {} ({} keys)",
         f.file_name(),
         f.key_count()
-    )
+    );
+    if let (Some(first), Some(last)) = (f.at.keys().first(), f.at.keys().last()) {
+        line.push_str(&format!(
+            ", path {} at {} s to {} at {} s",
+            point(&first.value),
+            first.time,
+            point(&last.value),
+            last.time
+        ));
+    }
+    line
 }
 
 fn point(p: &DVec2) -> String {
@@ -143,10 +154,12 @@ mod tests {
         });
         let table = key_table(&patch);
         assert!(
-            table.contains("  at: follows track.csv (3 keys)\n"),
+            table.contains(
+                "  at: follows track.csv (3 keys), path [1, 4] at 0 s to [3.5, 4] at 1 s\n"
+            ),
             "{table}"
         );
-        assert!(!table.contains("[3.5, 4]"), "{table}");
+        assert_eq!(table.lines().count(), 2, "{table}");
         // An edited key makes the keys the user's own again: listed one by one.
         patch
             .placement

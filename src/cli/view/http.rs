@@ -40,65 +40,51 @@ struct Refusal(&'static str, String);
 /// Reads one request from `stream` and answers it.
 pub fn accept(mut stream: TcpStream, routes: &Routes) -> std::io::Result<Accepted> {
     stream.set_read_timeout(Some(HEAD_TIMEOUT))?;
-    let (head, rest) = match read_head(&mut stream) {
-        Ok(read) => read,
-        Err(refusal) => {
-            respond(
-                &mut stream,
-                refusal.0,
-                "text/plain",
-                refusal.1.as_bytes(),
-                &[],
-            )?;
-            return Ok(Accepted::Answered);
-        }
-    };
-    match route(&head, routes) {
+    let routed = read_head(&mut stream).and_then(|(head, rest)| Ok((route(&head, routes)?, rest)));
+    match routed {
         Err(Refusal(status, body)) => {
-            respond(
-                &mut stream,
-                status,
-                "text/plain; charset=utf-8",
-                body.as_bytes(),
-                &[],
-            )?;
+            let kind = "text/plain; charset=utf-8";
+            respond(&mut stream, status, kind, body.as_bytes(), &[])?;
             Ok(Accepted::Answered)
         }
-        Ok(Route::Page) => {
-            let headers = [
-                ("Cache-Control", "no-store"),
-                ("Referrer-Policy", "no-referrer"),
-                ("X-Content-Type-Options", "nosniff"),
-                ("X-Frame-Options", "DENY"),
-                (
-                    "Content-Security-Policy",
-                    "default-src 'none'; script-src 'unsafe-inline'; style-src 'unsafe-inline'; \
-                     connect-src 'self'; img-src 'self' data:; frame-ancestors 'none'",
-                ),
-            ];
-            respond(
-                &mut stream,
-                "200 OK",
-                "text/html; charset=utf-8",
-                routes.page.as_bytes(),
-                &headers,
-            )?;
+        Ok((Route::Page, _)) => {
+            serve_page(&mut stream, routes)?;
             Ok(Accepted::Answered)
         }
-        Ok(Route::Socket { key }) => {
-            let reply = format!(
-                "HTTP/1.1 101 Switching Protocols\r\nConnection: Upgrade\r\nUpgrade: websocket\r\n\
-                 Sec-WebSocket-Accept: {}\r\n\r\n",
-                derive_accept_key(key.as_bytes())
-            );
-            stream.write_all(reply.as_bytes())?;
-            let config = WebSocketConfig::default()
-                .max_message_size(Some(MAX_MESSAGE_BYTES))
-                .max_frame_size(Some(MAX_MESSAGE_BYTES));
-            let socket = WebSocket::from_partially_read(stream, rest, Role::Server, Some(config));
-            Ok(Accepted::Socket(Box::new(socket)))
-        }
+        Ok((Route::Socket { key }, rest)) => upgrade(stream, &key, rest),
     }
+}
+
+/// The page, with headers that keep it out of frames and caches and its scripts its own.
+fn serve_page(stream: &mut TcpStream, routes: &Routes) -> std::io::Result<()> {
+    let headers = [
+        ("Cache-Control", "no-store"),
+        ("Referrer-Policy", "no-referrer"),
+        ("X-Content-Type-Options", "nosniff"),
+        ("X-Frame-Options", "DENY"),
+        (
+            "Content-Security-Policy",
+            "default-src 'none'; script-src 'unsafe-inline'; style-src 'unsafe-inline'; \
+             connect-src 'self'; img-src 'self' data:; frame-ancestors 'none'",
+        ),
+    ];
+    let kind = "text/html; charset=utf-8";
+    respond(stream, "200 OK", kind, routes.page.as_bytes(), &headers)
+}
+
+/// Answers the WebSocket handshake and gives the socket, its messages bounded.
+fn upgrade(mut stream: TcpStream, key: &str, rest: Vec<u8>) -> std::io::Result<Accepted> {
+    let reply = format!(
+        "HTTP/1.1 101 Switching Protocols\r\nConnection: Upgrade\r\nUpgrade: websocket\r\n\
+         Sec-WebSocket-Accept: {}\r\n\r\n",
+        derive_accept_key(key.as_bytes())
+    );
+    stream.write_all(reply.as_bytes())?;
+    let config = WebSocketConfig::default()
+        .max_message_size(Some(MAX_MESSAGE_BYTES))
+        .max_frame_size(Some(MAX_MESSAGE_BYTES));
+    let socket = WebSocket::from_partially_read(stream, rest, Role::Server, Some(config));
+    Ok(Accepted::Socket(Box::new(socket)))
 }
 
 /// The parts of a request head the routes look at.

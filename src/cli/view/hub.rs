@@ -168,23 +168,17 @@ impl Published {
             x1: self.width.min(i32::MAX as u32) as i32,
             y1: self.height.min(i32::MAX as u32) as i32,
         };
-        let union = match (self.region, region) {
-            (Some(old), Some(new)) if old.background == new.background => [old.rect, new.rect]
-                .into_iter()
-                .map(|r| r.intersect(&whole))
-                .filter(|r| !r.is_empty())
-                .reduce(|a, b| PixelRect {
-                    x0: a.x0.min(b.x0),
-                    y0: a.y0.min(b.y0),
-                    x1: a.x1.max(b.x1),
-                    y1: a.y1.max(b.y1),
-                }),
-            _ => Some(whole),
-        };
+        let union = compared_region(self.region, region, whole);
         self.region = region;
         let Some(union) = union else {
             return Some(None);
         };
+        Some(self.take_rows(frame, union))
+    }
+
+    /// Copies `frame`'s pixels inside `union` into the kept frame; gives the rectangle of
+    /// those that changed (`None`: none did).
+    fn take_rows(&mut self, frame: &Canvas, union: PixelRect) -> Option<[u32; 4]> {
         let (x0, w) = (union.x0 as usize, union.width());
         let row = self.width as usize * 4;
         // Rows are compared where they are: only the union's columns of each row.
@@ -218,7 +212,7 @@ impl Published {
             (left, right) = (left.min(first / 4), right.max(last / 4));
             old_row.copy_from_slice(new_row);
         }
-        Some((top <= bottom).then(|| {
+        (top <= bottom).then(|| {
             let x = (x0 + left) as u32;
             [
                 x,
@@ -226,7 +220,29 @@ impl Published {
                 (right - left + 1) as u32,
                 (bottom - top + 1) as u32,
             ]
-        }))
+        })
+    }
+}
+
+/// Where two frames can differ: the union of their drawn regions inside `whole` when both are
+/// known over the same background (`None`: both drew nothing), else the whole frame.
+fn compared_region(
+    old: Option<DrawnRegion>,
+    new: Option<DrawnRegion>,
+    whole: PixelRect,
+) -> Option<PixelRect> {
+    match (old, new) {
+        (Some(old), Some(new)) if old.background == new.background => [old.rect, new.rect]
+            .into_iter()
+            .map(|r| r.intersect(&whole))
+            .filter(|r| !r.is_empty())
+            .reduce(|a, b| PixelRect {
+                x0: a.x0.min(b.x0),
+                y0: a.y0.min(b.y0),
+                x1: a.x1.max(b.x1),
+                y1: a.y1.max(b.y1),
+            }),
+        _ => Some(whole),
     }
 }
 
