@@ -124,10 +124,58 @@ fn drags(args: &BrowserBenchArgs, chromium: &Path) -> anyhow::Result<Vec<Drag>> 
             steps,
             |scene, i| place(&scene["patches"][0], horse_target(i, steps)),
         )?;
-        Ok::<_, anyhow::Error>(vec![cat, horse])
+        let floor = floor_drag(chromium, &dir, steps)?;
+        Ok::<_, anyhow::Error>(vec![cat, horse, floor])
     })();
     let _ = std::fs::remove_dir_all(&dir);
     result
+}
+
+/// Chromium's own floor for the same measure: a page with the live view's two canvases,
+/// scaled the same way, that paints a cat-sized rectangle (216 kB, what a cat preview
+/// carries) on every pointer move itself, with no server, timed as the live view times.
+const FLOOR_PAGE: &str = r#"<!doctype html><html><head><style>
+body { margin: 0; background: #222; }
+#stage { position: relative; display: inline-block; margin: 10px; }
+#stage canvas { display: block; max-width: calc(100vw - 20px); max-height: calc(100vh - 170px); }
+#overlay { position: absolute; left: 0; top: 0; width: 100%; height: 100%; }
+</style></head><body><div id="stage"><canvas id="frame" width="1920" height="1080"></canvas>
+<canvas id="overlay" width="1920" height="1080"></canvas></div><script>
+const ctx = document.getElementById('frame').getContext('2d');
+const block = new ImageData(240, 225);
+const timings = (window.lapcloneTimings = []), paintedAt = (window.lapclonePaintedAt = []);
+let n = 0, down = false;
+const overlay = document.getElementById('overlay');
+overlay.addEventListener('pointerdown', () => { down = true; });
+overlay.addEventListener('pointerup', () => { down = false; window.lapcloneReleased = true; });
+overlay.addEventListener('pointermove', (e) => {
+  if (!down) return;
+  block.data.fill(n++ & 255);
+  ctx.putImageData(block, 600 + (n % 400), 400);
+  const from = e.timeStamp;
+  requestAnimationFrame(() => setTimeout(() => {
+    const now = performance.now();
+    timings.push(now - from); paintedAt.push(now);
+  }, 0));
+});
+window.lapcloneReady = true;
+</script></body></html>"#;
+
+fn floor_drag(chromium: &Path, dir: &Path, steps: usize) -> anyhow::Result<Drag> {
+    let page = dir.join("floor.html");
+    std::fs::write(&page, FLOOR_PAGE)?;
+    let profile = dir.join("profile-floor");
+    let url = format!("file://{}", page.display());
+    let mut browser = Browser::launch(chromium, &profile, WINDOW, &url)?;
+    browser.wait_for("window.lapcloneReady === true", PAGE_TIMEOUT)?;
+    let dispatched = pointer_drag(&mut browser, steps, |i| Ok(cat_at(i, steps)))?;
+    browser.wait_for("window.lapcloneReleased === true", PAGE_TIMEOUT)?;
+    browser.eval(
+        "new Promise(r => requestAnimationFrame(() => requestAnimationFrame(() => setTimeout(r, 0))))",
+    )?;
+    let timings = numbers(&browser.eval("window.lapcloneTimings")?);
+    let painted_at = numbers(&browser.eval("window.lapclonePaintedAt")?);
+    summary("floor", steps, dispatched, timings, &painted_at)
 }
 
 /// Canvas point of a patch's source point `q`, from the page's scene message (the page's

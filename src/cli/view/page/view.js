@@ -262,14 +262,24 @@
     pendingEdit = null;
   }
 
+  // A drag reads pointerrawupdate where the browser has it: it comes as the pointer moves,
+  // not held back to the next display frame as pointermove is, so the answer can be painted
+  // in that frame instead of the one after.
+  const rawUpdates = "onpointerrawupdate" in window;
   overlay.addEventListener("pointermove", (e) => {
-    const q = canvasPoint(e);
-    if (!gesture) {
-      const hit = pick(q);
-      overlay.style.cursor = !hit || hit.kind === "patch" ? "" : hit.kind === "radius" ? "ew-resize" : "move";
-      locate(q);
+    if (gesture) {
+      if (!rawUpdates) dragMove(e);
       return;
     }
+    const q = canvasPoint(e);
+    const hit = pick(q);
+    overlay.style.cursor = !hit || hit.kind === "patch" ? "" : hit.kind === "radius" ? "ew-resize" : "move";
+    locate(q);
+  });
+  if (rawUpdates) overlay.addEventListener("pointerrawupdate", (e) => { if (gesture) dragMove(e); });
+
+  function dragMove(e) {
+    const q = canvasPoint(e);
     if (dist(q, gesture.start) * (1 / screenScale()) > 2) gesture.moved = true;
     if (gesture.moved && gesture.kind !== "add") {
       gesture.last = editFor(gesture, q);
@@ -278,7 +288,7 @@
         queueEdit(gesture.last);
       }
     }
-  });
+  }
 
   overlay.addEventListener("pointerdown", (e) => {
     if (!scene || e.button !== 0) return;
