@@ -79,5 +79,6 @@ pub fn assemble_laplacian(n: usize, triangles: &[[u32; 3]], shares: &[[f64; 3]])
     // invariant: the rig validated indices < n, and shares are finite (degenerate triangles
     // get 0, others a finite cotangent).
     let matrix = SymmetricCsc::from_triplets(n, &triplets);
-    matrix.expect("finite shares") // invariant: indices come from the mesh, shares are finite
+    // invariant: indices come from the mesh, shares are finite
+    matrix.expect("finite shares")
 }

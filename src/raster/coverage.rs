@@ -235,7 +235,9 @@ fn ensure_mask(slot: &mut Option<Mask>, width: u32, height: u32) -> &mut Mask {
     if !fits {
         let (old_w, old_h) = slot.as_ref().map_or((0, 0), |m| (m.width(), m.height()));
         let mask = Mask::new(width.max(old_w), height.max(old_h));
-        *slot = Some(mask.expect("non-empty")); // invariant: both sizes include the border
+        // invariant: both sizes include the border
+        *slot = Some(mask.expect("non-empty"));
     }
-    slot.as_mut().expect("mask present") // invariant: set just above when missing.
+    // invariant: set just above when missing.
+    slot.as_mut().expect("mask present")
 }

@@ -57,7 +57,8 @@ impl Renderer {
                 Planned::Keep { index, rig } => {
                     update.reused += 1;
                     update.rigs_built += usize::from(rig.is_some());
-                    let mut layer = old[index].take().expect("layer kept once"); // invariant: plan_layers hands out each old index at most once.
+                    // invariant: plan_layers hands out each old index at most once.
+                    let mut layer = old[index].take().expect("layer kept once");
                     layer.update(patch, rig.map(|rig| *rig));
                     layer
                 }
