@@ -255,11 +255,7 @@ fn load_rect_typed<T: Element + Copy + CanvasTexel>(
     })?;
     let channels = layout.channel_count();
     let (red, blue) = if bgr && channels >= 3 { (2, 0) } else { (0, 2) };
-    let texel = |px: &[T]| match channels {
-        1 => [px[0], px[0], px[0], opaque],
-        3 => [px[red], px[1], px[blue], opaque],
-        _ => [px[red], px[1], px[blue], px[3]],
-    };
+    let texel = |px: &[T]| gather(px, channels, (red, blue), opaque);
     let (x0, x1) = (rect.x0 as usize, rect.x1 as usize);
     for y in rect.y0 as usize..rect.y1 as usize {
         let row = view.index_axis(Axis(0), y);
@@ -267,9 +263,11 @@ fn load_rect_typed<T: Element + Copy + CanvasTexel>(
         match row.as_slice() {
             // A contiguous row (the usual case): its samples in place.
             Some(samples) => {
-                let samples = samples[x0 * channels..x1 * channels].chunks_exact(channels);
-                for (t, px) in out.iter_mut().zip(samples) {
-                    *t = texel(px);
+                let samples = &samples[x0 * channels..x1 * channels];
+                match channels {
+                    1 => load_row::<T, 1>(out, samples, (red, blue), opaque),
+                    3 => load_row::<T, 3>(out, samples, (red, blue), opaque),
+                    _ => load_row::<T, 4>(out, samples, (red, blue), opaque),
                 }
             }
             None => {
@@ -405,11 +403,11 @@ fn write_rect_typed<T: Element + Copy>(
         match out.as_slice_mut() {
             // A contiguous row (the usual case): written in place.
             Some(dst) => {
-                let dst = dst[x0 * c..(x0 + columns) * c].chunks_exact_mut(c);
-                for (d, pixel) in dst.zip(row.chunks_exact(c)) {
-                    for (k, &value) in pixel.iter().enumerate() {
-                        d[channel(k)] = value;
-                    }
+                let dst = &mut dst[x0 * c..(x0 + columns) * c];
+                match c {
+                    1 => write_row::<T, 1>(dst, row, channel),
+                    3 => write_row::<T, 3>(dst, row, channel),
+                    _ => write_row::<T, 4>(dst, row, channel),
                 }
             }
             None => {
@@ -423,6 +421,42 @@ fn write_rect_typed<T: Element + Copy>(
         }
     }
     Ok(())
+}
+
+/// One contiguous row of `C`-channel samples into canvas texels. The channel count is a
+/// constant so each pixel's gather compiles to fixed moves instead of a loop.
+#[inline]
+fn load_row<T: Copy, const C: usize>(
+    out: &mut [[T; 4]],
+    samples: &[T],
+    red_blue: (usize, usize),
+    opaque: T,
+) {
+    for (t, px) in out.iter_mut().zip(samples.chunks_exact(C)) {
+        *t = gather(px, C, red_blue, opaque);
+    }
+}
+
+/// The canvas texel of one pixel's `channels` samples (grey spread to RGB, no alpha
+/// opaque), reading red and blue from the indices `red_blue`.
+#[inline(always)]
+fn gather<T: Copy>(px: &[T], channels: usize, (red, blue): (usize, usize), opaque: T) -> [T; 4] {
+    match channels {
+        1 => [px[0], px[0], px[0], opaque],
+        3 => [px[red], px[1], px[blue], opaque],
+        _ => [px[red], px[1], px[blue], px[3]],
+    }
+}
+
+/// One contiguous row of `C`-channel samples into an array row, channel `k` to
+/// `channel(k)`; the channel count is a constant for the same reason as in [`load_row`].
+#[inline]
+fn write_row<T: Copy, const C: usize>(dst: &mut [T], row: &[T], channel: impl Fn(usize) -> usize) {
+    for (d, pixel) in dst.chunks_exact_mut(C).zip(row.chunks_exact(C)) {
+        for (k, &value) in pixel.iter().enumerate() {
+            d[channel(k)] = value;
+        }
+    }
 }
 
 /// Checks that `out` is a writable array of exactly `layout`.
