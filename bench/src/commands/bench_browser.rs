@@ -138,7 +138,8 @@ fn drags(args: &BrowserBenchArgs, chromium: &Path) -> anyhow::Result<Vec<Drag>> 
 
 /// Chromium's own floor for the same measure: a page with the live view's two canvases,
 /// scaled the same way, that paints a cat-sized rectangle (216 kB, what a cat preview
-/// carries) on every pointer move itself, with no server, timed as the live view times.
+/// carries) on every pointer move itself (the same pointer event the live view reads), with
+/// no server, timed as the live view times.
 const FLOOR_PAGE: &str = r#"<!doctype html><html><head><style>
 body { margin: 0; background: #222; }
 #stage { position: relative; display: inline-block; margin: 10px; }
@@ -153,7 +154,9 @@ let n = 0, down = false;
 const overlay = document.getElementById('overlay');
 overlay.addEventListener('pointerdown', () => { down = true; });
 overlay.addEventListener('pointerup', () => { down = false; window.lapcloneReleased = true; });
-overlay.addEventListener('pointermove', (e) => {
+// The live view's own choice: pointerrawupdate where the browser has it.
+const move = 'onpointerrawupdate' in window ? 'pointerrawupdate' : 'pointermove';
+overlay.addEventListener(move, (e) => {
   if (!down) return;
   block.data.fill(n++ & 255);
   ctx.putImageData(block, 600 + (n % 400), 400);
