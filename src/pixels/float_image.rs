@@ -306,6 +306,17 @@ impl FloatImage {
         view.map(|view| (&view.texels[..], view.opaque))
     }
 
+    /// The 8-bit texels when the image is stored as them (as decoded from an 8-bit file),
+    /// without building anything: for readers of a few pixels of many frames, where
+    /// [`eight_bit_texels`](Self::eight_bit_texels)' scan of an `f32` image would cost more
+    /// than the reading.
+    pub(crate) fn stored_texels(&self) -> Option<&[[u8; 4]]> {
+        match &self.store {
+            Store::Levels { view, .. } => Some(&view.texels[..]),
+            Store::Float { .. } => None,
+        }
+    }
+
     /// Pixel (i, j); `None` outside the image.
     pub fn pixel(&self, i: u32, j: u32) -> Option<[f32; 4]> {
         (i < self.width && j < self.height)

@@ -59,6 +59,40 @@ impl Level {
     }
 }
 
+/// The luma of the `width × height` pixels from `origin`, pixels beyond the frame repeating
+/// its edge. An 8-bit frame is read through per-level tables (the same `f32` products as
+/// from its `f32` values, so the same bits) without making its `f32` buffer.
+fn grey_window(frame: &FloatImage, origin: [i64; 2], width: usize, height: usize) -> Vec<f32> {
+    let (fw, fh) = (i64::from(frame.width()), i64::from(frame.height()));
+    // Column of each window x, clamped into the frame: one lookup per pixel in the rows.
+    let columns: Vec<usize> = (0..width as i64)
+        .map(|x| (origin[0] + x).clamp(0, fw - 1) as usize)
+        .collect();
+    let mut values = Vec::with_capacity(width * height);
+    let row_of = |y: i64| (origin[1] + y).clamp(0, fh - 1) as usize * fw as usize;
+    if let Some(texels) = frame.stored_texels() {
+        let tables: [[f32; 256]; 3] =
+            std::array::from_fn(|c| std::array::from_fn(|k| LUMA[c] * (k as f32 / 255.0)));
+        for y in 0..height as i64 {
+            let row = &texels[row_of(y)..][..fw as usize];
+            values.extend(columns.iter().map(|&i| {
+                let [r, g, b, _] = row[i];
+                tables[0][usize::from(r)] + tables[1][usize::from(g)] + tables[2][usize::from(b)]
+            }));
+        }
+    } else {
+        let pixels = frame.pixels();
+        for y in 0..height as i64 {
+            let row = &pixels[row_of(y)..][..fw as usize];
+            values.extend(columns.iter().map(|&i| {
+                let [r, g, b, _] = row[i];
+                LUMA[0] * r + LUMA[1] * g + LUMA[2] * b
+            }));
+        }
+    }
+    values
+}
+
 /// Levels 0 (full size) to `levels − 1`.
 pub(super) struct Pyramid {
     pub(super) levels: Vec<Level>,
@@ -76,17 +110,7 @@ impl Pyramid {
         let x1 = align_down(centre.x + radius) + step;
         let y1 = align_down(centre.y + radius) + step;
         let (width, height) = ((x1 - x0) as usize, (y1 - y0) as usize);
-        let (fw, fh) = (i64::from(frame.width()), i64::from(frame.height()));
-        let mut values = Vec::with_capacity(width * height);
-        for y in y0..y1 {
-            let j = y.clamp(0, fh - 1) as u32;
-            for x in x0..x1 {
-                let i = x.clamp(0, fw - 1) as u32;
-                // invariant: i and j were clamped into the frame just above.
-                let [r, g, b, _] = frame.pixel(i, j).expect("clamped into the frame");
-                values.push(LUMA[0] * r + LUMA[1] * g + LUMA[2] * b);
-            }
-        }
+        let values = grey_window(frame, [x0, y0], width, height);
         let mut out = vec![Level {
             origin: [x0, y0],
             width,
