@@ -10,35 +10,8 @@ use lapclone::FrameRange;
 
 use crate::cli::UsageError;
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum OutputFormat {
-    /// A folder of frame_NNNN.png.
-    Png,
-    Gif,
-    Apng,
-    /// H.264 (through ffmpeg).
-    Mp4,
-    /// VP9 (through ffmpeg).
-    Webm,
-    /// H.264, or ProRes 4444 with alpha for a transparent canvas (through ffmpeg).
-    Mov,
-    /// YUV4MPEG2, 4:4:4 (written without ffmpeg; `-o -` for standard output).
-    Y4m,
-}
-
-impl OutputFormat {
-    pub(crate) fn kind(self) -> OutputKind {
-        match self {
-            OutputFormat::Png => OutputKind::PngFolder,
-            OutputFormat::Gif => OutputKind::Gif,
-            OutputFormat::Apng => OutputKind::Apng,
-            OutputFormat::Mp4 => OutputKind::Mp4,
-            OutputFormat::Webm => OutputKind::Webm,
-            OutputFormat::Mov => OutputKind::Mov,
-            OutputFormat::Y4m => OutputKind::Y4m,
-        }
-    }
-}
+/// `--format`'s values are the library's output kinds.
+pub use crate::output::OutputKind as OutputFormat;
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
 pub enum CompressionArg {
@@ -103,7 +76,7 @@ pub struct RenderArgs {
 impl RenderArgs {
     /// The output format: `--format`, else the one `-o`'s extension names.
     pub(crate) fn output_kind(&self) -> anyhow::Result<OutputKind> {
-        let kind = match OutputKind::resolve(&self.output, self.format.map(OutputFormat::kind)) {
+        let kind = match OutputKind::resolve(&self.output, self.format) {
             Ok(kind) => kind,
             Err(OutputError::UnknownExtension { extension, .. }) => {
                 return Err(UsageError(format!(

@@ -10,10 +10,13 @@ use std::path::Path;
 
 use super::OutputError;
 
-/// What `lapclone render` writes.
+/// What `lapclone render` writes (also its `--format` values: png, gif, apng, mp4, webm, mov,
+/// y4m).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum OutputKind {
     /// A folder of `frame_NNNN.png`.
+    #[cfg_attr(feature = "cli", value(name = "png"))]
     PngFolder,
     /// An animated GIF.
     Gif,

@@ -201,7 +201,7 @@ impl Session {
             Command::Keys(name) => print!("{}", self.keys(&name)?),
             Command::Undo => self.undo()?,
             Command::Render { range, output } => {
-                self.render_to(OutputFormat::Png, &output, range)?
+                self.render_to(OutputFormat::PngFolder, &output, range)?
             }
             Command::Gif(path) => self.render_to(OutputFormat::Gif, &path, None)?,
             Command::Stats => print!("{}", self.stats()?),

@@ -25,10 +25,10 @@ impl Session {
         let scene = self.current_scene()?;
         if let Some(loaded) = &self.installed {
             let imports = self.engine.module_files().files();
-            refuse_render_input(format.kind(), output, loaded, &imports)?;
+            refuse_render_input(format, output, loaded, &imports)?;
         }
         let started = Instant::now();
-        let plan = SinkPlan::new(format.kind(), output, Default::default())?;
+        let plan = SinkPlan::new(format, output, Default::default())?;
         let mut renderer = Renderer::new(scene).map_err(|e| anyhow::anyhow!("{e}"))?;
         let total = renderer.frame_count();
         let range = range.unwrap_or(FrameRange::all(total));
