@@ -17,6 +17,7 @@ mod gif_palette;
 mod inputs;
 mod png_sequence;
 mod pool;
+mod request;
 mod scene_render;
 mod sink;
 mod staging;
@@ -36,7 +37,8 @@ pub use png_sequence::{
 };
 pub use inputs::{refuse_input, refuse_render_input, refuse_scene_input};
 pub use scene_render::{render_frames, render_scene, RenderOptions, RenderProgress, Rendered};
-pub use sink::{check_output_folder, FrameRange, FrameSink, SinkPlan, SinkSettings};
+pub use request::{check_output_folder, FrameRange, SinkSettings};
+pub use sink::{FrameSink, SinkPlan};
 pub use y4m::{fps_fraction, Y4mWriter};
 pub use yuv::{frame_to_yuv420, rgb_to_ycbcr, yuv420_len, yuv420_size};
 

@@ -9,7 +9,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
 use super::inputs::refuse_render_input;
-use super::sink::{FrameRange, FrameSink, SinkPlan, SinkSettings};
+use super::request::{FrameRange, SinkSettings};
+use super::sink::{FrameSink, SinkPlan};
 use super::{OutputError, OutputKind};
 use crate::render::Renderer;
 use crate::script::LoadedScene;

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
-use super::sink::{check_output_folder, FrameRange, SinkSettings};
+use super::request::{check_output_folder, FrameRange, SinkSettings};
 use super::{foreign_frames, frame_digits, frame_file_name, OutputError, PngSequenceWriter};
 use crate::render::Renderer;
 
