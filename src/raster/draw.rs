@@ -65,7 +65,9 @@ pub fn draw_patch(
     if use_depth {
         scratch.depths.resize(work.area(), 0.0);
     }
-    own_pixels(scratch, work, use_depth, options.threads);
+    let all = 0..scratch.setups.len() as u32;
+    let (ids, depths) = (&mut scratch.ids, &mut scratch.depths);
+    rasterise_triangles(&scratch.setups, all, work, use_depth, ids, depths);
     let frame = Frame {
         patch,
         work,
@@ -86,43 +88,6 @@ pub fn draw_patch(
 
 /// Fewer rows than this per thread are shaded on the caller's thread alone.
 const MIN_ROWS_PER_THREAD: usize = 64;
-
-/// Fills the scratch's triangle ids (and depths) over `work`, in row bands on up to
-/// `threads` threads. Each band draws every triangle in index order clipped to its rows, so
-/// a pixel sees the same triangles in the same order as in one pass: the ids and depths are
-/// the same for any count.
-fn own_pixels(scratch: &mut RasterScratch, work: PixelRect, use_depth: bool, threads: usize) {
-    let setups = &scratch.setups[..];
-    let all = 0..setups.len() as u32;
-    let ids = &mut scratch.ids[..];
-    let depths: &mut [f32] = if use_depth { &mut scratch.depths } else { &mut [] };
-    let parts = threads.min(work.height() / MIN_ROWS_PER_THREAD).max(1);
-    if parts == 1 {
-        return rasterise_triangles(setups, all, work, use_depth, ids, depths);
-    }
-    let rows = work.height().div_ceil(parts);
-    let band_len = rows * work.width();
-    let mut depth_bands = depths.chunks_mut(band_len.max(1));
-    let bands = ids.chunks_mut(band_len).enumerate().map(|(k, ids)| {
-        let y0 = work.y0 + (k * rows) as i32;
-        let rect = PixelRect {
-            y0,
-            y1: (y0 + rows as i32).min(work.y1),
-            ..work
-        };
-        (rect, ids, depth_bands.next().unwrap_or_default())
-    });
-    std::thread::scope(|scope| {
-        let mut bands = bands.collect::<Vec<_>>().into_iter();
-        // invariant: `parts` ≥ 2, so there is a first band, drawn on this thread.
-        let (mine, my_ids, my_depths) = bands.next().expect("a band");
-        for (rect, ids, depths) in bands {
-            let all = all.clone();
-            scope.spawn(move || rasterise_triangles(setups, all, rect, use_depth, ids, depths));
-        }
-        rasterise_triangles(setups, all, mine, use_depth, my_ids, my_depths);
-    });
-}
 
 /// One draw's rectangles and canvas width.
 struct Frame<'a> {
