@@ -4,8 +4,13 @@
 "use strict";
 (() => {
   const $ = (id) => document.getElementById(id);
-  const frame = $("frame"), overlay = $("overlay");
-  const fctx = frame.getContext("2d"), octx = overlay.getContext("2d");
+  // `overlay` covers the frame and takes the pointer; what it shows is drawn into `marks`, a
+  // canvas only as large as the box the handles, pins and outlines need (see drawOverlay).
+  const frame = $("frame"), overlay = $("overlay"), marks = $("marks");
+  const fctx = frame.getContext("2d"), mctx = marks.getContext("2d");
+  // While drawOverlay measures, drawing goes nowhere; then it goes to `marks`.
+  const nowhere = new Proxy({}, { get: () => () => {}, set: () => true });
+  let octx = nowhere;
   const token = new URLSearchParams(location.search).get("token") || "";
   const TRACK_COLOURS = { at: "#f0c674", scale: "#81a2be", rotate: "#b294bb", depth: "#8abeb7", opacity: "#de935f" };
   let ws = null, scene = null, located = null, gesture = null, selected = null;
@@ -52,7 +57,6 @@
     if (frame.width !== width || frame.height !== height) {
       frame.width = overlay.width = width;
       frame.height = overlay.height = height;
-      overlayDrawn = null;
     }
     if (w > 0 && hh > 0) {
       const pixels = new Uint8ClampedArray(buffer, 28, w * hh * 4);
@@ -120,24 +124,40 @@
   const r2 = (v) => Math.round(v * 100) / 100;
   const dist = (a, b) => Math.hypot(a[0] - b[0], a[1] - b[1]);
 
-  // The overlay is redrawn per scene message; only the box it drew into last time is cleared,
-  // so the browser repaints that box, not the whole canvas.
-  let overlayDrawn = null, overlayPad = 0;
+  // The overlay is redrawn per scene message. Its drawing runs twice: once to find the box
+  // it covers (`mark`), then into `marks` sized to that box and placed over it, so the
+  // browser composites a small canvas per preview instead of a frame-sized one.
+  let overlayBox = null, overlayPad = 0;
   function mark(x, y, r) {
     const d = r + overlayPad;
-    if (!overlayDrawn) overlayDrawn = [x - d, y - d, x + d, y + d];
+    if (!overlayBox) overlayBox = [x - d, y - d, x + d, y + d];
     else {
-      const b = overlayDrawn;
+      const b = overlayBox;
       b[0] = Math.min(b[0], x - d); b[1] = Math.min(b[1], y - d);
       b[2] = Math.max(b[2], x + d); b[3] = Math.max(b[3], y + d);
     }
   }
   function drawOverlay() {
-    if (overlayDrawn) {
-      const [x0, y0, x1, y1] = overlayDrawn.map((v, i) => (i < 2 ? Math.floor(v) : Math.ceil(v)));
-      octx.clearRect(x0, y0, x1 - x0, y1 - y0);
-      overlayDrawn = null;
-    }
+    overlayBox = null;
+    octx = nowhere;
+    drawOverlayInto();
+    const b = overlayBox;
+    const [x0, y0] = b ? [Math.floor(Math.max(b[0], 0)), Math.floor(Math.max(b[1], 0))] : [0, 0];
+    const [x1, y1] = b ? [Math.ceil(Math.min(b[2], overlay.width)), Math.ceil(Math.min(b[3], overlay.height))] : [0, 0];
+    if (x1 <= x0 || y1 <= y0) { marks.style.display = "none"; return; }
+    marks.width = x1 - x0; // also clears it
+    marks.height = y1 - y0;
+    const place = (v, whole) => `${(100 * v) / whole}%`;
+    Object.assign(marks.style, {
+      display: "block",
+      left: place(x0, overlay.width), top: place(y0, overlay.height),
+      width: place(x1 - x0, overlay.width), height: place(y1 - y0, overlay.height),
+    });
+    octx = mctx;
+    octx.setTransform(1, 0, 0, 1, -x0, -y0);
+    drawOverlayInto();
+  }
+  function drawOverlayInto() {
     if (!scene) return;
     const px = screenScale();
     overlayPad = 3 * px + 2;
