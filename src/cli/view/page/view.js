@@ -147,11 +147,11 @@
     if (x1 <= x0 || y1 <= y0) { marks.style.display = "none"; return; }
     marks.width = x1 - x0; // also clears it
     marks.height = y1 - y0;
-    const place = (v, whole) => `${(100 * v) / whole}%`;
+    const percent = (v, whole) => `${(100 * v) / whole}%`;
     Object.assign(marks.style, {
       display: "block",
-      left: place(x0, overlay.width), top: place(y0, overlay.height),
-      width: place(x1 - x0, overlay.width), height: place(y1 - y0, overlay.height),
+      left: percent(x0, overlay.width), top: percent(y0, overlay.height),
+      width: percent(x1 - x0, overlay.width), height: percent(y1 - y0, overlay.height),
     });
     octx = mctx;
     octx.setTransform(1, 0, 0, 1, -x0, -y0);
