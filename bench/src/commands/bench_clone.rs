@@ -39,6 +39,9 @@ pub struct CloneBenchArgs {
     /// Approximate vertex count of the deformation case's patch.
     #[arg(long, default_value_t = 2_500)]
     pub vertices: usize,
+    /// Threads the deformation case's raster runs on (its pixels are the same for any count).
+    #[arg(long, default_value_t = 1)]
+    pub raster_threads: usize,
     /// Print JSON instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -100,9 +103,9 @@ struct Report {
 }
 
 pub fn run(args: CloneBenchArgs) -> anyhow::Result<()> {
-    if args.repeats == 0 || args.frames == 0 || args.vertices < 10 {
+    if args.repeats == 0 || args.frames == 0 || args.vertices < 10 || args.raster_threads == 0 {
         return Err(super::UsageError(
-            "--repeats and --frames must be positive, --vertices ≥ 10".into(),
+            "--repeats, --frames and --raster-threads must be positive, --vertices ≥ 10".into(),
         )
         .into());
     }
@@ -127,7 +130,12 @@ pub fn run(args: CloneBenchArgs) -> anyhow::Result<()> {
             args.repeats,
         )?);
     }
-    let deform = bench_deform(args.vertices, args.frames, &clone_options)?;
+    let deform = bench_deform(
+        args.vertices,
+        args.frames,
+        args.raster_threads,
+        &clone_options,
+    )?;
     let report = Report { spiral, deform };
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
@@ -310,6 +318,7 @@ fn disc_patch(vertices: usize) -> anyhow::Result<lapclone::mesh::Mesh> {
 fn bench_deform(
     vertices: usize,
     frames: usize,
+    raster_threads: usize,
     clone_options: &CloneOptions,
 ) -> anyhow::Result<DeformRow> {
     let mesh = disc_patch(vertices)?;
@@ -319,6 +328,7 @@ fn bench_deform(
     let background = Canvas::from_image(&synthetic(1920, 1080, 2.1)?);
     let mut canvas = background.clone();
     let mut cloner = PatchCloner::new(source, mesh, clone_options)?;
+    cloner.set_raster_threads(raster_threads);
     let mut rig = DeformRig::new(cloner.mesh(), LaplacianKind::Combinatorial)?;
     let mut deformed = Deformed::default();
     let centre = (min + max) * 0.5;

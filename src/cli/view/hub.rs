@@ -6,10 +6,11 @@
 //! differ, so only that part is converted and compared.
 
 use std::sync::mpsc::{Receiver, Sender};
-use std::sync::{Arc, Mutex};
+use std::sync::Mutex;
 
 use lapclone::pixels::{Canvas, CanvasPixels, PixelFormat, PixelRect};
 use lapclone::render::DrawnRegion;
+use tungstenite::{Bytes, Utf8Bytes};
 
 use super::lock;
 
@@ -17,11 +18,11 @@ use super::lock;
 /// width, canvas height, then the rectangle's x, y, width and height.
 pub const FRAME_HEADER: usize = 28;
 
-/// One message to a page.
+/// One message to a page; cloning one for another page shares its bytes.
 #[derive(Clone, Debug)]
 pub enum Outgoing {
-    Binary(Arc<Vec<u8>>),
-    Text(Arc<String>),
+    Binary(Bytes),
+    Text(Utf8Bytes),
 }
 
 struct Client {
@@ -43,7 +44,7 @@ struct State {
     next_id: u64,
     /// The last published frame.
     frame: Option<Published>,
-    scene: Option<(Arc<String>, Option<Arc<String>>)>,
+    scene: Option<(Utf8Bytes, Option<Utf8Bytes>)>,
 }
 
 /// The last published frame: its size, RGBA8 bytes and where it may differ from its
@@ -75,7 +76,7 @@ impl Hub {
         }) = &state.frame
         {
             let message = frame_message(*w, *h, rgba, [0, 0, *w, *h]);
-            let _ = tx.send(Outgoing::Binary(Arc::new(message)));
+            let _ = tx.send(Outgoing::Binary(message.into()));
         }
         if let Some((plain, _)) = &state.scene {
             let _ = tx.send(Outgoing::Text(plain.clone()));
@@ -130,9 +131,9 @@ impl Hub {
         let rect = rect.unwrap_or([0, 0, 0, 0]);
         // invariant: both arms above leave a published frame.
         let last = state.frame.as_ref().expect("a published frame");
-        let frame = Arc::new(frame_message(last.width, last.height, &last.rgba, rect));
-        let plain = Arc::new(scene.plain);
-        let with_mesh = scene.with_mesh.map(Arc::new);
+        let frame = Bytes::from(frame_message(last.width, last.height, &last.rgba, rect));
+        let plain = Utf8Bytes::from(scene.plain);
+        let with_mesh = scene.with_mesh.map(Utf8Bytes::from);
         state.clients.retain(|c| {
             let text = match (&with_mesh, c.mesh) {
                 (Some(m), true) => m.clone(),
@@ -146,7 +147,7 @@ impl Hub {
 
     /// Sends a text message to every page.
     pub fn broadcast(&self, text: String) {
-        let text = Arc::new(text);
+        let text = Utf8Bytes::from(text);
         lock(&self.state)
             .clients
             .retain(|c| c.tx.send(Outgoing::Text(text.clone())).is_ok());

@@ -140,12 +140,12 @@ fn page_loop(mut socket: WebSocket<TcpStream>, session: &Mutex<dyn LiveSession>,
     loop {
         match socket.read() {
             Ok(Message::Text(text)) => handle(text.as_str(), id, session, hub, &|m| {
-                let _ = tx.send(Outgoing::Text(Arc::new(m)));
+                let _ = tx.send(Outgoing::Text(m.into()));
             }),
             Ok(Message::Binary(_)) => {
-                let _ = tx.send(Outgoing::Text(Arc::new(error_message(
-                    "binary messages are not accepted",
-                ))));
+                let _ = tx.send(Outgoing::Text(
+                    error_message("binary messages are not accepted").into(),
+                ));
             }
             Ok(Message::Close(_)) => break,
             Ok(_) => {}
@@ -155,9 +155,9 @@ fn page_loop(mut socket: WebSocket<TcpStream>, session: &Mutex<dyn LiveSession>,
                     std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
                 ) => {}
             Err(tungstenite::Error::Capacity(e)) => {
-                let _ = tx.send(Outgoing::Text(Arc::new(error_message(&format!(
-                    "refused: {e}"
-                )))));
+                let _ = tx.send(Outgoing::Text(
+                    error_message(&format!("refused: {e}")).into(),
+                ));
             }
             Err(_) => break,
         }
@@ -173,8 +173,8 @@ fn flush(socket: &mut WebSocket<TcpStream>, rx: &std::sync::mpsc::Receiver<Outgo
     let mut sent = false;
     while let Ok(message) = rx.try_recv() {
         let message = match message {
-            Outgoing::Binary(bytes) => Message::Binary(bytes.as_ref().clone().into()),
-            Outgoing::Text(text) => Message::Text(text.as_str().into()),
+            Outgoing::Binary(bytes) => Message::Binary(bytes),
+            Outgoing::Text(text) => Message::Text(text),
         };
         if socket.write(message).is_err() {
             return false;

@@ -4,8 +4,13 @@
 "use strict";
 (() => {
   const $ = (id) => document.getElementById(id);
-  const frame = $("frame"), overlay = $("overlay");
-  const fctx = frame.getContext("2d"), octx = overlay.getContext("2d");
+  // `overlay` covers the frame and takes the pointer; what it shows is drawn into `marks`, a
+  // canvas only as large as the box the handles, pins and outlines need (see drawOverlay).
+  const frame = $("frame"), overlay = $("overlay"), marks = $("marks");
+  const fctx = frame.getContext("2d"), mctx = marks.getContext("2d");
+  // While drawOverlay measures, drawing goes nowhere; then it goes to `marks`.
+  const nowhere = new Proxy({}, { get: () => () => {}, set: () => true });
+  let octx = nowhere;
   const token = new URLSearchParams(location.search).get("token") || "";
   const TRACK_COLOURS = { at: "#f0c674", scale: "#81a2be", rotate: "#b294bb", depth: "#8abeb7", opacity: "#de935f" };
   let ws = null, scene = null, located = null, gesture = null, selected = null;
@@ -22,6 +27,9 @@
 
   function send(message) {
     if (ws && ws.readyState === 1) ws.send(JSON.stringify(message));
+  }
+  function setText(element, text) {
+    if (element.textContent !== text) element.textContent = text;
   }
   function notice(text, kind) {
     const n = $("notice");
@@ -43,8 +51,8 @@
   }
 
   function onFrame(buffer) {
-    const h = new Uint32Array(buffer.slice(0, 28));
-    const [kind, width, height, x, y, w, hh] = h;
+    const head = new DataView(buffer, 0, 28);
+    const [kind, width, height, x, y, w, hh] = [0, 4, 8, 12, 16, 20, 24].map((at) => head.getUint32(at, true));
     if (kind !== 1) return;
     if (frame.width !== width || frame.height !== height) {
       frame.width = overlay.width = width;
@@ -73,10 +81,12 @@
   function onText(m) {
     if (m.type === "scene") {
       scene = m;
-      $("file").textContent = m.file || "(no file)";
-      $("scrub").max = m.duration;
-      if (!scrubbing) $("scrub").value = m.t;
-      $("clock").textContent = `t = ${+m.t.toFixed(4)} s · frame ${m.frame} / ${m.frames}`;
+      // A drag sends a scene message per preview: only what changed is touched, so the page
+      // is not laid out again for nothing before the preview's paint.
+      setText($("file"), m.file || "(no file)");
+      if ($("scrub").max !== String(m.duration)) $("scrub").max = m.duration;
+      if (!scrubbing && $("scrub").value !== String(m.t)) $("scrub").value = m.t;
+      setText($("clock"), `t = ${+m.t.toFixed(4)} s · frame ${m.frame} / ${m.frames}`);
       drawMarkers();
       drawOverlay();
     } else if (m.type === "located") {
@@ -114,16 +124,50 @@
   const r2 = (v) => Math.round(v * 100) / 100;
   const dist = (a, b) => Math.hypot(a[0] - b[0], a[1] - b[1]);
 
+  // The overlay is redrawn per scene message. Its drawing runs twice: once to find the box
+  // it covers (`mark`), then into `marks` sized to that box and placed over it, so the
+  // browser composites a small canvas per preview instead of a frame-sized one.
+  let overlayBox = null, overlayPad = 0;
+  function mark(x, y, r) {
+    const d = r + overlayPad;
+    if (!overlayBox) overlayBox = [x - d, y - d, x + d, y + d];
+    else {
+      const b = overlayBox;
+      b[0] = Math.min(b[0], x - d); b[1] = Math.min(b[1], y - d);
+      b[2] = Math.max(b[2], x + d); b[3] = Math.max(b[3], y + d);
+    }
+  }
   function drawOverlay() {
-    octx.clearRect(0, 0, overlay.width, overlay.height);
+    overlayBox = null;
+    octx = nowhere;
+    drawOverlayInto();
+    const b = overlayBox;
+    const [x0, y0] = b ? [Math.floor(Math.max(b[0], 0)), Math.floor(Math.max(b[1], 0))] : [0, 0];
+    const [x1, y1] = b ? [Math.ceil(Math.min(b[2], overlay.width)), Math.ceil(Math.min(b[3], overlay.height))] : [0, 0];
+    if (x1 <= x0 || y1 <= y0) { marks.style.display = "none"; return; }
+    marks.width = x1 - x0; // also clears it
+    marks.height = y1 - y0;
+    const percent = (v, whole) => `${(100 * v) / whole}%`;
+    Object.assign(marks.style, {
+      display: "block",
+      left: percent(x0, overlay.width), top: percent(y0, overlay.height),
+      width: percent(x1 - x0, overlay.width), height: percent(y1 - y0, overlay.height),
+    });
+    octx = mctx;
+    octx.setTransform(1, 0, 0, 1, -x0, -y0);
+    drawOverlayInto();
+  }
+  function drawOverlayInto() {
     if (!scene) return;
     const px = screenScale();
+    overlayPad = 3 * px + 2;
     octx.lineWidth = 1.5 * px;
     if (meshOn && scene.meshes) {
       octx.strokeStyle = "rgba(120, 220, 255, 0.55)";
       octx.beginPath();
       for (const m of scene.meshes) {
         const P = m.points, T = m.triangles;
+        for (let i = 0; i < P.length; i += 2) mark(P[i], P[i + 1], 0);
         for (let i = 0; i < T.length; i += 3) {
           const a = T[i] * 2, b = T[i + 1] * 2, c = T[i + 2] * 2;
           octx.moveTo(P[a], P[a + 1]); octx.lineTo(P[b], P[b + 1]); octx.lineTo(P[c], P[c + 1]); octx.closePath();
@@ -138,6 +182,8 @@
     for (const p of scene.patches) {
       const hot = (located && located.patch === p.name) || (gesture && gesture.patch === p.name);
       if (hot && p.bbox) {
+        mark(p.bbox[0], p.bbox[1], 0);
+        mark(p.bbox[2], p.bbox[3], 0);
         octx.setLineDash([4 * px, 4 * px]);
         octx.strokeStyle = "rgba(255,255,255,0.7)";
         octx.strokeRect(p.bbox[0], p.bbox[1], p.bbox[2] - p.bbox[0], p.bbox[3] - p.bbox[1]);
@@ -147,6 +193,8 @@
         const grab = place(p, h.from), target = place(p, h.to);
         const sel = selected && selected.kind === "handle" && selected.patch === p.name && selected.index === i;
         const sizing = gesture && gesture.kind === "radius" && gesture.patch === p.name && gesture.index === i;
+        mark(target[0], target[1], Math.max(h.radius * p.scale, 5 * px));
+        mark(grab[0], grab[1], 3 * px);
         octx.strokeStyle = sel ? "#fff" : "rgba(255, 200, 80, 0.9)";
         if (sizing) octx.lineWidth = 3 * px;
         octx.beginPath(); octx.arc(target[0], target[1], h.radius * p.scale, 0, 2 * Math.PI); octx.stroke();
@@ -159,6 +207,7 @@
       });
       p.pins.forEach((pin, i) => {
         const q = place(p, pin.at);
+        mark(q[0], q[1], 4 * px);
         const sel = selected && selected.kind === "pin" && selected.patch === p.name && selected.index === i;
         octx.fillStyle = sel ? "#fff" : "#50c8ff";
         octx.fillRect(q[0] - 4 * px, q[1] - 4 * px, 8 * px, 8 * px);
@@ -170,6 +219,7 @@
   function drawPath(f, toCanvas, px) {
     const pts = f.path.map(toCanvas);
     if (!pts.length) return;
+    pts.forEach((q) => mark(q[0], q[1], 6 * px));
     octx.strokeStyle = "rgba(140, 255, 140, 0.85)";
     octx.setLineDash([6 * px, 3 * px]);
     octx.beginPath();
@@ -343,7 +393,16 @@
   }
 
   // --- timeline ---
+  // The markers are built again only when their keys, the duration or the selection change.
+  let markersDrawn = null;
   function drawMarkers() {
+    const drawn = scene && JSON.stringify([
+      scene.duration,
+      selected,
+      scene.patches.map((p) => [p.name, p.keys, p.handles.map((h) => h.keys)]),
+    ]);
+    if (drawn === markersDrawn) return;
+    markersDrawn = drawn;
     const box = $("markers");
     box.textContent = "";
     if (!scene) return;
@@ -397,6 +456,7 @@
     const move = (ev) => { to = timeAt(ev.clientX); m.style.left = `${(100 * to) / scene.duration}%`; };
     const up = (ev) => {
       move(ev);
+      markersDrawn = null; // the marker was moved by hand: the next scene message redraws it
       window.removeEventListener("pointermove", move);
       window.removeEventListener("pointerup", up);
       if (Math.abs(to - t) > 1e-9) {
