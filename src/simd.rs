@@ -10,6 +10,10 @@
 //! code computes exactly what the portable code computes, lane by lane; only the speed
 //! differs. `LAPCLONE_SIMD=portable` in the environment (read once) or [`set_portable`]
 //! forces the portable path, so the claim can be tested on any machine.
+//!
+//! The raster's 8-bit store ([`unit_to_levels`]) is here too: four lanes quantised at once
+//! with the baseline SSE2 instructions where the target has them (no run-time dispatch
+//! needed), the plain per-lane casts elsewhere; both give the same bytes (tested).
 
 use std::sync::atomic::{AtomicU8, Ordering};
 
@@ -121,4 +125,123 @@ where
     Row<S>: bytemuck::Pod,
 {
     bytemuck::cast_slice_mut(x)
+}
+
+/// Quantises four unit values to 8-bit levels, exactly as `(v · 255 + ½) as u8` does lane
+/// by lane for every input (the canvas's rounding, [`Texel::from_unit`]).
+///
+/// The SSE2 path clamps `v · 255 + ½` to [0, 255] the way the saturating cast does (NaN to
+/// 0: the first `max` returns its second operand for NaN), truncates to `i32` and packs with
+/// saturation that no longer bites: one convert and two packs instead of four saturating
+/// scalar casts and the shifts that join their bytes.
+///
+/// [`Texel::from_unit`]: crate::pixels::Texel::from_unit
+#[inline(always)]
+pub(crate) fn unit_to_levels(unit: [f32; 4]) -> [u8; 4] {
+    #[cfg(all(any(target_arch = "x86", target_arch = "x86_64"), target_feature = "sse2"))]
+    {
+        unit_to_levels_sse2(unit)
+    }
+    #[cfg(not(all(any(target_arch = "x86", target_arch = "x86_64"), target_feature = "sse2")))]
+    {
+        unit_to_levels_portable(unit)
+    }
+}
+
+/// [`unit_to_levels`] with the per-lane casts (the reference, and the path without SSE2).
+#[cfg(any(
+    test,
+    not(all(any(target_arch = "x86", target_arch = "x86_64"), target_feature = "sse2"))
+))]
+#[inline(always)]
+pub(crate) fn unit_to_levels_portable(unit: [f32; 4]) -> [u8; 4] {
+    // `as` saturates (NaN → 0).
+    unit.map(|v| (v * 255.0 + 0.5) as u8)
+}
+
+#[cfg(all(any(target_arch = "x86", target_arch = "x86_64"), target_feature = "sse2"))]
+#[inline(always)]
+fn unit_to_levels_sse2(unit: [f32; 4]) -> [u8; 4] {
+    use safe_arch::{
+        add_m128, get_i32_from_m128i_s, m128, max_m128, min_m128, mul_m128,
+        pack_i16_to_u8_m128i, pack_i32_to_i16_m128i, truncate_m128_to_m128i,
+    };
+    // The same two IEEE operations as the scalar rounding, in the same order.
+    let scaled = add_m128(
+        mul_m128(m128::from_array(unit), m128::from_array([255.0; 4])),
+        m128::from_array([0.5; 4]),
+    );
+    let clamped = min_m128(
+        max_m128(scaled, m128::from_array([0.0; 4])),
+        m128::from_array([255.0; 4]),
+    );
+    let levels = truncate_m128_to_m128i(clamped);
+    let words = pack_i32_to_i16_m128i(levels, levels);
+    let bytes = pack_i16_to_u8_m128i(words, words);
+    get_i32_from_m128i_s(bytes).to_le_bytes()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every level's rounding boundary (where `v · 255 + ½` crosses an integer) and a few
+    /// ulps either side, values outside [0, 1], NaN and infinities, and a fixed-seed sweep
+    /// of unit values and of any bits: the fast quantiser gives the per-lane casts' bytes.
+    #[test]
+    fn levels_match_the_per_lane_casts() {
+        let mut values = vec![
+            0.0f32,
+            -0.0,
+            1.0,
+            0.5,
+            f32::MIN_POSITIVE,
+            1.0 - f32::EPSILON,
+            -1.0,
+            -0.002,
+            1.002,
+            1.5,
+            3e9,
+            -3e9,
+            f32::MAX,
+            f32::MIN,
+            f32::NAN,
+            -f32::NAN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+        ];
+        for k in 0..=255u32 {
+            for centre in [(k as f32 - 0.5) / 255.0, k as f32 / 255.0, (k as f32 + 0.5) / 255.0] {
+                let mut v = centre;
+                for _ in 0..8 {
+                    v = f32::from_bits(v.to_bits().saturating_sub(1));
+                }
+                for _ in 0..17 {
+                    values.push(v);
+                    v = f32::from_bits(v.to_bits() + 1);
+                }
+            }
+        }
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        for _ in 0..200_000 {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            values.push((state >> 40) as f32 / (1u64 << 24) as f32);
+            values.push(f32::from_bits((state >> 7) as u32));
+        }
+        for chunk in values.chunks(4) {
+            let mut lanes = [0.0; 4];
+            lanes[..chunk.len()].copy_from_slice(chunk);
+            // Every rotation, so each value meets every lane.
+            for turn in 0..4 {
+                lanes.rotate_left(usize::from(turn > 0));
+                assert_eq!(
+                    unit_to_levels(lanes),
+                    unit_to_levels_portable(lanes),
+                    "{lanes:?}"
+                );
+            }
+        }
+    }
 }

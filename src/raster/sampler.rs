@@ -17,6 +17,7 @@ use crate::pixels::FloatImage;
 
 /// A texel type the sampler reads.
 pub(crate) trait SourceTexel: Copy {
+
     /// The texel's channels in the blend's units.
     fn blend_units(self) -> Vec4;
     /// A blend of texels in channel values.

@@ -14,6 +14,7 @@ use super::setup::TriangleSetup;
 use super::triangles::NO_TRIANGLE;
 use super::PixelRect;
 use crate::pixels::{FloatImage, Texel};
+use crate::simd::{Kernel, Path};
 
 /// Neighbour offsets within radius 2, nearest first (fixed order for determinism).
 const NEIGHBOURS: [(i32, i32); 24] = [
@@ -109,16 +110,47 @@ pub(crate) fn shade_and_composite<T: Texel, C: CoverageTexel>(
     canvas: &mut [[T; 4]],
     canvas_width: usize,
 ) -> (usize, usize) {
-    let source = input.source;
-    match source.eight_bit_view() {
-        Some((texels, _)) => {
-            let sampler = Sampler::with_texels(source, texels);
-            walk_rows(input, &sampler, rows, canvas, canvas_width)
+    Path::current().run(Shade {
+        input,
+        rows,
+        canvas,
+        canvas_width,
+    })
+}
+
+/// [`shade_and_composite`]'s arguments, as a kernel compiled for the CPU's best
+/// instruction set: the loops are separate IEEE operations in a fixed order, so any
+/// instruction set gives the same bits (see [`crate::simd`]).
+struct Shade<'a, 'c, T, C> {
+    input: &'a ShadeInput<'a, C>,
+    rows: PixelRect,
+    canvas: &'c mut [[T; 4]],
+    canvas_width: usize,
+}
+
+impl<T: Texel, C: CoverageTexel> Kernel for Shade<'_, '_, T, C> {
+    type Output = (usize, usize);
+
+    #[inline(always)]
+    fn call(self) -> (usize, usize) {
+        let Shade {
+            input,
+            rows,
+            canvas,
+            canvas_width,
+        } = self;
+        let source = input.source;
+        match source.eight_bit_view() {
+            Some((texels, _)) => {
+                let sampler = Sampler::with_texels(source, texels);
+                walk_rows(input, &sampler, rows, canvas, canvas_width)
+            }
+            None => walk_rows(input, &Sampler::new(source), rows, canvas, canvas_width),
         }
-        None => walk_rows(input, &Sampler::new(source), rows, canvas, canvas_width),
     }
 }
 
+#[inline(always)]
 fn walk_rows<S: SourceTexel, T: Texel, C: CoverageTexel>(
     input: &ShadeInput<C>,
     sampler: &Sampler<S>,
@@ -179,17 +211,19 @@ struct Span<'a, C> {
 
 /// Shades a run of pixels whose centres all lie in `setup`'s triangle. The single-precision
 /// maps are evaluated at every pixel centre relative to the triangle's own origin (small
-/// exact offsets), the same formula the fringe uses.
+/// exact offsets), the same formula the fringe uses, with the row's terms taken once.
+#[inline(always)]
 fn shade_span<S: SourceTexel, T: Texel, C: CoverageTexel>(
     setup: &TriangleSetup,
     sampler: &Sampler<S>,
     span: &Span<C>,
     pixels: &mut [[T; 4]],
 ) -> usize {
+    let maps = setup.span.along_row(span.y);
     let mut written = 0;
     for (x, (&texel, pixel)) in (span.x0..).zip(span.coverage.iter().zip(pixels.iter_mut())) {
         if texel.is_covered() {
-            let (u, v, membrane) = setup.span.at_pixel(x, span.y);
+            let (u, v, membrane) = maps.at(x);
             let sample = sampler.sample_texel_space(u, v);
             written += usize::from(shade_pixel(pixel, sample, membrane, texel));
         }
@@ -198,6 +232,7 @@ fn shade_span<S: SourceTexel, T: Texel, C: CoverageTexel>(
 }
 
 /// Source sample plus membrane, composited with the pixel's coverage; whether it changed.
+#[inline(always)]
 fn shade_pixel<T: Texel, C: CoverageTexel>(
     pixel: &mut [T; 4],
     sample: Vec4,
@@ -207,7 +242,7 @@ fn shade_pixel<T: Texel, C: CoverageTexel>(
     // The membrane's alpha lane is 0, so an opaque sample clamps to alpha 1 here.
     let mut colour = (sample + membrane).clamp(Vec4::ZERO, Vec4::ONE);
     if coverage.is_full() && sample.w >= 1.0 {
-        *pixel = colour.to_array().map(T::from_unit);
+        *pixel = T::from_unit4(colour.to_array());
         true
     } else {
         colour.w = sample.w;
@@ -217,6 +252,7 @@ fn shade_pixel<T: Texel, C: CoverageTexel>(
 
 /// Shades a run of pixels whose centres miss every triangle (the anti-aliased fringe): each
 /// extrapolates the maps of its owning triangle (see [`owning_triangle`]).
+#[inline(always)]
 fn shade_fringe<S: SourceTexel, T: Texel, C: CoverageTexel>(
     input: &ShadeInput<C>,
     sampler: &Sampler<S>,
@@ -246,18 +282,18 @@ fn composite<T: Texel>(pixel: &mut [T; 4], colour: [f32; 4], coverage: f32) -> b
         return false;
     }
     if alpha >= 1.0 {
-        *pixel = colour.map(T::from_unit);
+        *pixel = T::from_unit4(colour);
         return true;
     }
     let premultiplied = [colour[0] * alpha, colour[1] * alpha, colour[2] * alpha];
     let under = pixel.map(Texel::to_unit);
     let out = crate::pixels::canvas_composite_over(premultiplied, alpha, under);
-    *pixel = out.map(T::from_unit);
+    *pixel = T::from_unit4(out);
     true
 }
 
 /// The triangle at the pixel's centre, or the nearest hit neighbour's.
-#[inline]
+#[inline(always)]
 fn owning_triangle<C>(input: &ShadeInput<C>, x: i32, y: i32) -> Option<u32> {
     let rect = input.ids_rect;
     let width = rect.width();
