@@ -5,7 +5,7 @@
 //! (`TypeError` for what is not an array), never a crash.
 
 use lapclone::image::{DynamicImage, ImageBuffer, Luma, Rgb, Rgba};
-use lapclone::{Canvas, ColorKind, Depth, PixelFormat};
+use lapclone::{Canvas, CanvasPixels, ColorKind, Depth, PixelFormat};
 use numpy::ndarray::{ArrayViewD, ArrayViewMut3, Axis, Ix3};
 use numpy::{
     Element, PyArray2, PyArrayDescrMethods, PyArrayDyn, PyArrayMethods, PyUntypedArray,
@@ -354,7 +354,7 @@ fn shaped<'py, T: Element>(
 
 /// Writes samples of the `rect` part of an image in `layout` (as [`Canvas::samples_in`]
 /// gives them) into the same part of `array`, which has that layout.
-pub fn write_rect(
+fn write_rect(
     array: &Bound<'_, PyAny>,
     layout: &Layout,
     bgr: bool,
@@ -421,6 +421,90 @@ fn write_rect_typed<T: Element + Copy>(
         }
     }
     Ok(())
+}
+
+/// Writes the canvas's `rect` into `array` (of `layout`, which the canvas was loaded from):
+/// the samples [`Canvas::samples_in`] gives for the layout's format. RGB(A) canvas texels
+/// of the array's depth are those samples, so they are copied straight into the array;
+/// grey arrays take the canvas's luma through `samples_in`.
+pub fn write_canvas_rect(
+    array: &Bound<'_, PyAny>,
+    layout: &Layout,
+    bgr: bool,
+    canvas: &Canvas,
+    rect: Rect,
+) -> PyResult<()> {
+    if layout.channel_count() >= 3 {
+        match (canvas.pixels(), layout.dtype) {
+            (CanvasPixels::Eight(p), Dtype::U8) => {
+                return write_texels(array, layout, bgr, p, canvas.width(), rect)
+            }
+            (CanvasPixels::Sixteen(p), Dtype::U16) => {
+                return write_texels(array, layout, bgr, p, canvas.width(), rect)
+            }
+            _ => {}
+        }
+    }
+    let samples = canvas.samples_in(layout.format(), rect.x0..rect.x1, rect.y0..rect.y1);
+    write_rect(array, layout, bgr, &samples, rect)
+}
+
+/// [`write_canvas_rect`] for RGB(A) arrays of the canvas's depth: each texel's first
+/// `channels` values, red and blue swapped for `bgr`.
+fn write_texels<T: Element + Copy>(
+    array: &Bound<'_, PyAny>,
+    layout: &Layout,
+    bgr: bool,
+    texels: &[[T; 4]],
+    canvas_width: u32,
+    rect: Rect,
+) -> PyResult<()> {
+    let array = array.downcast::<PyArrayDyn<T>>()?;
+    let mut writable = array
+        .try_readwrite()
+        .map_err(|e| PyValueError::new_err(format!("out cannot be written: {e}")))?;
+    let mut view: ArrayViewMut3<'_, T> = writable
+        .as_array_mut()
+        .into_dimensionality::<Ix3>()
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let c = layout.channel_count();
+    let (x0, x1) = (rect.x0 as usize, rect.x1 as usize);
+    let order = if bgr { [2, 1, 0, 3] } else { [0, 1, 2, 3] };
+    let width = canvas_width as usize;
+    for y in rect.y0 as usize..rect.y1 as usize {
+        let row = &texels[y * width + x0..y * width + x1];
+        let mut out = view.index_axis_mut(Axis(0), y);
+        match out.as_slice_mut() {
+            // A contiguous row (the usual case): written in place.
+            Some(dst) => {
+                let dst = &mut dst[x0 * c..x1 * c];
+                match c {
+                    3 => texels_into_row::<T, 3>(dst, row, order),
+                    _ => texels_into_row::<T, 4>(dst, row, order),
+                }
+            }
+            None => {
+                for (texel, x) in row.iter().zip(x0..) {
+                    let mut d = out.index_axis_mut(Axis(0), x);
+                    for k in 0..c {
+                        d[k] = texel[order[k]];
+                    }
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Canvas texels into one contiguous array row of `C` channels, array channel `k` from
+/// texel channel `order[k]`.
+#[inline]
+fn texels_into_row<T: Copy, const C: usize>(dst: &mut [T], row: &[[T; 4]], order: [usize; 4]) {
+    for (d, texel) in dst.chunks_exact_mut(C).zip(row) {
+        for k in 0..C {
+            d[k] = texel[order[k]];
+        }
+    }
 }
 
 /// One contiguous row of `C`-channel samples into canvas texels. The channel count is a

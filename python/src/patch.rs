@@ -106,23 +106,31 @@ impl Patch {
     ) -> PyResult<Bound<'py, PyAny>> {
         let py = target.py();
         let shared: Py<PyAny> = target.clone().unbind();
-        let (rect, samples) = py.allow_threads(|| {
+        let out: Option<Py<PyAny>> = out.map(|out| out.clone().unbind());
+        let result = py.allow_threads(|| {
             // Waited for without the GIL, so a thread holding the lock can always take it.
             let mut state = lock(&self.state);
             let rect = state.prepare(pose, layout)?;
             Python::with_gil(|py| state.load_target(shared.bind(py), layout, bgr, rect))?;
-            let samples = state.draw(layout, rect)?;
-            Ok::<_, PyErr>((rect, samples))
+            state.draw()?;
+            // The result from the drawn canvas directly (no copy of the rectangle between).
+            Python::with_gil(|py| {
+                let target = shared.bind(py);
+                let result = match &out {
+                    Some(out) => {
+                        let out = out.bind(py);
+                        arrays::copy_into(target, out, layout)?;
+                        out.clone()
+                    }
+                    None => target.call_method0("copy")?,
+                };
+                // invariant: `load_target` left a canvas.
+                let canvas = state.canvas.as_ref().expect("loaded before drawing");
+                arrays::write_canvas_rect(&result, layout, bgr, canvas, rect)?;
+                Ok::<_, PyErr>(result.unbind())
+            })
         })?;
-        let result = match out {
-            Some(out) => {
-                arrays::copy_into(target, out, layout)?;
-                out.clone()
-            }
-            None => target.call_method0("copy")?,
-        };
-        arrays::write_rect(&result, layout, bgr, &samples, rect)?;
-        Ok(result)
+        Ok(result.into_bound(py))
     }
 }
 
@@ -189,14 +197,13 @@ impl PatchState {
         arrays::load_rect(target, layout, bgr, canvas, rect)
     }
 
-    /// The membrane solve and the raster on the canvas, and the samples of `rect` in the
-    /// target's format.
-    fn draw(&mut self, layout: &Layout, rect: Rect) -> PyResult<Vec<u8>> {
+    /// The membrane solve and the raster on the canvas.
+    fn draw(&mut self) -> PyResult<()> {
         // invariant: the clone calls `load_target`, which leaves a canvas, before every `draw`.
         let canvas = self.canvas.as_mut().expect("loaded before drawing");
         let depth = self.deformed_now.then_some(&self.deformed.depth[..]);
         self.cloner.clone_prepared(canvas, depth).map_err(to_py)?;
-        Ok(canvas.samples_in(layout.format(), rect.x0..rect.x1, rect.y0..rect.y1))
+        Ok(())
     }
 }
 

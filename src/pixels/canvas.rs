@@ -15,6 +15,12 @@ pub trait Texel: Copy + Send + Sync + 'static {
     fn to_unit(self) -> f32;
     /// Rounds a value in [0, 1] (clamped) to the nearest representable one.
     fn from_unit(value: f32) -> Self;
+    /// [`from_unit`](Self::from_unit) of four values (one pixel's channels), the same
+    /// values; vector code where that is faster.
+    #[inline]
+    fn from_unit4(values: [f32; 4]) -> [Self; 4] {
+        values.map(Self::from_unit)
+    }
 }
 
 impl Texel for f32 {
@@ -37,6 +43,10 @@ impl Texel for u8 {
     fn from_unit(value: f32) -> Self {
         // `as` saturates and maps NaN to 0.
         (value * 255.0 + 0.5) as u8
+    }
+    #[inline(always)]
+    fn from_unit4(values: [f32; 4]) -> [Self; 4] {
+        crate::simd::unit_to_levels(values)
     }
 }
 
@@ -438,7 +448,7 @@ fn blend_premultiplied_over<T: Texel>(dst: &mut [[T; 4]], src: &[tiny_skia::Prem
 
 /// Source-over in straight alpha: `source_premultiplied` is the source colour times
 /// `source_alpha`. When the destination is opaque this is `src·α + (1 − α)·dst`.
-#[inline]
+#[inline(always)]
 pub(crate) fn composite_over_straight(
     source_premultiplied: [f32; 3],
     source_alpha: f32,

@@ -14,9 +14,11 @@
 use glam::Vec4;
 
 use crate::pixels::FloatImage;
+use crate::simd::texel_taps;
 
 /// A texel type the sampler reads.
 pub(crate) trait SourceTexel: Copy {
+
     /// The texel's channels in the blend's units.
     fn blend_units(self) -> Vec4;
     /// A blend of texels in channel values.
@@ -55,6 +57,8 @@ pub(crate) struct Sampler<'a, S = [f32; 4]> {
     last_y: usize,
     last_x_f32: f32,
     last_y_f32: f32,
+    /// Both bounds below 2^31, as [`texel_taps`] needs (images are far smaller).
+    taps_fit_i32: bool,
 }
 
 impl<'a> Sampler<'a> {
@@ -92,6 +96,7 @@ impl<'a, S: SourceTexel> Sampler<'a, S> {
             last_y: source.height().saturating_sub(1) as usize,
             last_x_f32: last_as_f32(source.width()),
             last_y_f32: last_as_f32(source.height()),
+            taps_fit_i32: source.width().max(source.height()) <= 1 << 31,
         }
     }
 
@@ -107,8 +112,20 @@ impl<'a, S: SourceTexel> Sampler<'a, S> {
     /// where texel (i, j)'s centre is at (i, j) (the shading loop folds the ½ into its maps).
     #[inline(always)]
     pub fn sample_texel_space(&self, x: f32, y: f32) -> Vec4 {
-        let (x0, x1, tx) = taps_shifted(x, self.last_x, self.last_x_f32);
-        let (y0, y1, ty) = taps_shifted(y, self.last_y, self.last_y_f32);
+        let ((x0, x1, tx), (y0, y1, ty)) = if self.taps_fit_i32 {
+            // Both axes in one go: the same comparisons and truncation (see `texel_taps`).
+            let ([i, j], [tx, ty]) = texel_taps([x, y], [self.last_x_f32, self.last_y_f32]);
+            let (i, j) = (i as usize, j as usize);
+            (
+                (i, i + usize::from(i < self.last_x), tx),
+                (j, j + usize::from(j < self.last_y), ty),
+            )
+        } else {
+            (
+                taps_shifted(x, self.last_x, self.last_x_f32),
+                taps_shifted(y, self.last_y, self.last_y_f32),
+            )
+        };
         let (row0, row1) = (y0 * self.width, y1 * self.width);
         // The taps are ≤ last_x < width and ≤ last_y < height (see `taps_shifted`).
         let texel = |i: usize| self.pixels[i].blend_units();

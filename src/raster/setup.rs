@@ -103,14 +103,6 @@ impl MembraneSpan {
         }
     }
 
-    /// The membrane at pixel `(x, y)`'s centre.
-    #[inline(always)]
-    pub fn at_pixel(&self, x: i32, y: i32) -> Vec4 {
-        let dx = (x - self.origin[0]) as f32;
-        let dy = (y - self.origin[1]) as f32;
-        let [m_origin, m_x, m_y] = self.maps;
-        m_origin + m_x * dx + m_y * dy
-    }
 }
 
 /// `⌊v⌋` for `|v| ≤ MAX_COORDINATE` (NaN gives 0), without the libm call `f64::floor`
@@ -224,14 +216,50 @@ impl SpanSetup {
     /// The source position (texel space) and membrane at pixel `(x, y)`'s centre.
     #[inline(always)]
     pub fn at_pixel(&self, x: i32, y: i32) -> (f32, f32, Vec4) {
-        let dx = (x - self.membrane.origin[0]) as f32;
+        self.along_row(y).at(x)
+    }
+
+    /// The maps along row `y`: each map's `d/dy · dy` term taken once for the row.
+    #[inline(always)]
+    pub fn along_row(&self, y: i32) -> RowMaps {
         let dy = (y - self.membrane.origin[1]) as f32;
-        let at = |m: &[f32; 3]| m[0] + m[1] * dx + m[2] * dy;
-        (
-            at(&self.texel_x),
-            at(&self.texel_y),
-            self.membrane.at_pixel(x, y),
-        )
+        let [m_origin, m_x, m_y] = self.membrane.maps;
+        RowMaps {
+            origin_x: self.membrane.origin[0],
+            texel_x: [self.texel_x[0], self.texel_x[1], self.texel_x[2] * dy],
+            texel_y: [self.texel_y[0], self.texel_y[1], self.texel_y[2] * dy],
+            membrane: [m_origin, m_x, m_y * dy],
+        }
+    }
+}
+
+/// A triangle's maps along one canvas row ([`SpanSetup::along_row`]): at pixel `x` each is
+/// `(at origin + d/dx · dx) + (d/dy · dy)`, the same operations in the same order as
+/// evaluating the whole map at the pixel, with the row's term computed once.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct RowMaps {
+    origin_x: i32,
+    /// `[at origin, d/dx, d/dy · dy]`.
+    texel_x: [f32; 3],
+    texel_y: [f32; 3],
+    membrane: [Vec4; 3],
+}
+
+impl RowMaps {
+    /// The source position (texel space) and membrane at the row's pixel `x`.
+    #[inline(always)]
+    pub fn at(&self, x: i32) -> (f32, f32, Vec4) {
+        let dx = (x - self.origin_x) as f32;
+        let at = |m: &[f32; 3]| m[0] + m[1] * dx + m[2];
+        (at(&self.texel_x), at(&self.texel_y), self.membrane_at(x))
+    }
+
+    /// The membrane alone at the row's pixel `x`.
+    #[inline(always)]
+    pub fn membrane_at(&self, x: i32) -> Vec4 {
+        let dx = (x - self.origin_x) as f32;
+        let [m_origin, m_x, m_row] = self.membrane;
+        m_origin + m_x * dx + m_row
     }
 }
 
