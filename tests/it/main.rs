@@ -11,8 +11,16 @@ mod files;
 mod fixtures;
 #[path = "../common/golden.rs"]
 mod golden;
+// lapclone-bench's reader, for the written Laplacian's round trip.
+#[path = "../../bench/src/matrix_market.rs"]
+#[allow(dead_code)]
+mod matrix_market;
+#[path = "../common/mesh_fixtures.rs"]
+mod mesh_fixtures;
 #[path = "../common/raster_meshes.rs"]
 mod raster_meshes;
+#[path = "../common/synth_masks.rs"]
+mod synth;
 #[path = "../common/track_footage.rs"]
 mod track_footage;
 
