@@ -36,7 +36,8 @@ mod triangulate;
 mod types;
 
 pub use bitmask::{BitMask, MASK_THRESHOLD};
-pub use contour::{label_pieces, trace_crack_loops, CrackLoop};
+pub use centre_loops::outside_centre_loops;
+pub use contour::{for_each_edge_pixel, label_pieces, trace_crack_loops, CrackLoop};
 pub use coverage::{
     uncovered_mask_pixels, COVERAGE_TOLERANCE_PX,
 };
