@@ -16,7 +16,7 @@ mod membrane;
 mod patch_mesh;
 mod placement;
 
-pub use beneath::{find_beneath, weights_if_strictly_inside, Beneath, CandidateGrid};
+pub use beneath::{find_beneath, Beneath, CandidateGrid};
 pub use boundary_data::{BoundaryData, BoundarySampler, HAT_SAMPLE_SPACING};
 pub use cloner::{CloneMode, CloneOptions, CloneStats, PatchCloner};
 pub use error::CloneError;
