@@ -100,27 +100,50 @@ fn destination(path: &Path) -> std::io::Result<Destination> {
     } else {
         path.to_path_buf()
     };
+    match kind_of(&meta) {
+        Kind::File => Ok(Destination::Replace(target)),
+        Kind::Fifo | Kind::CharDevice => Ok(Destination::Through(target)),
+        Kind::Folder => Err(refuse("a folder")),
+        Kind::BlockDevice => Err(refuse("a block device")),
+        Kind::Socket => Err(refuse("a socket")),
+        Kind::Other => Err(refuse("not a regular file")),
+    }
+}
+
+/// What a path names, as the output and input rules tell them apart.
+#[cfg_attr(not(unix), allow(dead_code))]
+enum Kind {
+    File,
+    Folder,
+    Fifo,
+    CharDevice,
+    BlockDevice,
+    Socket,
+    Other,
+}
+
+fn kind_of(meta: &std::fs::Metadata) -> Kind {
     let kind = meta.file_type();
-    if kind.is_file() {
-        return Ok(Destination::Replace(target));
-    }
-    if kind.is_dir() {
-        return Err(refuse("a folder"));
-    }
     #[cfg(unix)]
     {
         use std::os::unix::fs::FileTypeExt;
-        if kind.is_fifo() || kind.is_char_device() {
-            return Ok(Destination::Through(target));
-        }
-        if kind.is_block_device() {
-            return Err(refuse("a block device"));
-        }
-        if kind.is_socket() {
-            return Err(refuse("a socket"));
+        let special = [
+            (kind.is_fifo(), Kind::Fifo),
+            (kind.is_char_device(), Kind::CharDevice),
+            (kind.is_block_device(), Kind::BlockDevice),
+            (kind.is_socket(), Kind::Socket),
+        ];
+        if let Some((_, special)) = special.into_iter().find(|(is, _)| *is) {
+            return special;
         }
     }
-    Err(refuse("not a regular file"))
+    if kind.is_file() {
+        Kind::File
+    } else if kind.is_dir() {
+        Kind::Folder
+    } else {
+        Kind::Other
+    }
 }
 
 /// The one way lapclone writes an output file. A regular (or missing) destination gets a
@@ -153,10 +176,6 @@ impl TempOutput {
                     .file_name()
                     .map(|n| n.to_string_lossy().into_owned())
                     .unwrap_or_default();
-                let folder = match dest.parent() {
-                    Some(dir) if !dir.as_os_str().is_empty() => dir.to_path_buf(),
-                    _ => PathBuf::from("."),
-                };
                 let prefix = format!(".{name}.");
                 let mut builder = tempfile::Builder::new();
                 builder.prefix(&prefix).suffix(".tmp");
@@ -167,7 +186,7 @@ impl TempOutput {
                     builder.permissions(std::fs::Permissions::from_mode(0o666));
                 }
                 let file = builder
-                    .tempfile_in(&folder)
+                    .tempfile_in(folder_of(&dest))
                     .map_err(|e| std::io::Error::new(e.kind(), e.to_string()))?;
                 Inner::Temporary { file, dest }
             }
@@ -219,27 +238,14 @@ pub fn not_a_file(path: &Path) -> Option<&'static str> {
             "does not exist"
         });
     };
-    let kind = meta.file_type();
-    if kind.is_file() {
-        return None;
-    }
-    if kind.is_dir() {
-        return Some("is a folder, not a file");
-    }
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::FileTypeExt;
-        if kind.is_fifo() {
-            return Some("is not a regular file (a FIFO)");
-        }
-        if kind.is_char_device() || kind.is_block_device() {
-            return Some("is not a regular file (a device)");
-        }
-        if kind.is_socket() {
-            return Some("is not a regular file (a socket)");
-        }
-    }
-    Some("is not a regular file")
+    Some(match kind_of(&meta) {
+        Kind::File => return None,
+        Kind::Folder => "is a folder, not a file",
+        Kind::Fifo => "is not a regular file (a FIFO)",
+        Kind::CharDevice | Kind::BlockDevice => "is not a regular file (a device)",
+        Kind::Socket => "is not a regular file (a socket)",
+        Kind::Other => "is not a regular file",
+    })
 }
 
 /// An input must be a regular file: reading a FIFO or a device could wait forever, and a
@@ -258,6 +264,14 @@ pub fn check_input_file(path: &Path) -> std::io::Result<()> {
     }
 }
 
+/// The folder `path` is in (`.` for a bare file name).
+pub fn folder_of(path: &Path) -> &Path {
+    match path.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() => dir,
+        _ => Path::new("."),
+    }
+}
+
 /// Whether `a` and `b` name one existing file: after following links, and on Unix also
 /// through hard links (same device and inode).
 pub fn same_file(a: &Path, b: &Path) -> bool {
@@ -272,64 +286,5 @@ pub fn same_file(a: &Path, b: &Path) -> bool {
     #[cfg(not(unix))]
     {
         matches!((a.canonicalize(), b.canonicalize()), (Ok(x), Ok(y)) if x == y)
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn failed_write_leaves_no_file() {
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("out.bin");
-        let err = write_atomic_with(&path, |_| Err(std::io::Error::other("boom")));
-        assert!(err.is_err());
-        assert!(!path.exists());
-        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
-    }
-
-    #[test]
-    fn write_lands_whole() {
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("out.bin");
-        write_atomic(&path, b"hello").unwrap();
-        assert_eq!(std::fs::read(&path).unwrap(), b"hello");
-    }
-
-    #[test]
-    fn two_writes_of_one_path_never_share_a_temporary_file() {
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("out.bin");
-        let first = TempOutput::new(&path).unwrap();
-        let second = TempOutput::new(&path).unwrap();
-        assert_ne!(first.temp_path(), second.temp_path());
-        std::fs::write(first.temp_path(), b"one").unwrap();
-        std::fs::write(second.temp_path(), b"two").unwrap();
-        first.commit().unwrap();
-        assert_eq!(std::fs::read(&path).unwrap(), b"one");
-        second.commit().unwrap();
-        assert_eq!(std::fs::read(&path).unwrap(), b"two");
-        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
-    }
-
-    #[cfg(unix)]
-    #[test]
-    fn devices_are_written_through_and_folders_refused() {
-        let null = TempOutput::new(Path::new("/dev/null")).unwrap();
-        assert!(!null.is_temporary());
-        assert_eq!(null.temp_path(), Path::new("/dev/null"));
-        null.open().unwrap().write_all(b"gone").unwrap();
-        null.commit().unwrap();
-        let dir = tempfile::tempdir().unwrap();
-        let error = TempOutput::new(dir.path()).unwrap_err();
-        assert!(error.to_string().contains("it is a folder"), "{error}");
-    }
-
-    #[test]
-    fn missing_folder_is_an_error() {
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("nope").join("out.bin");
-        assert!(write_atomic(&path, b"x").is_err());
     }
 }

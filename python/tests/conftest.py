@@ -100,7 +100,7 @@ def smooth_target(width, height):
 
 
 def spiral_mask(width, height):
-    """The paper's spiral band (as lapclone's mesh::synth::spiral), 255 inside."""
+    """The paper's spiral band (as tests/common/synth_masks.rs's spiral), 255 inside."""
     y, x = np.mgrid[0:height, 0:width].astype(np.float64)
     cx, cy = width / 2.0, height / 2.0
     dx, dy = x + 0.5 - cx, y + 0.5 - cy

@@ -14,7 +14,7 @@
 
 use glam::DVec2;
 
-use crate::raster::PointGrid;
+use crate::raster::{weights_if_strictly_inside, PointGrid};
 
 /// A candidate over a lower layer: the triangle beneath it and its weights there.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -100,23 +100,4 @@ pub fn find_beneath(
         grid.sweep_triangle((placed, depth), triangle);
     }
     out.extend(grid.best.iter().flatten().map(|&(_, hit)| hit));
-}
-
-/// Barycentric weights of `p` when it lies strictly inside the (either-oriented) triangle,
-/// by the coverage query's predicate (edge functions of the area's strict sign, then the
-/// quotients strictly positive).
-pub fn weights_if_strictly_inside(corners: [DVec2; 3], p: DVec2) -> Option<[f64; 3]> {
-    let [a, b, c] = corners;
-    let area = (b - a).perp_dot(c - a);
-    let edges = [
-        (c - b).perp_dot(p - b),
-        (a - c).perp_dot(p - c),
-        (b - a).perp_dot(p - a),
-    ];
-    let same_sign = |e: f64| if area > 0.0 { e > 0.0 } else { e < 0.0 };
-    if area == 0.0 || !edges.iter().all(|&e| same_sign(e)) {
-        return None;
-    }
-    let weights = edges.map(|e| e / area);
-    weights.iter().all(|&w| w > 0.0).then_some(weights)
 }

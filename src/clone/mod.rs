@@ -16,7 +16,7 @@ mod membrane;
 mod patch_mesh;
 mod placement;
 
-pub use beneath::{find_beneath, weights_if_strictly_inside, Beneath, CandidateGrid};
+pub use beneath::{find_beneath, Beneath, CandidateGrid};
 pub use boundary_data::{BoundaryData, BoundarySampler, HAT_SAMPLE_SPACING};
 pub use cloner::{CloneMode, CloneOptions, CloneStats, PatchCloner};
 pub use error::CloneError;
@@ -24,4 +24,4 @@ pub use expand::{expand_boundary, HALF_PIXEL};
 pub use glue::{Glue, GlueFrame, GlueStats, GluedVertex, GLUE_TOLERANCE, MAX_GLUE_ITERATIONS};
 pub use membrane::{MembraneSolver, MembraneStats, MEMBRANE_CHANNELS};
 pub use patch_mesh::{finish_mask_mesh, mesh_from_mask, mesh_from_polygons, PatchMesh};
-pub use placement::{Anchor, Placement};
+pub use placement::{Anchor, Placement, PLACED_GRID};

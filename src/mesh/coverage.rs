@@ -1,6 +1,5 @@
-//! Mask-aware checks of a mesh: [`uncovered_mask_pixels`] counts inside pixels whose centre
-//! is neither in a triangle nor within 0.5 px of the mesh; [`max_outside_distance`] gives how
-//! far the mesh reaches outside the mask (distance to the union of inside pixel squares).
+//! Mask-aware check of a mesh: [`uncovered_mask_pixels`] counts inside pixels whose centre
+//! is neither in a triangle nor within 0.5 px of the mesh.
 
 use glam::DVec2;
 
@@ -135,60 +134,6 @@ fn distance_to_segment(p: DVec2, a: DVec2, b: DVec2) -> f64 {
     p.distance(a + ab * t)
 }
 
-/// Largest distance from a point of the mesh to the mask's inside region (the union of its
-/// inside pixel squares), sampled at every vertex, every triangle centroid and every 0.25 px
-/// along every boundary edge — the mesh reaches outside the mask only through its boundary,
-/// so this is exact up to the sampling step.
-pub fn max_outside_distance(mesh: &Mesh, mask: &BitMask) -> f64 {
-    let mut worst = 0.0f64;
-    let mut probe = |p: DVec2| worst = worst.max(distance_to_mask(mask, p));
-    for &p in &mesh.positions {
-        probe(p);
-    }
-    for t in &mesh.triangles {
-        probe(t.iter().map(|&v| mesh.positions[v as usize]).sum::<DVec2>() / 3.0);
-    }
-    for lp in &mesh.loops {
-        let n = lp.vertices.len();
-        for i in 0..n {
-            let a = mesh.positions[lp.vertices[i] as usize];
-            let b = mesh.positions[lp.vertices[(i + 1) % n] as usize];
-            let steps = (a.distance(b) / 0.25).ceil().max(1.0) as usize;
-            for k in 1..steps {
-                probe(a.lerp(b, k as f64 / steps as f64));
-            }
-        }
-    }
-    worst
-}
-
-/// Distance from `p` to the nearest inside pixel square (0 inside or on one).
-pub fn distance_to_mask(mask: &BitMask, p: DVec2) -> f64 {
-    let square_distance = |x: i64, y: i64| {
-        let dx = (x as f64 - p.x).max(p.x - (x as f64 + 1.0)).max(0.0);
-        let dy = (y as f64 - p.y).max(p.y - (y as f64 + 1.0)).max(0.0);
-        dx.hypot(dy)
-    };
-    let (px, py) = (p.x.floor() as i64, p.y.floor() as i64);
-    let limit = (mask.width.max(mask.height) as i64) + px.abs() + py.abs() + 2;
-    let mut best = f64::INFINITY;
-    let mut radius = 1i64;
-    loop {
-        for y in py - radius..=py + radius {
-            for x in px - radius..=px + radius {
-                if mask.get(x, y) {
-                    best = best.min(square_distance(x, y));
-                }
-            }
-        }
-        // Squares outside this window are at least `radius` away.
-        if best <= radius as f64 || radius > limit {
-            return best;
-        }
-        radius *= 2;
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::super::triangulate::assemble_mesh;
@@ -209,7 +154,6 @@ mod tests {
         let mask = BitMask::from_fn(6, 5, |x, y| (1..5).contains(&x) && (1..4).contains(&y));
         let mesh = rect_mesh(1.0, 1.0, 5.0, 4.0);
         assert_eq!(uncovered_mask_pixels(&mesh, &mask), 0);
-        assert_eq!(max_outside_distance(&mesh, &mask), 0.0);
     }
 
     #[test]
@@ -225,19 +169,5 @@ mod tests {
             uncovered_mask_pixels(&rect_mesh(1.0, 1.0, 3.8, 4.0), &mask),
             3
         );
-    }
-
-    #[test]
-    fn overhang_is_measured() {
-        let mask = BitMask::from_fn(6, 5, |x, y| (1..5).contains(&x) && (1..4).contains(&y));
-        let d = max_outside_distance(&rect_mesh(1.0, 1.0, 5.75, 4.0), &mask);
-        assert!((d - 0.75).abs() < 1e-12, "{d}");
-    }
-
-    #[test]
-    fn distance_to_far_mask() {
-        let mask = BitMask::from_fn(40, 40, |x, y| x == 30 && y == 30);
-        let d = distance_to_mask(&mask, DVec2::new(0.0, 30.5));
-        assert!((d - 30.0).abs() < 1e-12, "{d}");
     }
 }

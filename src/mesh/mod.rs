@@ -13,28 +13,33 @@
 //! (`triangulate`) → [`Mesh`], verified by [`Mesh::sanity_check`]. Every mask is meshed
 //! whole, on the calling thread. [`relax_interior`] evens out the interior for the
 //! combinatorial Laplacian (the clone stage applies it). Mask-aware checks are in
-//! `coverage`; test/bench masks in [`synth`].
+//! `coverage`.
 
 mod bitmask;
 mod centre_loops;
 mod contour;
 mod coverage;
 mod error;
-#[doc(hidden)]
+// Test meshes and masks; the integration tests and benchmarks include the same files.
+#[cfg(test)]
+#[path = "../../tests/common/mesh_fixtures.rs"]
 pub mod fixtures;
 mod mesh_mask;
 mod options;
 mod relax;
 mod sanity;
 mod simplify;
+#[cfg(test)]
+#[path = "../../tests/common/synth_masks.rs"]
 pub mod synth;
 mod triangulate;
 mod types;
 
 pub use bitmask::{BitMask, MASK_THRESHOLD};
-pub use contour::{label_pieces, trace_crack_loops, CrackLoop};
+pub use centre_loops::outside_centre_loops;
+pub use contour::{for_each_edge_pixel, label_pieces, trace_crack_loops, CrackLoop};
 pub use coverage::{
-    distance_to_mask, max_outside_distance, uncovered_mask_pixels, COVERAGE_TOLERANCE_PX,
+    uncovered_mask_pixels, COVERAGE_TOLERANCE_PX,
 };
 pub use error::{MeshError, SanityError};
 pub use mesh_mask::{mesh_mask, mesh_polygons, Polygon, MAX_POLYGON_COORDINATE};

@@ -92,35 +92,3 @@ impl OutputKind {
         matches!(self, OutputKind::Mp4 | OutputKind::Webm | OutputKind::Mov)
     }
 }
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn extensions_name_their_formats() {
-        let kind = |p: &str| OutputKind::from_path(Path::new(p));
-        assert_eq!(kind("out/cat.gif"), Ok(OutputKind::Gif));
-        assert_eq!(kind("cat.MP4"), Ok(OutputKind::Mp4));
-        assert_eq!(kind("cat.png"), Ok(OutputKind::PngFolder));
-        assert_eq!(kind("cat.apng"), Ok(OutputKind::Apng));
-        assert_eq!(kind("frames"), Ok(OutputKind::PngFolder));
-        assert_eq!(kind("-"), Ok(OutputKind::Y4m));
-        assert_eq!(kind("cat.jpg"), Err("jpg".to_string()));
-    }
-
-    #[test]
-    fn names_and_paths_resolve_to_formats() {
-        assert_eq!(OutputKind::from_name("GIF").ok(), Some(OutputKind::Gif));
-        assert_eq!(OutputKind::from_name("png").ok(), Some(OutputKind::PngFolder));
-        assert!(matches!(
-            OutputKind::from_name("jpeg"),
-            Err(OutputError::UnknownFormat(name)) if name == "jpeg"
-        ));
-        let resolve = |p: &str, f| OutputKind::resolve(Path::new(p), f);
-        assert_eq!(resolve("a.mp4", Some(OutputKind::Y4m)).ok(), Some(OutputKind::Y4m));
-        assert_eq!(resolve("a.apng", None).ok(), Some(OutputKind::Apng));
-        assert!(matches!(resolve("a.bmp", None), Err(OutputError::UnknownExtension { .. })));
-        assert!(matches!(resolve("-", Some(OutputKind::Gif)), Err(OutputError::StdoutNeedsY4m)));
-    }
-}

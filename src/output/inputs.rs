@@ -10,7 +10,7 @@ use super::{foreign_frames, OutputError, OutputKind};
 use crate::pixels::footage::Pattern;
 use crate::scene::{Background, Footage, FootageSource, Shape};
 use crate::script::LoadedScene;
-use crate::util::same_file;
+use crate::util::{folder_of, same_file};
 
 /// Something a render reads: a file, or the files of a numbered sequence it shows.
 enum Input {
@@ -35,12 +35,7 @@ impl Input {
                 let Some(name) = path.file_name() else {
                     return false;
                 };
-                let folder = pattern.path(*first);
-                let same_folder = match (folder.parent(), path.parent()) {
-                    (Some(a), Some(b)) => same_file(&dir_or_here(a), &dir_or_here(b)),
-                    _ => false,
-                };
-                same_folder
+                same_file(folder_of(&pattern.path(*first)), folder_of(path))
                     && (*first..first.saturating_add(*count))
                         .any(|n| pattern.path(n).file_name() == Some(name))
             }
@@ -52,14 +47,6 @@ impl Input {
             Input::File(file) => file.display().to_string(),
             Input::Sequence { pattern, .. } => pattern.text().to_string(),
         }
-    }
-}
-
-fn dir_or_here(dir: &Path) -> PathBuf {
-    if dir.as_os_str().is_empty() {
-        PathBuf::from(".")
-    } else {
-        dir.to_path_buf()
     }
 }
 
@@ -97,19 +84,22 @@ fn scene_inputs(loaded: &LoadedScene, imports: &[PathBuf]) -> Vec<Input> {
 }
 
 /// Refuses a render's output (of `kind`) that is one of its scene's inputs: a file, or for
-/// a PNG folder a frame file that an input sequence shows. `render` and the REPL's
-/// `:render` both ask here.
+/// a PNG folder a frame file in it that an input sequence shows (a render would replace it,
+/// or `--force` remove it). `render` and the REPL's `:render` both ask here.
 pub fn refuse_render_input(
     kind: OutputKind,
     output: &Path,
     loaded: &LoadedScene,
     imports: &[PathBuf],
 ) -> Result<(), OutputError> {
-    if kind == OutputKind::PngFolder {
-        refuse_scene_input_frames(output, loaded, imports)
-    } else {
-        refuse_scene_input(output, loaded, imports)
+    if kind != OutputKind::PngFolder {
+        return refuse_scene_input(output, loaded, imports);
     }
+    if !output.is_dir() {
+        return Ok(());
+    }
+    let frames = foreign_frames(output, |_| false).unwrap_or_default();
+    refuse_replacing(&frames, loaded, imports)
 }
 
 /// Refuses a file output (`-o`) that is one of the scene's inputs.
@@ -121,30 +111,18 @@ pub fn refuse_scene_input(
     if output.as_os_str() == "-" || !output.exists() {
         return Ok(());
     }
-    match scene_inputs(loaded, imports)
-        .iter()
-        .find(|input| input.covers(output))
-    {
-        Some(input) => Err(overwrite(output, &input.describe())),
-        None => Ok(()),
-    }
+    refuse_replacing(&[output.to_path_buf()], loaded, imports)
 }
 
-/// Refuses a PNG frame folder holding frame files that are also the scene's inputs (a
-/// render would replace them, or `--force` remove them).
-fn refuse_scene_input_frames(
-    folder: &Path,
+fn refuse_replacing(
+    files: &[PathBuf],
     loaded: &LoadedScene,
     imports: &[PathBuf],
 ) -> Result<(), OutputError> {
-    if !folder.is_dir() {
-        return Ok(());
-    }
-    let frames = foreign_frames(folder, |_| false).unwrap_or_default();
     let inputs = scene_inputs(loaded, imports);
-    for frame in &frames {
-        if let Some(input) = inputs.iter().find(|input| input.covers(frame)) {
-            return Err(overwrite(frame, &input.describe()));
+    for file in files {
+        if let Some(input) = inputs.iter().find(|input| input.covers(file)) {
+            return Err(overwrite(file, &input.describe()));
         }
     }
     Ok(())

@@ -71,15 +71,11 @@ pub(crate) fn open_png_folder(
         check_output_folder(output)?;
         Vec::new()
     };
-    let parent = match output.parent() {
-        Some(dir) if !dir.as_os_str().is_empty() => dir,
-        _ => Path::new("."),
-    };
     let name = output.file_name().unwrap_or_default().to_string_lossy();
     let temp = tempfile::Builder::new()
         .prefix(&format!(".{name}."))
         .suffix(".tmp")
-        .tempdir_in(parent)
+        .tempdir_in(crate::util::folder_of(output))
         .map_err(|source| OutputError::CreatingFolder {
             beside: output.to_path_buf(),
             source,

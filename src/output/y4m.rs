@@ -168,15 +168,3 @@ fn write_all(sink: &mut Sink, bytes: &[u8]) -> Result<(), OutputError> {
             .map_err(|e| OutputError::io(Path::new("standard output"), e)),
     }
 }
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn rates_become_fractions() {
-        assert_eq!(fps_fraction(24.0), (24, 1));
-        assert_eq!(fps_fraction(30000.0 / 1001.0), (30000, 1001));
-        assert_eq!(fps_fraction(12.5), (25, 2));
-    }
-}

@@ -96,14 +96,22 @@ pub fn covered_boundary_vertices(
 }
 
 /// Interpolated depth at `p` when it lies strictly inside the (either-oriented) triangle.
+#[inline]
+fn depth_if_strictly_inside(corners: [DVec2; 3], depth: [f32; 3], p: DVec2) -> Option<f64> {
+    let [wa, wb, wc] = weights_if_strictly_inside(corners, p)?;
+    Some(wa * f64::from(depth[0]) + wb * f64::from(depth[1]) + wc * f64::from(depth[2]))
+}
+
+/// Barycentric weights of `p` when it lies strictly inside the (either-oriented) triangle:
+/// the rule of the coverage query and of the clone's beneath query alike.
 ///
 /// Most triangles near a vertex do not contain it, so the three edge functions are tested
 /// against the area's sign first, without dividing: `e / area > 0` needs `e` and `area` of
-/// the same strict sign. Only then are the barycentric weights formed and tested exactly as
-/// before (a quotient can still underflow to 0), so the answer is the same as testing the
-/// weights alone (tests compare with a brute force).
+/// the same strict sign. Only then are the weights formed and tested (a quotient can still
+/// underflow to 0), so the answer is the same as testing the weights alone (tests compare
+/// with a brute force).
 #[inline]
-fn depth_if_strictly_inside(corners: [DVec2; 3], depth: [f32; 3], p: DVec2) -> Option<f64> {
+pub fn weights_if_strictly_inside(corners: [DVec2; 3], p: DVec2) -> Option<[f64; 3]> {
     let [a, b, c] = corners;
     let area = (b - a).perp_dot(c - a);
     let edges = [
@@ -115,9 +123,8 @@ fn depth_if_strictly_inside(corners: [DVec2; 3], depth: [f32; 3], p: DVec2) -> O
     if area == 0.0 || !edges.iter().all(|&e| same_sign(e)) {
         return None;
     }
-    let [wa, wb, wc] = edges.map(|e| e / area);
-    (wa > 0.0 && wb > 0.0 && wc > 0.0)
-        .then(|| wa * f64::from(depth[0]) + wb * f64::from(depth[1]) + wc * f64::from(depth[2]))
+    let weights = edges.map(|e| e / area);
+    weights.iter().all(|&w| w > 0.0).then_some(weights)
 }
 
 fn validate(

@@ -44,7 +44,7 @@ mod shade;
 mod triangles;
 
 pub use crate::pixels::PixelRect;
-pub use covered::{covered_boundary_vertices, CoverageGrid};
+pub use covered::{covered_boundary_vertices, weights_if_strictly_inside, CoverageGrid};
 pub use point_grid::PointGrid;
 pub use draw::{draw_patch, RasterOptions, RasterStats};
 pub use error::RasterError;

@@ -46,7 +46,7 @@ pub mod update;
 
 pub use csc::SymmetricCsc;
 pub use laplacian::{laplacian, LaplacianKind};
-pub use matrix_market::{read_constrained_list, read_matrix_market, write_matrix_market};
+pub use matrix_market::write_matrix_market;
 pub use penalty::{PenaltyFactor, PenaltyOptions, SwitchStats};
 pub use symbolic::FactorMethod;
 

@@ -5,7 +5,7 @@
 //! `#[path = "common/solve_checks.rs"] mod checks;`.
 #![allow(dead_code)]
 
-use lapclone::mesh::fixtures;
+use crate::mesh_fixtures as fixtures;
 use lapclone::mesh::Mesh;
 use lapclone::simd::Path;
 use lapclone::solve::FactorMethod;

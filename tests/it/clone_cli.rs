@@ -7,7 +7,8 @@ use crate::fixtures;
 use std::path::Path;
 use std::process::{Command, Output};
 
-use lapclone::mesh::{synth, BitMask};
+use crate::synth;
+use lapclone::mesh::BitMask;
 use lapclone::pixels::FloatImage;
 
 use fixtures::*;

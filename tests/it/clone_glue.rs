@@ -15,13 +15,11 @@ use std::process::Command;
 
 use fixtures::{cloner_for, smooth_target, RGB8};
 use glam::DVec2;
-use lapclone::clone::{
-    weights_if_strictly_inside, Anchor, CloneOptions, CloneStats, PatchCloner, Placement,
-    GLUE_TOLERANCE,
-};
+use lapclone::clone::{Anchor, CloneOptions, CloneStats, PatchCloner, Placement, GLUE_TOLERANCE};
 use lapclone::deform::{DeformRig, Deformed, Handle, Pin};
 use lapclone::mesh::BitMask;
 use lapclone::pixels::{Canvas, FloatImage};
+use lapclone::raster::weights_if_strictly_inside;
 use lapclone::solve::{laplacian, LaplacianKind};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed, TestCaseError, TestRunner};

@@ -10,10 +10,11 @@ use crate::golden;
 
 use std::process::Command;
 
+use crate::synth;
 use glam::DVec2;
 use lapclone::clone::{CloneOptions, Placement};
 use lapclone::deform::{DeformRig, Deformed, Handle};
-use lapclone::mesh::{synth, BitMask};
+use lapclone::mesh::BitMask;
 use lapclone::pixels::{Canvas, FloatImage};
 use lapclone::solve::LaplacianKind;
 

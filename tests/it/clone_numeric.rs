@@ -6,11 +6,11 @@
 
 use crate::fixtures;
 
+use crate::synth;
 use glam::DVec2;
 use lapclone::clone::{
     BoundaryData, BoundarySampler, CloneMode, CloneOptions, MembraneSolver, PatchCloner, Placement,
 };
-use lapclone::mesh::synth;
 use lapclone::pixels::{Canvas, ColorKind, Depth, FloatImage, PixelFormat};
 use lapclone::raster::{draw_patch, Patch, RasterOptions, RasterScratch};
 use lapclone::solve::LaplacianKind;

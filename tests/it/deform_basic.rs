@@ -1,8 +1,8 @@
 //! Deformation: identity, rigid whole-patch drags, locality, handle accuracy and depth.
 
+use crate::mesh_fixtures as fixtures;
 use glam::DVec2;
 use lapclone::deform::{DeformOptions, DeformRig, Deformed, Handle, Pin};
-use lapclone::mesh::fixtures;
 use lapclone::mesh::Mesh;
 use lapclone::solve::LaplacianKind;
 

@@ -2,9 +2,9 @@
 //! no inverted triangles for moderate drags (proptest, fixed seed), and the shares-built
 //! Laplacian against the solver's.
 
+use crate::mesh_fixtures as fixtures;
 use glam::DVec2;
 use lapclone::deform::{DeformRig, Deformed, Handle, Pin};
-use lapclone::mesh::fixtures;
 use lapclone::mesh::Mesh;
 use lapclone::solve::{laplacian, LaplacianKind};
 use proptest::prelude::*;

@@ -4,7 +4,7 @@
 use std::path::Path;
 use std::process::Command;
 
-use lapclone::mesh::synth;
+use crate::synth;
 
 fn lapclone(args: &[&str]) -> std::process::Output {
     Command::new(env!("CARGO_BIN_EXE_lapclone"))
@@ -239,8 +239,9 @@ fn quality_flags_shape_the_mask_mesh() {
 
 #[test]
 fn the_laplacian_text_of_two_triangles_is_exact_and_reads_back() {
+    use crate::matrix_market::read_matrix_market;
     use lapclone::glam::DVec2;
-    use lapclone::solve::{laplacian, read_matrix_market, write_matrix_market, LaplacianKind};
+    use lapclone::solve::{laplacian, write_matrix_market, LaplacianKind};
     let p = vec![DVec2::ZERO, DVec2::X, DVec2::ONE, DVec2::Y];
     let mesh = lapclone::mesh::assemble_mesh(p, vec![[0, 1, 2], [0, 2, 3]]);
     let l = laplacian(&mesh, LaplacianKind::Combinatorial);

@@ -5,8 +5,9 @@
 
 use std::collections::BTreeSet;
 
+use crate::synth;
 use lapclone::clone::mesh_from_mask;
-use lapclone::mesh::{mesh_mask, synth, BitMask, BoundaryPlacement, MeshError, MeshOptions};
+use lapclone::mesh::{mesh_mask, BitMask, BoundaryPlacement, MeshError, MeshOptions};
 use proptest::prelude::*;
 
 fn centres_options() -> MeshOptions {

@@ -2,9 +2,11 @@
 //! mask pixel centre within 0.5 px, stays within the simplification tolerance of the mask,
 //! and has the hole and piece counts of the shape.
 
+use crate::synth;
+use glam::DVec2;
 use lapclone::mesh::{
-    self, max_outside_distance, mesh_mask, mesh_polygons, synth, uncovered_mask_pixels, BitMask,
-    MeshError, MeshOptions, Polygon,
+    self, assemble_mesh, mesh_mask, mesh_polygons, uncovered_mask_pixels, BitMask, Mesh, MeshError,
+    MeshOptions, Polygon,
 };
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed};
@@ -23,6 +25,82 @@ fn check(mask: &BitMask, options: &MeshOptions) -> mesh::MeshResult {
         "mesh reaches {outside} px outside the mask"
     );
     result
+}
+
+/// Largest distance from a point of the mesh to the mask's inside region (the union of its
+/// inside pixel squares), sampled at every vertex, every triangle centroid and every 0.25 px
+/// along every boundary edge — the mesh reaches outside the mask only through its boundary,
+/// so this is exact up to the sampling step.
+fn max_outside_distance(mesh: &Mesh, mask: &BitMask) -> f64 {
+    let mut worst = 0.0f64;
+    let mut probe = |p: DVec2| worst = worst.max(distance_to_mask(mask, p));
+    for &p in &mesh.positions {
+        probe(p);
+    }
+    for t in &mesh.triangles {
+        probe(t.iter().map(|&v| mesh.positions[v as usize]).sum::<DVec2>() / 3.0);
+    }
+    for lp in &mesh.loops {
+        let n = lp.vertices.len();
+        for i in 0..n {
+            let a = mesh.positions[lp.vertices[i] as usize];
+            let b = mesh.positions[lp.vertices[(i + 1) % n] as usize];
+            let steps = (a.distance(b) / 0.25).ceil().max(1.0) as usize;
+            for k in 1..steps {
+                probe(a.lerp(b, k as f64 / steps as f64));
+            }
+        }
+    }
+    worst
+}
+
+/// Distance from `p` to the nearest inside pixel square (0 inside or on one).
+fn distance_to_mask(mask: &BitMask, p: DVec2) -> f64 {
+    let square_distance = |x: i64, y: i64| {
+        let dx = (x as f64 - p.x).max(p.x - (x as f64 + 1.0)).max(0.0);
+        let dy = (y as f64 - p.y).max(p.y - (y as f64 + 1.0)).max(0.0);
+        dx.hypot(dy)
+    };
+    let (px, py) = (p.x.floor() as i64, p.y.floor() as i64);
+    let limit = (mask.width.max(mask.height) as i64) + px.abs() + py.abs() + 2;
+    let mut best = f64::INFINITY;
+    let mut radius = 1i64;
+    loop {
+        for y in py - radius..=py + radius {
+            for x in px - radius..=px + radius {
+                if mask.get(x, y) {
+                    best = best.min(square_distance(x, y));
+                }
+            }
+        }
+        // Squares outside this window are at least `radius` away.
+        if best <= radius as f64 || radius > limit {
+            return best;
+        }
+        radius *= 2;
+    }
+}
+
+fn rect_mesh(x0: f64, y0: f64, x1: f64, y1: f64) -> Mesh {
+    let corners = [(x0, y0), (x1, y0), (x1, y1), (x0, y1)];
+    assemble_mesh(
+        corners.map(|(x, y)| DVec2::new(x, y)).to_vec(),
+        vec![[0, 1, 2], [0, 2, 3]],
+    )
+}
+
+#[test]
+fn overhang_is_measured() {
+    let mask = BitMask::from_fn(6, 5, |x, y| (1..5).contains(&x) && (1..4).contains(&y));
+    let d = max_outside_distance(&rect_mesh(1.0, 1.0, 5.75, 4.0), &mask);
+    assert!((d - 0.75).abs() < 1e-12, "{d}");
+}
+
+#[test]
+fn distance_to_far_mask() {
+    let mask = BitMask::from_fn(40, 40, |x, y| x == 30 && y == 30);
+    let d = distance_to_mask(&mask, DVec2::new(0.0, 30.5));
+    assert!((d - 30.0).abs() < 1e-12, "{d}");
 }
 
 fn topology(mask: &BitMask) -> (usize, usize) {
@@ -188,5 +266,46 @@ proptest! {
             let holes = mesh::trace_crack_loops(&mask).iter().filter(|l| l.is_hole()).count();
             prop_assert_eq!(r.stats.holes, holes);
         }
+    }
+}
+
+/// The shared synthetic masks have the shapes their names promise.
+mod synth_masks {
+    use crate::synth::*;
+    use lapclone::mesh::{label_pieces, trace_crack_loops, BitMask};
+
+    fn topology(mask: &BitMask) -> (usize, usize) {
+        let holes = trace_crack_loops(mask)
+            .iter()
+            .filter(|l| l.is_hole())
+            .count();
+        (label_pieces(mask).1.len(), holes)
+    }
+
+    #[test]
+    fn known_shapes_have_known_topology() {
+        assert_eq!(topology(&disc(64, 64, 20.0)), (1, 0));
+        assert_eq!(topology(&annulus(64, 64, 10.0, 25.0)), (1, 1));
+        assert_eq!(topology(&two_holes(120, 80)), (1, 2));
+        assert_eq!(topology(&nested(200, 200)), (3, 2));
+        assert_eq!(topology(&comb(200, 100, 6, 2)), (1, 0));
+        assert_eq!(topology(&line(50, 9, 30)), (1, 0));
+        assert_eq!(topology(&diagonal_line(10)), (1, 0));
+    }
+
+    #[test]
+    fn spiral_is_one_thin_strip() {
+        let mask = spiral(770, 743);
+        assert_eq!(topology(&mask), (1, 0));
+        // A strip a few to ~20 px wide: area well below the disc it spans.
+        let area = mask.count_inside() as f64;
+        assert!(area > 20_000.0 && area < 100_000.0, "{area}");
+    }
+
+    #[test]
+    fn seeded_masks_are_deterministic() {
+        assert_eq!(blobs(100, 80, 7), blobs(100, 80, 7));
+        assert_ne!(blobs(100, 80, 7), blobs(100, 80, 8));
+        assert_eq!(speckle(30, 30, 0.3, 1), speckle(30, 30, 0.3, 1));
     }
 }

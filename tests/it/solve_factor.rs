@@ -1,6 +1,6 @@
 //! Factorisation, solve and Laplacian tests for the solve stage, against dense references.
 
-use lapclone::mesh::fixtures;
+use crate::mesh_fixtures as fixtures;
 use lapclone::mesh::Mesh;
 use lapclone::solve::{laplacian, LaplacianKind, PenaltyFactor, PenaltyOptions, SymmetricCsc};
 

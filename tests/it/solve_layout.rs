@@ -3,7 +3,7 @@
 //! must rebuild `L·D·Lᵀ` = the permuted penalised matrix. Fails if a faer upgrade changes
 //! how it stores a simplicial or supernodal LDLᵀ factor.
 
-use lapclone::mesh::fixtures;
+use crate::mesh_fixtures as fixtures;
 use lapclone::solve::{laplacian, FactorMethod, LaplacianKind, PenaltyFactor, PenaltyOptions};
 
 #[test]

@@ -4,7 +4,7 @@
 //! bit for bit); random meshes
 //! and right-hand sides by proptest with a fixed seed.
 
-use lapclone::mesh::fixtures;
+use crate::mesh_fixtures as fixtures;
 use lapclone::mesh::Mesh;
 use lapclone::solve::solve::ldlt_solve_interleaved;
 use lapclone::solve::solve_supernodal::{inverse_diagonal, lanes_for, ldlt_solve_supernodal_at};

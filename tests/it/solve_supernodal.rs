@@ -5,8 +5,8 @@
 use lapclone::solve::symbolic::{SymbolicFactor, SUPERNODAL_MIN_VERTICES};
 
 use crate::checks;
+use crate::mesh_fixtures as fixtures;
 use checks::{dense_solve, rel_diff, Rng};
-use lapclone::mesh::fixtures;
 use lapclone::solve::{
     laplacian, FactorMethod, LaplacianKind, PenaltyFactor, PenaltyOptions, SymmetricCsc,
 };

@@ -1,6 +1,6 @@
 //! Rank-1 constraint switching: updated factors against fresh factorisations, and the guards.
 
-use lapclone::mesh::fixtures;
+use crate::mesh_fixtures as fixtures;
 use lapclone::solve::{
     laplacian, LaplacianKind, PenaltyFactor, PenaltyOptions, SolveError, SymmetricCsc,
 };

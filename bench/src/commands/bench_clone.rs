@@ -17,10 +17,11 @@
 use std::path::Path;
 use std::time::Instant;
 
+use crate::synth;
 use glam::DVec2;
 use lapclone::clone::{mesh_from_mask, CloneOptions, CloneStats, PatchCloner, Placement};
 use lapclone::deform::{DeformRig, Deformed, Handle};
-use lapclone::mesh::{synth, BitMask, MeshOptions};
+use lapclone::mesh::{BitMask, MeshOptions};
 use lapclone::pixels::{Canvas, ColorKind, Depth, FloatImage, PixelFormat};
 use lapclone::solve::LaplacianKind;
 

@@ -3,9 +3,9 @@
 //! solves), a step that toggles one pin (2 rank-1 switches per frame), and a step that changes
 //! the handle radius by 2% (a ring of far-field switches). Use a release build.
 
+use crate::fixtures;
 use glam::DVec2;
 use lapclone::deform::{DeformRig, Deformed, Handle, Pin};
-use lapclone::mesh::fixtures;
 use lapclone::solve::LaplacianKind;
 use std::time::Instant;
 

@@ -5,8 +5,9 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
+use crate::synth;
 use anyhow::Context;
-use lapclone::mesh::{self, synth, BitMask, MeshOptions};
+use lapclone::mesh::{self, BitMask, MeshOptions};
 
 #[derive(clap::Args, Debug)]
 pub struct MeshBenchArgs {

@@ -2,14 +2,15 @@
 //! analyse, factor, 3-RHS solve and rank-1 switches — on a Matrix Market Laplacian or on the
 //! built-in disc meshes. Release builds only give meaningful figures.
 
+use crate::fixtures;
+use crate::matrix_market::{read_constrained_list, read_matrix_market};
 use anyhow::Context;
-use lapclone::mesh::fixtures;
 use lapclone::simd::Path;
 use lapclone::solve::solve::ldlt_solve_interleaved;
 use lapclone::solve::solve_supernodal::{inverse_diagonal, ldlt_solve_supernodal_at};
 use lapclone::solve::{
-    laplacian, read_constrained_list, read_matrix_market, write_matrix_market, FactorMethod,
-    LaplacianKind, PenaltyFactor, PenaltyOptions, SymmetricCsc,
+    laplacian, write_matrix_market, FactorMethod, LaplacianKind, PenaltyFactor, PenaltyOptions,
+    SymmetricCsc,
 };
 use std::path::PathBuf;
 use std::time::Instant;

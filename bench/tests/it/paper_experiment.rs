@@ -3,11 +3,12 @@
 //! figure's shape, and the `bench paper --quick` command's columns.
 
 use lapclone::clone::BoundaryData;
-use lapclone::mesh::{synth, BoundaryPlacement, MeshOptions};
+use lapclone::mesh::{BoundaryPlacement, MeshOptions};
 use lapclone::pixels::{FloatImage, PixelFormat};
 use lapclone_bench::reference::experiment::{Experiment, MvcOutcome, RunOptions};
 use lapclone_bench::reference::figure::comparison_figure;
 use lapclone_bench::reference::GridMask;
+use lapclone_bench::synth;
 
 const SIZE: usize = 64;
 

@@ -1,9 +1,12 @@
 //! Test and benchmark meshes built directly (no mask, no mesher): takes sizes and gives
 //! triangulated grids, hexagonal-ring discs and disjoint unions as complete [`Mesh`] values
 //! (positions, positively oriented triangles, boundary loops, flags, pieces).
+//! Shared by the library's unit tests (as `crate::mesh::fixtures`), the integration tests and
+//! the benchmarks with `#[path = "…/tests/common/mesh_fixtures.rs"] mod fixtures;`.
+#![allow(dead_code)]
 
-use super::{BoundaryLoop, LoopKind, Mesh};
 use glam::DVec2;
+use lapclone::mesh::{BoundaryLoop, LoopKind, Mesh};
 
 /// A `cols × rows` cell grid of unit squares, each split into two triangles;
 /// `(cols + 1)(rows + 1)` vertices, vertex `(i, j)` at `(i, j)` with index `j (cols + 1) + i`.

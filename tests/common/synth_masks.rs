@@ -1,11 +1,13 @@
 //! Deterministic synthetic masks for tests and benchmarks: takes sizes (and a seed where
 //! random) and gives a [`BitMask`]. The paper's spiral strip, disc, annulus, a patch with two
 //! holes, a comb with deep slots, nested holes with islands, 1-px lines, speckle noise and
-//! random blobs. Everything is a pure function of its arguments.
+//! random blobs. Everything is a pure function of its arguments. Shared by the library's
+//! unit tests (as `crate::mesh::synth`), the integration tests and the benchmarks with
+//! `#[path = "…/tests/common/synth_masks.rs"] mod synth;`.
+#![allow(dead_code)]
 
 use glam::DVec2;
-
-use super::BitMask;
+use lapclone::mesh::BitMask;
 
 /// A tiny deterministic generator (SplitMix64), so masks do not depend on a `rand` version.
 #[derive(Clone, Debug)]
@@ -183,45 +185,4 @@ pub fn blobs(width: usize, height: usize, seed: u64) -> BitMask {
         discs.iter().any(|(c, r)| p.distance(*c) <= *r)
             && holes.iter().all(|(c, r)| p.distance(*c) > *r)
     })
-}
-
-#[cfg(test)]
-mod tests {
-    use super::super::contour::{label_pieces, trace_crack_loops};
-    use super::*;
-
-    fn topology(mask: &BitMask) -> (usize, usize) {
-        let holes = trace_crack_loops(mask)
-            .iter()
-            .filter(|l| l.is_hole())
-            .count();
-        (label_pieces(mask).1.len(), holes)
-    }
-
-    #[test]
-    fn known_shapes_have_known_topology() {
-        assert_eq!(topology(&disc(64, 64, 20.0)), (1, 0));
-        assert_eq!(topology(&annulus(64, 64, 10.0, 25.0)), (1, 1));
-        assert_eq!(topology(&two_holes(120, 80)), (1, 2));
-        assert_eq!(topology(&nested(200, 200)), (3, 2));
-        assert_eq!(topology(&comb(200, 100, 6, 2)), (1, 0));
-        assert_eq!(topology(&line(50, 9, 30)), (1, 0));
-        assert_eq!(topology(&diagonal_line(10)), (1, 0));
-    }
-
-    #[test]
-    fn spiral_is_one_thin_strip() {
-        let mask = spiral(770, 743);
-        assert_eq!(topology(&mask), (1, 0));
-        // A strip a few to ~20 px wide: area well below the disc it spans.
-        let area = mask.count_inside() as f64;
-        assert!(area > 20_000.0 && area < 100_000.0, "{area}");
-    }
-
-    #[test]
-    fn seeded_masks_are_deterministic() {
-        assert_eq!(blobs(100, 80, 7), blobs(100, 80, 7));
-        assert_ne!(blobs(100, 80, 7), blobs(100, 80, 8));
-        assert_eq!(speckle(30, 30, 0.3, 1), speckle(30, 30, 0.3, 1));
-    }
 }
