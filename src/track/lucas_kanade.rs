@@ -119,29 +119,26 @@ impl Template {
         let similarity = self.similarity.as_ref()?;
         let inverse = similarity.inverse?;
         let (mut p, mut m) = (start, m);
-        let side = (2 * self.half + 1) as usize;
         let mut seen = Vec::with_capacity(self.values.len());
+        let mut previous: Option<[f64; 4]> = None;
         for _ in 0..MAX_ITERATIONS {
             level.sample_warped(p, m, self.half, &mut seen);
-            let mut b = [0.0f64; 4];
-            let rows = seen.chunks_exact(side).zip(self.values.chunks_exact(side));
-            for ((seen, values), steepest) in rows.zip(similarity.steepest.chunks_exact(side)) {
-                // Summed a row at a time in f32, the rows in f64.
-                let mut row = [0.0f32; 4];
-                for ((&s, &v), st) in seen.iter().zip(values).zip(steepest) {
-                    let error = s - v;
-                    for (r, st) in row.iter_mut().zip(st) {
-                        *r += st * error;
-                    }
-                }
-                for (br, r) in b.iter_mut().zip(row) {
-                    *br += f64::from(r);
-                }
-            }
-            let d: [f64; 4] = std::array::from_fn(|r| (0..4).map(|c| inverse[r][c] * b[c]).sum());
+            let b = self.similarity_errors(&similarity.steepest, &seen);
+            let mut d: [f64; 4] =
+                std::array::from_fn(|r| (0..4).map(|c| inverse[r][c] * b[c]).sum());
             if d.iter().any(|v| !v.is_finite()) {
                 return None;
             }
+            // The step in pixels: the translation, and the turn and scale at the corners.
+            let h = f64::from(self.half);
+            let moved = [d[0], d[1], h * d[2], h * d[3]];
+            let step = d[0].hypot(d[1]) + h * d[2].hypot(d[3]);
+            let factor = match previous {
+                Some(last) if step >= done => speed_up(&last, &moved),
+                _ => 1.0,
+            };
+            previous = (factor == 1.0).then_some(moved);
+            d = d.map(|v| v * factor);
             // Compose with the inverse of the step: M ← M (I + A)⁻¹, p ← p − M t.
             let (a, bb) = (1.0 + d[2], d[3]);
             let det = a * a + bb * bb;
@@ -152,12 +149,31 @@ impl Template {
             if !(0.25..=4.0).contains(&scale) {
                 return None;
             }
-            let step = d[0].hypot(d[1]) + f64::from(self.half) * d[2].hypot(d[3]);
             if step < done {
                 break;
             }
         }
         Some((p, m))
+    }
+
+    /// `Σ steepest · (seen − values)`, summed a row at a time in f32 and the rows in f64.
+    fn similarity_errors(&self, steepest: &[[f32; 4]], seen: &[f32]) -> [f64; 4] {
+        let side = (2 * self.half + 1) as usize;
+        let mut b = [0.0f64; 4];
+        let rows = seen.chunks_exact(side).zip(self.values.chunks_exact(side));
+        for ((seen, values), steepest) in rows.zip(steepest.chunks_exact(side)) {
+            let mut row = [0.0f32; 4];
+            for ((&s, &v), st) in seen.iter().zip(values).zip(steepest) {
+                let error = s - v;
+                for (r, st) in row.iter_mut().zip(st) {
+                    *r += st * error;
+                }
+            }
+            for (br, r) in b.iter_mut().zip(row) {
+                *br += f64::from(r);
+            }
+        }
+        b
     }
 
     /// [`correlation`](Self::correlation) with the template warped by shape `m`.
@@ -177,6 +193,7 @@ impl Template {
         let [a, b, c] = self.inverse?;
         let mut p = start;
         let mut seen = Vec::with_capacity(self.values.len());
+        let mut previous = None;
         for _ in 0..MAX_ITERATIONS {
             level.sample_grid(p, self.half, &mut seen);
             let (bx, by) = weighted_errors(&self.gx, &self.gy, &seen, &self.values);
@@ -184,10 +201,15 @@ impl Template {
             if !step.is_finite() {
                 return None;
             }
-            p -= step;
             if step.length() < done {
+                p -= step;
                 break;
             }
+            let factor = previous.map_or(1.0, |last: DVec2| {
+                speed_up(&[last.x, last.y], &[step.x, step.y])
+            });
+            previous = (factor == 1.0).then_some(step);
+            p -= step * factor;
         }
         Some(p)
     }
@@ -198,6 +220,24 @@ impl Template {
         let mut seen = Vec::with_capacity(self.values.len());
         level.sample_grid(p, self.half, &mut seen);
         ncc(&self.values, &seen)
+    }
+}
+
+/// How much to lengthen `step` when it repeats `last` shrunk by a steady ratio r: the
+/// iterations converge linearly where the template's gradients carry noise the frame's do
+/// not share (the Hessian is too large by that noise), so the remaining steps would add up
+/// to `step · r / (1 − r)`; taking them at once lands near the same fixed point, which the
+/// next iterations then confirm. Only small steps in the same direction are lengthened, by at
+/// most 10×; anything else is taken as it is.
+fn speed_up(last: &[f64], step: &[f64]) -> f64 {
+    let dot: f64 = last.iter().zip(step).map(|(a, b)| a * b).sum();
+    let norm = |v: &[f64]| v.iter().map(|a| a * a).sum::<f64>().sqrt();
+    let (l, s) = (norm(last), norm(step));
+    let r = s / l;
+    if s < 0.5 && dot > 0.95 * l * s && (0.3..=0.9).contains(&r) {
+        1.0 / (1.0 - r)
+    } else {
+        1.0
     }
 }
 
