@@ -10,8 +10,6 @@ use super::pyramid::Level;
 
 /// Iterations per level before giving up on convergence.
 const MAX_ITERATIONS: usize = 30;
-/// A step shorter than this (pixels at the level) ends the iterations.
-const STEP_DONE: f64 = 1e-3;
 
 /// A square of grey values around a point with its gradients and their Hessian (fixed for
 /// every iteration: the inverse-compositional form never recomputes them).
@@ -23,26 +21,41 @@ pub(super) struct Template {
     gy: Vec<f32>,
     /// The inverse of Σ ∇T ∇Tᵀ, or `None` when it is singular (no texture).
     inverse: Option<[f64; 3]>,
-    /// The inverse of the similarity warp's 4 × 4 Hessian, or `None` when singular.
-    similarity_inverse: Option<[[f64; 4]; 4]>,
+    /// What [`align_similarity`](Self::align_similarity) needs, once
+    /// [`prepare_similarity`](Self::prepare_similarity) made it (only the templates that are
+    /// turned and scaled pay for it).
+    similarity: Option<Similarity>,
     /// Standard deviation of the values.
     pub(super) contrast: f64,
+}
+
+/// The similarity warp's steepest-descent rows, and the inverse of their 4 × 4 Hessian
+/// (`None` when singular).
+#[derive(Clone)]
+struct Similarity {
+    steepest: Vec<[f32; 4]>,
+    inverse: Option<[[f64; 4]; 4]>,
 }
 
 impl Template {
     /// The `(2 half + 1)²` template centred on `centre` (level coordinates).
     pub(super) fn cut(level: &Level, centre: DVec2, half: i32) -> Template {
         let side = (2 * half + 1) as usize;
+        // One grid a pixel wider on every side gives the values and their central
+        // differences (the neighbours share the centre's fraction).
+        let wide = side + 2;
+        let mut grid = Vec::with_capacity(wide * wide);
+        level.sample_grid(centre, half + 1, &mut grid);
         let mut values = Vec::with_capacity(side * side);
         let mut gx = Vec::with_capacity(side * side);
         let mut gy = Vec::with_capacity(side * side);
         let (mut sxx, mut sxy, mut syy) = (0.0f64, 0.0f64, 0.0f64);
-        for j in -half..=half {
-            for i in -half..=half {
-                let p = centre + DVec2::new(f64::from(i), f64::from(j));
-                values.push(level.sample(p));
-                let dx = 0.5 * (level.sample(p + DVec2::X) - level.sample(p - DVec2::X));
-                let dy = 0.5 * (level.sample(p + DVec2::Y) - level.sample(p - DVec2::Y));
+        for r in 1..=side {
+            for c in 1..=side {
+                let k = r * wide + c;
+                values.push(grid[k]);
+                let dx = 0.5 * (grid[k + 1] - grid[k - 1]);
+                let dy = 0.5 * (grid[k + wide] - grid[k - wide]);
                 gx.push(dx);
                 gy.push(dy);
                 sxx += f64::from(dx * dx);
@@ -56,72 +69,76 @@ impl Template {
         let inverse = (det > 1e-9 * (sxx + syy).powi(2) && det > 0.0)
             .then(|| [syy / det, -sxy / det, sxx / det]);
         let contrast = std_dev(&values);
-        let mut template = Template {
+        Template {
             half,
             values,
             gx,
             gy,
             inverse,
-            similarity_inverse: None,
+            similarity: None,
             contrast,
-        };
-        template.similarity_inverse = template.similarity_hessian().and_then(invert4);
-        template
+        }
     }
 
-    /// The similarity warp's steepest-descent row at pixel `k`, offset `(i, j)`.
-    fn steepest(&self, k: usize, i: i32, j: i32) -> [f64; 4] {
-        let (x, y) = (f64::from(i), f64::from(j));
-        let (gx, gy) = (f64::from(self.gx[k]), f64::from(self.gy[k]));
-        [gx, gy, gx * x + gy * y, gy * x - gx * y]
-    }
-
-    fn similarity_hessian(&self) -> Option<[[f64; 4]; 4]> {
-        self.inverse?;
-        let mut h = [[0.0; 4]; 4];
+    /// Makes what [`align_similarity`](Self::align_similarity) needs: the similarity warp's
+    /// steepest-descent row at every pixel and the inverse of their Hessian.
+    pub(super) fn prepare_similarity(&mut self) {
+        let mut steepest = Vec::with_capacity(self.values.len());
+        let mut h = [[0.0f64; 4]; 4];
         let mut k = 0;
         for j in -self.half..=self.half {
             for i in -self.half..=self.half {
-                let s = self.steepest(k, i, j);
+                let (x, y) = (i as f32, j as f32);
+                let (gx, gy) = (self.gx[k], self.gy[k]);
+                let s = [gx, gy, gx * x + gy * y, gy * x - gx * y];
                 for (row, sr) in h.iter_mut().zip(s) {
                     for (cell, sc) in row.iter_mut().zip(s) {
-                        *cell += sr * sc;
+                        *cell += f64::from(sr) * f64::from(sc);
                     }
                 }
+                steepest.push(s);
                 k += 1;
             }
         }
-        Some(h)
+        let inverse = self.inverse.and_then(|_| invert4(h));
+        self.similarity = Some(Similarity { steepest, inverse });
     }
 
     /// Refines position `start` and shape `m` (the template's offset d appears at
-    /// `p + [[m0, −m1], [m1, m0]] d`: a turn and a scale) until the template fits `level`;
-    /// `None` without texture, on divergence, or when the shape leaves ¼–4× scale.
+    /// `p + [[m0, −m1], [m1, m0]] d`: a turn and a scale) until the template fits `level`,
+    /// stopping when a step moves the template's corners less than `done` pixels; `None`
+    /// without texture (or before [`prepare_similarity`](Self::prepare_similarity)), on
+    /// divergence, or when the shape leaves ¼–4× scale.
     pub(super) fn align_similarity(
         &self,
         level: &Level,
         start: DVec2,
         m: [f64; 2],
+        done: f64,
     ) -> Option<(DVec2, [f64; 2])> {
-        let inverse = self.similarity_inverse?;
+        let similarity = self.similarity.as_ref()?;
+        let inverse = similarity.inverse?;
         let (mut p, mut m) = (start, m);
+        let mut seen = Vec::with_capacity(self.values.len());
+        let mut previous: Option<[f64; 4]> = None;
         for _ in 0..MAX_ITERATIONS {
-            let mut b = [0.0f64; 4];
-            let mut k = 0;
-            for j in -self.half..=self.half {
-                for i in -self.half..=self.half {
-                    let error = f64::from(level.sample(p + warp(m, i, j)) - self.values[k]);
-                    let s = self.steepest(k, i, j);
-                    for (br, sr) in b.iter_mut().zip(s) {
-                        *br += sr * error;
-                    }
-                    k += 1;
-                }
-            }
-            let d: [f64; 4] = std::array::from_fn(|r| (0..4).map(|c| inverse[r][c] * b[c]).sum());
+            level.sample_warped(p, m, self.half, &mut seen);
+            let b = self.similarity_errors(&similarity.steepest, &seen);
+            let mut d: [f64; 4] =
+                std::array::from_fn(|r| (0..4).map(|c| inverse[r][c] * b[c]).sum());
             if d.iter().any(|v| !v.is_finite()) {
                 return None;
             }
+            // The step in pixels: the translation, and the turn and scale at the corners.
+            let h = f64::from(self.half);
+            let moved = [d[0], d[1], h * d[2], h * d[3]];
+            let step = d[0].hypot(d[1]) + h * d[2].hypot(d[3]);
+            let factor = match previous {
+                Some(last) if step >= done => speed_up(&last, &moved),
+                _ => 1.0,
+            };
+            previous = (factor == 1.0).then_some(moved);
+            d = d.map(|v| v * factor);
             // Compose with the inverse of the step: M ← M (I + A)⁻¹, p ← p − M t.
             let (a, bb) = (1.0 + d[2], d[3]);
             let det = a * a + bb * bb;
@@ -132,50 +149,67 @@ impl Template {
             if !(0.25..=4.0).contains(&scale) {
                 return None;
             }
-            let step = d[0].hypot(d[1]) + f64::from(self.half) * d[2].hypot(d[3]);
-            if step < STEP_DONE {
+            if step < done {
                 break;
             }
         }
         Some((p, m))
     }
 
-    /// [`correlation`](Self::correlation) with the template warped by shape `m`.
-    pub(super) fn correlation_warped(&self, level: &Level, p: DVec2, m: [f64; 2]) -> f64 {
-        let mut seen = Vec::with_capacity(self.values.len());
-        for j in -self.half..=self.half {
-            for i in -self.half..=self.half {
-                seen.push(level.sample(p + warp(m, i, j)));
+    /// `Σ steepest · (seen − values)`, summed a row at a time in f32 and the rows in f64.
+    fn similarity_errors(&self, steepest: &[[f32; 4]], seen: &[f32]) -> [f64; 4] {
+        let side = (2 * self.half + 1) as usize;
+        let mut b = [0.0f64; 4];
+        let rows = seen.chunks_exact(side).zip(self.values.chunks_exact(side));
+        for ((seen, values), steepest) in rows.zip(steepest.chunks_exact(side)) {
+            let mut row = [0.0f32; 4];
+            for ((&s, &v), st) in seen.iter().zip(values).zip(steepest) {
+                let error = s - v;
+                for (r, st) in row.iter_mut().zip(st) {
+                    *r += st * error;
+                }
+            }
+            for (br, r) in b.iter_mut().zip(row) {
+                *br += f64::from(r);
             }
         }
+        b
+    }
+
+    /// [`correlation`](Self::correlation) with the template warped by shape `m`.
+    pub(super) fn correlation_warped(&self, level: &Level, p: DVec2, m: [f64; 2]) -> f64 {
+        if m == [1.0, 0.0] {
+            return self.correlation(level, p);
+        }
+        let mut seen = Vec::with_capacity(self.values.len());
+        level.sample_warped(p, m, self.half, &mut seen);
         ncc(&self.values, &seen)
     }
 
-    /// Refines `start` (level coordinates) until the template fits `level` there; `None`
-    /// when the template has no texture or the iterations diverge.
-    pub(super) fn align(&self, level: &Level, start: DVec2) -> Option<DVec2> {
+    /// Refines `start` (level coordinates) until the template fits `level` there, stopping
+    /// when a step is shorter than `done` pixels; `None` when the template has no texture or
+    /// the iterations diverge.
+    pub(super) fn align(&self, level: &Level, start: DVec2, done: f64) -> Option<DVec2> {
         let [a, b, c] = self.inverse?;
         let mut p = start;
+        let mut seen = Vec::with_capacity(self.values.len());
+        let mut previous = None;
         for _ in 0..MAX_ITERATIONS {
-            let (mut bx, mut by) = (0.0f64, 0.0f64);
-            let mut k = 0;
-            for j in -self.half..=self.half {
-                for i in -self.half..=self.half {
-                    let q = p + DVec2::new(f64::from(i), f64::from(j));
-                    let error = level.sample(q) - self.values[k];
-                    bx += f64::from(self.gx[k] * error);
-                    by += f64::from(self.gy[k] * error);
-                    k += 1;
-                }
-            }
+            level.sample_grid(p, self.half, &mut seen);
+            let (bx, by) = weighted_errors(&self.gx, &self.gy, &seen, &self.values);
             let step = DVec2::new(a * bx + b * by, b * bx + c * by);
             if !step.is_finite() {
                 return None;
             }
-            p -= step;
-            if step.length() < STEP_DONE {
+            if step.length() < done {
+                p -= step;
                 break;
             }
+            let factor = previous.map_or(1.0, |last: DVec2| {
+                speed_up(&[last.x, last.y], &[step.x, step.y])
+            });
+            previous = (factor == 1.0).then_some(step);
+            p -= step * factor;
         }
         Some(p)
     }
@@ -183,15 +217,58 @@ impl Template {
     /// Normalised cross-correlation of the template with `level` at `p`, in [−1, 1]; 0 when
     /// either side is flat (nothing to correlate).
     pub(super) fn correlation(&self, level: &Level, p: DVec2) -> f64 {
-        self.correlation_warped(level, p, [1.0, 0.0])
+        let mut seen = Vec::with_capacity(self.values.len());
+        level.sample_grid(p, self.half, &mut seen);
+        ncc(&self.values, &seen)
     }
 }
 
-/// Offset `(i, j)` under shape `m`.
-#[inline]
-fn warp(m: [f64; 2], i: i32, j: i32) -> DVec2 {
-    let (x, y) = (f64::from(i), f64::from(j));
-    DVec2::new(m[0] * x - m[1] * y, m[1] * x + m[0] * y)
+/// How much to lengthen `step` when it repeats `last` shrunk by a steady ratio r: the
+/// iterations converge linearly where the template's gradients carry noise the frame's do
+/// not share (the Hessian is too large by that noise), so the remaining steps would add up
+/// to `step · r / (1 − r)`; taking them at once lands near the same fixed point, which the
+/// next iterations then confirm. Only small steps in the same direction are lengthened, by at
+/// most 10×; anything else is taken as it is.
+fn speed_up(last: &[f64], step: &[f64]) -> f64 {
+    let dot: f64 = last.iter().zip(step).map(|(a, b)| a * b).sum();
+    let norm = |v: &[f64]| v.iter().map(|a| a * a).sum::<f64>().sqrt();
+    let (l, s) = (norm(last), norm(step));
+    let r = s / l;
+    if s < 0.5 && dot > 0.95 * l * s && (0.3..=0.9).contains(&r) {
+        1.0 / (1.0 - r)
+    } else {
+        1.0
+    }
+}
+
+/// `(Σ gx (seen − values), Σ gy (seen − values))`, summed in eight f32 lanes (which
+/// vectorise) and the lanes in f64.
+fn weighted_errors(gx: &[f32], gy: &[f32], seen: &[f32], values: &[f32]) -> (f64, f64) {
+    const LANES: usize = 8;
+    let (mut ax, mut ay) = ([0.0f32; LANES], [0.0f32; LANES]);
+    let chunks = gx
+        .chunks_exact(LANES)
+        .zip(gy.chunks_exact(LANES))
+        .zip(seen.chunks_exact(LANES).zip(values.chunks_exact(LANES)));
+    for ((gx, gy), (seen, values)) in chunks {
+        for l in 0..LANES {
+            let error = seen[l] - values[l];
+            ax[l] += gx[l] * error;
+            ay[l] += gy[l] * error;
+        }
+    }
+    let (mut bx, mut by) = (0.0f64, 0.0f64);
+    for l in 0..LANES {
+        bx += f64::from(ax[l]);
+        by += f64::from(ay[l]);
+    }
+    let tail = values.len() / LANES * LANES;
+    for k in tail..values.len() {
+        let error = seen[k] - values[k];
+        bx += f64::from(gx[k] * error);
+        by += f64::from(gy[k] * error);
+    }
+    (bx, by)
 }
 
 /// The inverse of a symmetric 4 × 4 matrix (Gauss–Jordan with partial pivoting).
@@ -283,7 +360,7 @@ mod tests {
         let a = Pyramid::around(&blobs(DVec2::ZERO), centre, 30.0, 1);
         let b = Pyramid::around(&blobs(shift), centre, 30.0, 1);
         let template = Template::cut(&a.levels[0], centre, 7);
-        let found = template.align(&b.levels[0], centre).unwrap();
+        let found = template.align(&b.levels[0], centre, 1e-3).unwrap();
         assert!((found - (centre + shift)).length() < 0.02, "{found}");
         assert!(template.correlation(&b.levels[0], found) > 0.999);
     }
@@ -302,9 +379,12 @@ mod tests {
         })
         .unwrap();
         let b = Pyramid::around(&turned, centre, 40.0, 1);
-        let template = Template::cut(&a.levels[0], centre, 10);
+        let mut template = Template::cut(&a.levels[0], centre, 10);
+        template.prepare_similarity();
         let start = centre + DVec2::new(0.4, -0.3);
-        let (found, m) = template.align_similarity(&b.levels[0], start, [1.0, 0.0]).unwrap();
+        let (found, m) = template
+            .align_similarity(&b.levels[0], start, [1.0, 0.0], 1e-3)
+            .unwrap();
         assert!(found.distance(centre) < 0.05, "{found}");
         let (scale, angle) = (m[0].hypot(m[1]), m[1].atan2(m[0]));
         assert!((scale - grow).abs() < 0.005, "{scale}");

@@ -25,7 +25,8 @@ impl Level {
     pub(super) fn sample(&self, p: DVec2) -> f32 {
         let u = (p.x - 0.5 - self.origin[0] as f64).clamp(0.0, (self.width - 1) as f64);
         let v = (p.y - 0.5 - self.origin[1] as f64).clamp(0.0, (self.height - 1) as f64);
-        let (i, j) = (u.floor() as usize, v.floor() as usize);
+        // Clamped to at least 0, so truncating is flooring (without a libm call per sample).
+        let (i, j) = (u as usize, v as usize);
         let (fx, fy) = ((u - i as f64) as f32, (v - j as f64) as f32);
         let i1 = (i + 1).min(self.width - 1);
         let j1 = (j + 1).min(self.height - 1);
@@ -34,6 +35,91 @@ impl Level {
         let top = self.values[row0 + i] * (1.0 - fx) + self.values[row0 + i1] * fx;
         let bottom = self.values[row1 + i] * (1.0 - fx) + self.values[row1 + i1] * fx;
         top * (1.0 - fy) + bottom * fy
+    }
+
+    /// Bilinear samples at `p + (i, j)` for `i, j` in `−half..=half`, row-major into `out`
+    /// (cleared first). Every sample shares `p`'s fraction, so one pair of weights serves the
+    /// whole grid and rows are read as runs; a grid reaching the level's edge is sampled
+    /// point by point, edges replicated, as [`sample`](Self::sample) does.
+    pub(super) fn sample_grid(&self, p: DVec2, half: i32, out: &mut Vec<f32>) {
+        out.clear();
+        let side = (2 * half + 1) as usize;
+        let u = p.x - 0.5 - self.origin[0] as f64 - f64::from(half);
+        let v = p.y - 0.5 - self.origin[1] as f64 - f64::from(half);
+        // Every sample's right and lower neighbours inside (false for NaN too).
+        let inside = u >= 0.0
+            && v >= 0.0
+            && u + (side as f64) < self.width as f64
+            && v + (side as f64) < self.height as f64;
+        if !inside {
+            for j in -half..=half {
+                for i in -half..=half {
+                    out.push(self.sample(p + DVec2::new(f64::from(i), f64::from(j))));
+                }
+            }
+            return;
+        }
+        let (i0, j0) = (u as usize, v as usize);
+        let (fx, fy) = ((u - i0 as f64) as f32, (v - j0 as f64) as f32);
+        for r in 0..side {
+            let top = &self.values[(j0 + r) * self.width + i0..][..=side];
+            let bottom = &self.values[(j0 + r + 1) * self.width + i0..][..=side];
+            let pairs = top[..side].iter().zip(&top[1..]);
+            out.extend(
+                pairs
+                    .zip(bottom[..side].iter().zip(&bottom[1..]))
+                    .map(|((&a, &b), (&c, &d))| {
+                        let top = a * (1.0 - fx) + b * fx;
+                        let bottom = c * (1.0 - fx) + d * fx;
+                        top * (1.0 - fy) + bottom * fy
+                    }),
+            );
+        }
+    }
+
+    /// Bilinear samples at `p + M (i, j)` for `i, j` in `−half..=half`, row-major into `out`
+    /// (cleared first), where `M = [[m0, −m1], [m1, m0]]` turns and scales. A grid whose
+    /// corners and their neighbours are inside the level is read without clamping (in
+    /// level-window coordinates, so `f32` keeps a hundred-thousandth of a pixel); otherwise
+    /// point by point as [`sample`](Self::sample) does.
+    pub(super) fn sample_warped(&self, p: DVec2, m: [f64; 2], half: i32, out: &mut Vec<f32>) {
+        out.clear();
+        let extent = (m[0].abs() + m[1].abs()) * f64::from(half);
+        let u = p.x - 0.5 - self.origin[0] as f64;
+        let v = p.y - 0.5 - self.origin[1] as f64;
+        // A thousandth of a pixel to spare for the f32 rounding below.
+        let inside = u - extent >= 0.0
+            && v - extent >= 0.0
+            && u + extent + 1.001 < self.width as f64
+            && v + extent + 1.001 < self.height as f64;
+        if !inside {
+            for j in -half..=half {
+                for i in -half..=half {
+                    let (x, y) = (f64::from(i), f64::from(j));
+                    let q = DVec2::new(m[0] * x - m[1] * y, m[1] * x + m[0] * y);
+                    out.push(self.sample(p + q));
+                }
+            }
+            return;
+        }
+        let (m0, m1) = (m[0] as f32, m[1] as f32);
+        let (u, v) = (u as f32, v as f32);
+        for j in -half..=half {
+            let y = j as f32;
+            let (row_x, row_y) = (u - m1 * y, v + m0 * y);
+            for i in -half..=half {
+                let x = i as f32;
+                let (x0, y0) = (row_x + m0 * x, row_y + m1 * x);
+                // Inside by the test above: truncating is flooring, and i + 1, j + 1 exist.
+                let (i, j) = (x0 as usize, y0 as usize);
+                let (fx, fy) = (x0 - i as f32, y0 - j as f32);
+                let k = j * self.width + i;
+                let top = self.values[k] * (1.0 - fx) + self.values[k + 1] * fx;
+                let below = &self.values[k + self.width..];
+                let bottom = below[0] * (1.0 - fx) + below[1] * fx;
+                out.push(top * (1.0 - fy) + bottom * fy);
+            }
+        }
     }
 
     /// The level below, halved by 2 × 2 means (the width and height are even).
@@ -60,8 +146,8 @@ impl Level {
 }
 
 /// The luma of the `width × height` pixels from `origin`, pixels beyond the frame repeating
-/// its edge. An 8-bit frame is read through per-level tables (the same `f32` products as
-/// from its `f32` values, so the same bits) without making its `f32` buffer.
+/// its edge. An 8-bit frame is read from its texels (the same `f32` products as from its
+/// `f32` values, so the same bits) without making its `f32` buffer.
 fn grey_window(frame: &FloatImage, origin: [i64; 2], width: usize, height: usize) -> Vec<f32> {
     let (fw, fh) = (i64::from(frame.width()), i64::from(frame.height()));
     // Column of each window x, clamped into the frame: one lookup per pixel in the rows.
@@ -70,15 +156,21 @@ fn grey_window(frame: &FloatImage, origin: [i64; 2], width: usize, height: usize
         .collect();
     let mut values = Vec::with_capacity(width * height);
     let row_of = |y: i64| (origin[1] + y).clamp(0, fh - 1) as usize * fw as usize;
+    // Whole rows of the window inside the frame are read as runs (which vectorise).
+    let run = (origin[0] >= 0 && origin[0] + width as i64 <= fw).then(|| origin[0] as usize);
     if let Some(texels) = frame.stored_texels() {
-        let tables: [[f32; 256]; 3] =
-            std::array::from_fn(|c| std::array::from_fn(|k| LUMA[c] * (k as f32 / 255.0)));
+        // The same products as `LUMA[c] * (k / 255)` on the f32 values, so the same bits.
+        let luma = |[r, g, b, _]: [u8; 4]| {
+            LUMA[0] * (f32::from(r) / 255.0)
+                + LUMA[1] * (f32::from(g) / 255.0)
+                + LUMA[2] * (f32::from(b) / 255.0)
+        };
         for y in 0..height as i64 {
             let row = &texels[row_of(y)..][..fw as usize];
-            values.extend(columns.iter().map(|&i| {
-                let [r, g, b, _] = row[i];
-                tables[0][usize::from(r)] + tables[1][usize::from(g)] + tables[2][usize::from(b)]
-            }));
+            match run {
+                Some(x0) => values.extend(row[x0..x0 + width].iter().map(|&t| luma(t))),
+                None => values.extend(columns.iter().map(|&i| luma(row[i]))),
+            }
         }
     } else {
         let pixels = frame.pixels();
@@ -147,5 +239,41 @@ mod tests {
         // Level 1 pixel 15 is the mean of level-0 pixels 30 and 31.
         let level1 = &pyramid.levels[1];
         assert!((level1.sample(DVec2::new(15.5, 10.5)) - 30.5 / 64.0).abs() < 1e-5);
+    }
+
+    /// The grid samplers give what sampling point by point gives, inside the window and
+    /// where the grid runs over its edge.
+    #[test]
+    fn grids_are_their_points() {
+        let frame = FloatImage::from_fn(80, 60, PixelFormat::RGBA8, |i, j| {
+            let v = ((i * 7 + j * 13) % 31) as f32 / 31.0;
+            [v, 1.0 - v, v * v, 1.0]
+        })
+        .unwrap();
+        let level = &Pyramid::around(&frame, DVec2::new(40.0, 30.0), 25.0, 1).levels[0];
+        let half = 4;
+        let m = [1.03 * 0.2f64.cos(), 1.03 * 0.2f64.sin()];
+        let mut out = Vec::new();
+        for p in [DVec2::new(40.3, 29.8), DVec2::new(17.6, 8.1), DVec2::new(63.2, 51.9)] {
+            level.sample_grid(p, half, &mut out);
+            let mut k = 0;
+            for j in -half..=half {
+                for i in -half..=half {
+                    let q = p + DVec2::new(f64::from(i), f64::from(j));
+                    assert!((out[k] - level.sample(q)).abs() < 1e-6, "{p} {i} {j}");
+                    k += 1;
+                }
+            }
+            level.sample_warped(p, m, half, &mut out);
+            let mut k = 0;
+            for j in -half..=half {
+                for i in -half..=half {
+                    let (x, y) = (f64::from(i), f64::from(j));
+                    let q = p + DVec2::new(m[0] * x - m[1] * y, m[1] * x + m[0] * y);
+                    assert!((out[k] - level.sample(q)).abs() < 1e-4, "{p} {i} {j}");
+                    k += 1;
+                }
+            }
+        }
     }
 }

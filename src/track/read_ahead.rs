@@ -40,7 +40,7 @@ pub fn read_ahead<E: From<FootageError>>(
                 scope.spawn(move || {
                     let start = *lane_range.start();
                     for index in lane_range.filter(|i| (i - start) % threads as u64 == lane) {
-                        let frame = reader.frame(index).cloned();
+                        let frame = reader.take_frame(index);
                         let failed = frame.is_err();
                         // A closed channel means the consumer stopped: stop too.
                         if send.send(frame).is_err() || failed {

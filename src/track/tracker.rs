@@ -29,6 +29,20 @@ const ANCHOR_REACH: f64 = 1.5;
 /// A template whose grey values vary less than this (standard deviation, of 1) has nothing
 /// to lock on to.
 const FLAT_BELOW: f64 = 0.01;
+/// How far (pixels) the point may stray from where its motion so far predicts for the
+/// small search around the prediction to be tried first.
+const NEAR: f64 = 8.0;
+/// The small search's match is taken only when it correlates at least this well with the
+/// last frame's look; anything less searches the whole range.
+const NEAR_ABOVE: f64 = 0.9;
+/// A step shorter than this (pixels) ends the iterations that place a point.
+const PRECISE: f64 = 1e-3;
+/// The same at a coarse pyramid level (its pixels): the level below refines the estimate
+/// anyway, so finer steps there would be wasted.
+const COARSE: f64 = 0.02;
+/// The same for the forward–backward check, which only asks whether the point comes back
+/// within [`BACK_WITHIN`].
+const CHECKED: f64 = 0.01;
 /// Largest `size` and `search`, in pixels.
 pub const MAX_SIZE: u32 = 255;
 /// Largest search radius, in pixels.
@@ -88,7 +102,6 @@ pub struct Estimate {
 
 struct PointState {
     first: Vec<Template>,
-    first_at: DVec2,
     sure: Vec<Template>,
     sure_at: DVec2,
     velocity: DVec2,
@@ -105,6 +118,9 @@ pub struct PointTracker {
     half: i32,
     search: f64,
     levels: usize,
+    /// Levels of the small search around the prediction; `None` when the whole range is
+    /// no larger.
+    near_levels: Option<usize>,
     size: (u32, u32),
     points: Vec<PointState>,
 }
@@ -120,10 +136,12 @@ impl PointTracker {
         let half = (options.size / 2) as i32;
         let search = f64::from(options.search);
         let levels = levels_for(half, search);
+        let near_levels = (search > NEAR).then(|| levels_for(half, NEAR));
         let mut tracker = PointTracker {
             half,
             search,
             levels,
+            near_levels,
             size: (first.width(), first.height()),
             points: Vec::with_capacity(points.len()),
         };
@@ -142,8 +160,10 @@ impl PointTracker {
                     height: first.height(),
                 });
             }
-            let pyramid = Pyramid::around(first, at, tracker.reach(search), levels);
+            let pyramid = Pyramid::around(first, at, tracker.reach(search, levels), levels);
             let templates = tracker.templates(&pyramid, at);
+            let mut anchors = templates.clone();
+            anchors[0].prepare_similarity();
             let lost = tracker.lost_reason(&templates[0], at, 1.0, LOST_BELOW);
             estimates.push(Estimate {
                 at,
@@ -151,8 +171,7 @@ impl PointTracker {
                 lost,
             });
             tracker.points.push(PointState {
-                first: templates.clone(),
-                first_at: at,
+                first: anchors,
                 sure: templates,
                 sure_at: at,
                 velocity: DVec2::ZERO,
@@ -184,19 +203,17 @@ impl PointTracker {
     fn follow(&mut self, index: usize, frame: &FloatImage) -> Estimate {
         let state = &self.points[index];
         let predicted = state.sure_at + state.velocity;
-        let pyramid = Pyramid::around(frame, predicted, self.reach(self.search), self.levels);
-        let carried = self
-            .pyramidal(&state.sure, &pyramid, state.sure_at, predicted)
-            .filter(|&p| state.sure[0].correlation(&pyramid.levels[0], p) >= LOST_BELOW);
+        let (pyramid, carried) = self.carry(state, frame, predicted);
         // Re-anchor on the first frame's look, turned and scaled as the feature now is:
         // from the carried estimate when there is one, from the whole search range when
         // the point was lost or the last frame's look is gone.
         let first = &state.first[0];
+        let anchor = |p| first.align_similarity(&pyramid.levels[0], p, state.shape, PRECISE);
         let anchored = match carried {
-            Some(p) => first.align_similarity(&pyramid.levels[0], p, state.shape),
+            Some(p) => anchor(p),
             None => self
-                .pyramidal(&state.first, &pyramid, state.first_at, predicted)
-                .and_then(|p| first.align_similarity(&pyramid.levels[0], p, state.shape)),
+                .pyramidal(&state.first, &pyramid, predicted, self.search)
+                .and_then(anchor),
         };
         let (mut at, mut shape) = (carried.unwrap_or(predicted), state.shape);
         if let Some((p, m)) = anchored.filter(|(p, _)| p.is_finite()) {
@@ -237,41 +254,98 @@ impl PointTracker {
         }
     }
 
+    /// The pyramid of `frame` the point is looked for in, and where the last frame's look
+    /// carries it (`None` when it does not match there). Most frames the point is close to
+    /// where its motion predicts and still looks as it did: a small pyramid around the
+    /// prediction finds it at a fraction of the cost. Anything else searches the whole range,
+    /// with the last frame's look when it was cut at every level, and otherwise leaves the
+    /// search to the first frame's look.
+    fn carry(
+        &self,
+        state: &PointState,
+        frame: &FloatImage,
+        predicted: DVec2,
+    ) -> (Pyramid, Option<DVec2>) {
+        if let Some(levels) = self.near_levels {
+            let near = Pyramid::around(frame, predicted, self.reach(NEAR, levels), levels);
+            let found = self
+                .pyramidal(&state.sure, &near, predicted, NEAR)
+                .filter(|&p| state.sure[0].correlation(&near.levels[0], p) >= NEAR_ABOVE);
+            if found.is_some() {
+                return (near, found);
+            }
+        }
+        let reach = self.reach(self.search, self.levels);
+        let pyramid = Pyramid::around(frame, predicted, reach, self.levels);
+        let carried = (state.sure.len() == self.levels)
+            .then(|| self.pyramidal(&state.sure, &pyramid, predicted, self.search))
+            .flatten()
+            .filter(|&p| state.sure[0].correlation(&pyramid.levels[0], p) >= LOST_BELOW);
+        (pyramid, carried)
+    }
+
     /// Whether `templates` (cut at `at`), tracked back into the last frame, land where the
-    /// point was there; true when the last frame was not sure (nothing to go back to).
+    /// point was there; true when the last frame was not sure (nothing to go back to). The
+    /// way back starts off the last position by as much as the way forward missed its
+    /// prediction (as far as the last frame's pyramid reaches), so it has as far to go.
     fn comes_back(&self, templates: &[Template], index: usize, at: DVec2) -> bool {
         let state = &self.points[index];
         let Some(last) = &state.last else {
             return true;
         };
-        self.pyramidal(templates, last, at, at)
+        let levels = templates.len().min(last.levels.len());
+        let motion = if levels == self.levels {
+            self.search
+        } else {
+            NEAR
+        };
+        let missed = at - (state.sure_at + state.velocity);
+        let start = state.sure_at + missed.clamp_length_max(motion);
+        self.pyramidal_to(&templates[..levels], last, start, motion, CHECKED)
             .is_some_and(|back| back.distance(state.sure_at) <= BACK_WITHIN)
     }
 
-    /// Pyramidal alignment of `templates` (cut at `from`) starting at `start`.
+    /// [`pyramidal_to`](Self::pyramidal_to) to [`PRECISE`] steps.
     fn pyramidal(
         &self,
         templates: &[Template],
         pyramid: &Pyramid,
-        from: DVec2,
         start: DVec2,
+        motion: f64,
     ) -> Option<DVec2> {
-        let mut shift = start - from;
-        for level in (0..self.levels).rev() {
+        self.pyramidal_to(templates, pyramid, start, motion, PRECISE)
+    }
+
+    /// Pyramidal alignment of `templates` (cut around one point, at every level) starting
+    /// with their centre at `start`, over the levels both have, to steps shorter than `done`
+    /// pixels at full size; where their centre lands, or `None` when it strays much beyond
+    /// `motion` pixels from `start` (the pyramid's window ends there).
+    fn pyramidal_to(
+        &self,
+        templates: &[Template],
+        pyramid: &Pyramid,
+        start: DVec2,
+        motion: f64,
+        done: f64,
+    ) -> Option<DVec2> {
+        let levels = templates.len().min(pyramid.levels.len());
+        let mut at = start;
+        for level in (0..levels).rev() {
             let scale = f64::from(1u32 << level);
-            let guess = (from + shift) / scale;
-            let found = templates[level].align(&pyramid.levels[level], guess)?;
-            shift = found * scale - from;
-            if shift.length() > self.search * 1.5 + 2.0 {
+            let guess = at / scale;
+            let done = if level == 0 { done } else { COARSE };
+            let found = templates[level].align(&pyramid.levels[level], guess, done)?;
+            at = found * scale;
+            if at.distance(start) > motion * 1.5 + 2.0 {
                 return None;
             }
         }
-        Some(from + shift)
+        Some(at)
     }
 
-    /// Templates at every level around `at`.
+    /// Templates at every level of `pyramid` around `at`.
     fn templates(&self, pyramid: &Pyramid, at: DVec2) -> Vec<Template> {
-        (0..self.levels)
+        (0..pyramid.levels.len())
             .map(|level| {
                 let scale = f64::from(1u32 << level);
                 Template::cut(&pyramid.levels[level], at / scale, self.half)
@@ -301,8 +375,8 @@ impl PointTracker {
 
     /// Half-side of the window a frame's pyramid must cover: the motion allowed, plus the
     /// template at the coarsest level, plus the gradients' border.
-    fn reach(&self, motion: f64) -> f64 {
-        let coarse = f64::from(1u32 << (self.levels - 1));
+    fn reach(&self, motion: f64, levels: usize) -> f64 {
+        let coarse = f64::from(1u32 << (levels - 1));
         motion + (f64::from(self.half) + 2.0) * coarse
     }
 }

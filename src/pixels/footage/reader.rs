@@ -46,6 +46,14 @@ impl FootageReader {
         Ok(&self.current.as_ref().expect("frame just read").1)
     }
 
+    /// Scene frame `index` (from 0), handed over rather than kept: for a reader whose
+    /// frames go elsewhere, which would otherwise copy each one.
+    pub fn take_frame(&mut self, index: u64) -> Result<FloatImage, FootageError> {
+        self.frame(index)?;
+        // invariant: `frame` just stored frame `index`.
+        Ok(self.current.take().expect("frame just read").1)
+    }
+
     fn sequence_frame(
         &self,
         pattern: &Pattern,
