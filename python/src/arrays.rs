@@ -367,6 +367,16 @@ fn write_rect(
     }
 }
 
+/// The output array borrowed for writing, or why it cannot be.
+fn writable<'py, T: Element>(
+    array: &Bound<'py, PyAny>,
+) -> PyResult<numpy::PyReadwriteArrayDyn<'py, T>> {
+    array
+        .downcast::<PyArrayDyn<T>>()?
+        .try_readwrite()
+        .map_err(|e| PyValueError::new_err(format!("out cannot be written: {e}")))
+}
+
 fn write_rect_typed<T: Element + Copy>(
     array: &Bound<'_, PyAny>,
     layout: &Layout,
@@ -374,10 +384,7 @@ fn write_rect_typed<T: Element + Copy>(
     samples: &[T],
     rect: Rect,
 ) -> PyResult<()> {
-    let array = array.downcast::<PyArrayDyn<T>>()?;
-    let mut writable = array
-        .try_readwrite()
-        .map_err(|e| PyValueError::new_err(format!("out cannot be written: {e}")))?;
+    let mut writable = writable(array)?;
     let view = writable.as_array_mut();
     let view = match view.ndim() {
         2 => view.insert_axis(Axis(2)),
@@ -459,10 +466,7 @@ fn write_texels<T: Element + Copy>(
     canvas_width: u32,
     rect: Rect,
 ) -> PyResult<()> {
-    let array = array.downcast::<PyArrayDyn<T>>()?;
-    let mut writable = array
-        .try_readwrite()
-        .map_err(|e| PyValueError::new_err(format!("out cannot be written: {e}")))?;
+    let mut writable = writable(array)?;
     let mut view: ArrayViewMut3<'_, T> = writable
         .as_array_mut()
         .into_dimensionality::<Ix3>()
