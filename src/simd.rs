@@ -11,7 +11,7 @@
 //! differs. `LAPCLONE_SIMD=portable` in the environment (read once) or [`set_portable`]
 //! forces the portable path, so the claim can be tested on any machine.
 //!
-//! The raster's 8-bit store ([`unit_to_levels`]) and bilinear taps ([`texel_taps`]) are here
+//! The raster's 8-bit store (`unit_to_levels`) and bilinear taps (`texel_taps`) are here
 //! too: four lanes at once with the baseline SSE2 instructions where the target has them (no
 //! run-time dispatch needed), the plain per-lane casts and comparisons elsewhere; both give
 //! the same bits (tested).
