@@ -706,12 +706,12 @@ impl CustomType for HandleRef {
                 move |ctx: NativeCallContext, h: &mut HandleRef, t: Dynamic, v: Dynamic, e: &str| {
                     call(h, ctx, t, v, e)
                 },
-            )
-            .with_fn(
-                "radius",
-                |ctx: NativeCallContext, h: &mut HandleRef, r: Dynamic| h.set_radius(ctx, r),
             );
         }
+        b.with_fn(
+            "radius",
+            |ctx: NativeCallContext, h: &mut HandleRef, r: Dynamic| h.set_radius(ctx, r),
+        );
         super::edit_api::build_handle(&mut b);
     }
 }
