@@ -516,18 +516,7 @@ fn each_page_edit_is_one_line_and_gives_the_scene_typing_it_gives() {
     let mut script: Vec<String> = vec![":t 0.5".into()];
     script.extend(edits.iter().map(|(_, line)| line.to_string()));
     script.push(format!(":save {}", typed.display()));
-    let out = Command::new(env!("CARGO_BIN_EXE_lapclone"))
-        .args(["repl", scene.to_str().unwrap(), "--preview"])
-        .arg(dir.path().join("typed.png"))
-        .arg("--script")
-        .arg(write_script(dir.path(), &script))
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    run_typed(dir.path(), &scene, &script);
     assert_eq!(
         std::fs::read_to_string(&from_page).unwrap(),
         std::fs::read_to_string(&typed).unwrap()
@@ -535,10 +524,22 @@ fn each_page_edit_is_one_line_and_gives_the_scene_typing_it_gives() {
     assert!(frame == preview_png(dir.path(), &typed, 0.5).as_raw()[..]);
 }
 
-fn write_script(dir: &Path, lines: &[String]) -> PathBuf {
-    let path = dir.join("typed_script.txt");
-    std::fs::write(&path, lines.join("\n") + "\n").unwrap();
-    path
+/// Runs `lines` as a typed REPL session on `scene` (with a preview) and checks it succeeds.
+fn run_typed(dir: &Path, scene: &Path, lines: &[String]) {
+    let script = dir.join("typed_script.txt");
+    std::fs::write(&script, lines.join("\n") + "\n").unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_lapclone"))
+        .args(["repl", scene.to_str().unwrap(), "--preview"])
+        .arg(dir.join("typed.png"))
+        .arg("--script")
+        .arg(script)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
 }
 
 #[test]
@@ -621,18 +622,7 @@ fn a_circle_drag_changes_the_radius_live_and_commits_one_line_preview_agrees_wit
         "cat.handle(0).radius(70.12);".to_string(),
         format!(":save {}", typed.display()),
     ];
-    let out = Command::new(env!("CARGO_BIN_EXE_lapclone"))
-        .args(["repl", scene.to_str().unwrap(), "--preview"])
-        .arg(dir.path().join("typed.png"))
-        .arg("--script")
-        .arg(write_script(dir.path(), &script))
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    run_typed(dir.path(), &scene, &script);
     assert_eq!(
         std::fs::read_to_string(&saved).unwrap(),
         std::fs::read_to_string(&typed).unwrap()

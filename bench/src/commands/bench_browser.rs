@@ -7,30 +7,20 @@
 //! answer painted), the median, 95th percentile and the updates painted per second during
 //! the drag (table or JSON). Without chromium it reports the drags as skipped, saying why.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::{Duration, Instant};
 
 use anyhow::Context as _;
 use serde_json::{json, Value};
 
-use super::bench_view::{cat_at, cat_scene, horse_scene, horse_target, spread, ViewServer};
+use super::bench_view::{
+    cat_at, cat_scene, horse_scene, horse_target, spread, ViewBenchArgs, ViewServer,
+};
 use crate::cdp::{find_chromium, Browser};
 
-#[derive(clap::Args, Debug)]
-pub struct BrowserBenchArgs {
-    /// Pointer steps per drag (dispatched at 60 Hz).
-    #[arg(long, default_value_t = 200)]
-    pub steps: usize,
-    /// Folder holding the bundled photos.
-    #[arg(long, default_value = "assets")]
-    pub assets: PathBuf,
-    /// The `lapclone` binary (default: the one beside this program).
-    #[arg(long)]
-    pub lapclone: Option<PathBuf>,
-    /// Print JSON instead of a table.
-    #[arg(long)]
-    pub json: bool,
-}
+/// The same options as the server-side drag bench: steps (dispatched at 60 Hz here),
+/// assets, the binary, JSON.
+pub type BrowserBenchArgs = ViewBenchArgs;
 
 /// The pointer's report rate: a mouse's events reach a page once per 60 Hz display frame.
 const POINTER_PERIOD: Duration = Duration::from_nanos(16_666_667);
