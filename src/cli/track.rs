@@ -25,7 +25,8 @@ pub struct TrackArgs {
     pub footage: PathBuf,
     /// A point to follow, X,Y in pixels on the first frame of the range (repeat for two:
     /// the CSV then also has the pair's rotation and scale).
-    #[arg(long = "point", value_name = "X,Y", required = true, value_parser = super::point)]
+    #[arg(long = "point", value_name = "X,Y", required = true, value_parser = super::point,
+          allow_hyphen_values = true)]
     pub points: Vec<[f64; 2]>,
     /// Side of the square matched around each point, in pixels.
     #[arg(long, value_name = "PX", default_value_t = TrackOptions::default().size)]

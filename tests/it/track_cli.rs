@@ -161,3 +161,45 @@ fn a_covered_point_is_reported_lost_and_found_again() {
         }
     }
 }
+
+#[test]
+fn bad_points_and_ranges_are_usage_errors_that_write_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let photo = FloatImage::load(Path::new(&asset("chelsea.png"))).unwrap();
+    let mut noise = Noise::new(7);
+    for k in 0..3 {
+        let image = frame(&photo, SIZE, &Motion::translation(), k, 0.0, &mut noise);
+        std::fs::write(
+            dir.path().join(format!("f_{:04}.jpg", k + 1)),
+            jpeg(&image, 90),
+        )
+        .unwrap();
+    }
+    let cases: [(&[&str], &str); 5] = [
+        // A negative coordinate is a value, not a flag: the point is refused for where it is.
+        (&["--point", "-5,10"], "outside the first frame"),
+        (&["--point", "nan,3"], "not a finite number"),
+        (
+            &["--point", "100,100", "--frames", "3..2"],
+            "must have 1 ≤ A ≤ B",
+        ),
+        (&["--point", "100,100", "--size", "0"], "between 5 and 255"),
+        (&["--point", "1e12,5"], "outside the first frame"),
+    ];
+    for (args, message) in cases {
+        let mut command = Command::new(env!("CARGO_BIN_EXE_lapclone"));
+        command
+            .arg("track")
+            .arg(dir.path().join("f_%04d.jpg"))
+            .args(args);
+        let out = command
+            .arg("-o")
+            .arg(dir.path().join("track.csv"))
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(stderr.contains(message), "{args:?}: {stderr}");
+        assert!(!dir.path().join("track.csv").exists(), "{args:?}");
+    }
+}
