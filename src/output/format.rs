@@ -41,16 +41,8 @@ impl OutputKind {
         let Some(extension) = path.extension().and_then(|e| e.to_str()) else {
             return Ok(OutputKind::PngFolder);
         };
-        Ok(match extension.to_ascii_lowercase().as_str() {
-            "gif" => OutputKind::Gif,
-            "apng" => OutputKind::Apng,
-            "png" => OutputKind::PngFolder,
-            "mp4" => OutputKind::Mp4,
-            "webm" => OutputKind::Webm,
-            "mov" => OutputKind::Mov,
-            "y4m" => OutputKind::Y4m,
-            _ => return Err(extension.to_string()),
-        })
+        // An extension is a format's name (`.png` names the frame folder, as `png` does).
+        OutputKind::from_name(extension).map_err(|_| extension.to_string())
     }
 
     /// The format a name stands for: `png` (a folder of frames), `gif`, `apng`, `mp4`,
