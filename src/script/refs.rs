@@ -49,6 +49,7 @@ pub(super) enum Placed {
     Opacity,
 }
 
+/// The [`Placed`] variants' names, in declaration order.
 pub(super) const PLACEMENT_KEYS: [&str; 5] = ["at", "scale", "rotate", "depth", "opacity"];
 
 impl Placed {
@@ -66,13 +67,7 @@ impl Placed {
 
     /// The track's scene-language name.
     pub(super) fn name(self) -> &'static str {
-        match self {
-            Placed::At => "at",
-            Placed::Scale => "scale",
-            Placed::Rotate => "rotate",
-            Placed::Depth => "depth",
-            Placed::Opacity => "opacity",
-        }
+        PLACEMENT_KEYS[self as usize]
     }
 
     pub(super) fn push(
