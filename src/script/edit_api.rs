@@ -166,33 +166,6 @@ pub fn register(engine: &mut Engine, draft: &SharedDraft) {
 }
 
 impl PatchRef {
-    fn remove_key(
-        &mut self,
-        ctx: NativeCallContext,
-        t: Dynamic,
-        track: Option<&str>,
-    ) -> Fallible<Self> {
-        self.edit(&ctx, |p| {
-            let t = values::time(&t)?;
-            patch_tracks(p).remove_key(t, track)
-        })?;
-        Ok(self.clone())
-    }
-
-    fn move_key(
-        &mut self,
-        ctx: NativeCallContext,
-        from: Dynamic,
-        to: Dynamic,
-        track: Option<&str>,
-    ) -> Fallible<Self> {
-        self.edit(&ctx, |p| {
-            let (from, to) = (values::time(&from)?, values::time(&to)?);
-            patch_tracks(p).move_key(from, to, track)
-        })?;
-        Ok(self.clone())
-    }
-
     /// The patch's handle at index `which`, as the value `drag` returned for it.
     fn handle_at(&mut self, ctx: NativeCallContext, which: Dynamic) -> Fallible<HandleRef> {
         let d = self.draft.lock();
@@ -330,14 +303,35 @@ fn listed(items: impl Iterator<Item = String>, none: &str, some: &str) -> String
     format!("{some}{}", items.join(", "))
 }
 
-impl HandleRef {
+/// A patch or a handle: what owns keyframed tracks a script edits by name.
+trait KeyOwner: Clone + Send + Sync + 'static {
+    /// Applies `edit` to this owner's tracks, committing only if it succeeds.
     fn edit_tracks(
         &mut self,
-        ctx: NativeCallContext,
+        ctx: &NativeCallContext,
+        edit: impl FnOnce(&mut Tracks) -> Result<(), String>,
+    ) -> Fallible<Self>;
+}
+
+impl KeyOwner for PatchRef {
+    fn edit_tracks(
+        &mut self,
+        ctx: &NativeCallContext,
+        edit: impl FnOnce(&mut Tracks) -> Result<(), String>,
+    ) -> Fallible<Self> {
+        self.edit(ctx, |p| edit(&mut patch_tracks(p)))?;
+        Ok(self.clone())
+    }
+}
+
+impl KeyOwner for HandleRef {
+    fn edit_tracks(
+        &mut self,
+        ctx: &NativeCallContext,
         edit: impl FnOnce(&mut Tracks) -> Result<(), String>,
     ) -> Fallible<Self> {
         let this = self.clone();
-        edit_draft(&self.draft, &ctx, |d| {
+        edit_draft(&self.draft, ctx, |d| {
             let (p, h) = this
                 .indices(d)
                 .ok_or("this handle no longer exists in the scene")?;
@@ -348,30 +342,42 @@ impl HandleRef {
     }
 }
 
+/// `remove_key(t [, track])` and `move_key(from, to [, track])`, on a patch or a handle.
+fn build_key_edits<T: KeyOwner>(b: &mut TypeBuilder<T>) {
+    let remove = |ctx: &NativeCallContext, o: &mut T, t: Dynamic, track: Option<&str>| {
+        o.edit_tracks(ctx, |tracks| tracks.remove_key(values::time(&t)?, track))
+    };
+    let move_key = |ctx: &NativeCallContext, o: &mut T, from: Dynamic, to: Dynamic, track: Option<&str>| {
+        o.edit_tracks(ctx, |tracks| {
+            tracks.move_key(values::time(&from)?, values::time(&to)?, track)
+        })
+    };
+    b.with_fn("remove_key", move |ctx: NativeCallContext, o: &mut T, t: Dynamic| {
+        remove(&ctx, o, t, None)
+    })
+    .with_fn(
+        "remove_key",
+        move |ctx: NativeCallContext, o: &mut T, t: Dynamic, track: &str| {
+            remove(&ctx, o, t, Some(track))
+        },
+    )
+    .with_fn(
+        "move_key",
+        move |ctx: NativeCallContext, o: &mut T, from: Dynamic, to: Dynamic| {
+            move_key(&ctx, o, from, to, None)
+        },
+    )
+    .with_fn(
+        "move_key",
+        move |ctx: NativeCallContext, o: &mut T, from: Dynamic, to: Dynamic, track: &str| {
+            move_key(&ctx, o, from, to, Some(track))
+        },
+    );
+}
+
 pub fn build_patch(b: &mut TypeBuilder<PatchRef>) {
+    build_key_edits(b);
     b.with_fn(
-        "remove_key",
-        |ctx: NativeCallContext, p: &mut PatchRef, t: Dynamic| p.remove_key(ctx, t, None),
-    )
-    .with_fn(
-        "remove_key",
-        |ctx: NativeCallContext, p: &mut PatchRef, t: Dynamic, track: &str| {
-            p.remove_key(ctx, t, Some(track))
-        },
-    )
-    .with_fn(
-        "move_key",
-        |ctx: NativeCallContext, p: &mut PatchRef, from: Dynamic, to: Dynamic| {
-            p.move_key(ctx, from, to, None)
-        },
-    )
-    .with_fn(
-        "move_key",
-        |ctx: NativeCallContext, p: &mut PatchRef, from: Dynamic, to: Dynamic, track: &str| {
-            p.move_key(ctx, from, to, Some(track))
-        },
-    )
-    .with_fn(
         "remove_handle",
         |ctx: NativeCallContext, p: &mut PatchRef, h: Dynamic| p.remove_handle(ctx, h),
     )
@@ -396,34 +402,5 @@ pub fn build_patch(b: &mut TypeBuilder<PatchRef>) {
 }
 
 pub fn build_handle(b: &mut TypeBuilder<HandleRef>) {
-    b.with_fn(
-        "remove_key",
-        |ctx: NativeCallContext, h: &mut HandleRef, t: Dynamic| {
-            h.edit_tracks(ctx, |tracks| tracks.remove_key(values::time(&t)?, None))
-        },
-    )
-    .with_fn(
-        "remove_key",
-        |ctx: NativeCallContext, h: &mut HandleRef, t: Dynamic, track: &str| {
-            h.edit_tracks(ctx, |tracks| {
-                tracks.remove_key(values::time(&t)?, Some(track))
-            })
-        },
-    )
-    .with_fn(
-        "move_key",
-        |ctx: NativeCallContext, h: &mut HandleRef, from: Dynamic, to: Dynamic| {
-            h.edit_tracks(ctx, |tracks| {
-                tracks.move_key(values::time(&from)?, values::time(&to)?, None)
-            })
-        },
-    )
-    .with_fn(
-        "move_key",
-        |ctx: NativeCallContext, h: &mut HandleRef, from: Dynamic, to: Dynamic, track: &str| {
-            h.edit_tracks(ctx, |tracks| {
-                tracks.move_key(values::time(&from)?, values::time(&to)?, Some(track))
-            })
-        },
-    );
+    build_key_edits(b);
 }
