@@ -339,16 +339,11 @@ fn check_arguments(args: &CloneArgs) -> anyhow::Result<()> {
             .validate()
             .map_err(|e| UsageError(format!("--density: {e}")))?;
     }
-    check_output_folder(&args.output)?;
+    lapclone::output::check_output_folder(&args.output)?;
     Ok(lapclone::output::refuse_input(
         &args.output,
         &[&args.source, &args.mask, &args.target],
     )?)
-}
-
-/// Fails before any work when the output's folder does not exist.
-pub fn check_output_folder(output: &Path) -> anyhow::Result<()> {
-    Ok(lapclone::output::check_output_folder(output)?)
 }
 
 fn laplacian_kind(arg: LaplacianArg) -> LaplacianKind {

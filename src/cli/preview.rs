@@ -26,7 +26,7 @@ pub fn run_preview(args: PreviewArgs) -> anyhow::Result<()> {
     if args.t.is_some_and(|t| t < 0.0) || args.frame == Some(0) {
         return Err(UsageError("--t must be ≥ 0 and --frame ≥ 1".into()).into());
     }
-    super::clone::check_output_folder(&args.output)?;
+    lapclone::output::check_output_folder(&args.output)?;
     let (loaded, imports, mut renderer) = load_renderer(&args.scene)?;
     lapclone::output::refuse_scene_input(&args.output, &loaded, &imports)?;
     let format = renderer.output_format();

@@ -60,7 +60,7 @@ pub struct EntriesFailed(pub usize);
 pub fn run(args: ReplArgs) -> anyhow::Result<()> {
     let interactive = args.script.is_none() && std::io::stdin().is_terminal();
     let preview_path = args.preview.clone().unwrap_or_else(default_preview_path);
-    preview::check_preview_path(&preview_path)?;
+    lapclone::output::check_output_folder(&preview_path)?;
     let cancel = Arc::new(AtomicBool::new(false));
     let words = Arc::new(Mutex::new(completion::Words::default()));
     // The default preview is this process's own temp file: removed when the session ends.

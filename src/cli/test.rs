@@ -54,7 +54,7 @@ pub fn run(args: TestArgs) -> anyhow::Result<()> {
     }
     // lapclone never creates a missing parent of a path it is given.
     for path in args.junit.iter().chain(&args.out).chain(&args.goldens) {
-        super::clone::check_output_folder(path)?;
+        lapclone::output::check_output_folder(path)?;
     }
     let scenes = find_scenes(&paths, &args.out_dir())?;
     if scenes.is_empty() {

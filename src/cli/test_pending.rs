@@ -199,7 +199,7 @@ fn show(args: &TestArgs, file: &Path) -> anyhow::Result<()> {
         }
     }
     let sheet = triptych(expected.as_ref(), &actual, &thresholds);
-    if !show_inline(&sheet) {
+    if !super::repl::show_picture(&sheet) {
         let name = format!("{}.png", scene_slug(&file.with_extension("")));
         let path = args.out_dir().join("review").join(name);
         write_file(&path, &lapclone::golden::encode_rgba_png(&sheet))?;
@@ -209,9 +209,4 @@ fn show(args: &TestArgs, file: &Path) -> anyhow::Result<()> {
         ));
     }
     Ok(())
-}
-
-/// The one place `--review` reaches the terminal-image code it shares with the REPL preview.
-fn show_inline(picture: &image::RgbaImage) -> bool {
-    super::repl::show_picture(picture)
 }

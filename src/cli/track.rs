@@ -155,7 +155,7 @@ fn check_arguments(args: &TrackArgs) -> anyhow::Result<()> {
     if args.output.is_dir() {
         return Err(UsageError(format!("-o {} is a folder", args.output.display())).into());
     }
-    super::clone::check_output_folder(&args.output)
+    Ok(lapclone::output::check_output_folder(&args.output)?)
 }
 
 fn same_file(a: &std::path::Path, b: &std::path::Path) -> bool {

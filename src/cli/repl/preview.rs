@@ -4,7 +4,7 @@
 //! sequences unless interactive.
 
 use std::io::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use anyhow::Context as _;
 use lapclone::raster::overlay::{draw_mesh_overlay, OverlayStyle};
@@ -212,11 +212,6 @@ fn write_kitty(out: &mut impl std::io::Write, data: &str) -> std::io::Result<()>
 pub fn base64(bytes: &[u8]) -> String {
     use ::base64::Engine as _;
     ::base64::engine::general_purpose::STANDARD.encode(bytes)
-}
-
-/// Whether `path` can hold a preview: its folder exists.
-pub fn check_preview_path(path: &Path) -> anyhow::Result<()> {
-    crate::cli::clone::check_output_folder(path)
 }
 
 #[cfg(test)]

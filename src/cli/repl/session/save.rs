@@ -12,7 +12,7 @@ impl Session {
     /// Writes the live scene (see `save.rs` for the two forms it takes).
     pub(super) fn save(&mut self, path: &Path) -> anyhow::Result<()> {
         let scene = self.current_scene()?;
-        crate::cli::clone::check_output_folder(path)?;
+        lapclone::output::check_output_folder(path)?;
         let (text, form) = saved_text(&scene, self.base_text.as_deref(), &self.edits, path);
         lapclone::util::write_atomic(path, text.as_bytes())
             .with_context(|| format!("writing {}", path.display()))?;
