@@ -13,83 +13,57 @@ pub struct CommandInfo {
     pub help: &'static str,
 }
 
+impl CommandInfo {
+    const fn new(name: &'static str, usage: &'static str, help: &'static str) -> Self {
+        CommandInfo { name, usage, help }
+    }
+}
+
 /// Every command, in the order `:help` lists them.
 pub const COMMANDS: &[CommandInfo] = &[
-    CommandInfo {
-        name: "help",
-        usage: "",
-        help: "this list",
-    },
-    CommandInfo {
-        name: "load",
-        usage: "FILE",
-        help: "load a scene file (replaces the live scene)",
-    },
-    CommandInfo {
-        name: "reload",
-        usage: "",
-        help: "load the current scene file again (drops REPL edits)",
-    },
-    CommandInfo {
-        name: "save",
-        usage: "FILE",
-        help: "write the live scene as a Rhai scene file",
-    },
-    CommandInfo {
-        name: "t",
-        usage: "SECONDS",
-        help: "show the scene at a time",
-    },
-    CommandInfo {
-        name: "frame",
-        usage: "N",
-        help: "show frame N (from 1)",
-    },
-    CommandInfo {
-        name: "show",
-        usage: "",
-        help: "render and show the current frame again",
-    },
-    CommandInfo {
-        name: "mesh",
-        usage: "",
-        help: "toggle the deformed-mesh overlay on the preview",
-    },
-    CommandInfo {
-        name: "list",
-        usage: "",
-        help: "canvas, patches, keys, handles, pins, layer order and variables",
-    },
-    CommandInfo {
-        name: "keys",
-        usage: "NAME",
-        help: "a patch's keys as a table: track, time, value, easing (and its handles')",
-    },
-    CommandInfo {
-        name: "undo",
-        usage: "",
-        help: "undo the last change to the scene",
-    },
-    CommandInfo {
-        name: "render",
-        usage: "[A..B] [-o DIR]",
-        help: "render frames A..B (default all) to DIR/frame_NNNN.png (default frames)",
-    },
-    CommandInfo {
-        name: "gif",
-        usage: "FILE",
-        help: "render every frame into an animated GIF",
-    },
-    CommandInfo {
-        name: "stats",
-        usage: "",
-        help: "timings of the last frame and what the last edit rebuilt",
-    },
-    CommandInfo {
-        name: "quit",
-        usage: "",
-        help: "leave (Ctrl-D does too)",
-    },
+    CommandInfo::new("help", "", "this list"),
+    CommandInfo::new(
+        "load",
+        "FILE",
+        "load a scene file (replaces the live scene)",
+    ),
+    CommandInfo::new(
+        "reload",
+        "",
+        "load the current scene file again (drops REPL edits)",
+    ),
+    CommandInfo::new("save", "FILE", "write the live scene as a Rhai scene file"),
+    CommandInfo::new("t", "SECONDS", "show the scene at a time"),
+    CommandInfo::new("frame", "N", "show frame N (from 1)"),
+    CommandInfo::new("show", "", "render and show the current frame again"),
+    CommandInfo::new(
+        "mesh",
+        "",
+        "toggle the deformed-mesh overlay on the preview",
+    ),
+    CommandInfo::new(
+        "list",
+        "",
+        "canvas, patches, keys, handles, pins, layer order and variables",
+    ),
+    CommandInfo::new(
+        "keys",
+        "NAME",
+        "a patch's keys as a table: track, time, value, easing (and its handles')",
+    ),
+    CommandInfo::new("undo", "", "undo the last change to the scene"),
+    CommandInfo::new(
+        "render",
+        "[A..B] [-o DIR]",
+        "render frames A..B (default all) to DIR/frame_NNNN.png (default frames)",
+    ),
+    CommandInfo::new("gif", "FILE", "render every frame into an animated GIF"),
+    CommandInfo::new(
+        "stats",
+        "",
+        "timings of the last frame and what the last edit rebuilt",
+    ),
+    CommandInfo::new("quit", "", "leave (Ctrl-D does too)"),
 ];
 
 /// Commands that take a file path argument (completed with file names).
