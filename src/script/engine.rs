@@ -7,7 +7,7 @@ use std::sync::Arc;
 
 use rhai::{Dynamic, Engine, Scope, AST};
 
-use super::draft::{Draft, Origins, SharedDraft};
+use super::draft::{Draft, Origin, Origins, SharedDraft};
 use super::error::{ErrorKind, SceneError};
 use super::memory::MemoryBudget;
 use super::sandbox::{sandboxed_engine, Limits, ModuleFiles, SandboxResolver};
@@ -82,15 +82,19 @@ impl LoadedScene {
     /// position when no patch is named or known.
     pub fn error_at_patch(&self, patch: Option<&str>, message: impl Into<String>) -> SceneError {
         let index = patch.and_then(|name| self.scene.patches.iter().position(|p| p.name == name));
-        let origin = index.and_then(|i| self.origins.patches.get(i));
-        let (file, position) = origin
-            .map(|o| (o.file.clone(), o.position))
-            .unwrap_or((self.file.clone(), rhai::Position::NONE));
-        let mut error = SceneError::new(ErrorKind::Validation, &file, position, message);
-        if file == self.file {
-            error.load_source_line(Some(&self.text));
-        }
-        error
+        self.error_at(index.and_then(|i| self.origins.patches.get(i)), message)
+    }
+
+    /// A validation error at `origin`: the scene file itself when there is none, or when the
+    /// origin names the scene's folder (a call without a source).
+    pub(super) fn error_at(&self, origin: Option<&Origin>, message: impl Into<String>) -> SceneError {
+        let (file, position) = match origin {
+            Some(o) if !o.file.is_dir() => (o.file.as_path(), o.position),
+            Some(o) => (self.file.as_path(), o.position),
+            None => (self.file.as_path(), rhai::Position::NONE),
+        };
+        let text = (file == self.file).then_some(self.text.as_str());
+        SceneError::with_text(ErrorKind::Validation, file, position, message, text)
     }
 
     /// What `lapclone check` warns about: old spellings the file used (positioned), then
@@ -177,10 +181,9 @@ impl SceneEngine {
     pub fn scene(&self, file: &Path) -> Result<(Scene, Origins), SceneError> {
         let draft = self.draft();
         let Some(canvas) = draft.canvas else {
-            return Err(SceneError::new(
+            return Err(SceneError::in_file(
                 ErrorKind::Validation,
                 file,
-                rhai::Position::NONE,
                 "the scene has no canvas: add canvas(width, height, #{ fps: 24, duration: 2 })",
             ));
         };
@@ -189,14 +192,9 @@ impl SceneEngine {
             patches: draft.patches,
             golden: draft.golden,
         };
-        scene.sanity_check().map_err(|e| {
-            SceneError::new(
-                ErrorKind::Validation,
-                file,
-                rhai::Position::NONE,
-                e.to_string(),
-            )
-        })?;
+        scene
+            .sanity_check()
+            .map_err(|e| SceneError::in_file(ErrorKind::Validation, file, e.to_string()))?;
         Ok((scene, draft.origins))
     }
 }
@@ -212,14 +210,7 @@ pub fn load_scene_and_imports(path: &Path) -> Result<(LoadedScene, Vec<PathBuf>)
     // A FIFO or a device would be read until it ends, which may be never.
     let text = crate::util::check_input_file(path)
         .and_then(|()| std::fs::read_to_string(path))
-        .map_err(|e| {
-        SceneError::new(
-            ErrorKind::Io,
-            path,
-            rhai::Position::NONE,
-            format!("cannot read scene: {e}"),
-        )
-    })?;
+        .map_err(|e| SceneError::in_file(ErrorKind::Io, path, format!("cannot read scene: {e}")))?;
     run_scene(&text, path, &ScriptOptions::for_scene_file(path))
 }
 

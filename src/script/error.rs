@@ -49,6 +49,23 @@ impl SceneError {
         position: Position,
         message: impl Into<String>,
     ) -> Self {
+        Self::with_text(kind, file, position, message, None)
+    }
+
+    /// An error of `kind` about `file` as a whole (no position).
+    pub(super) fn in_file(kind: ErrorKind, file: &Path, message: impl Into<String>) -> Self {
+        Self::new(kind, file, Position::NONE, message)
+    }
+
+    /// [`SceneError::new`] with its source line taken from `text` (the file's contents), or
+    /// read from disk for `None`.
+    pub(super) fn with_text(
+        kind: ErrorKind,
+        file: &Path,
+        position: Position,
+        message: impl Into<String>,
+        text: Option<&str>,
+    ) -> Self {
         let mut error = SceneError {
             kind,
             file: file.to_path_buf(),
@@ -56,7 +73,7 @@ impl SceneError {
             message: message.into(),
             source_line: None,
         };
-        error.load_source_line(None);
+        error.load_source_line(text);
         error
     }
 
@@ -91,15 +108,8 @@ impl SceneError {
 
     /// A syntax error from Rhai's parser.
     pub fn from_parse(error: &ParseError, file: &Path, text: &str) -> Self {
-        let mut e = SceneError {
-            kind: ErrorKind::Syntax,
-            file: file.to_path_buf(),
-            position: error.position(),
-            message: format!("syntax error: {}", error.err_type()),
-            source_line: None,
-        };
-        e.load_source_line(Some(text));
-        e
+        let message = format!("syntax error: {}", error.err_type());
+        Self::with_text(ErrorKind::Syntax, file, error.position(), message, Some(text))
     }
 
     /// An evaluation error: unwraps function-call and module wrappers down to the innermost
@@ -133,15 +143,8 @@ impl SceneError {
         let mut error = error;
         let position = error.take_position();
         let (kind, message) = classify(&error);
-        let mut e = SceneError {
-            kind,
-            file: current_file.clone(),
-            position,
-            message,
-            source_line: None,
-        };
-        e.load_source_line((current_file == file).then_some(text));
-        e
+        let text = (current_file == file).then_some(text);
+        Self::with_text(kind, &current_file, position, message, text)
     }
 }
 

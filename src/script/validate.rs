@@ -5,9 +5,8 @@
 
 use std::path::Path;
 
-use super::draft::Origin;
 use super::engine::LoadedScene;
-use super::error::{ErrorKind, SceneError};
+use super::error::SceneError;
 use crate::mesh::{BitMask, MASK_THRESHOLD};
 use crate::scene::{Background, FrameState, Patch, Shape};
 
@@ -24,15 +23,14 @@ pub struct CheckSummary {
 
 pub fn validate_scene(loaded: &LoadedScene) -> Result<CheckSummary, SceneError> {
     let scene = &loaded.scene;
-    let fail = |origin: Option<&Origin>, message: String| failure(loaded, origin, message);
     if let Background::Image(path) = &scene.canvas.background {
-        decode(path).map_err(|m| fail(loaded.origins.canvas.as_ref(), m))?;
+        decode(path).map_err(|m| loaded.error_at(loaded.origins.canvas.as_ref(), m))?;
     }
     let mut inside_pixels = Vec::with_capacity(scene.patches.len());
     for (i, patch) in scene.patches.iter().enumerate() {
         let origin = loaded.origins.patches.get(i);
         let inside = inside_pixels_of(patch)
-            .map_err(|m| fail(origin, format!("patch `{}`: {m}", patch.name)))?;
+            .map_err(|m| loaded.error_at(origin, format!("patch `{}`: {m}", patch.name)))?;
         inside_pixels.push(inside);
     }
     let mut state = FrameState::default();
@@ -42,7 +40,7 @@ pub fn validate_scene(loaded: &LoadedScene) -> Result<CheckSummary, SceneError> 
             &mut state,
         );
         if let Some(i) = state.patches.iter().position(|p| !state_is_finite(p)) {
-            return Err(fail(
+            return Err(loaded.error_at(
                 loaded.origins.patches.get(i),
                 format!(
                     "patch `{}` has non-finite values at frame {index}",
@@ -58,23 +56,6 @@ pub fn validate_scene(loaded: &LoadedScene) -> Result<CheckSummary, SceneError> 
         pins: scene.patches.iter().map(|p| p.pins.len()).sum(),
         inside_pixels,
     })
-}
-
-/// A validation error at `origin` (the scene file itself when there is none).
-fn failure(loaded: &LoadedScene, origin: Option<&Origin>, message: String) -> SceneError {
-    let (file, position) = origin
-        .map(|o| (o.file.clone(), o.position))
-        .unwrap_or((loaded.file.clone(), rhai::Position::NONE));
-    let file = if file.is_dir() {
-        loaded.file.clone()
-    } else {
-        file
-    };
-    let mut e = SceneError::new(ErrorKind::Validation, &file, position, message);
-    if file == loaded.file {
-        e.load_source_line(Some(&loaded.text));
-    }
-    e
 }
 
 /// The patch's inside pixels (polygons: their rounded area); an empty patch, or a mask whose
