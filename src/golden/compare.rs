@@ -42,16 +42,6 @@ pub enum Verdict {
     Fail,
 }
 
-impl Verdict {
-    pub fn word(self) -> &'static str {
-        match self {
-            Verdict::Pass => "PASS",
-            Verdict::Warn => "WARN",
-            Verdict::Fail => "FAIL",
-        }
-    }
-}
-
 /// The largest channel difference and where it is (the first such pixel in row order, the
 /// first such channel in RGBA order).
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -55,16 +55,6 @@ impl SinkPlan {
         })
     }
 
-    /// The format it writes.
-    pub fn kind(&self) -> OutputKind {
-        self.kind
-    }
-
-    /// The output path.
-    pub fn output(&self) -> &Path {
-        &self.output
-    }
-
     /// Opens the sink for `renderer`'s frames in `range`, encoding on `jobs` threads.
     pub fn open(
         self,

@@ -206,12 +206,6 @@ impl ModuleFiles {
         files.sort();
         files
     }
-
-    /// Forgets loaded modules so the next import re-reads them (the REPL's `:reload`).
-    pub fn clear(&self) {
-        lock(&self.files).clear();
-        lock(&self.modules).clear();
-    }
 }
 
 impl ModuleResolver for SandboxResolver {
