@@ -23,53 +23,45 @@ pub fn number(value: &Dynamic, what: &str) -> Result<f64, String> {
     }
 }
 
-pub fn positive(value: &Dynamic, what: &str) -> Result<f64, String> {
+/// A number `ok` accepts; otherwise the error says it must be `rule`.
+fn number_where(
+    value: &Dynamic,
+    what: &str,
+    ok: impl Fn(f64) -> bool,
+    rule: &str,
+) -> Result<f64, String> {
     let v = number(value, what)?;
-    if v > 0.0 {
+    if ok(v) {
         Ok(v)
     } else {
-        Err(format!("{what} must be > 0, got {v}"))
+        Err(format!("{what} must be {rule}, got {v}"))
     }
 }
 
+pub fn positive(value: &Dynamic, what: &str) -> Result<f64, String> {
+    number_where(value, what, |v| v > 0.0, "> 0")
+}
+
 pub fn non_negative(value: &Dynamic, what: &str) -> Result<f64, String> {
-    let v = number(value, what)?;
-    if v >= 0.0 {
-        Ok(v)
-    } else {
-        Err(format!("{what} must be ≥ 0, got {v}"))
-    }
+    number_where(value, what, |v| v >= 0.0, "≥ 0")
 }
 
 /// A number in [0, 1] (opacity).
 pub fn unit(value: &Dynamic, what: &str) -> Result<f64, String> {
-    let v = number(value, what)?;
-    if (0.0..=1.0).contains(&v) {
-        Ok(v)
-    } else {
-        Err(format!("{what} must be in [0, 1], got {v}"))
-    }
+    number_where(value, what, |v| (0.0..=1.0).contains(&v), "in [0, 1]")
 }
 
 /// A key time: finite and ≥ 0.
 pub fn time(value: &Dynamic) -> Result<f64, String> {
-    let t = number(value, "key time")?;
-    if t < 0.0 {
-        return Err(format!("key time must be ≥ 0, got {t}"));
-    }
-    Ok(t)
+    number_where(value, "key time", |t| t >= 0.0, "≥ 0")
 }
 
 /// A canvas side: a whole number of pixels ≥ 1.
 pub fn size(value: &Dynamic, what: &str) -> Result<u32, String> {
-    let v = number(value, what)?;
     let max = crate::scene::MAX_CANVAS_SIDE;
-    if v.fract() != 0.0 || v < 1.0 || v > max as f64 {
-        return Err(format!(
-            "{what} must be a whole number of pixels in 1..={max}, got {v}"
-        ));
-    }
-    Ok(v as u32)
+    let whole = |v: f64| v.fract() == 0.0 && (1.0..=max as f64).contains(&v);
+    let rule = format!("a whole number of pixels in 1..={max}");
+    Ok(number_where(value, what, whole, &rule)? as u32)
 }
 
 /// `[x, y]` with finite numbers.
