@@ -19,12 +19,7 @@ impl Channel {
     const ALL: [Channel; 4] = [Channel::R, Channel::G, Channel::B, Channel::A];
 
     pub fn letter(self) -> &'static str {
-        match self {
-            Channel::R => "R",
-            Channel::G => "G",
-            Channel::B => "B",
-            Channel::A => "A",
-        }
+        ["R", "G", "B", "A"][self as usize]
     }
 }
 
