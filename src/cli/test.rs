@@ -24,7 +24,7 @@ use super::test_args::{
     find_scenes, golden_dir, is_ci, overrides, pending_path, remove_if_present, write_file,
     FramePaths, FrameResult, Outcome, Pictures, SceneFailure, SceneResult, Status, TestArgs,
 };
-use super::test_report::{self, Reporter};
+use super::test_report;
 use super::UsageError;
 
 /// Everything a worker needs, shared by all scenes.
@@ -73,7 +73,6 @@ fn list(paths: &[PathBuf]) -> String {
 fn check_all(args: &TestArgs, scenes: &[PathBuf], jobs: usize) -> anyhow::Result<()> {
     let started = Instant::now();
     let job = Job { args, ci: is_ci() };
-    let mut reporter = Reporter::new(args.json);
     let mut results: Vec<Option<SceneResult>> = (0..scenes.len()).map(|_| None).collect();
     let next = AtomicUsize::new(0);
     let (sender, receiver) = mpsc::channel();
@@ -97,13 +96,13 @@ fn check_all(args: &TestArgs, scenes: &[PathBuf], jobs: usize) -> anyhow::Result
         for (index, result) in receiver {
             results[index] = Some(result);
             while let Some(Some(result)) = results.get(printed) {
-                reporter.scene(result);
+                test_report::print_scene(result, args.json);
                 printed += 1;
             }
         }
     });
     let results: Vec<SceneResult> = results.into_iter().flatten().collect();
-    test_report::finish(args, &results, started.elapsed().as_secs_f64(), &reporter)
+    test_report::finish(args, &results, started.elapsed().as_secs_f64())
 }
 
 /// Loads, renders and compares one scene; never panics on bad input.

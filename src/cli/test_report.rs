@@ -11,29 +11,19 @@ use serde_json::json;
 use super::test_args::{FrameResult, Outcome, SceneResult, Status, TestArgs};
 use super::UsageError;
 
-/// Prints results as scenes finish.
-pub struct Reporter {
-    json: bool,
-}
-
-impl Reporter {
-    pub fn new(json: bool) -> Self {
-        Reporter { json }
+/// Prints a finished scene's results: a line (or, with `json`, an object) per frame.
+pub fn print_scene(result: &SceneResult, json: bool) {
+    if let Some(failure) = &result.failure {
+        eprintln!("ERROR {}", failure.message);
     }
-
-    pub fn scene(&mut self, result: &SceneResult) {
-        if let Some(failure) = &result.failure {
-            eprintln!("ERROR {}", failure.message);
-        }
-        // A failed write here is reported by the summary line, written the same way.
-        for frame in &result.frames {
-            if self.json {
-                let _ = super::say(frame_json(&result.scene, frame));
-            } else {
-                let _ = super::say(frame_line(&result.scene, frame));
-                if let Some(detail) = detail_line(frame) {
-                    let _ = super::say(detail);
-                }
+    // A failed write here is reported by the summary line, written the same way.
+    for frame in &result.frames {
+        if json {
+            let _ = super::say(frame_json(&result.scene, frame));
+        } else {
+            let _ = super::say(frame_line(&result.scene, frame));
+            if let Some(detail) = detail_line(frame) {
+                let _ = super::say(detail);
             }
         }
     }
@@ -79,12 +69,7 @@ pub fn count(results: &[SceneResult]) -> Counts {
 }
 
 /// Summary, reports and the exit status.
-pub fn finish(
-    args: &TestArgs,
-    results: &[SceneResult],
-    seconds: f64,
-    _reporter: &Reporter,
-) -> anyhow::Result<()> {
+pub fn finish(args: &TestArgs, results: &[SceneResult], seconds: f64) -> anyhow::Result<()> {
     let counts = count(results);
     let shown: Vec<(&SceneResult, &FrameResult)> = results
         .iter()
