@@ -4,7 +4,6 @@
 
 use std::path::PathBuf;
 
-use clap::ValueEnum;
 use lapclone::output::{OutputError, OutputKind, PngCompression, SinkSettings};
 use lapclone::FrameRange;
 
@@ -12,14 +11,6 @@ use crate::cli::UsageError;
 
 /// `--format`'s values are the library's output kinds.
 pub use crate::output::OutputKind as OutputFormat;
-
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
-pub enum CompressionArg {
-    #[default]
-    Fast,
-    Default,
-    Best,
-}
 
 pub fn frame_range(text: &str) -> Result<FrameRange, String> {
     let (a, b) = text
@@ -65,9 +56,9 @@ pub struct RenderArgs {
     /// such a folder is refused).
     #[arg(long)]
     pub force: bool,
-    /// PNG deflate effort for frame folders: fast (default; unchanged rows reuse the frame before's bands), default, or best (smaller files).
+    /// PNG deflate effort for frame folders.
     #[arg(long, value_enum, default_value = "fast")]
-    pub png_compression: CompressionArg,
+    pub png_compression: PngCompression,
     /// Constant quality for MP4/WebM/MOV (lower is better; H.264 default 20, VP9 default 32).
     #[arg(long, visible_alias = "quality", value_parser = clap::value_parser!(u32).range(0..=63))]
     pub crf: Option<u32>,
@@ -103,11 +94,7 @@ impl RenderArgs {
     pub(crate) fn sink_settings(&self) -> SinkSettings {
         SinkSettings {
             force: self.force,
-            png_compression: match self.png_compression {
-                CompressionArg::Fast => PngCompression::Fast,
-                CompressionArg::Default => PngCompression::Default,
-                CompressionArg::Best => PngCompression::Best,
-            },
+            png_compression: self.png_compression,
             crf: self.crf,
         }
     }

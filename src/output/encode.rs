@@ -10,8 +10,10 @@ use crate::png_bands::{BandEncoder, EncodedBand, PngColor, PngHeader};
 
 use super::{Frame, FrameRef, OutputError, Pixels};
 
-/// PNG compression effort; `Fast` is the default for frame sequences.
+/// PNG compression effort; `Fast` is the default for frame sequences (also the values of
+/// `lapclone render --png-compression`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum PngCompression {
     /// Fast deflate; a sequence's unchanged rows reuse the frame before's bands.
     #[default]
