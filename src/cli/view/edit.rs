@@ -53,14 +53,9 @@ impl Track {
         matches!(self, Track::At | Track::Rotate)
     }
 
+    /// Its scene-language name (the one the page sends).
     fn name(self) -> &'static str {
-        match self {
-            Track::At => "at",
-            Track::Scale => "scale",
-            Track::Rotate => "rotate",
-            Track::Depth => "depth",
-            Track::Opacity => "opacity",
-        }
+        ["at", "scale", "rotate", "depth", "opacity"][self as usize]
     }
 }
 
