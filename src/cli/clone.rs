@@ -437,14 +437,8 @@ fn write_output(
         &markers,
         &style,
     )?;
-    let mut bytes = Vec::new();
-    picture
-        .write_to(
-            &mut std::io::Cursor::new(&mut bytes),
-            image::ImageFormat::Png,
-        )
-        .context("encoding the overlay")?;
-    lapclone::util::write_atomic(&args.output, &bytes)
+    let png = lapclone::golden::encode_rgba_png(&picture);
+    lapclone::util::write_atomic(&args.output, &png)
         .with_context(|| format!("writing {}", args.output.display()))
 }
 

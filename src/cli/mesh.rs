@@ -141,18 +141,7 @@ fn write_picture(mesh: &Mesh, mask: &BitMask, path: &Path) -> anyhow::Result<()>
         &[],
         &style,
     )?;
-    lapclone::util::write_atomic_with(path, |file| {
-        let mut buffered = std::io::BufWriter::new(file);
-        let encoder = image::codecs::png::PngEncoder::new(&mut buffered);
-        image::ImageEncoder::write_image(
-            encoder,
-            picture.as_raw(),
-            picture.width(),
-            picture.height(),
-            image::ExtendedColorType::Rgba8,
-        )
-        .map_err(std::io::Error::other)?;
-        std::io::Write::flush(&mut buffered)
-    })
-    .with_context(|| format!("cannot write {}", path.display()))
+    let png = lapclone::golden::encode_rgba_png(&picture);
+    lapclone::util::write_atomic(path, &png)
+        .with_context(|| format!("cannot write {}", path.display()))
 }

@@ -80,7 +80,8 @@ pub fn triptych(
     })
 }
 
-/// PNG bytes of an 8-bit RGBA image.
+/// PNG bytes of an 8-bit RGBA image (the pictures `lapclone` writes or shows: triptychs,
+/// mesh overlays, previews).
 pub fn encode_rgba_png(image: &RgbaImage) -> Vec<u8> {
     let mut bytes = Vec::new();
     let encoder = image::codecs::png::PngEncoder::new(&mut bytes);

@@ -99,11 +99,7 @@ impl Preview {
             )
             .with_context(|| format!("mesh overlay of `{}`", placed.name))?;
         }
-        let mut png = Vec::new();
-        picture
-            .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
-            .context("encoding the preview")?;
-        Ok(png)
+        Ok(lapclone::golden::encode_rgba_png(&picture))
     }
 
     fn show(&mut self, renderer: &Renderer, png: &[u8]) {
@@ -146,13 +142,8 @@ pub fn show_picture(picture: &image::RgbaImage) -> bool {
         Inline::None => false,
         Inline::Sixel => write_sixel(picture),
         protocol => {
-            let mut png = Vec::new();
-            let encoded =
-                picture.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png);
-            if encoded.is_ok() {
-                print_inline(protocol, &png);
-            }
-            encoded.is_ok()
+            print_inline(protocol, &lapclone::golden::encode_rgba_png(picture));
+            true
         }
     }
 }
