@@ -2,9 +2,10 @@
 //! scene's [`GoldenSettings`], validated at the call (a refusal is a runtime error at its
 //! position). Only `lapclone test` reads the settings; rendering ignores them.
 
-use rhai::{Dynamic, Engine, EvalAltResult, Map, NativeCallContext};
+use rhai::{Dynamic, Engine, Map, NativeCallContext};
 
 use super::draft::SharedDraft;
+use super::refs::{fail, Fallible};
 use super::values;
 use crate::golden::GoldenSettings;
 
@@ -12,13 +13,10 @@ pub fn register(engine: &mut Engine, draft: &SharedDraft) {
     let d = draft.clone();
     engine.register_fn(
         "golden",
-        move |ctx: NativeCallContext, options: Dynamic| -> Result<(), Box<EvalAltResult>> {
-            let fail = |m: String| -> Box<EvalAltResult> {
-                EvalAltResult::ErrorRuntime(m.into(), ctx.call_position()).into()
-            };
+        move |ctx: NativeCallContext, options: Dynamic| -> Fallible<()> {
             let mut draft = d.lock();
             let frame_count = draft.canvas.as_ref().map(|c| c.frame_count());
-            let settings = parse(&options, frame_count).map_err(fail)?;
+            let settings = parse(&options, frame_count).map_err(|m| fail(&ctx, m))?;
             draft.golden = Some(settings);
             Ok(())
         },
@@ -41,16 +39,10 @@ fn parse(options: &Dynamic, frame_count: Option<u64>) -> Result<GoldenSettings, 
             _ => Ok(value),
         }
     };
-    let min_ssim = match options.get("min_ssim") {
-        None => None,
-        Some(v) => {
-            let s = values::number(v, "min_ssim")?;
-            if !(0.0..=1.0).contains(&s) {
-                return Err(format!("min_ssim must be in 0..=1, got {s}"));
-            }
-            Some(s)
-        }
-    };
+    let min_ssim = options
+        .get("min_ssim")
+        .map(|v| values::number_where(v, "min_ssim", |s| (0.0..=1.0).contains(&s), "in 0..=1"))
+        .transpose()?;
     Ok(GoldenSettings {
         frames: frames(&options, frame_count)?,
         fail: level("fail")?,

@@ -24,7 +24,7 @@ pub fn number(value: &Dynamic, what: &str) -> Result<f64, String> {
 }
 
 /// A number `ok` accepts; otherwise the error says it must be `rule`.
-fn number_where(
+pub(super) fn number_where(
     value: &Dynamic,
     what: &str,
     ok: impl Fn(f64) -> bool,
