@@ -65,6 +65,12 @@ impl SinkPlan {
     ) -> Result<FrameSink, OutputError> {
         let canvas = &renderer.scene().canvas;
         let output = self.output.as_path();
+        // A file's folder must exist (a PNG folder's is checked as it is staged, a video's
+        // when its ffmpeg started; `-` is standard output).
+        let file = matches!(self.kind, OutputKind::Gif | OutputKind::Apng | OutputKind::Y4m);
+        if file && output.as_os_str() != "-" {
+            check_output_folder(output)?;
+        }
         let mut note = None;
         let sink = match self.kind {
             OutputKind::PngFolder => {
@@ -72,15 +78,9 @@ impl SinkPlan {
                     open_png_folder(output, renderer, range, jobs, cancel, self.settings)?;
                 Sink::Png(writer, Box::new(staging))
             }
-            OutputKind::Gif => {
-                check_output_folder(output)?;
-                Sink::Gif(Box::new(GifWriter::create(output, canvas.fps)?))
-            }
+            OutputKind::Gif => Sink::Gif(Box::new(GifWriter::create(output, canvas.fps)?)),
             OutputKind::Y4m => {
                 let path = (output.as_os_str() != "-").then_some(output);
-                if let Some(path) = path {
-                    check_output_folder(path)?;
-                }
                 let writer = Y4mWriter::create(path, canvas.width, canvas.height, canvas.fps)?;
                 Sink::Y4m(Box::new(writer))
             }
@@ -91,10 +91,7 @@ impl SinkPlan {
                 note = padded;
                 Sink::Video(Box::new(writer))
             }
-            OutputKind::Apng => {
-                check_output_folder(output)?;
-                Sink::Apng(Box::new(open_apng(output, renderer, range)?))
-            }
+            OutputKind::Apng => Sink::Apng(Box::new(open_apng(output, renderer, range)?)),
         };
         Ok(FrameSink { sink, note })
     }
