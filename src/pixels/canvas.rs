@@ -6,6 +6,7 @@
 use std::ops::Range;
 use std::path::Path;
 
+use super::float_image::check_size;
 use super::png_encode::{interleave, write_png_rgba};
 use super::PixelRect;
 use super::{sample_bilinear_rgba, Depth, FloatImage, PixelError, PixelFormat};
@@ -98,16 +99,7 @@ impl Canvas {
 
     /// An 8-bit canvas holding `pixels` (straight RGBA, row-major).
     pub fn from_rgba8(width: u32, height: u32, pixels: Vec<[u8; 4]>) -> Result<Canvas, PixelError> {
-        if width == 0 || height == 0 {
-            return Err(PixelError::EmptyImage { width, height });
-        }
-        if pixels.len() != width as usize * height as usize {
-            return Err(PixelError::BufferSize {
-                width,
-                height,
-                actual: pixels.len(),
-            });
-        }
+        check_size(width, height, pixels.len())?;
         Ok(Canvas {
             width,
             height,
