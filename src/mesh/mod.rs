@@ -46,5 +46,6 @@ pub use options::{
 };
 pub use relax::relax_interior;
 pub use simplify::doubled_signed_area;
+pub(crate) use simplify::Segment;
 pub use triangulate::{assemble_mesh, Refinement};
 pub use types::{BoundaryLoop, LoopKind, Mesh};
