@@ -239,6 +239,41 @@ proptest! {
     }
 }
 
+/// Patches named as Rhai keywords or reserved words (`is` among them) get variables the
+/// scene language accepts, and the scene reads back.
+#[test]
+fn patches_named_as_keywords_round_trip() {
+    let names = ["is", "let", "print", "fn", "this", "goto", "type", "global"];
+    let patches = names
+        .iter()
+        .map(|name| {
+            Patch::new(
+                *name,
+                asset("astronaut.png"),
+                Shape::Mask(asset("horse_mask.png")),
+            )
+        })
+        .collect();
+    let canvas = Canvas {
+        width: 64,
+        height: 48,
+        fps: 24.0,
+        duration: 1.0,
+        background: Background::Colour([0.0, 0.0, 0.0, 1.0]),
+    };
+    let original = Scene::new(canvas, patches);
+    let text = original.to_rhai();
+    let options = ScriptOptions {
+        scene_dir: std::env::temp_dir(),
+        scripts_dir: None,
+        limits: Limits::default(),
+        cancel: Default::default(),
+    };
+    let parsed = parse_scene(&text, &PathBuf::from("saved.rhai"), &options)
+        .unwrap_or_else(|e| panic!("{e}\n---\n{text}"));
+    assert_eq!(parsed.scene, original, "{text}");
+}
+
 /// One edit as a REPL user would type it; indices pick among what exists when it runs.
 #[derive(Clone, Debug)]
 enum Edit {
