@@ -196,13 +196,7 @@ impl Canvas {
                 other_depth: other.depth(),
             });
         }
-        let whole = PixelRect {
-            x0: 0,
-            y0: 0,
-            x1: self.width.min(i32::MAX as u32) as i32,
-            y1: self.height.min(i32::MAX as u32) as i32,
-        };
-        let clipped = rect.intersect(&whole);
+        let clipped = rect.intersect(&self.bounds());
         if clipped.is_empty() {
             return Ok(());
         }
@@ -217,6 +211,17 @@ impl Canvas {
             _ => unreachable!("depths checked equal"),
         }
         Ok(())
+    }
+
+    /// The whole canvas as a pixel rectangle, for clipping.
+    pub(crate) fn bounds(&self) -> PixelRect {
+        let side = |n: u32| n.min(i32::MAX as u32) as i32;
+        PixelRect {
+            x0: 0,
+            y0: 0,
+            x1: side(self.width),
+            y1: side(self.height),
+        }
     }
 
     /// Pixel (i, j) as straight RGBA in [0, 1]; `None` outside the canvas.
