@@ -4,11 +4,13 @@
 //! consistent with the factored matrix; see the rules in [`deform`](super)).
 //!
 //! Edge k of triangle `[a, b, c]` runs from corner k to corner k+1 (ab, bc, ca); for cotangent
-//! weights its share is ½ cot of the angle at the third corner, computed with the same formula
-//! and degeneracy rule as [`solve::laplacian`](fn@crate::solve::laplacian), and an edge whose total
+//! weights its share is ½ cot of the angle at the third corner, from the solver's own
+//! `half_cotangents` (so [`solve::laplacian`](fn@crate::solve::laplacian) has the same
+//! weights), and an edge whose total
 //! is negative gets share 0 in every triangle (the solver's clamp to 0).
 
 use crate::mesh::Mesh;
+use crate::solve::laplacian::half_cotangents;
 use crate::solve::{LaplacianKind, SymmetricCsc};
 
 /// `shares[t][k]`: triangle t's share of the weight of its edge k (corner k → corner k+1).
@@ -18,7 +20,11 @@ pub fn edge_shares(mesh: &Mesh, kind: LaplacianKind) -> Vec<[f64; 3]> {
         LaplacianKind::Cotangent => mesh
             .triangles
             .iter()
-            .map(|t| half_cotangents(mesh, t))
+            .map(|t| {
+                // Edge k is opposite corner k + 2.
+                let h = half_cotangents(t.map(|v| mesh.positions[v as usize]));
+                [h[2], h[0], h[1]]
+            })
             .collect(),
     };
     // Sum per undirected edge, then rescale (combinatorial) or clamp (cotangent) each share.
@@ -42,27 +48,6 @@ pub fn edge_shares(mesh: &Mesh, kind: LaplacianKind) -> Vec<[f64; 3]> {
         }
     }
     shares
-}
-
-/// ½ cot of the angle opposite each edge (edge k is opposite corner k+2); 0 when degenerate.
-fn half_cotangents(mesh: &Mesh, tri: &[u32; 3]) -> [f64; 3] {
-    let p = tri.map(|v| mesh.positions[v as usize]);
-    let twice_area = (p[1] - p[0]).perp_dot(p[2] - p[0]).abs();
-    let scale = (p[1] - p[0])
-        .length_squared()
-        .max((p[2] - p[0]).length_squared());
-    // Written so that a NaN area also counts as degenerate.
-    if twice_area.partial_cmp(&(1e-12 * scale)) != Some(std::cmp::Ordering::Greater) {
-        return [0.0; 3];
-    }
-    let mut out = [0.0; 3];
-    for (k, share) in out.iter_mut().enumerate() {
-        let corner = (k + 2) % 3;
-        let u = p[(corner + 1) % 3] - p[corner];
-        let v = p[(corner + 2) % 3] - p[corner];
-        *share = 0.5 * u.dot(v) / twice_area;
-    }
-    out
 }
 
 /// The Laplacian `Σ_t L_t` (lower triangle) built from the shares.

@@ -108,21 +108,12 @@ fn from_bytes(image: &image::DynamicImage, threshold: f32) -> Option<Vec<bool>> 
     let every_value: Vec<u8> = (0..=255u8)
         .flat_map(|v| std::iter::repeat_n(v, channels))
         .collect();
-    let flags: Vec<bool> = match channels {
-        1 => {
-            let all = image::GrayImage::from_raw(256, 1, every_value)?;
-            let floats = image::DynamicImage::ImageLuma8(all).to_luma32f();
-            floats.pixels().map(|p| p.0[0] >= threshold).collect()
-        }
-        _ => {
-            let all = match channels {
-                2 => image::DynamicImage::ImageLumaA8(image::GrayAlphaImage::from_raw(256, 1, every_value)?),
-                _ => image::DynamicImage::ImageRgba8(image::RgbaImage::from_raw(256, 1, every_value)?),
-            };
-            all.to_rgba32f().pixels().map(|p| p.0[3] >= threshold).collect()
-        }
+    let all = match channels {
+        1 => ImageLuma8(image::GrayImage::from_raw(256, 1, every_value)?),
+        2 => ImageLumaA8(image::GrayAlphaImage::from_raw(256, 1, every_value)?),
+        _ => ImageRgba8(image::RgbaImage::from_raw(256, 1, every_value)?),
     };
-    let table: [bool; 256] = flags.try_into().ok()?;
+    let table: [bool; 256] = from_floats(&all, threshold).try_into().ok()?;
     let pixels = image.width() as usize * image.height() as usize;
     let bytes = image.as_bytes();
     if channels == 1 {

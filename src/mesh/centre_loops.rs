@@ -16,6 +16,7 @@
 use glam::DVec2;
 
 use super::contour::CrackLoop;
+use super::simplify::Segment;
 
 /// How far outside its crack a vertex of a shared outside pixel sits, px.
 const SHARED_OFFSET: f64 = 0.25;
@@ -58,7 +59,7 @@ fn thin_loop(lp: &KeptLoop, spacing: f64) -> Vec<DVec2> {
         let a = points[from];
         let extends = !keep[to]
             && a.distance(end) <= spacing
-            && (from + 1..=to).all(|k| distance_to_segment(points[k], a, end) <= THIN_TOLERANCE);
+            && (from + 1..=to).all(|k| Segment::new(a, end).distance(points[k]) <= THIN_TOLERANCE);
         if !extends {
             out.push(points[to]);
             from = to;
@@ -69,12 +70,6 @@ fn thin_loop(lp: &KeptLoop, spacing: f64) -> Vec<DVec2> {
         return points.to_vec();
     }
     out
-}
-
-fn distance_to_segment(p: DVec2, a: DVec2, b: DVec2) -> f64 {
-    let ab = b - a;
-    let t = ((p - a).dot(ab) / ab.length_squared().max(f64::MIN_POSITIVE)).clamp(0.0, 1.0);
-    p.distance(a + ab * t)
 }
 
 /// A closed loop's points before thinning.

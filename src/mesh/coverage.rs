@@ -3,6 +3,7 @@
 
 use glam::DVec2;
 
+use super::simplify::Segment;
 use super::{BitMask, Mesh};
 
 /// How far outside the mesh a mask pixel centre may lie and still count as covered.
@@ -117,21 +118,10 @@ impl BoundaryGrid {
             (c0..=c1).any(|c| {
                 self.buckets[r * self.cols + c]
                     .iter()
-                    .any(|&(a, b)| distance_to_segment(p, a, b) <= radius + 1e-12)
+                    .any(|&(a, b)| Segment::new(a, b).distance(p) <= radius + 1e-12)
             })
         })
     }
-}
-
-fn distance_to_segment(p: DVec2, a: DVec2, b: DVec2) -> f64 {
-    let ab = b - a;
-    let len2 = ab.length_squared();
-    let t = if len2 > 0.0 {
-        ((p - a).dot(ab) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    p.distance(a + ab * t)
 }
 
 #[cfg(test)]

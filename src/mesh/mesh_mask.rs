@@ -65,11 +65,7 @@ pub fn mesh_mask(mask: &BitMask, options: &MeshOptions) -> Result<MeshResult, Me
         );
     }
     if !meshed.complete {
-        warnings.push(format!(
-            "refinement stopped at its vertex budget (max_vertices {}, or the size-based bound) \
-             before every angle reached {}°",
-            options.max_vertices, options.min_angle_deg
-        ));
+        warnings.push(budget_warning(options));
     }
     let mut stats = stats_of(
         &meshed.mesh,
@@ -233,12 +229,7 @@ pub fn mesh_polygons(polygons: &[Polygon], options: &MeshOptions) -> Result<Mesh
             }
             // Refuse before allocating: a vertex at 1e9 px would need 3e8 boundary points.
             boundary_len += subdivided_len(&ring, options.density);
-            if boundary_len > options.max_vertices as f64 {
-                return Err(MeshError::VertexBudget {
-                    max_vertices: options.max_vertices,
-                    needed: boundary_len.min(usize::MAX as f64) as usize,
-                });
-            }
+            check_budget(boundary_len, options)?;
             subdivide_loop(&ring, options.density, &mut scratch);
             loops.push(scratch.clone());
         }
@@ -251,11 +242,7 @@ pub fn mesh_polygons(polygons: &[Polygon], options: &MeshOptions) -> Result<Mesh
     t.mesh.sanity_check()?;
     let mut warnings = Vec::new();
     if !t.refinement_complete {
-        warnings.push(format!(
-            "refinement stopped at its vertex budget (max_vertices {}, or the size-based bound) \
-             before every angle reached {}°",
-            options.max_vertices, options.min_angle_deg
-        ));
+        warnings.push(budget_warning(options));
     }
     let stats = stats_of(&t.mesh, 0.0, false, t.refinement_complete, 0, 0);
     Ok(MeshResult {
@@ -279,12 +266,8 @@ fn clean_ring(ring: &[DVec2]) -> Result<Vec<DVec2>, String> {
             p.x, p.y
         ));
     }
-    let mut out: Vec<DVec2> = Vec::with_capacity(ring.len());
-    for &p in ring {
-        if out.last() != Some(&p) {
-            out.push(p);
-        }
-    }
+    let mut out = ring.to_vec();
+    out.dedup();
     while out.len() > 1 && out.first() == out.last() {
         out.pop();
     }
@@ -353,7 +336,16 @@ fn sample_crack_loops(
     Ok((loops, deviation))
 }
 
-/// Refuses boundaries of more than `max_vertices` points.
+/// The warning of a refinement that ran out of vertices.
+fn budget_warning(options: &MeshOptions) -> String {
+    format!(
+        "refinement stopped at its vertex budget (max_vertices {}, or the size-based bound) \
+         before every angle reached {}°",
+        options.max_vertices, options.min_angle_deg
+    )
+}
+
+/// Refuses boundaries of more than `max_vertices` points (`as` saturates a huge count).
 fn check_budget(points: f64, options: &MeshOptions) -> Result<(), MeshError> {
     if points > options.max_vertices as f64 {
         return Err(MeshError::VertexBudget {

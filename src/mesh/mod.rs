@@ -38,18 +38,14 @@ mod types;
 pub use bitmask::{BitMask, MASK_THRESHOLD};
 pub use centre_loops::outside_centre_loops;
 pub use contour::{for_each_edge_pixel, label_pieces, trace_crack_loops, CrackLoop};
-pub use coverage::{
-    uncovered_mask_pixels, COVERAGE_TOLERANCE_PX,
-};
+pub use coverage::uncovered_mask_pixels;
 pub use error::{MeshError, SanityError};
-pub use mesh_mask::{mesh_mask, mesh_polygons, Polygon, MAX_POLYGON_COORDINATE};
+pub use mesh_mask::{mesh_mask, mesh_polygons, Polygon};
 pub use options::{
     min_angle_deg, BoundaryPlacement, MeshOptions, MeshResult, MeshStats, MAX_RELAX_SWEEPS,
-    MIN_MAX_AREA, SEAM_QUALITY_MIN_ANGLE_DEG, SEAM_QUALITY_RELAX_SWEEPS,
 };
 pub use relax::relax_interior;
-pub use simplify::{
-    doubled_signed_area, simplify_loop, subdivide_loop, subdivided_len, Simplified,
-};
-pub use triangulate::{assemble_mesh, triangulate_loops, Refinement, Triangulated};
+pub use simplify::doubled_signed_area;
+pub(crate) use simplify::Segment;
+pub use triangulate::{assemble_mesh, Refinement};
 pub use types::{BoundaryLoop, LoopKind, Mesh};

@@ -21,15 +21,16 @@ pub fn doubled_signed_area(points: &[DVec2]) -> f64 {
         .sum()
 }
 
-/// A segment with the parts of the point distance that do not depend on the point.
-struct Segment {
+/// A segment with the parts of the point distance that do not depend on the point: the one
+/// point-to-segment distance of the mesher, its coverage check and the renderer's warnings.
+pub(crate) struct Segment {
     a: DVec2,
     ab: DVec2,
     len2: f64,
 }
 
 impl Segment {
-    fn new(a: DVec2, b: DVec2) -> Self {
+    pub(crate) fn new(a: DVec2, b: DVec2) -> Self {
         let ab = b - a;
         Segment {
             a,
@@ -38,8 +39,8 @@ impl Segment {
         }
     }
 
-    /// Distance from `p` to the segment.
-    fn distance(&self, p: DVec2) -> f64 {
+    /// Distance from `p` to the segment (to `a` when the segment is a point).
+    pub(crate) fn distance(&self, p: DVec2) -> f64 {
         if self.len2 == 0.0 {
             return p.distance(self.a);
         }

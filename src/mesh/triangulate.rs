@@ -403,7 +403,7 @@ mod tests {
     #[test]
     fn refinement_beyond_30_degrees_stops_at_the_size_bound() {
         let mut boundary = Vec::new();
-        crate::mesh::subdivide_loop(&square(0.0, 0.0, 12.0), 0.45, &mut boundary);
+        crate::mesh::simplify::subdivide_loop(&square(0.0, 0.0, 12.0), 0.45, &mut boundary);
         let loops = vec![boundary];
         let input = loops[0].len();
         let t = triangulate_loops(&loops, &Refinement::new(34.9, 2_000_000)).unwrap();

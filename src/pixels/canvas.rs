@@ -6,6 +6,7 @@
 use std::ops::Range;
 use std::path::Path;
 
+use super::float_image::check_size;
 use super::png_encode::{interleave, write_png_rgba};
 use super::PixelRect;
 use super::{sample_bilinear_rgba, Depth, FloatImage, PixelError, PixelFormat};
@@ -98,16 +99,7 @@ impl Canvas {
 
     /// An 8-bit canvas holding `pixels` (straight RGBA, row-major).
     pub fn from_rgba8(width: u32, height: u32, pixels: Vec<[u8; 4]>) -> Result<Canvas, PixelError> {
-        if width == 0 || height == 0 {
-            return Err(PixelError::EmptyImage { width, height });
-        }
-        if pixels.len() != width as usize * height as usize {
-            return Err(PixelError::BufferSize {
-                width,
-                height,
-                actual: pixels.len(),
-            });
-        }
+        check_size(width, height, pixels.len())?;
         Ok(Canvas {
             width,
             height,
@@ -204,13 +196,7 @@ impl Canvas {
                 other_depth: other.depth(),
             });
         }
-        let whole = PixelRect {
-            x0: 0,
-            y0: 0,
-            x1: self.width.min(i32::MAX as u32) as i32,
-            y1: self.height.min(i32::MAX as u32) as i32,
-        };
-        let clipped = rect.intersect(&whole);
+        let clipped = rect.intersect(&self.bounds());
         if clipped.is_empty() {
             return Ok(());
         }
@@ -225,6 +211,17 @@ impl Canvas {
             _ => unreachable!("depths checked equal"),
         }
         Ok(())
+    }
+
+    /// The whole canvas as a pixel rectangle, for clipping.
+    pub(crate) fn bounds(&self) -> PixelRect {
+        let side = |n: u32| n.min(i32::MAX as u32) as i32;
+        PixelRect {
+            x0: 0,
+            y0: 0,
+            x1: side(self.width),
+            y1: side(self.height),
+        }
     }
 
     /// Pixel (i, j) as straight RGBA in [0, 1]; `None` outside the canvas.
@@ -371,55 +368,6 @@ impl Canvas {
         let image = image::RgbaImage::from_raw(self.width, self.height, bytes);
         image.expect("buffer size") // invariant: the buffer holds width × height RGBA pixels
     }
-
-    internal_fn! {
-        /// An 8-bit premultiplied copy for tiny-skia drawing (16-bit values are rounded).
-        fn to_tiny_skia_pixmap(&self) -> tiny_skia::Pixmap {
-            let mut pixmap = tiny_skia::Pixmap::new(self.width, self.height).expect("non-empty"); // invariant: the canvas size is non-zero (checked at construction).
-            let write = |dst: &mut [tiny_skia::PremultipliedColorU8],
-                         rgba: &mut dyn Iterator<Item = [f32; 4]>| {
-                for (d, [r, g, b, a]) in dst.iter_mut().zip(rgba) {
-                    let c = tiny_skia::ColorU8::from_rgba(
-                        u8::from_unit(r),
-                        u8::from_unit(g),
-                        u8::from_unit(b),
-                        u8::from_unit(a),
-                    );
-                    *d = c.premultiply();
-                }
-            };
-            match &self.pixels {
-                CanvasPixels::Eight(p) => write(
-                    pixmap.pixels_mut(),
-                    &mut p.iter().map(|px| px.map(Texel::to_unit)),
-                ),
-                CanvasPixels::Sixteen(p) => write(
-                    pixmap.pixels_mut(),
-                    &mut p.iter().map(|px| px.map(Texel::to_unit)),
-                ),
-            }
-            pixmap
-        }
-    }
-
-    internal_fn! {
-        /// Composites a premultiplied tiny-skia pixmap of the same size over the canvas
-        /// (source-over; overlays drawn on a transparent pixmap). Other sizes are an error.
-        fn draw_pixmap_over(&mut self, pixmap: &tiny_skia::Pixmap) -> Result<(), PixelError> {
-            if pixmap.width() != self.width || pixmap.height() != self.height {
-                return Err(PixelError::BufferSize {
-                    width: self.width,
-                    height: self.height,
-                    actual: pixmap.pixels().len(),
-                });
-            }
-            match &mut self.pixels {
-                CanvasPixels::Eight(p) => blend_premultiplied_over(p, pixmap.pixels()),
-                CanvasPixels::Sixteen(p) => blend_premultiplied_over(p, pixmap.pixels()),
-            }
-            Ok(())
-        }
-    }
 }
 
 /// Copies `rect` (non-empty, inside both buffers) row by row.
@@ -433,17 +381,6 @@ fn copy_rows<T: Copy>(dst: &mut [T], src: &[T], width: usize, rect: PixelRect) {
 
 fn quantise<T: Texel>(pixels: &[[f32; 4]]) -> Vec<[T; 4]> {
     pixels.iter().map(|px| px.map(T::from_unit)).collect()
-}
-
-fn blend_premultiplied_over<T: Texel>(dst: &mut [[T; 4]], src: &[tiny_skia::PremultipliedColorU8]) {
-    for (d, s) in dst.iter_mut().zip(src) {
-        if s.alpha() == 0 {
-            continue;
-        }
-        let alpha = s.alpha().to_unit();
-        let premultiplied = [s.red().to_unit(), s.green().to_unit(), s.blue().to_unit()];
-        *d = composite_over_straight(premultiplied, alpha, d.map(Texel::to_unit)).map(T::from_unit);
-    }
 }
 
 /// Source-over in straight alpha: `source_premultiplied` is the source colour times

@@ -368,7 +368,7 @@ pub(crate) fn open_error(path: &Path, error: crate::limits::ImageOpenError) -> P
 }
 
 /// Both sizes non-zero and `len` pixels for them.
-fn check_size(width: u32, height: u32, len: usize) -> Result<(), PixelError> {
+pub(super) fn check_size(width: u32, height: u32, len: usize) -> Result<(), PixelError> {
     if width == 0 || height == 0 {
         return Err(PixelError::EmptyImage { width, height });
     }

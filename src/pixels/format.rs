@@ -79,25 +79,26 @@ impl PixelFormat {
 /// R = G = B, a missing alpha 255): the levels `to_rgba8` gives, without its colour-space
 /// path. `None` for other depths.
 pub(crate) fn rgba8_levels(decoded: &image::DynamicImage) -> Option<Vec<[u8; 4]>> {
-    use image::DynamicImage as D;
-    let levels = match decoded {
-        D::ImageRgb8(img) => img
-            .as_raw()
-            .chunks_exact(3)
-            .map(|p| [p[0], p[1], p[2], 255])
-            .collect(),
-        D::ImageRgba8(img) => img
-            .as_raw()
-            .chunks_exact(4)
-            .map(|p| [p[0], p[1], p[2], p[3]])
-            .collect(),
-        D::ImageLuma8(img) => img.as_raw().iter().map(|&l| [l, l, l, 255]).collect(),
-        D::ImageLumaA8(img) => img
-            .as_raw()
-            .chunks_exact(2)
-            .map(|p| [p[0], p[0], p[0], p[1]])
-            .collect(),
-        _ => return None,
-    };
+    let format = PixelFormat::of(decoded);
+    if format.depth != Depth::Eight {
+        return None;
+    }
+    let mut levels = Vec::with_capacity(decoded.width() as usize * decoded.height() as usize);
+    extend_rgba8(decoded.as_bytes(), format, &mut levels);
     Some(levels)
+}
+
+/// Appends 8-bit samples laid out as `format` says (grey or RGB, alpha or not) to `out` as
+/// RGBA levels: grey expanded to R = G = B, a missing alpha 255.
+pub(crate) fn extend_rgba8(samples: &[u8], format: PixelFormat, out: &mut Vec<[u8; 4]>) {
+    match (format.color, format.alpha) {
+        (ColorKind::Rgb, false) => {
+            out.extend(samples.chunks_exact(3).map(|p| [p[0], p[1], p[2], 255]))
+        }
+        (ColorKind::Rgb, true) => out.extend_from_slice(bytemuck::cast_slice(samples)),
+        (ColorKind::Grey, false) => out.extend(samples.iter().map(|&l| [l, l, l, 255])),
+        (ColorKind::Grey, true) => {
+            out.extend(samples.chunks_exact(2).map(|p| [p[0], p[0], p[0], p[1]]))
+        }
+    }
 }

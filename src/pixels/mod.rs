@@ -11,7 +11,7 @@
 //!
 //! 16-bit output: tiny-skia only holds 8-bit premultiplied pixmaps, so 16-bit canvases are
 //! stored as `u16` here and encoded through `png_bands` like 8-bit ones; an 8-bit copy
-//! exists for tiny-skia overlays (a 16-bit canvas is rounded down to 8 bits for it).
+//! ([`Canvas::to_rgba8_image`]) exists for overlays (a 16-bit canvas is rounded to 8 bits).
 
 mod bilinear;
 mod canvas;

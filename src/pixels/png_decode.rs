@@ -10,6 +10,7 @@ use std::path::Path;
 
 use crate::limits::{check_image_size, image_dimensions, ImageOpenError, MAX_DECODER_ALLOC};
 
+use super::format::extend_rgba8;
 use super::{ColorKind, Depth, PixelFormat};
 
 /// The first eight bytes of every PNG file.
@@ -44,14 +45,14 @@ pub(crate) fn decode_png_levels(path: &Path) -> Result<Option<Levels>, ImageOpen
     if depth != png::BitDepth::Eight || reader.info().interlaced {
         return Ok(None);
     }
-    let Some((format, expand)) = layout(colour) else {
+    let Some(format) = layout(colour) else {
         return Ok(None);
     };
     let info = reader.info();
     let (width, height) = (info.width, info.height);
     let mut levels = Vec::with_capacity(width as usize * height as usize);
     while let Some(row) = reader.next_row().map_err(decode_error)? {
-        expand(row.data(), &mut levels);
+        extend_rgba8(row.data(), format, &mut levels);
     }
     Ok(Some(Levels {
         width,
@@ -62,29 +63,19 @@ pub(crate) fn decode_png_levels(path: &Path) -> Result<Option<Levels>, ImageOpen
 }
 
 /// Appends one row's samples to the levels as RGBA.
-type Expand = fn(&[u8], &mut Vec<[u8; 4]>);
-
-/// The format of an 8-bit colour type after expansion, and how its rows become RGBA.
-fn layout(colour: png::ColorType) -> Option<(PixelFormat, Expand)> {
-    let format = |color, alpha| PixelFormat {
+/// The format of an 8-bit colour type after expansion (`None`: still indexed).
+fn layout(colour: png::ColorType) -> Option<PixelFormat> {
+    let (color, alpha) = match colour {
+        png::ColorType::Rgb => (ColorKind::Rgb, false),
+        png::ColorType::Rgba => (ColorKind::Rgb, true),
+        png::ColorType::Grayscale => (ColorKind::Grey, false),
+        png::ColorType::GrayscaleAlpha => (ColorKind::Grey, true),
+        png::ColorType::Indexed => return None,
+    };
+    Some(PixelFormat {
         color,
         alpha,
         depth: Depth::Eight,
-    };
-    Some(match colour {
-        png::ColorType::Rgb => (format(ColorKind::Rgb, false), |row, out| {
-            out.extend(row.chunks_exact(3).map(|p| [p[0], p[1], p[2], 255]));
-        }),
-        png::ColorType::Rgba => (format(ColorKind::Rgb, true), |row, out| {
-            out.extend(row.chunks_exact(4).map(|p| [p[0], p[1], p[2], p[3]]));
-        }),
-        png::ColorType::Grayscale => (format(ColorKind::Grey, false), |row, out| {
-            out.extend(row.iter().map(|&l| [l, l, l, 255]));
-        }),
-        png::ColorType::GrayscaleAlpha => (format(ColorKind::Grey, true), |row, out| {
-            out.extend(row.chunks_exact(2).map(|p| [p[0], p[0], p[0], p[1]]));
-        }),
-        png::ColorType::Indexed => return None,
     })
 }
 

@@ -66,4 +66,12 @@ impl RenderError {
             RenderError::Pixels(_) | RenderError::Scene(_) => None,
         }
     }
+
+    /// A footage error of `patch`'s animated source (`None`: of the background footage).
+    pub(crate) fn footage(patch: Option<&str>, error: crate::pixels::FootageError) -> Self {
+        RenderError::Footage {
+            patch: patch.map(str::to_string),
+            source: Box::new(error),
+        }
+    }
 }

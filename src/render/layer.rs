@@ -125,10 +125,9 @@ impl Layer {
         if *held == index {
             return Ok(());
         }
-        let image = reader.frame(index).map_err(|e| RenderError::Footage {
-            patch: Some(self.name.clone()),
-            source: Box::new(e),
-        })?;
+        let image = reader
+            .frame(index)
+            .map_err(|e| RenderError::footage(Some(&self.name), e))?;
         self.cloner.set_source(image.clone());
         *held = index;
         Ok(())
@@ -149,7 +148,7 @@ impl Layer {
             rotation_deg: state.rotation,
         };
         let deform_stats = self.deform(state)?;
-        let result = if self.deforming() {
+        let result = if self.deforms() {
             self.cloner.prepare_deformed(
                 &placement,
                 &self.deformed.positions,
@@ -165,18 +164,14 @@ impl Layer {
     /// After [`prepare`](Self::prepare): clones onto `canvas` (the composite of the layers
     /// below).
     pub fn composite(&mut self, canvas: &mut Canvas) -> Result<CloneStats, RenderError> {
-        let depth = self.deforming().then_some(&self.deformed.depth[..]);
+        let depth = self.deforms().then_some(&self.deformed.depth[..]);
         let result = self.cloner.clone_prepared(canvas, depth);
         result.map_err(|source| self.clone_error(source))
     }
 
-    fn deforming(&self) -> bool {
-        self.rig.is_some() && self.deforms
-    }
-
     /// Whether this layer deforms in the current version of its patch.
     pub fn deforms(&self) -> bool {
-        self.deforming()
+        self.rig.is_some() && self.deforms
     }
 
     fn clone_error(&self, source: crate::clone::CloneError) -> RenderError {
@@ -276,19 +271,16 @@ fn mesh_patch(
     };
     match &patch.shape {
         Shape::Mask(path) => {
-            let mask = BitMask::load(path, MASK_THRESHOLD).map_err(|source| RenderError::Mask {
+            let mask_error = |source| RenderError::Mask {
                 patch: patch.name.clone(),
                 path: path.clone(),
                 source: Box::new(source),
-            })?;
+            };
+            let mask = BitMask::load(path, MASK_THRESHOLD).map_err(mask_error)?;
             mesh_from_mask(&mask, None, (source.width(), source.height()), options).map_err(
                 |error| match error {
                     // A mesh error of a mask names the mask, as a read error does.
-                    crate::clone::CloneError::Mesh(source) => RenderError::Mask {
-                        patch: patch.name.clone(),
-                        path: path.clone(),
-                        source: Box::new(source),
-                    },
+                    crate::clone::CloneError::Mesh(source) => mask_error(source),
                     other => clone_error(other),
                 },
             )

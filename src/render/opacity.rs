@@ -12,13 +12,7 @@ use crate::pixels::PixelRect;
 /// canvases have the same size and depth (the renderer keeps `below` as a copy of `frame`).
 pub(super) fn blend_over_below(frame: &mut Canvas, below: &Canvas, rect: PixelRect, opacity: f64) {
     let width = frame.width() as usize;
-    let whole = PixelRect {
-        x0: 0,
-        y0: 0,
-        x1: frame.width().min(i32::MAX as u32) as i32,
-        y1: frame.height().min(i32::MAX as u32) as i32,
-    };
-    let rect = rect.intersect(&whole);
+    let rect = rect.intersect(&frame.bounds());
     if rect.is_empty() {
         return;
     }

@@ -7,7 +7,7 @@
 use glam::DVec2;
 
 use super::Renderer;
-use crate::mesh::Mesh;
+use crate::mesh::{Mesh, Segment};
 
 /// How far outside its patch (px, source coordinates) a point may lie unremarked: the
 /// mesh boundary runs along outside pixel centres, so a point on a mask's edge pixel is in.
@@ -62,7 +62,7 @@ fn outside(mesh: &Mesh, p: DVec2) -> Option<(f64, DVec2)> {
             return None;
         }
         for (s, e) in [(a, b), (b, c), (c, a)] {
-            distance = distance.min(segment_distance(s, e, p));
+            distance = distance.min(Segment::new(s, e).distance(p));
         }
     }
     if distance.is_nan() || distance <= OUTSIDE_TOLERANCE {
@@ -84,17 +84,6 @@ fn contains(a: DVec2, b: DVec2, c: DVec2, p: DVec2) -> bool {
     let negative = d1 < 0.0 || d2 < 0.0 || d3 < 0.0;
     let positive = d1 > 0.0 || d2 > 0.0 || d3 > 0.0;
     !(negative && positive)
-}
-
-fn segment_distance(s: DVec2, e: DVec2, p: DVec2) -> f64 {
-    let d = e - s;
-    let length2 = d.length_squared();
-    let along = if length2 > 0.0 {
-        ((p - s).dot(d) / length2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    p.distance(s + d * along)
 }
 
 #[cfg(test)]

@@ -270,10 +270,9 @@ impl Renderer {
     /// Puts footage at scene frame `index`: the background's plate and animated sources.
     fn seek_footage(&mut self, index: u64) -> Result<(), RenderError> {
         if let Some((reader, held)) = self.plates.as_mut().filter(|(_, held)| *held != index) {
-            let plate = reader.frame(index).map_err(|e| RenderError::Footage {
-                patch: None,
-                source: Box::new(e),
-            })?;
+            let plate = reader
+                .frame(index)
+                .map_err(|e| RenderError::footage(None, e))?;
             let (width, height) = (self.scene.canvas.width, self.scene.canvas.height);
             self.background = canvas_over(plate, width, height)?;
             self.background_id = next_background_id();

@@ -85,80 +85,13 @@ fn relative_path(folder: &Path, path: &Path) -> Option<PathBuf> {
     Some(out)
 }
 
-/// Rhai's keywords and reserved words, which cannot name a variable.
-const RESERVED: &[&str] = &[
-    "let",
-    "const",
-    "fn",
-    "if",
-    "else",
-    "for",
-    "in",
-    "while",
-    "loop",
-    "do",
-    "until",
-    "return",
-    "throw",
-    "try",
-    "catch",
-    "true",
-    "false",
-    "import",
-    "export",
-    "as",
-    "private",
-    "this",
-    "switch",
-    "break",
-    "continue",
-    "global",
-    "Fn",
-    "call",
-    "curry",
-    "eval",
-    "is_def_var",
-    "is_def_fn",
-    "is_shared",
-    "print",
-    "debug",
-    "type_of",
-    "var",
-    "static",
-    "shared",
-    "with",
-    "go",
-    "sync",
-    "async",
-    "await",
-    "yield",
-    "default",
-    "void",
-    "null",
-    "nil",
-    "spawn",
-    "thread",
-    "module",
-    "package",
-    "super",
-    "new",
-    "use",
-    "public",
-    "protected",
-    "match",
-    "case",
-    "goto",
-    "exit",
-    "sizeof",
-    "function",
-    "include",
-    "static",
-    "enum",
-    "struct",
-    "type",
-    "impl",
-    "trait",
-];
+/// Whether Rhai refuses `name` as a variable: its keywords and the words it reserves, as the
+/// parser itself says (a copied list drifts from the Rhai in use).
+fn is_reserved(name: &str) -> bool {
+    rhai::Engine::new_raw()
+        .compile(format!("let {name} = 0;"))
+        .is_err()
+}
 
 /// A Rhai variable named after the patch (`cat`, `big_dog`), unique among `taken`.
 fn variable_name(patch: &str, taken: &[String]) -> String {
@@ -176,7 +109,7 @@ fn variable_name(patch: &str, taken: &[String]) -> String {
     if base.is_empty() || base.starts_with(|c: char| c.is_ascii_digit()) {
         base = format!("patch_{base}");
     }
-    if RESERVED.contains(&base.as_str()) {
+    if is_reserved(&base) {
         base.push_str("_patch");
     }
     let mut name = base.clone();

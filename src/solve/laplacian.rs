@@ -7,6 +7,8 @@
 //! semi-definiteness; a negative edge total is clamped to 0. Triangles with (numerically) zero
 //! area contribute nothing instead of an infinite cotangent. Rows always sum to zero.
 
+use glam::DVec2;
+
 use super::SymmetricCsc;
 use crate::mesh::Mesh;
 
@@ -83,30 +85,34 @@ fn from_sorted_edges(n: usize, edges: &[(u32, u32, f64)]) -> SymmetricCsc {
     csc
 }
 
+/// ½ cot of the angle at each corner of the triangle `p`: that triangle's share of the weight
+/// of the edge opposite the corner. All 0 when the triangle has (numerically) zero area: its
+/// doubled area not above 1e-12 of the longer edge from corner 0, squared, or NaN.
+pub(crate) fn half_cotangents(p: [DVec2; 3]) -> [f64; 3] {
+    let twice_area = (p[1] - p[0]).perp_dot(p[2] - p[0]).abs();
+    let scale = (p[1] - p[0])
+        .length_squared()
+        .max((p[2] - p[0]).length_squared());
+    // NaN-safe: a NaN area counts as degenerate.
+    #[allow(clippy::neg_cmp_op_on_partial_ord)]
+    if !(twice_area > 1e-12 * scale) {
+        return [0.0; 3];
+    }
+    std::array::from_fn(|corner| {
+        let u = p[(corner + 1) % 3] - p[corner];
+        let v = p[(corner + 2) % 3] - p[corner];
+        0.5 * (u.dot(v) / twice_area)
+    })
+}
+
 /// Edges (i < j, sorted) with their clamped cotangent weight.
 fn cotangent_edges(mesh: &Mesh) -> Vec<(u32, u32, f64)> {
     let mut half: Vec<(u32, u32, f64)> = Vec::with_capacity(mesh.triangles.len() * 3);
     for t in &mesh.triangles {
-        let p = t.map(|v| mesh.positions[v as usize]);
-        let twice_area = (p[1] - p[0]).perp_dot(p[2] - p[0]).abs();
-        let scale = (p[1] - p[0])
-            .length_squared()
-            .max((p[2] - p[0]).length_squared());
-        // NaN-safe: a NaN area counts as degenerate.
-        #[allow(clippy::neg_cmp_op_on_partial_ord)]
-        let degenerate = !(twice_area > 1e-12 * scale);
-        for corner in 0..3 {
+        let shares = half_cotangents(t.map(|v| mesh.positions[v as usize]));
+        for (corner, share) in shares.into_iter().enumerate() {
             let (a, b) = (t[(corner + 1) % 3], t[(corner + 2) % 3]);
-            let (u, v) = (
-                p[(corner + 1) % 3] - p[corner],
-                p[(corner + 2) % 3] - p[corner],
-            );
-            let cot = if degenerate {
-                0.0
-            } else {
-                u.dot(v) / twice_area
-            };
-            half.push((a.min(b), a.max(b), 0.5 * cot));
+            half.push((a.min(b), a.max(b), share));
         }
     }
     half.sort_by_key(|e| (e.0, e.1));

@@ -21,10 +21,7 @@ use glam::DVec2;
 pub use csv::{write_csv, TrackedFrame};
 pub use error::TrackError;
 pub use read_ahead::read_ahead;
-pub use tracker::{
-    pair_motion, Estimate, LostReason, PointTracker, TrackOptions, FOUND_ABOVE, LOST_BELOW, MAX_SEARCH,
-    MAX_SIZE,
-};
+pub use tracker::{pair_motion, Estimate, LostReason, PointTracker, TrackOptions, LOST_BELOW};
 
 /// Largest track file read, in bytes.
 pub const MAX_FILE_BYTES: u64 = 64 * 1024 * 1024;

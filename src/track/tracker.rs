@@ -212,7 +212,7 @@ impl PointTracker {
         let anchored = match carried {
             Some(p) => anchor(p),
             None => self
-                .pyramidal(&state.first, &pyramid, predicted, self.search)
+                .pyramidal(&state.first, &pyramid, predicted, self.search, PRECISE)
                 .and_then(anchor),
         };
         let (mut at, mut shape) = (carried.unwrap_or(predicted), state.shape);
@@ -269,7 +269,7 @@ impl PointTracker {
         if let Some(levels) = self.near_levels {
             let near = Pyramid::around(frame, predicted, self.reach(NEAR, levels), levels);
             let found = self
-                .pyramidal(&state.sure, &near, predicted, NEAR)
+                .pyramidal(&state.sure, &near, predicted, NEAR, PRECISE)
                 .filter(|&p| state.sure[0].correlation(&near.levels[0], p) >= NEAR_ABOVE);
             if found.is_some() {
                 return (near, found);
@@ -278,7 +278,7 @@ impl PointTracker {
         let reach = self.reach(self.search, self.levels);
         let pyramid = Pyramid::around(frame, predicted, reach, self.levels);
         let carried = (state.sure.len() == self.levels)
-            .then(|| self.pyramidal(&state.sure, &pyramid, predicted, self.search))
+            .then(|| self.pyramidal(&state.sure, &pyramid, predicted, self.search, PRECISE))
             .flatten()
             .filter(|&p| state.sure[0].correlation(&pyramid.levels[0], p) >= LOST_BELOW);
         (pyramid, carried)
@@ -301,26 +301,15 @@ impl PointTracker {
         };
         let missed = at - (state.sure_at + state.velocity);
         let start = state.sure_at + missed.clamp_length_max(motion);
-        self.pyramidal_to(&templates[..levels], last, start, motion, CHECKED)
+        self.pyramidal(&templates[..levels], last, start, motion, CHECKED)
             .is_some_and(|back| back.distance(state.sure_at) <= BACK_WITHIN)
-    }
-
-    /// [`pyramidal_to`](Self::pyramidal_to) to [`PRECISE`] steps.
-    fn pyramidal(
-        &self,
-        templates: &[Template],
-        pyramid: &Pyramid,
-        start: DVec2,
-        motion: f64,
-    ) -> Option<DVec2> {
-        self.pyramidal_to(templates, pyramid, start, motion, PRECISE)
     }
 
     /// Pyramidal alignment of `templates` (cut around one point, at every level) starting
     /// with their centre at `start`, over the levels both have, to steps shorter than `done`
     /// pixels at full size; where their centre lands, or `None` when it strays much beyond
     /// `motion` pixels from `start` (the pyramid's window ends there).
-    fn pyramidal_to(
+    fn pyramidal(
         &self,
         templates: &[Template],
         pyramid: &Pyramid,

@@ -169,29 +169,3 @@ fn saving_into_a_missing_folder_fails_without_a_file() {
     assert!(canvas.save_png(&path, PixelFormat::RGBA8).is_err());
     assert!(!path.exists());
 }
-
-#[test]
-fn tiny_skia_pixmap_round_trip_for_opaque_pixels() {
-    let format = PixelFormat {
-        color: ColorKind::Rgb,
-        alpha: false,
-        depth: Depth::Eight,
-    };
-    let canvas = Canvas::from_image(&test_image(format));
-    let pixmap = canvas.to_tiny_skia_pixmap();
-    for j in 0..canvas.height() {
-        for i in 0..canvas.width() {
-            let p = pixmap.pixel(i, j).unwrap();
-            let expected = canvas
-                .pixel_f32(i, j)
-                .unwrap()
-                .map(|v| (v * 255.0).round() as u8);
-            assert_eq!([p.red(), p.green(), p.blue(), p.alpha()], expected);
-        }
-    }
-    let mut overlaid = canvas.clone();
-    overlaid
-        .draw_pixmap_over(&tiny_skia::Pixmap::new(canvas.width(), canvas.height()).unwrap())
-        .unwrap();
-    assert_eq!(overlaid, canvas, "a transparent overlay changes nothing");
-}

@@ -225,18 +225,45 @@ proptest! {
     fn to_rhai_round_trips(original in scene()) {
         prop_assert!(original.sanity_check().is_ok());
         let text = original.to_rhai();
-        let options = ScriptOptions {
-            scene_dir: std::env::temp_dir(),
-            scripts_dir: None,
-            limits: Limits::default(),
-            cancel: Default::default(),
-        };
-        let parsed = parse_scene(&text, &PathBuf::from("saved.rhai"), &options)
-            .map_err(|e| TestCaseError::fail(format!("{e}\n---\n{text}")))?;
-        prop_assert_eq!(&parsed.scene, &original, "{}", text);
+        let parsed = read_back(&text).map_err(TestCaseError::fail)?;
+        prop_assert_eq!(&parsed, &original, "{}", text);
         // Writing again is a fixed point.
-        prop_assert_eq!(parsed.scene.to_rhai(), text);
+        prop_assert_eq!(parsed.to_rhai(), text);
     }
+}
+
+/// The scene `text` (as `to_rhai` wrote it) reads back as; the error shows the text.
+fn read_back(text: &str) -> Result<Scene, String> {
+    parse_scene(text, &PathBuf::from("saved.rhai"), &temp_options())
+        .map(|parsed| parsed.scene)
+        .map_err(|e| format!("{e}\n---\n{text}"))
+}
+
+/// Patches named as Rhai keywords or reserved words (`is` among them) get variables the
+/// scene language accepts, and the scene reads back.
+#[test]
+fn patches_named_as_keywords_round_trip() {
+    let names = ["is", "let", "print", "fn", "this", "goto", "type", "global"];
+    let patches = names
+        .iter()
+        .map(|name| {
+            Patch::new(
+                *name,
+                asset("astronaut.png"),
+                Shape::Mask(asset("horse_mask.png")),
+            )
+        })
+        .collect();
+    let canvas = Canvas {
+        width: 64,
+        height: 48,
+        fps: 24.0,
+        duration: 1.0,
+        background: Background::Colour([0.0, 0.0, 0.0, 1.0]),
+    };
+    let original = Scene::new(canvas, patches);
+    let text = original.to_rhai();
+    assert_eq!(read_back(&text).unwrap(), original, "{text}");
 }
 
 /// One edit as a REPL user would type it; indices pick among what exists when it runs.

@@ -114,10 +114,7 @@ const OPAQUE_RGB8: PixelFormat = PixelFormat {
 
 /// An 8-bit RGBA buffer as an opaque-format image of its levels.
 fn rgba8_image(width: u32, height: u32, bytes: &[u8]) -> Result<FloatImage, FootageError> {
-    let levels = bytes
-        .chunks_exact(4)
-        .map(|p| [p[0], p[1], p[2], p[3]])
-        .collect();
+    let levels = bytemuck::cast_slice(bytes).to_vec();
     FloatImage::from_levels(width, height, levels, OPAQUE_RGB8)
         .map_err(|e| FootageError::Image(Box::new(e)))
 }

@@ -27,11 +27,7 @@ pub(super) fn source_image(
 ) -> Result<FloatImage, RenderError> {
     if let Some(footage) = &patch.footage {
         let mut reader = FootageReader::new(footage.clone(), 1.0);
-        let image = reader.frame(0).map_err(|e| RenderError::Footage {
-            patch: Some(patch.name.clone()),
-            source: Box::new(e),
-        })?;
-        return Ok(image.clone());
+        return reader.take_frame(0).map_err(|e| RenderError::footage(Some(&patch.name), e));
     }
     if let Some(image) = sources.get(&patch.source) {
         return Ok(image.clone());
@@ -45,23 +41,18 @@ pub(super) fn source_image(
 /// it holds its last frame).
 pub(super) fn check_footage(scene: &Scene) -> Result<(), RenderError> {
     let (frames, fps) = (scene.canvas.frame_count(), scene.canvas.fps);
-    if let Background::Footage(footage) = &scene.canvas.background {
+    let background = match &scene.canvas.background {
+        Background::Footage(footage) => Some((None, footage)),
+        _ => None,
+    };
+    let sources = scene
+        .patches
+        .iter()
+        .filter_map(|patch| Some((Some(patch.name.as_str()), patch.footage.as_ref()?)));
+    for (patch, footage) in background.into_iter().chain(sources) {
         footage
             .check_covers(frames, fps)
-            .map_err(|e| RenderError::Footage {
-                patch: None,
-                source: Box::new(e),
-            })?;
-    }
-    for patch in &scene.patches {
-        if let Some(footage) = &patch.footage {
-            footage
-                .check_covers(frames, fps)
-                .map_err(|e| RenderError::Footage {
-                    patch: Some(patch.name.clone()),
-                    source: Box::new(e),
-                })?;
-        }
+            .map_err(|e| RenderError::footage(patch, e))?;
     }
     Ok(())
 }
@@ -77,35 +68,23 @@ pub(super) fn background_canvas(scene: &Scene) -> Result<(Canvas, Option<(Footag
         }
         Background::Image(path) => {
             let decoded = FloatImage::decode(path)?;
-            if let Some(canvas) = eight_bit_canvas(&decoded, width, height)? {
-                return Ok((canvas, None));
+            // An 8-bit image of the canvas's size straight from its bytes (no float copy; the
+            // same bytes as the float path).
+            if (decoded.width(), decoded.height()) == (width, height) {
+                if let Some(canvas) = Canvas::from_eight_bit(&decoded) {
+                    return Ok((canvas, None));
+                }
             }
             let picture = FloatImage::from_dynamic(&decoded)?;
             Ok((canvas_over(&picture, width, height)?, None))
         }
         Background::Footage(footage) => {
             let mut reader = FootageReader::new(footage.clone(), scene.canvas.fps);
-            let plate = reader.frame(0).map_err(|e| RenderError::Footage {
-                patch: None,
-                source: Box::new(e),
-            })?;
+            let plate = reader.frame(0).map_err(|e| RenderError::footage(None, e))?;
             let canvas = canvas_over(plate, width, height)?;
             Ok((canvas, Some((reader, 0))))
         }
     }
-}
-
-/// A decoded 8-bit image of the canvas's size as the canvas, straight from its bytes (no
-/// float copy; the same bytes as the float path); `None` for other depths and sizes.
-fn eight_bit_canvas(
-    decoded: &image::DynamicImage,
-    width: u32,
-    height: u32,
-) -> Result<Option<Canvas>, RenderError> {
-    if (decoded.width(), decoded.height()) != (width, height) {
-        return Ok(None);
-    }
-    Ok(Canvas::from_eight_bit(decoded))
 }
 
 /// `picture` at the origin of a `width`×`height` canvas, opaque black where it does not
