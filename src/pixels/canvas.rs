@@ -214,7 +214,7 @@ impl Canvas {
     }
 
     /// The whole canvas as a pixel rectangle, for clipping.
-    pub(crate) fn bounds(&self) -> PixelRect {
+    pub fn bounds(&self) -> PixelRect {
         let side = |n: u32| n.min(i32::MAX as u32) as i32;
         PixelRect {
             x0: 0,

@@ -1,5 +1,5 @@
 //! Integer pixel rectangles: takes pixel bounds and gives half-open rectangles
-//! [x0, x1) × [y0, y1) with intersection and size helpers.
+//! [x0, x1) × [y0, y1) with intersection, union and size helpers.
 
 /// A half-open rectangle of pixels, [x0, x1) × [y0, y1).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
@@ -42,6 +42,16 @@ impl PixelRect {
             y0: self.y0.max(other.y0),
             x1: self.x1.min(other.x1),
             y1: self.y1.min(other.y1),
+        }
+    }
+
+    /// The smallest rectangle holding both.
+    pub fn union(&self, other: &PixelRect) -> PixelRect {
+        PixelRect {
+            x0: self.x0.min(other.x0),
+            y0: self.y0.min(other.y0),
+            x1: self.x1.max(other.x1),
+            y1: self.y1.max(other.y1),
         }
     }
 

@@ -316,14 +316,8 @@ impl Renderer {
             .dirty
             .iter()
             .filter(|r| !r.is_empty())
-            .fold(None, |union: Option<PixelRect>, r| {
-                Some(union.map_or(*r, |u| PixelRect {
-                    x0: u.x0.min(r.x0),
-                    y0: u.y0.min(r.y0),
-                    x1: u.x1.max(r.x1),
-                    y1: u.y1.max(r.y1),
-                }))
-            })
+            .copied()
+            .reduce(|a, b| a.union(&b))
             .unwrap_or_default();
         Some(DrawnRegion {
             background: self.background_id,

@@ -163,13 +163,7 @@ impl Published {
         if (frame.width(), frame.height()) != (self.width, self.height) {
             return None;
         }
-        let whole = PixelRect {
-            x0: 0,
-            y0: 0,
-            x1: self.width.min(i32::MAX as u32) as i32,
-            y1: self.height.min(i32::MAX as u32) as i32,
-        };
-        let union = compared_region(self.region, region, whole);
+        let union = compared_region(self.region, region, frame.bounds());
         self.region = region;
         let Some(union) = union else {
             return Some(None);
@@ -237,12 +231,7 @@ fn compared_region(
             .into_iter()
             .map(|r| r.intersect(&whole))
             .filter(|r| !r.is_empty())
-            .reduce(|a, b| PixelRect {
-                x0: a.x0.min(b.x0),
-                y0: a.y0.min(b.y0),
-                x1: a.x1.max(b.x1),
-                y1: a.y1.max(b.y1),
-            }),
+            .reduce(|a, b| a.union(&b)),
         _ => Some(whole),
     }
 }
