@@ -71,7 +71,7 @@ pub fn draw_patch(
     let frame = Frame {
         patch,
         work,
-        target: work.intersect(&canvas_rect(canvas)),
+        target: work.intersect(&canvas.bounds()),
         width: canvas.width() as usize,
         threads: options.threads,
     };
@@ -253,15 +253,6 @@ impl Frame<'_> {
     }
 }
 
-fn canvas_rect(canvas: &Canvas) -> PixelRect {
-    PixelRect {
-        x0: 0,
-        y0: 0,
-        x1: canvas.width().min(i32::MAX as u32) as i32,
-        y1: canvas.height().min(i32::MAX as u32) as i32,
-    }
-}
-
 /// The placed bounding box grown by the AA band and the feather width, intersected with the
 /// canvas grown by the feather width (so distances near the canvas edge see the silhouette
 /// just outside it). `None` when nothing can reach the canvas.
@@ -286,6 +277,6 @@ fn work_rect(patch: &Patch, canvas: &Canvas, feather: f32) -> Option<PixelRect> 
         x1: clamp(max.x.ceil()) + 1,
         y1: clamp(max.y.ceil()) + 1,
     };
-    let work = placed.intersect(&canvas_rect(canvas).grow(margin));
-    (!work.is_empty() && !placed.intersect(&canvas_rect(canvas)).is_empty()).then_some(work)
+    let work = placed.intersect(&canvas.bounds().grow(margin));
+    (!work.is_empty() && !placed.intersect(&canvas.bounds()).is_empty()).then_some(work)
 }
