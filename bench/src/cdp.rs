@@ -111,8 +111,9 @@ impl Browser {
         Ok(browser)
     }
 
-    /// Calls `method` (on the page once attached) and returns its result.
-    pub fn call(&mut self, method: &str, params: Value) -> Result<Value, CdpError> {
+    /// Sends `method` (on the page once attached) without waiting for its reply; gives the
+    /// call's id.
+    fn send(&mut self, method: &str, params: Value) -> Result<u64, CdpError> {
         self.next_id += 1;
         let id = self.next_id;
         let mut message = json!({ "id": id, "method": method, "params": params });
@@ -121,6 +122,12 @@ impl Browser {
         }
         self.socket
             .send(Message::Text(message.to_string().into()))?;
+        Ok(id)
+    }
+
+    /// Calls `method` (on the page once attached) and returns its result.
+    pub fn call(&mut self, method: &str, params: Value) -> Result<Value, CdpError> {
+        let id = self.send(method, params)?;
         loop {
             if let Message::Text(text) = self.socket.read()? {
                 let reply: Value = serde_json::from_str(text.as_str())?;
@@ -167,12 +174,17 @@ impl Browser {
     /// Dispatches a left-button mouse event (`mouseMoved`, `mousePressed`, `mouseReleased`)
     /// at page point (`x`, `y`); moves carry the button held, as in a drag.
     pub fn mouse(&mut self, kind: &str, x: f64, y: f64) -> Result<(), CdpError> {
-        let buttons = if kind == "mouseReleased" { 0 } else { 1 };
-        self.call(
-            "Input.dispatchMouseEvent",
-            json!({ "type": kind, "x": x, "y": y, "button": "left", "buttons": buttons, "clickCount": 1 }),
-        )
-        .map(drop)
+        self.call("Input.dispatchMouseEvent", mouse_event(kind, x, y))
+            .map(drop)
+    }
+
+    /// Dispatches the same event without waiting for chromium's reply, as a mouse hands the
+    /// browser its reports whether or not the page has taken the last one: chromium answers a
+    /// move only once the page has handled it, so waiting would pace the moves by the page's
+    /// frames. The next `call` passes over the replies (a refused move is not reported).
+    pub fn mouse_unacked(&mut self, kind: &str, x: f64, y: f64) -> Result<(), CdpError> {
+        self.send("Input.dispatchMouseEvent", mouse_event(kind, x, y))
+            .map(drop)
     }
 
     /// Presses and releases `key` (its DOM name, and its Windows virtual key code).
@@ -202,6 +214,12 @@ impl Drop for Browser {
         let _ = self.child.kill();
         let _ = self.child.wait();
     }
+}
+
+/// A left-button mouse event at page point (`x`, `y`), the button held but on release.
+fn mouse_event(kind: &str, x: f64, y: f64) -> Value {
+    let buttons = if kind == "mouseReleased" { 0 } else { 1 };
+    json!({ "type": kind, "x": x, "y": y, "button": "left", "buttons": buttons, "clickCount": 1 })
 }
 
 /// The `ws://` address chromium prints on stderr; a thread keeps draining stderr afterwards so

@@ -11,7 +11,9 @@ use base64::Engine as _;
 use super::view_ws::{cat_scene, handle_scene, preview_png, ViewRepl};
 
 // The DevTools client the browser benchmark uses too: one copy, in the bench crate (which the
-// tests cannot depend on, as it depends on lapclone).
+// tests cannot depend on, as it depends on lapclone). The tests wait for every dispatched
+// event, so the benchmark's unanswered moves go unused here.
+#[allow(dead_code)]
 #[path = "../../bench/src/cdp.rs"]
 mod cdp;
 

@@ -2,10 +2,12 @@
 //! `lapclone` and Debian's `chromium`, starts `lapclone repl SCENE --view` on the two
 //! 1920×1080 scenes of `lapclone-bench view` (the cat moved across the canvas; the horse's
 //! depth handle dragged so the leg folds over its belly), opens the page in headless chromium
-//! and drags with dispatched pointer events paced at 60 Hz, as a mouse reports. Gives, from
+//! and drags with dispatched pointer moves, 60 a second by default, each at its own point of
+//! the display's frame and none waiting for the page, as a mouse's reports come. Gives, from
 //! the page's own timings (`window.lapcloneTimings`: pointer event → the frame showing the
-//! answer painted), the median, 95th percentile and the updates painted per second during
-//! the drag (table or JSON). Without chromium it reports the drags as skipped, saying why.
+//! answer painted), the median, 95th percentile, updates painted per second and the medians
+//! of where the time went (table or JSON). Without chromium it reports the drags as skipped,
+//! saying why.
 
 use std::path::Path;
 use std::time::{Duration, Instant};
@@ -18,18 +20,36 @@ use super::bench_view::{
 };
 use crate::cdp::{find_chromium, Browser};
 
-/// The same options as the server-side drag bench: steps (dispatched at 60 Hz here),
-/// assets, the binary, JSON.
-pub type BrowserBenchArgs = ViewBenchArgs;
-
-/// The pointer's report rate: a mouse's events reach a page once per 60 Hz display frame.
-const POINTER_PERIOD: Duration = Duration::from_nanos(16_666_667);
+/// The server-side drag bench's options, and the rate the pointer reports at.
+#[derive(clap::Args, Debug)]
+pub struct BrowserBenchArgs {
+    #[command(flatten)]
+    pub view: ViewBenchArgs,
+    /// Pointer moves per second.
+    #[arg(long, default_value_t = 60.0)]
+    pub pointer_hz: f64,
+    /// Wait for chromium to answer each move before the next. Chromium answers once the page
+    /// has handled the move, so this paces the moves by the page's own frames (a mouse does
+    /// not wait); the figures it gives depend on where the moves fall in the frame.
+    #[arg(long)]
+    pub acked: bool,
+}
 
 /// The browser window: a full-HD screen (the 1920×1080 canvas is shown scaled to fit).
 const WINDOW: (u32, u32) = (1920, 1080);
 
 /// How long the page may take to connect, draw and commit.
 const PAGE_TIMEOUT: Duration = Duration::from_secs(60);
+
+/// How a drag's pointer moves are dispatched.
+#[derive(Clone, Copy)]
+struct Pacing {
+    steps: usize,
+    /// The time between two moves.
+    period: Duration,
+    /// Wait for chromium's reply to each move before the next.
+    acked: bool,
+}
 
 #[derive(serde::Serialize)]
 struct Drag {
@@ -44,11 +64,17 @@ struct Drag {
     max_ms: f64,
     /// Previews painted per second, from the first pointer event answered to the last paint.
     updates_per_s: f64,
+    /// Medians of where the time went (the live view's page only), ms: waiting to be sent,
+    /// the round trip to the pixels put in the canvas, waiting for the frame, its paint.
+    parts_median_ms: Option<[f64; 4]>,
 }
 
 pub fn run(args: BrowserBenchArgs) -> anyhow::Result<()> {
-    if args.steps < 2 {
+    if args.view.steps < 2 {
         return Err(super::UsageError("--steps must be at least 2".into()).into());
+    }
+    if !(1.0..=1000.0).contains(&args.pointer_hz) {
+        return Err(super::UsageError("--pointer-hz must be within 1 to 1000".into()).into());
     }
     let report = match find_chromium() {
         Some(chromium) => json!({ "drags": drags(&args, &chromium)?, "skipped": null }),
@@ -57,7 +83,7 @@ pub fn run(args: BrowserBenchArgs) -> anyhow::Result<()> {
             "skipped": "chromium is not installed (apt-get install chromium)",
         }),
     };
-    if args.json {
+    if args.view.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
         return Ok(());
     }
@@ -83,31 +109,47 @@ pub fn run(args: BrowserBenchArgs) -> anyhow::Result<()> {
                 "targets ≤ 16, ≤ 33 ms, ≥ 50/s"
             },
         );
+        if let Some(parts) = d["parts_median_ms"].as_array() {
+            let part = |k: usize| parts.get(k).and_then(Value::as_f64).unwrap_or(f64::NAN);
+            println!(
+                "         medians of its parts: {:.1} ms to be sent, {:.1} ms round trip to the canvas, {:.1} ms waiting for the frame, {:.1} ms its paint",
+                part(0),
+                part(1),
+                part(2),
+                part(3),
+            );
+        }
     }
     Ok(())
 }
 
 /// Both drags, each against a fresh server and browser.
 fn drags(args: &BrowserBenchArgs, chromium: &Path) -> anyhow::Result<Vec<Drag>> {
-    let binary = match &args.lapclone {
+    let binary = match &args.view.lapclone {
         Some(path) => path.clone(),
         None => super::bench_opencv::beside_this_program("lapclone")?,
     };
     let assets = args
+        .view
         .assets
         .canonicalize()
         .context("cannot find the assets folder")?;
     let dir = std::env::temp_dir().join(format!("lapclone-bench-browser-{}", std::process::id()));
     std::fs::create_dir_all(&dir)?;
     let result = (|| {
-        let steps = args.steps;
+        let steps = args.view.steps;
+        let pacing = Pacing {
+            steps,
+            period: Duration::from_secs_f64(1.0 / args.pointer_hz),
+            acked: args.acked,
+        };
         let cat = drag(
             &binary,
             chromium,
             &dir,
             "cat",
             &cat_scene(&assets),
-            steps,
+            pacing,
             |_, i| Ok(cat_at(i, steps)),
         )?;
         let horse = drag(
@@ -116,10 +158,10 @@ fn drags(args: &BrowserBenchArgs, chromium: &Path) -> anyhow::Result<Vec<Drag>> 
             &dir,
             "horse",
             &horse_scene(&assets),
-            steps,
+            pacing,
             |scene, i| place(&scene["patches"][0], horse_target(i, steps)),
         )?;
-        let floor = floor_drag(chromium, &dir, steps)?;
+        let floor = floor_drag(chromium, &dir, pacing)?;
         Ok::<_, anyhow::Error>(vec![cat, horse, floor])
     })();
     let _ = std::fs::remove_dir_all(&dir);
@@ -159,14 +201,15 @@ overlay.addEventListener(move, (e) => {
 window.lapcloneReady = true;
 </script></body></html>"#;
 
-fn floor_drag(chromium: &Path, dir: &Path, steps: usize) -> anyhow::Result<Drag> {
+fn floor_drag(chromium: &Path, dir: &Path, pacing: Pacing) -> anyhow::Result<Drag> {
+    let steps = pacing.steps;
     let page = dir.join("floor.html");
     std::fs::write(&page, FLOOR_PAGE)?;
     let profile = dir.join("profile-floor");
     let url = format!("file://{}", page.display());
     let mut browser = Browser::launch(chromium, &profile, WINDOW, &url)?;
     browser.wait_for("window.lapcloneReady === true", PAGE_TIMEOUT)?;
-    let dispatched = pointer_drag(&mut browser, steps, |i| Ok(cat_at(i, steps)))?;
+    let dispatched = pointer_drag(&mut browser, pacing, |i| Ok(cat_at(i, steps)))?;
     browser.wait_for("window.lapcloneReleased === true", PAGE_TIMEOUT)?;
     browser.eval(
         "new Promise(r => requestAnimationFrame(() => requestAnimationFrame(() => setTimeout(r, 0))))",
@@ -202,9 +245,10 @@ fn drag(
     dir: &Path,
     name: &'static str,
     scene_text: &str,
-    steps: usize,
+    pacing: Pacing,
     point: impl Fn(&Value, usize) -> anyhow::Result<[f64; 2]>,
 ) -> anyhow::Result<Drag> {
+    let steps = pacing.steps;
     let scene_path = dir.join(format!("{name}.rhai"));
     std::fs::write(&scene_path, scene_text)?;
     let server = ViewServer::start(binary, &scene_path)?;
@@ -218,7 +262,7 @@ fn drag(
     let rev = scene["rev"]
         .as_u64()
         .context("the scene message has no rev")?;
-    let dispatched = pointer_drag(&mut browser, steps, |i| point(&scene, i))?;
+    let dispatched = pointer_drag(&mut browser, pacing, |i| point(&scene, i))?;
     // The commit's scene message comes after every preview's frame; then let the last
     // preview's paint be recorded.
     browser.wait_for(&format!("window.lapcloneScene().rev > {rev}"), PAGE_TIMEOUT)?;
@@ -227,16 +271,19 @@ fn drag(
     )?;
     let timings = numbers(&browser.eval("window.lapcloneTimings")?);
     let painted_at = numbers(&browser.eval("window.lapclonePaintedAt")?);
+    let parts = browser.eval("window.lapcloneTimingParts")?;
     drop(browser);
     drop(server);
-    summary(name, steps, dispatched, timings, &painted_at)
+    let mut drag = summary(name, steps, dispatched, timings, &painted_at)?;
+    drag.parts_median_ms = Some(part_medians(&parts));
+    Ok(drag)
 }
 
-/// Presses at canvas point `point(0)`, moves through `point(1..=steps)` at 60 Hz (a move
-/// that falls behind goes at once) and releases; gives how long the moves took.
+/// Presses at canvas point `point(0)`, moves through `point(1..=steps)`, one a `period` (a
+/// move that falls behind goes at once), and releases; gives how long the moves took.
 fn pointer_drag(
     browser: &mut Browser,
-    steps: usize,
+    pacing: Pacing,
     point: impl Fn(usize) -> anyhow::Result<[f64; 2]>,
 ) -> anyhow::Result<Duration> {
     let r = canvas_on_page(browser)?;
@@ -245,16 +292,24 @@ fn pointer_drag(
     browser.mouse("mouseMoved", x, y)?;
     browser.mouse("mousePressed", x, y)?;
     let started = Instant::now();
-    for i in 1..=steps {
-        let due = POINTER_PERIOD * i as u32;
+    for i in 1..=pacing.steps {
+        // The pointer's clock is not the display's: each move falls at its own point of its
+        // period, spread evenly over the run (the golden-ratio sequence), so the figures
+        // weigh every phase of chromium's frame alike instead of the one a fixed beat locks to.
+        let phase = (i as f64 * 0.618_033_988_749_895).fract();
+        let due = pacing.period.mul_f64(i as f64 - 1.0 + phase);
         if let Some(wait) = due.checked_sub(started.elapsed()) {
             std::thread::sleep(wait);
         }
         let (x, y) = page(i)?;
-        browser.mouse("mouseMoved", x, y)?;
+        if pacing.acked {
+            browser.mouse("mouseMoved", x, y)?;
+        } else {
+            browser.mouse_unacked("mouseMoved", x, y)?;
+        }
     }
     let dispatched = started.elapsed();
-    let (x, y) = page(steps)?;
+    let (x, y) = page(pacing.steps)?;
     browser.mouse("mouseReleased", x, y)?;
     Ok(dispatched)
 }
@@ -296,6 +351,23 @@ fn summary(
         p95_ms,
         max_ms,
         updates_per_s: painted as f64 / (span / 1e3),
+        parts_median_ms: None,
+    })
+}
+
+/// The median of each of the page's four timing parts.
+fn part_medians(parts: &Value) -> [f64; 4] {
+    std::array::from_fn(|k| {
+        let mut column: Vec<f64> = parts
+            .as_array()
+            .into_iter()
+            .flatten()
+            .filter_map(|row| row[k].as_f64())
+            .collect();
+        if column.is_empty() {
+            return f64::NAN;
+        }
+        spread(&mut column).0
     })
 }
 

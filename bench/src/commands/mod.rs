@@ -50,8 +50,9 @@ pub enum BenchCommand {
     /// The live view's drag on 1920×1080 scenes (the cat; the horse folding over itself):
     /// pointer message in → changed pixels out, through the release `lapclone repl --view`.
     View(bench_view::ViewBenchArgs),
-    /// The live view's drag in headless chromium on the same scenes, pointer events at 60 Hz:
-    /// pointer event → pixels painted (the page's own timing) and updates painted per second.
+    /// The live view's drag in headless chromium on the same scenes, pointer moves at 60 Hz
+    /// by default: pointer event → pixels painted (the page's own timing), updates painted
+    /// per second and where the time went.
     Browser(bench_browser::BrowserBenchArgs),
 }
 

@@ -21,9 +21,12 @@
   // and benchmark), and when each was painted (performance.now(), for updates per second).
   const timings = (window.lapcloneTimings = []);
   const paintedAt = (window.lapclonePaintedAt = []);
+  // Where each timing went, ms: [waiting to be sent, the round trip to the pixels put in the
+  // canvas, waiting for the frame that paints them, that frame's paint]; they add up to it.
+  const timingParts = (window.lapcloneTimingParts = []);
   // The last scene message, for tests that drive the page.
   window.lapcloneScene = () => scene;
-  let pointerAt = 0, sentAt = 0;
+  let pointerAt = 0, sentAt = 0, sendAt = 0;
 
   function send(message) {
     if (ws && ws.readyState === 1) ws.send(JSON.stringify(message));
@@ -65,13 +68,17 @@
     if (sentAt) {
       // requestAnimationFrame runs just before the frame's paint; a task queued from it runs
       // once that paint is done.
-      const from = sentAt;
+      const [from, sent, put] = [sentAt, sendAt, performance.now()];
       sentAt = 0;
-      requestAnimationFrame(() => setTimeout(() => {
-        const now = performance.now();
-        timings.push(now - from);
-        paintedAt.push(now);
-      }, 0));
+      requestAnimationFrame(() => {
+        const frameAt = performance.now();
+        setTimeout(() => {
+          const now = performance.now();
+          timings.push(now - from);
+          paintedAt.push(now);
+          timingParts.push([sent - from, put - sent, frameAt - put, now - frameAt]);
+        }, 0);
+      });
     }
     inFlight = false;
     flushEdit();
@@ -305,7 +312,8 @@
   }
   function flushEdit() {
     if (inFlight || !pendingEdit || !scene) return;
-    sentAt = pointerAt || performance.now();
+    sendAt = performance.now();
+    sentAt = pointerAt || sendAt;
     pointerAt = 0;
     inFlight = true;
     send({ type: "edit", rev: scene.rev, commit: false, edit: pendingEdit });
