@@ -41,7 +41,7 @@ fn refinement_budget(loops: &[Vec<DVec2>], boundary_vertices: usize) -> usize {
         + 64
 }
 
-/// How [`triangulate_loops`] refines.
+/// How `triangulate_loops` refines.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Refinement {
     pub min_angle_deg: f64,
