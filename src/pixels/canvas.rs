@@ -22,6 +22,13 @@ pub trait Texel: Copy + Send + Sync + 'static {
     fn from_unit4(values: [f32; 4]) -> [Self; 4] {
         values.map(Self::from_unit)
     }
+    /// The pixels as 8-bit levels, if they are (the shading's eight-lane path writes only
+    /// those).
+    #[doc(hidden)]
+    #[inline(always)]
+    fn as_levels_mut(_pixels: &mut [[Self; 4]]) -> Option<&mut [[u8; 4]]> {
+        None
+    }
 }
 
 impl Texel for f32 {
@@ -48,6 +55,10 @@ impl Texel for u8 {
     #[inline(always)]
     fn from_unit4(values: [f32; 4]) -> [Self; 4] {
         crate::simd::unit_to_levels(values)
+    }
+    #[inline(always)]
+    fn as_levels_mut(pixels: &mut [[Self; 4]]) -> Option<&mut [[u8; 4]]> {
+        Some(pixels)
     }
 }
 

@@ -14,10 +14,12 @@
 use glam::Vec4;
 
 use crate::pixels::FloatImage;
-use crate::simd::texel_taps;
+use crate::simd::{texel_taps, LevelSource};
 
 /// A texel type the sampler reads.
 pub(crate) trait SourceTexel: Copy {
+    /// The texels as 8-bit levels, if they are.
+    fn as_levels(texels: &[Self]) -> Option<&[[u8; 4]]>;
 
     /// The texel's channels in the blend's units.
     fn blend_units(self) -> Vec4;
@@ -26,6 +28,11 @@ pub(crate) trait SourceTexel: Copy {
 }
 
 impl SourceTexel for [f32; 4] {
+    #[inline(always)]
+    fn as_levels(_: &[Self]) -> Option<&[[u8; 4]]> {
+        None
+    }
+
     #[inline(always)]
     fn blend_units(self) -> Vec4 {
         Vec4::from_array(self)
@@ -38,6 +45,11 @@ impl SourceTexel for [f32; 4] {
 }
 
 impl SourceTexel for [u8; 4] {
+    #[inline(always)]
+    fn as_levels(texels: &[Self]) -> Option<&[[u8; 4]]> {
+        Some(texels)
+    }
+
     #[inline(always)]
     fn blend_units(self) -> Vec4 {
         Vec4::from_array(self.map(f32::from))
@@ -98,6 +110,14 @@ impl<'a, S: SourceTexel> Sampler<'a, S> {
             last_y_f32: last_as_f32(source.height()),
             taps_fit_i32: source.width().max(source.height()) <= 1 << 31,
         }
+    }
+
+    /// The source as the eight-lane shader reads it, if its texels are 8-bit levels and its
+    /// indices fit the lanes (see [`LevelSource::new`]).
+    pub fn levels(&self) -> Option<LevelSource<'a>> {
+        let texels = S::as_levels(self.pixels)?;
+        let last = [self.last_x_f32, self.last_y_f32];
+        LevelSource::new(texels, self.width, last).filter(|_| self.taps_fit_i32)
     }
 
     /// [`sample`](Self::sample) with `f32` coordinates and tap arithmetic (the shading hot

@@ -9,6 +9,8 @@
 
 use glam::{DVec2, Vec4};
 
+use crate::simd::RowAffine;
+
 /// Fixed-point subpixel resolution (1/256 px).
 pub(crate) const SUBPIXEL_BITS: u32 = 8;
 pub(crate) const SUBPIXEL: i64 = 1 << SUBPIXEL_BITS;
@@ -252,6 +254,17 @@ impl RowMaps {
         let dx = (x - self.origin_x) as f32;
         let at = |m: &[f32; 3]| m[0] + m[1] * dx + m[2];
         (at(&self.texel_x), at(&self.texel_y), self.membrane_at(x))
+    }
+
+    /// The maps as the eight-lane shader takes them, and the column they are based at.
+    #[inline(always)]
+    pub fn affine(&self) -> (RowAffine, i32) {
+        let maps = RowAffine {
+            texel_x: self.texel_x,
+            texel_y: self.texel_y,
+            membrane: self.membrane.map(|m| m.to_array()),
+        };
+        (maps, self.origin_x)
     }
 
     /// The membrane alone at the row's pixel `x`.

@@ -10,11 +10,11 @@
 use glam::Vec4;
 
 use super::sampler::{Sampler, SourceTexel};
-use super::setup::TriangleSetup;
+use super::setup::{RowMaps, TriangleSetup};
 use super::triangles::NO_TRIANGLE;
 use super::PixelRect;
 use crate::pixels::{FloatImage, Texel};
-use crate::simd::{Kernel, Path};
+use crate::simd::{Kernel, LevelSource, Path, Wide};
 
 /// Neighbour offsets within radius 2, nearest first (fixed order for determinism).
 const NEIGHBOURS: [(i32, i32); 24] = [
@@ -103,18 +103,21 @@ pub(crate) struct ShadeInput<'a, C> {
 ///
 /// Each row is walked in runs of equal triangle id, so a run reads its triangle's setup
 /// once; only the fringe (coverage without a triangle at the centre) looks at neighbours.
-/// Sources loaded from 8-bit files are sampled from their 8-bit texels.
+/// Sources loaded from 8-bit files are sampled from their 8-bit texels, and onto an 8-bit
+/// canvas the interior goes eight pixels at a time where the CPU allows ([`Wide`]).
 pub(crate) fn shade_and_composite<T: Texel, C: CoverageTexel>(
     input: &ShadeInput<C>,
     rows: PixelRect,
     canvas: &mut [[T; 4]],
     canvas_width: usize,
 ) -> (usize, usize) {
-    Path::current().run(Shade {
+    let path = Path::current();
+    path.run(Shade {
         input,
         rows,
         canvas,
         canvas_width,
+        wide: Wide::detect(path),
     })
 }
 
@@ -126,7 +129,11 @@ struct Shade<'a, 'c, T, C> {
     rows: PixelRect,
     canvas: &'c mut [[T; 4]],
     canvas_width: usize,
+    wide: Option<Wide>,
 }
+
+/// The eight-lane shader and the source as it reads it, where both apply.
+type Fast<'a> = Option<(Wide, LevelSource<'a>)>;
 
 impl<T: Texel, C: CoverageTexel> Kernel for Shade<'_, '_, T, C> {
     type Output = (usize, usize);
@@ -138,14 +145,18 @@ impl<T: Texel, C: CoverageTexel> Kernel for Shade<'_, '_, T, C> {
             rows,
             canvas,
             canvas_width,
+            wide,
         } = self;
         let source = input.source;
+        // The eight lanes write 8-bit levels only (an empty slice tells the canvas's kind).
+        let wide = wide.filter(|_| T::as_levels_mut(&mut []).is_some());
         match source.eight_bit_view() {
             Some((texels, _)) => {
                 let sampler = Sampler::with_texels(source, texels);
-                walk_rows(input, &sampler, rows, canvas, canvas_width)
+                let fast = wide.zip(sampler.levels());
+                walk_rows(input, &sampler, fast, rows, (canvas, canvas_width))
             }
-            None => walk_rows(input, &Sampler::new(source), rows, canvas, canvas_width),
+            None => walk_rows(input, &Sampler::new(source), None, rows, (canvas, canvas_width)),
         }
     }
 }
@@ -154,9 +165,9 @@ impl<T: Texel, C: CoverageTexel> Kernel for Shade<'_, '_, T, C> {
 fn walk_rows<S: SourceTexel, T: Texel, C: CoverageTexel>(
     input: &ShadeInput<C>,
     sampler: &Sampler<S>,
+    fast: Fast,
     rows: PixelRect,
-    canvas: &mut [[T; 4]],
-    canvas_width: usize,
+    (canvas, canvas_width): (&mut [[T; 4]], usize),
 ) -> (usize, usize) {
     let ids_rect = input.ids_rect;
     let ids_width = ids_rect.width();
@@ -171,35 +182,103 @@ fn walk_rows<S: SourceTexel, T: Texel, C: CoverageTexel>(
     let (mut hits, mut written) = (0, 0);
     for y in rows.y0..rows.y1 {
         let ids_row = (y - ids_rect.y0) as usize * ids_width;
-        let ids = &input.ids[ids_row + first..ids_row + last];
         let cover_row = (y - input.coverage_origin.1) as usize * input.coverage_stride;
-        let coverage = &input.coverage[cover_row + cover_first..cover_row + cover_last];
         let canvas_row = (y - rows.y0) as usize * canvas_width;
+        let span = Span {
+            x0: rows.x0,
+            y,
+            coverage: &input.coverage[cover_row + cover_first..cover_row + cover_last],
+        };
         let row = &mut canvas[canvas_row + rows.x0 as usize..canvas_row + rows.x1 as usize];
-        let mut start = 0;
-        while start < ids.len() {
-            let id = ids[start];
-            let end = start
-                + ids[start..]
-                    .iter()
-                    .take_while(|&&other| other == id)
-                    .count();
-            let span = Span {
-                x0: rows.x0 + start as i32,
-                y,
-                coverage: &coverage[start..end],
-            };
-            let pixels = &mut row[start..end];
-            written += if id == NO_TRIANGLE {
-                shade_fringe(input, sampler, &span, pixels)
-            } else {
-                hits += end - start;
-                shade_span(&input.setups[id as usize], sampler, &span, pixels)
-            };
-            start = end;
-        }
+        let ids = &input.ids[ids_row + first..ids_row + last];
+        let (row_hits, row_written) = shade_row(input, sampler, fast, ids, &span, row);
+        hits += row_hits;
+        written += row_written;
     }
     (hits, written)
+}
+
+/// Shades one row (`span`, its triangle `ids`, its `pixels`): eight pixels at a time
+/// where all eight are inside triangles and fully covered and `fast` applies, runs of equal
+/// triangle id otherwise (at most eight long with `fast`, so the eight lanes come back
+/// after the fringe). Gives the pixels whose centre a triangle owns and those written.
+#[inline(always)]
+fn shade_row<S: SourceTexel, T: Texel, C: CoverageTexel>(
+    input: &ShadeInput<C>,
+    sampler: &Sampler<S>,
+    fast: Fast,
+    ids: &[u32],
+    span: &Span<C>,
+    pixels: &mut [[T; 4]],
+) -> (usize, usize) {
+    let (mut hits, mut written, mut start) = (0, 0, 0);
+    while start < ids.len() {
+        let end = ids.len().min(start + 8);
+        let x0 = span.x0 + start as i32;
+        let lanes = Span {
+            x0,
+            y: span.y,
+            coverage: &span.coverage[start..end],
+        };
+        let eight = end - start == 8
+            && ids[start..end].iter().all(|&id| id != NO_TRIANGLE)
+            && lanes.coverage.iter().all(|c| c.is_full());
+        if let (Some(fast), true) = (fast, eight) {
+            if let Some(out) = T::as_levels_mut(&mut pixels[start..end]) {
+                written += shade_eight(input, fast, sampler, &lanes, &ids[start..end], out);
+                hits += 8;
+                start = end;
+                continue;
+            }
+        }
+        let id = ids[start];
+        let limit = if fast.is_some() { end } else { ids.len() };
+        let end = start + ids[start..limit].iter().take_while(|&&other| other == id).count();
+        let run = Span {
+            x0,
+            y: span.y,
+            coverage: &span.coverage[start..end],
+        };
+        let pixels = &mut pixels[start..end];
+        written += if id == NO_TRIANGLE {
+            shade_fringe(input, sampler, &run, pixels)
+        } else {
+            hits += end - start;
+            shade_span(&input.setups[id as usize], sampler, &run, pixels)
+        };
+        start = end;
+    }
+    (hits, written)
+}
+
+/// Eight pixels inside triangles (`ids`) and fully covered, through the eight-lane shader;
+/// the lanes whose sample is not opaque through the plain code. Returns the pixels written.
+#[inline(always)]
+fn shade_eight<S: SourceTexel, C: CoverageTexel>(
+    input: &ShadeInput<C>,
+    (wide, source): (Wide, LevelSource),
+    sampler: &Sampler<S>,
+    span: &Span<C>,
+    ids: &[u32],
+    out: &mut [[u8; 4]],
+) -> usize {
+    let setups = input.setups;
+    let lane_ids = std::array::from_fn(|lane| ids[lane]);
+    let (levels, opaque) = wide.shade_opaque(&source, span.x0, lane_ids, |id| {
+        setups[id as usize].span.along_row(span.y).affine()
+    });
+    let mut written = 0;
+    for (lane, (pixel, &texel)) in out.iter_mut().zip(span.coverage).enumerate() {
+        if opaque >> lane & 1 == 1 {
+            *pixel = levels[lane];
+            written += 1;
+        } else {
+            let maps = setups[ids[lane] as usize].span.along_row(span.y);
+            let x = span.x0 + lane as i32;
+            written += shade_at(&maps, sampler, x, texel, pixel);
+        }
+    }
+    written
 }
 
 /// A run of pixels of one row starting at canvas column `x0`, with their coverage.
@@ -222,13 +301,26 @@ fn shade_span<S: SourceTexel, T: Texel, C: CoverageTexel>(
     let maps = setup.span.along_row(span.y);
     let mut written = 0;
     for (x, (&texel, pixel)) in (span.x0..).zip(span.coverage.iter().zip(pixels.iter_mut())) {
-        if texel.is_covered() {
-            let (u, v, membrane) = maps.at(x);
-            let sample = sampler.sample_texel_space(u, v);
-            written += usize::from(shade_pixel(pixel, sample, membrane, texel));
-        }
+        written += shade_at(&maps, sampler, x, texel, pixel);
     }
     written
+}
+
+/// One pixel of a triangle's row at column `x`, if covered; whether it was written.
+#[inline(always)]
+fn shade_at<S: SourceTexel, T: Texel, C: CoverageTexel>(
+    maps: &RowMaps,
+    sampler: &Sampler<S>,
+    x: i32,
+    texel: C,
+    pixel: &mut [T; 4],
+) -> usize {
+    if !texel.is_covered() {
+        return 0;
+    }
+    let (u, v, membrane) = maps.at(x);
+    let sample = sampler.sample_texel_space(u, v);
+    usize::from(shade_pixel(pixel, sample, membrane, texel))
 }
 
 /// Source sample plus membrane, composited with the pixel's coverage; whether it changed.
@@ -414,9 +506,14 @@ mod tests {
         };
         // Pixels the reference changed, over all cases: the test must shade something.
         let changed = std::cell::Cell::new(0usize);
+        // Stretches the eight lanes must have taken (on a CPU with them).
+        let stretches = std::cell::Cell::new(0usize);
         TestRunner::new(config)
             .run(&any::<u64>(), |seed| {
                 let mut rng = Rng(seed | 1);
+                // Half the cases are wide and mostly covered, so the eight-lane path runs
+                // (across triangle edges too); the rest stress the fringe and coverage.
+                let interior = rng.next() % 2 == 0;
                 let (w, h) = (2 + rng.next() % 9, 2 + rng.next() % 7);
                 let opaque = rng.next() % 2 == 0;
                 let levels: Vec<[u8; 4]> = (0..w * h)
@@ -436,15 +533,21 @@ mod tests {
                 let rect = PixelRect {
                     x0: 0,
                     y0: 0,
-                    x1: 13,
+                    x1: if interior { 43 } else { 13 },
                     y1: 11,
                 };
+                let right = f64::from(rect.x1) + 2.0;
                 let setups: Vec<TriangleSetup> = (0..1 + rng.next() % 6)
-                    .map(|_| {
+                    .map(|k| {
+                        let mut placed = [0; 3]
+                            .map(|_| DVec2::new(rng.range(-2.0, right), rng.range(-2.0, 15.0)));
+                        if interior && k == 0 {
+                            // Under the others, over the whole rectangle: long covered rows.
+                            placed = [[-9.0, -9.0], [99.0, -9.0], [-9.0, 40.0]].map(DVec2::from);
+                        }
                         let mut point = |lo: f64, hi: f64| {
                             DVec2::new(rng.range(lo, hi), rng.range(lo, hi))
                         };
-                        let placed = [point(-2.0, 15.0), point(-2.0, 15.0), point(-2.0, 15.0)];
                         let rest = [point(-3.0, 12.0), point(-3.0, 12.0), point(-3.0, 12.0)];
                         let mut m = || rng.range(-0.7, 0.7) as f32;
                         let membrane = [[m(), m(), m()], [m(), m(), m()], [m(), m(), m()]];
@@ -455,12 +558,16 @@ mod tests {
                 let all = 0..setups.len() as u32;
                 rasterise_triangles(&setups, all, rect, false, &mut ids, &mut []);
                 let coverage: Vec<u8> = (0..rect.area())
-                    .map(|_| match rng.next() % 4 {
-                        0 => 0,
-                        1 | 2 => u8::MAX,
-                        _ => rng.byte(),
+                    .map(|_| match (interior, rng.next() % 16) {
+                        (_, 0) => 0,
+                        (true, 1) | (false, 1..=4) => rng.byte(),
+                        (true, _) | (false, 5..=11) => u8::MAX,
+                        (false, _) => 0,
                     })
                     .collect();
+                if opaque && source.eight_bit_view().is_some() {
+                    stretches.set(stretches.get() + eight_lane_stretches(&ids, &coverage, rect));
+                }
                 let canvas: Vec<[u8; 4]> = (0..rect.area())
                     .map(|_| {
                         let a = if rng.next() % 3 == 0 { rng.byte() } else { 255 };
@@ -492,6 +599,7 @@ mod tests {
                         rows: rect,
                         canvas: &mut shaded,
                         canvas_width: rect.width(),
+                        wide: Wide::detect(path),
                     });
                     prop_assert_eq!(&shaded, &expected, "{:?}", path);
                 }
@@ -499,5 +607,20 @@ mod tests {
             })
             .unwrap();
         assert!(changed.get() > 3_000, "{} pixels shaded", changed.get());
+        assert!(stretches.get() > 200, "{} eight-lane stretches", stretches.get());
+    }
+
+    /// Stretches of 16 pixels in a row, all inside triangles and fully covered: the row walk
+    /// steps at most 8 pixels at a time, so it starts eight lanes in each.
+    fn eight_lane_stretches(ids: &[u32], coverage: &[u8], rect: PixelRect) -> usize {
+        let fits: Vec<bool> = ids
+            .iter()
+            .zip(coverage)
+            .map(|(&id, &c)| id != NO_TRIANGLE && c == u8::MAX)
+            .collect();
+        fits.chunks(rect.width())
+            .flat_map(|row| row.split(|&f| !f))
+            .map(|run| run.len() / 16)
+            .sum()
     }
 }

@@ -14,9 +14,14 @@
 //! The raster's 8-bit store (`unit_to_levels`) and bilinear taps (`texel_taps`) are here
 //! too: four lanes at once with the baseline SSE2 instructions where the target has them (no
 //! run-time dispatch needed), the plain per-lane casts and comparisons elsewhere; both give
-//! the same bits (tested).
+//! the same bits (tested). The shading's interior pixels go eight at a time with AVX2 where
+//! the CPU has it ([`Wide`], in `shade8`), each lane giving the plain code's bytes.
 
 use std::sync::atomic::{AtomicU8, Ordering};
+
+mod shade8;
+
+pub(crate) use shade8::{LevelSource, RowAffine, Wide};
 
 /// How a kernel is compiled for this run.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
