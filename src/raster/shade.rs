@@ -51,6 +51,11 @@ pub(crate) trait CoverageTexel: Copy {
     fn is_covered(self) -> bool;
     /// `unit() >= 1`, without the conversion.
     fn is_full(self) -> bool;
+    /// Whether every texel of `texels` [`is_full`](Self::is_full).
+    #[inline(always)]
+    fn all_full(texels: &[Self]) -> bool {
+        texels.iter().all(|c| c.is_full())
+    }
 }
 
 impl CoverageTexel for u8 {
@@ -65,6 +70,14 @@ impl CoverageTexel for u8 {
     #[inline(always)]
     fn is_full(self) -> bool {
         self == u8::MAX
+    }
+    #[inline(always)]
+    fn all_full(texels: &[Self]) -> bool {
+        // Eight at a time as one word where there are eight (the eight-lane chunks).
+        match texels.first_chunk::<8>() {
+            Some(eight) if texels.len() == 8 => u64::from_ne_bytes(*eight) == u64::MAX,
+            _ => texels.iter().all(|&c| c == u8::MAX),
+        }
     }
 }
 
@@ -221,8 +234,8 @@ fn shade_row<S: SourceTexel, T: Texel, C: CoverageTexel>(
             coverage: &span.coverage[start..end],
         };
         let eight = end - start == 8
-            && ids[start..end].iter().all(|&id| id != NO_TRIANGLE)
-            && lanes.coverage.iter().all(|c| c.is_full());
+            && C::all_full(lanes.coverage)
+            && ids[start..end].iter().all(|&id| id != NO_TRIANGLE);
         if let (Some(fast), true) = (fast, eight) {
             if let Some(out) = T::as_levels_mut(&mut pixels[start..end]) {
                 written += shade_eight(input, fast, sampler, &lanes, &ids[start..end], out);
@@ -267,6 +280,10 @@ fn shade_eight<S: SourceTexel, C: CoverageTexel>(
     let (levels, opaque) = wide.shade_opaque(&source, span.x0, lane_ids, |id| {
         setups[id as usize].span.along_row(span.y).affine()
     });
+    if opaque == u8::MAX {
+        out.copy_from_slice(&levels);
+        return 8;
+    }
     let mut written = 0;
     for (lane, (pixel, &texel)) in out.iter_mut().zip(span.coverage).enumerate() {
         if opaque >> lane & 1 == 1 {
