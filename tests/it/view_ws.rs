@@ -200,9 +200,19 @@ impl Page {
 
     fn apply(&mut self, bytes: &[u8]) {
         let u = |i: usize| u32::from_le_bytes(bytes[i * 4..i * 4 + 4].try_into().unwrap());
-        assert_eq!(u(0), 1, "frame message kind");
         let (width, height, x, y, w, h) = (u(1), u(2), u(3), u(4), u(5), u(6));
-        assert_eq!(bytes.len(), 28 + (w * h * 4) as usize);
+        // Each row's run of changed pixels: [first column from x, length].
+        let runs: Vec<[u32; 2]> = match u(0) {
+            1 => vec![[0, w]; h as usize],
+            2 => (0..h as usize)
+                .map(|j| [u(7 + 2 * j), u(8 + 2 * j)])
+                .collect(),
+            kind => panic!("frame message kind {kind}"),
+        };
+        let table = if u(0) == 2 { 8 * h as usize } else { 0 };
+        let pixels: usize = runs.iter().map(|r| r[1] as usize * 4).sum();
+        assert_eq!(bytes.len(), 28 + table + pixels);
+        assert!(runs.iter().all(|&[first, length]| first + length <= w));
         if (width, height) != (self.width, self.height) {
             assert_eq!(
                 (x, y, w, h),
@@ -212,11 +222,12 @@ impl Page {
             self.frame = vec![0; (width * height * 4) as usize];
             (self.width, self.height) = (width, height);
         }
-        for j in 0..h {
-            let src = 28 + (j * w * 4) as usize;
-            let dst = (((y + j) * width + x) * 4) as usize;
-            self.frame[dst..dst + (w * 4) as usize]
-                .copy_from_slice(&bytes[src..src + (w * 4) as usize]);
+        let mut src = 28 + table;
+        for (j, [first, length]) in (0..).zip(runs) {
+            let dst = (((y + j) * width + x + first) * 4) as usize;
+            let len = (length * 4) as usize;
+            self.frame[dst..dst + len].copy_from_slice(&bytes[src..src + len]);
+            src += len;
         }
         self.rects.push([x, y, w, h]);
     }

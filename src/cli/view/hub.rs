@@ -1,7 +1,8 @@
 //! What every open page is sent: takes each rendered frame (and the scene message that goes
-//! with it) from the session and gives the connected pages binary frame updates — only the
-//! rectangle where the 8-bit RGBA frame changed since the last one, or the whole frame to a
-//! page that just connected — plus JSON text messages, in the order they were published.
+//! with it) from the session and gives the connected pages binary frame updates — only what
+//! changed in the 8-bit RGBA frame since the last one (each row's run from its first to its
+//! last changed pixel), or the whole frame to a page that just connected — plus JSON text
+//! messages, in the order they were published.
 //! Between two frames over the same background only the union of their drawn regions can
 //! differ, so only that part is converted and compared.
 
@@ -14,9 +15,26 @@ use tungstenite::{Bytes, Utf8Bytes};
 
 use super::lock;
 
-/// Bytes before the pixels of a frame message: seven little-endian u32 — kind (1), canvas
-/// width, canvas height, then the rectangle's x, y, width and height.
+/// Bytes before the pixels of a frame message: seven little-endian u32 — kind ([`RECT`] or
+/// [`RUNS`]), canvas width, canvas height, then the rectangle's x, y, width and height.
 pub const FRAME_HEADER: usize = 28;
+
+/// A frame message carrying its rectangle's rows whole.
+pub const RECT: u32 = 1;
+
+/// A frame message carrying, per row of its rectangle, the run from the row's first to its
+/// last changed pixel: after the header, per row two u32 (the run's first column from the
+/// rectangle's left, its length), then the runs' pixels one after the other.
+pub const RUNS: u32 = 2;
+
+/// What changed in a frame: the smallest rectangle holding every changed pixel and, per row
+/// of it, `[first column from the rectangle's left, length]` of the run from the row's first
+/// to its last changed pixel (`[0, 0]`: the row did not change).
+#[derive(Debug, PartialEq)]
+struct Changes {
+    rect: [u32; 4],
+    runs: Vec<[u32; 2]>,
+}
 
 /// One message to a page; cloning one for another page shares its bytes.
 #[derive(Clone, Debug)]
@@ -110,28 +128,27 @@ impl Hub {
     /// ([`Renderer::drawn_region`](lapclone::Renderer::drawn_region)).
     pub fn publish(&self, frame: &Canvas, region: Option<DrawnRegion>, scene: SceneText) {
         let mut state = lock(&self.state);
-        let rect = state
+        let changes = state
             .frame
             .as_mut()
             .and_then(|last| last.update(frame, region));
-        let rect = match rect {
-            Some(rect) => rect,
-            None => {
+        let message = match (changes, &state.frame) {
+            (Some(Some(changes)), Some(last)) => runs_message(last, &changes),
+            (Some(None), Some(last)) => frame_message(last.width, last.height, &last.rgba, [0; 4]),
+            _ => {
                 let (width, height) = (frame.width(), frame.height());
                 let rgba = frame.to_rgba8_image().into_raw();
+                let message = frame_message(width, height, &rgba, [0, 0, width, height]);
                 state.frame = Some(Published {
                     width,
                     height,
                     rgba,
                     region,
                 });
-                Some([0, 0, width, height])
+                message
             }
         };
-        let rect = rect.unwrap_or([0, 0, 0, 0]);
-        // invariant: both arms above leave a published frame.
-        let last = state.frame.as_ref().expect("a published frame");
-        let frame = Bytes::from(frame_message(last.width, last.height, &last.rgba, rect));
+        let frame = Bytes::from(message);
         let plain = Utf8Bytes::from(scene.plain);
         let with_mesh = scene.with_mesh.map(Utf8Bytes::from);
         state.clients.retain(|c| {
@@ -157,9 +174,9 @@ impl Hub {
 impl Published {
     /// Takes in `frame` when it has this frame's size, comparing only the union of the two
     /// drawn regions when both are known over the same background, else the whole frame.
-    /// Gives the changed rectangle (`None` inside: nothing changed), or `None` when the size
-    /// differs and the whole frame must be taken instead.
-    fn update(&mut self, frame: &Canvas, region: Option<DrawnRegion>) -> Option<Option<[u32; 4]>> {
+    /// Gives what changed (`None` inside: nothing did), or `None` when the size differs and
+    /// the whole frame must be taken instead.
+    fn update(&mut self, frame: &Canvas, region: Option<DrawnRegion>) -> Option<Option<Changes>> {
         if (frame.width(), frame.height()) != (self.width, self.height) {
             return None;
         }
@@ -171,13 +188,14 @@ impl Published {
         Some(self.take_rows(frame, union))
     }
 
-    /// Copies `frame`'s pixels inside `union` into the kept frame; gives the rectangle of
-    /// those that changed (`None`: none did).
-    fn take_rows(&mut self, frame: &Canvas, union: PixelRect) -> Option<[u32; 4]> {
+    /// Copies `frame`'s pixels inside `union` into the kept frame; gives what changed
+    /// (`None`: nothing did).
+    fn take_rows(&mut self, frame: &Canvas, union: PixelRect) -> Option<Changes> {
         let (x0, w) = (union.x0 as usize, union.width());
         let row = self.width as usize * 4;
-        // Rows are compared where they are: only the union's columns of each row.
-        let (mut top, mut bottom, mut left, mut right) = (usize::MAX, 0, usize::MAX, 0);
+        // Rows are compared where they are: only the union's columns of each row. Each
+        // changed row's run, as (row, first, last) in the union's pixels.
+        let mut changed: Vec<[usize; 3]> = Vec::new();
         let mut converted: Vec<u8>;
         for y in union.y0 as usize..union.y1 as usize {
             let new_row = match frame.pixels() {
@@ -203,20 +221,30 @@ impl Published {
                 .zip(new_row)
                 .rposition(|(a, b)| a != b)
                 .expect("a difference");
-            (top, bottom) = (top.min(y), y);
-            (left, right) = (left.min(first / 4), right.max(last / 4));
+            changed.push([y, first / 4, last / 4]);
             old_row.copy_from_slice(new_row);
         }
-        (top <= bottom).then(|| {
-            let x = (x0 + left) as u32;
-            [
-                x,
-                top as u32,
-                (right - left + 1) as u32,
-                (bottom - top + 1) as u32,
-            ]
-        })
+        changes(&changed, x0)
     }
+}
+
+/// The rectangle and row runs of the changed rows' runs `[row, first, last]` (columns from
+/// `x0`, rows ascending).
+fn changes(changed: &[[usize; 3]], x0: usize) -> Option<Changes> {
+    let (&[top, ..], &[bottom, ..]) = (changed.first()?, changed.last()?);
+    let left = changed.iter().map(|c| c[1]).min()?;
+    let right = changed.iter().map(|c| c[2]).max()?;
+    let mut runs = vec![[0, 0]; bottom - top + 1];
+    for &[y, first, last] in changed {
+        runs[y - top] = [(first - left) as u32, (last - first + 1) as u32];
+    }
+    let rect = [
+        (x0 + left) as u32,
+        top as u32,
+        (right - left + 1) as u32,
+        runs.len() as u32,
+    ];
+    Some(Changes { rect, runs })
 }
 
 /// Where two frames can differ: the union of their drawn regions inside `whole` when both are
@@ -241,17 +269,36 @@ pub fn channel() -> (Sender<Outgoing>, Receiver<Outgoing>) {
     std::sync::mpsc::channel()
 }
 
-/// The binary frame message for `rect` of the `width`×`height` frame `rgba`.
+/// The binary frame message ([`RECT`]) for `rect` of the `width`×`height` frame `rgba`.
 pub fn frame_message(width: u32, height: u32, rgba: &[u8], rect: [u32; 4]) -> Vec<u8> {
     let [x, y, w, h] = rect;
     let mut out = Vec::with_capacity(FRAME_HEADER + (w * h * 4) as usize);
-    for v in [1, width, height, x, y, w, h] {
+    for v in [RECT, width, height, x, y, w, h] {
         out.extend_from_slice(&v.to_le_bytes());
     }
     let row = width as usize * 4;
     for j in y..y + h {
         let start = j as usize * row + x as usize * 4;
         out.extend_from_slice(&rgba[start..start + w as usize * 4]);
+    }
+    out
+}
+
+/// The binary frame message ([`RUNS`]) for `changes` of the published frame `last`.
+fn runs_message(last: &Published, changes: &Changes) -> Vec<u8> {
+    let [x, y, w, h] = changes.rect;
+    let pixels: usize = changes.runs.iter().map(|r| r[1] as usize * 4).sum();
+    let mut out = Vec::with_capacity(FRAME_HEADER + changes.runs.len() * 8 + pixels);
+    for v in [RUNS, last.width, last.height, x, y, w, h] {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+    for v in changes.runs.iter().flatten() {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+    let row = last.width as usize * 4;
+    for (j, &[first, length]) in (y as usize..).zip(&changes.runs) {
+        let start = j * row + (x + first) as usize * 4;
+        out.extend_from_slice(&last.rgba[start..start + length as usize * 4]);
     }
     out
 }
@@ -325,6 +372,58 @@ mod tests {
             panic!("no frame");
         };
         assert_eq!(&m[FRAME_HEADER..], canvas(&[]).samples(PixelFormat::RGBA8));
+    }
+
+    /// The pixels a message carries, written into `frame` (6 px wide) as a page does.
+    fn apply(message: &Outgoing, frame: &mut [[u8; 4]]) {
+        let Outgoing::Binary(m) = message else {
+            panic!("not a frame: {message:?}");
+        };
+        let word = |k: usize| u32::from_le_bytes(m[4 * k..4 * k + 4].try_into().unwrap()) as usize;
+        let [x, y, w, h] = [3, 4, 5, 6].map(word);
+        let mut at = FRAME_HEADER + if word(0) == RUNS as usize { 8 * h } else { 0 };
+        for j in 0..h {
+            let [first, length] = match word(0) as u32 {
+                RUNS => [word(7 + 2 * j), word(8 + 2 * j)],
+                _ => [0, w],
+            };
+            for (k, pixel) in m[at..at + 4 * length].chunks(4).enumerate() {
+                frame[(y + j) * 6 + x + first + k].copy_from_slice(pixel);
+            }
+            at += 4 * length;
+        }
+        assert_eq!(at, m.len());
+    }
+
+    /// Row by row only the runs that changed go out, and a page applying them ends with the
+    /// published frame; rows with nothing changed inside the rectangle carry no pixels.
+    #[test]
+    fn updates_carry_each_rows_changed_run() {
+        let hub = Hub::default();
+        let (tx, rx) = channel();
+        hub.connect(tx);
+        let first = canvas(&[]);
+        hub.publish(&first, region(1, 0, 0, 6, 5), scene());
+        let mut page = vec![[0u8; 4]; 30];
+        apply(&rx.recv().unwrap(), &mut page);
+        rx.recv().unwrap();
+        // Row 1: columns 1 and 4 (the run spans 1..=4); row 2 unchanged; row 3: column 2.
+        let changed = [
+            (6 + 1, [1, 1, 1, 1]),
+            (6 + 4, [2, 2, 2, 2]),
+            (18 + 2, [3, 3, 3, 3]),
+        ];
+        let next = canvas(&changed);
+        hub.publish(&next, region(1, 0, 0, 6, 5), scene());
+        let message = rx.recv().unwrap();
+        assert_eq!(rect_of(&message), [1, 1, 4, 3]);
+        let Outgoing::Binary(m) = &message else {
+            panic!("no frame");
+        };
+        // Header, three rows' runs, then 4 + 0 + 1 pixels.
+        assert_eq!(m.len(), FRAME_HEADER + 3 * 8 + 5 * 4);
+        apply(&message, &mut page);
+        assert_eq!(page.as_flattened(), next.samples(PixelFormat::RGBA8));
     }
 
     #[test]

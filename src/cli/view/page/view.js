@@ -53,17 +53,34 @@
     ws.onmessage = (event) => (typeof event.data === "string" ? onText(JSON.parse(event.data)) : onFrame(event.data));
   }
 
+  // The frame's pixels as the canvas holds them: updates that carry only each row's changed
+  // run are written into it, then its changed rectangle is put into the canvas.
+  let frameData = null;
+
   function onFrame(buffer) {
     const head = new DataView(buffer, 0, 28);
     const [kind, width, height, x, y, w, hh] = [0, 4, 8, 12, 16, 20, 24].map((at) => head.getUint32(at, true));
-    if (kind !== 1) return;
-    if (frame.width !== width || frame.height !== height) {
+    if (kind !== 1 && kind !== 2) return;
+    if (frame.width !== width || frame.height !== height || !frameData) {
       frame.width = overlay.width = width;
       frame.height = overlay.height = height;
+      frameData = new ImageData(width, height);
     }
     if (w > 0 && hh > 0) {
-      const pixels = new Uint8ClampedArray(buffer, 28, w * hh * 4);
-      fctx.putImageData(new ImageData(pixels, w, hh), x, y);
+      const data = frameData.data;
+      if (kind === 1) {
+        for (let j = 0; j < hh; j++) data.set(new Uint8Array(buffer, 28 + j * w * 4, w * 4), ((y + j) * width + x) * 4);
+      } else {
+        const runs = new DataView(buffer, 28, hh * 8);
+        let at = 28 + hh * 8;
+        for (let j = 0; j < hh; j++) {
+          const first = runs.getUint32(j * 8, true), length = runs.getUint32(j * 8 + 4, true);
+          if (!length) continue;
+          data.set(new Uint8Array(buffer, at, length * 4), ((y + j) * width + x + first) * 4);
+          at += length * 4;
+        }
+      }
+      fctx.putImageData(frameData, 0, 0, x, y, w, hh);
     }
     if (sentAt) {
       // requestAnimationFrame runs just before the frame's paint; a task queued from it runs
