@@ -15,7 +15,7 @@
 //! too: four lanes at once with the baseline SSE2 instructions where the target has them (no
 //! run-time dispatch needed), the plain per-lane casts and comparisons elsewhere; both give
 //! the same bits (tested). The shading's interior pixels go eight at a time with AVX2 where
-//! the CPU has it ([`Wide`], in `shade8`), each lane giving the plain code's bytes.
+//! the CPU has it (`Wide`, in `shade8`), each lane giving the plain code's bytes.
 
 use std::sync::atomic::{AtomicU8, Ordering};
 

@@ -17,6 +17,7 @@ use super::Path;
 
 /// The source as eight lanes read it: its 8-bit texels as bytes, its width and last row.
 #[derive(Clone, Copy)]
+#[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
 pub(crate) struct LevelSource<'a> {
     bytes: &'a [u8],
     width: i32,
