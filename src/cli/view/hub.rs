@@ -210,18 +210,17 @@ impl Published {
             if *old_row == *new_row {
                 continue;
             }
+            // Pixel by pixel (one 32-bit compare each), not byte by byte.
+            // invariant: both rows are whole RGBA pixels, so the casts cannot fail.
+            let pixels = || {
+                let old: &[[u8; 4]] = bytemuck::cast_slice(old_row);
+                let new: &[[u8; 4]] = bytemuck::cast_slice(new_row);
+                old.iter().zip(new)
+            };
             // invariant: the rows differ, so a first and a last difference exist.
-            let first = old_row
-                .iter()
-                .zip(new_row)
-                .position(|(a, b)| a != b)
-                .expect("a difference");
-            let last = old_row
-                .iter()
-                .zip(new_row)
-                .rposition(|(a, b)| a != b)
-                .expect("a difference");
-            changed.push([y, first / 4, last / 4]);
+            let first = pixels().position(|(a, b)| a != b).expect("a difference");
+            let last = pixels().rposition(|(a, b)| a != b).expect("a difference");
+            changed.push([y, first, last]);
             old_row.copy_from_slice(new_row);
         }
         changes(&changed, x0)
