@@ -271,10 +271,7 @@ pub fn channel() -> (Sender<Outgoing>, Receiver<Outgoing>) {
 /// The binary frame message ([`RECT`]) for `rect` of the `width`×`height` frame `rgba`.
 pub fn frame_message(width: u32, height: u32, rgba: &[u8], rect: [u32; 4]) -> Vec<u8> {
     let [x, y, w, h] = rect;
-    let mut out = Vec::with_capacity(FRAME_HEADER + (w * h * 4) as usize);
-    for v in [RECT, width, height, x, y, w, h] {
-        out.extend_from_slice(&v.to_le_bytes());
-    }
+    let mut out = header(RECT, width, height, rect, (w * h * 4) as usize);
     let row = width as usize * 4;
     for j in y..y + h {
         let start = j as usize * row + x as usize * 4;
@@ -283,14 +280,21 @@ pub fn frame_message(width: u32, height: u32, rgba: &[u8], rect: [u32; 4]) -> Ve
     out
 }
 
-/// The binary frame message ([`RUNS`]) for `changes` of the published frame `last`.
-fn runs_message(last: &Published, changes: &Changes) -> Vec<u8> {
-    let [x, y, w, h] = changes.rect;
-    let pixels: usize = changes.runs.iter().map(|r| r[1] as usize * 4).sum();
-    let mut out = Vec::with_capacity(FRAME_HEADER + changes.runs.len() * 8 + pixels);
-    for v in [RUNS, last.width, last.height, x, y, w, h] {
+/// A frame message's header, with room for `body` more bytes.
+fn header(kind: u32, width: u32, height: u32, [x, y, w, h]: [u32; 4], body: usize) -> Vec<u8> {
+    let mut out = Vec::with_capacity(FRAME_HEADER + body);
+    for v in [kind, width, height, x, y, w, h] {
         out.extend_from_slice(&v.to_le_bytes());
     }
+    out
+}
+
+/// The binary frame message ([`RUNS`]) for `changes` of the published frame `last`.
+fn runs_message(last: &Published, changes: &Changes) -> Vec<u8> {
+    let [x, y, ..] = changes.rect;
+    let pixels: usize = changes.runs.iter().map(|r| r[1] as usize * 4).sum();
+    let body = changes.runs.len() * 8 + pixels;
+    let mut out = header(RUNS, last.width, last.height, changes.rect, body);
     for v in changes.runs.iter().flatten() {
         out.extend_from_slice(&v.to_le_bytes());
     }
