@@ -78,16 +78,35 @@ fn rasterise_one(
 }
 
 /// The depth test along one span: pixel k gets depth `first + step·k` and takes the
-/// triangle when that is ≥ the stored depth (never when it is NaN).
+/// triangle when that is ≥ the stored depth (never when it is NaN). Written without a
+/// branch per pixel: whether a triangle wins flips along a fold, and the mispredictions
+/// cost more than the selects; groups of eight vectorise.
 #[inline]
 fn depth_test_span(index: u32, (first, step): (f32, f32), ids: &mut [u32], depths: &mut [f32]) {
-    for (k, (id, stored)) in ids.iter_mut().zip(depths.iter_mut()).enumerate() {
-        let depth = first + step * k as i32 as f32;
-        if depth >= *stored {
-            *stored = depth;
-            *id = index;
+    const LANES: usize = 8;
+    let mut id_groups = ids.chunks_exact_mut(LANES);
+    let mut depth_groups = depths.chunks_exact_mut(LANES);
+    let mut k = 0usize;
+    for (ids, stored) in (&mut id_groups).zip(&mut depth_groups) {
+        for lane in 0..LANES {
+            depth_test_pixel(index, first + step * (k + lane) as i32 as f32, &mut ids[lane], &mut stored[lane]);
         }
+        k += LANES;
     }
+    let tail = id_groups.into_remainder().iter_mut();
+    for (id, stored) in tail.zip(depth_groups.into_remainder()) {
+        depth_test_pixel(index, first + step * k as i32 as f32, id, stored);
+        k += 1;
+    }
+}
+
+/// One pixel of [`depth_test_span`], as selects.
+#[inline(always)]
+fn depth_test_pixel(index: u32, depth: f32, id: &mut u32, stored: &mut f32) {
+    let wins = depth >= *stored;
+    let keep = u32::from(wins).wrapping_sub(1);
+    *id = (index & !keep) | (*id & keep);
+    *stored = f32::from_bits((depth.to_bits() & !keep) | (stored.to_bits() & keep));
 }
 
 /// Calls `visit(x, y)` for every pixel of `clip` whose centre the placed triangle owns under
