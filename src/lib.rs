@@ -103,6 +103,7 @@ pub use script::{
     load_scene, load_scene_and_imports, set_allocation_probe, ErrorKind as SceneErrorKind,
     LoadedScene, SceneError,
 };
+pub use simd::{levels_to_rgb8, rgb8_to_levels};
 pub use solve::{FactorMethod, LaplacianKind, PenaltyOptions, SolveError, SwitchStats};
 
 /// Opens a scene file as `lapclone render` does: loads and runs it ([`load_scene`]), then

@@ -266,7 +266,7 @@ fn load_rect_typed<T: Element + Copy + CanvasTexel>(
                 let samples = &samples[x0 * channels..x1 * channels];
                 match channels {
                     1 => load_row::<T, 1>(out, samples, (red, blue), opaque),
-                    3 => load_row::<T, 3>(out, samples, (red, blue), opaque),
+                    3 => T::load_rgb_row(out, samples, (red, blue), opaque),
                     _ => load_row::<T, 4>(out, samples, (red, blue), opaque),
                 }
             }
@@ -285,8 +285,25 @@ fn load_rect_typed<T: Element + Copy + CanvasTexel>(
 }
 
 /// Canvas storage of one sample type.
-pub trait CanvasTexel: Sized {
+pub trait CanvasTexel: Copy + Sized {
     fn texels_mut(canvas: &mut Canvas) -> Option<&mut Vec<[Self; 4]>>;
+
+    /// One contiguous row of three-sample pixels into texels, red and blue read from the
+    /// indices `red_blue`, alpha `opaque`.
+    fn load_rgb_row(
+        out: &mut [[Self; 4]],
+        samples: &[Self],
+        red_blue: (usize, usize),
+        opaque: Self,
+    ) {
+        load_row::<Self, 3>(out, samples, red_blue, opaque);
+    }
+
+    /// Texels into one contiguous row of three-sample pixels, red and blue swapped for `bgr`.
+    fn write_rgb_row(dst: &mut [Self], row: &[[Self; 4]], bgr: bool) {
+        let order = if bgr { [2, 1, 0, 3] } else { [0, 1, 2, 3] };
+        texels_into_row::<Self, 3>(dst, row, order);
+    }
 }
 
 impl CanvasTexel for u8 {
@@ -295,6 +312,16 @@ impl CanvasTexel for u8 {
             lapclone::CanvasPixels::Eight(p) => Some(p),
             _ => None,
         }
+    }
+
+    // 8-bit rows go through lapclone's converters, compiled for this CPU's vector unit (the
+    // plain loop has no byte shuffle at the baseline instruction set). Opaque is 255 here.
+    fn load_rgb_row(out: &mut [[u8; 4]], samples: &[u8], (red, _): (usize, usize), _: u8) {
+        lapclone::rgb8_to_levels(samples, red == 2, out);
+    }
+
+    fn write_rgb_row(dst: &mut [u8], row: &[[u8; 4]], bgr: bool) {
+        lapclone::levels_to_rgb8(row, bgr, dst);
     }
 }
 
@@ -458,7 +485,7 @@ pub fn write_canvas_rect(
 
 /// [`write_canvas_rect`] for RGB(A) arrays of the canvas's depth: each texel's first
 /// `channels` values, red and blue swapped for `bgr`.
-fn write_texels<T: Element + Copy>(
+fn write_texels<T: Element + CanvasTexel>(
     array: &Bound<'_, PyAny>,
     layout: &Layout,
     bgr: bool,
@@ -483,7 +510,7 @@ fn write_texels<T: Element + Copy>(
             Some(dst) => {
                 let dst = &mut dst[x0 * c..x1 * c];
                 match c {
-                    3 => texels_into_row::<T, 3>(dst, row, order),
+                    3 => T::write_rgb_row(dst, row, bgr),
                     _ => texels_into_row::<T, 4>(dst, row, order),
                 }
             }

@@ -93,7 +93,9 @@ pub(crate) fn rgba8_levels(decoded: &image::DynamicImage) -> Option<Vec<[u8; 4]>
 pub(crate) fn extend_rgba8(samples: &[u8], format: PixelFormat, out: &mut Vec<[u8; 4]>) {
     match (format.color, format.alpha) {
         (ColorKind::Rgb, false) => {
-            out.extend(samples.chunks_exact(3).map(|p| [p[0], p[1], p[2], 255]))
+            let start = out.len();
+            out.resize(start + samples.len() / 3, [0; 4]);
+            crate::simd::rgb8_to_levels(samples, false, &mut out[start..]);
         }
         (ColorKind::Rgb, true) => out.extend_from_slice(bytemuck::cast_slice(samples)),
         (ColorKind::Grey, false) => out.extend(samples.iter().map(|&l| [l, l, l, 255])),

@@ -19,7 +19,10 @@
 
 use std::sync::atomic::{AtomicU8, Ordering};
 
+mod rgb;
 mod shade8;
+
+pub use rgb::{levels_to_rgb8, rgb8_to_levels};
 
 pub(crate) use shade8::{LevelSource, RowAffine, Wide};
 
