@@ -18,7 +18,7 @@ use super::{BoundaryData, CloneError, Placement};
 use crate::mesh::Mesh;
 use crate::pixels::{Canvas, FloatImage};
 use crate::raster::{
-    covered_boundary_vertices, draw_patch, CoverageGrid, Patch, RasterOptions, RasterScratch,
+    boundary_layers, draw_patch, Beneath, CoverageGrid, Patch, RasterOptions, RasterScratch,
     RasterStats,
 };
 use crate::solve::LaplacianKind;
@@ -133,6 +133,7 @@ impl PatchCloner {
             hidden: HiddenVertices {
                 marks: vec![false; n],
                 covered: Vec::new(),
+                beneath: Vec::new(),
                 grid: CoverageGrid::new(),
             },
             glue,
@@ -236,19 +237,18 @@ impl PatchCloner {
         depth: Option<&[f32]>,
     ) -> Result<(), CloneError> {
         self.place_deformed(placement, deformed, depth)?;
+        self.find_layers(depth)
+    }
+
+    /// The boundary vertices hidden under the patch itself and those glued over a lower
+    /// layer of it, at the placed positions (none without `depth`).
+    fn find_layers(&mut self, depth: Option<&[f32]>) -> Result<(), CloneError> {
         let boundary = self.membrane.boundary_vertices();
         let frame = (&self.placed[..], &self.mesh.triangles[..]);
-        let hidden = self.hidden.find(frame, boundary, depth)?;
+        self.hidden.find(frame, boundary, depth)?;
         let rest = &self.mesh.positions[..];
-        find_glue(
-            &mut self.glue,
-            rest,
-            frame,
-            depth,
-            boundary,
-            hidden,
-            &self.source,
-        );
+        let beneath = &self.hidden.beneath;
+        find_glue(&mut self.glue, rest, frame, depth, beneath, &self.source);
         Ok(())
     }
 
@@ -289,18 +289,11 @@ impl PatchCloner {
             return Err(CloneError::VertexCountMismatch(self.placed.len(), n));
         }
         let started = Instant::now();
-        let frame = (&self.placed[..], &self.mesh.triangles[..]);
-        let hidden = match hidden_by {
-            HiddenBy::Query => {
-                let boundary = self.membrane.boundary_vertices();
-                let hidden = self.hidden.find(frame, boundary, depth)?;
-                let rest = &self.mesh.positions[..];
-                find_glue(&mut self.glue, rest, frame, depth, boundary, hidden, &self.source);
-                hidden
-            }
-            HiddenBy::Preparation => &self.hidden.marks,
-        };
-        let mut membrane = self.membrane.solve(frame.0, canvas, Some(hidden))?;
+        if hidden_by == HiddenBy::Query {
+            self.find_layers(depth)?;
+        }
+        let hidden = &self.hidden.marks;
+        let mut membrane = self.membrane.solve(&self.placed, canvas, Some(hidden))?;
         let glued = self.membrane.solve_glue(&mut self.glue);
         (membrane.glued, membrane.glue_iterations) = (glued.glued, glued.iterations);
         let solved = Instant::now();
@@ -337,32 +330,38 @@ enum HiddenBy {
     Query,
 }
 
-/// The boundary vertices under the patch's own front layer, and the query's buffers.
+/// The boundary vertices under the patch's own front layer, those over a lower layer, and
+/// the query's buffers.
 struct HiddenVertices {
     /// Per vertex: hidden.
     marks: Vec<bool>,
     covered: Vec<u32>,
+    /// The boundary vertices not hidden that lie over a lower layer.
+    beneath: Vec<Beneath>,
     grid: CoverageGrid,
 }
 
 impl HiddenVertices {
     /// Marks the `boundary` vertices of the placed `(positions, triangles)` under the
-    /// patch's own front layer (none without `depth`); gives the marks.
+    /// patch's own front layer and lists the others over a lower layer (none without
+    /// `depth`).
     fn find(
         &mut self,
         (placed, triangles): (&[DVec2], &[[u32; 3]]),
         boundary: &[u32],
         depth: Option<&[f32]>,
-    ) -> Result<&[bool], CloneError> {
+    ) -> Result<(), CloneError> {
         self.marks.fill(false);
+        self.beneath.clear();
         if let Some(depth) = depth {
             let (grid, covered) = (&mut self.grid, &mut self.covered);
-            covered_boundary_vertices(placed, triangles, depth, boundary, grid, covered)?;
+            let geometry = (placed, triangles, depth);
+            boundary_layers(geometry, boundary, grid, covered, &mut self.beneath)?;
             for &v in covered.iter() {
                 self.marks[v as usize] = true;
             }
         }
-        Ok(&self.marks)
+        Ok(())
     }
 }
 
@@ -375,8 +374,7 @@ fn find_glue(
     rest: &[DVec2],
     (placed, triangles): Frame,
     depth: Option<&[f32]>,
-    boundary: &[u32],
-    hidden: &[bool],
+    beneath: &[Beneath],
     source: &FloatImage,
 ) {
     match depth {
@@ -387,7 +385,7 @@ fn find_glue(
                 triangles,
                 depth,
             };
-            glue.find(frame, boundary, hidden, source);
+            glue.find(frame, beneath, source);
         }
         None => glue.clear(),
     }

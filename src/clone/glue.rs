@@ -1,7 +1,7 @@
 //! Glue where a patch overlaps itself: takes the placed patch (rest and placed positions,
 //! triangles, per-vertex depth), its source and the boundary vertices not hidden under its own
 //! front layer, and gives the *glued* vertices — front-layer boundary vertices lying over a
-//! lower layer of the same patch ([`find_beneath`]) — and then the membrane in which each of
+//! lower layer of the same patch (`raster::boundary_layers`) — and then the membrane in which each of
 //! them continues the patch's own composite beneath it instead of the target pixel there,
 //! which the lower layer covers.
 //!
@@ -22,10 +22,11 @@
 
 use glam::DVec2;
 
-use super::beneath::{find_beneath, Beneath, CandidateGrid};
+
 use super::{BoundaryData, HAT_SAMPLE_SPACING};
 use crate::mesh::Mesh;
 use crate::pixels::FloatImage;
+use crate::raster::Beneath;
 use crate::solve::PenaltyFactor;
 
 /// The iteration stops once no glued Dirichlet value changes by more than this (colour units
@@ -70,8 +71,6 @@ pub struct Glue {
     kind: BoundaryData,
     /// Per boundary slot: its neighbours along its loop (`u32::MAX` where there is none).
     neighbours: Vec<[u32; 2]>,
-    grid: CandidateGrid,
-    found: Vec<Beneath>,
     glued: Vec<GluedVertex>,
     /// Per glued vertex: its Dirichlet value in the last solve.
     current: Vec<[f64; 3]>,
@@ -103,8 +102,6 @@ impl Glue {
         Self {
             kind,
             neighbours,
-            grid: CandidateGrid::default(),
-            found: Vec::new(),
             glued: Vec::new(),
             current: Vec::new(),
             correction: Vec::new(),
@@ -121,28 +118,11 @@ impl Glue {
         &self.glued
     }
 
-    /// Finds the boundary vertices (`boundary`, slot order) not `hidden` that lie over a
-    /// lower layer of the patch in `frame`, and samples `source` beneath them.
-    pub fn find(
-        &mut self,
-        frame: GlueFrame,
-        boundary: &[u32],
-        hidden: &[bool],
-        source: &FloatImage,
-    ) {
-        let candidates = (0..boundary.len() as u32)
-            .map(|slot| (slot, boundary[slot as usize]))
-            .filter(|&(_, v)| !hidden[v as usize]);
-        let geometry = (frame.placed, frame.triangles);
-        find_beneath(
-            geometry,
-            frame.depth,
-            candidates,
-            &mut self.grid,
-            &mut self.found,
-        );
+    /// Takes the boundary vertices found over a lower layer of the patch in `frame`
+    /// (`raster::boundary_layers`' answer) and samples `source` beneath them.
+    pub fn find(&mut self, frame: GlueFrame, found: &[Beneath], source: &FloatImage) {
         self.glued.clear();
-        for &beneath in &self.found {
+        for &beneath in found {
             let source_beneath = self.sample_beneath(frame, &beneath, source);
             self.glued.push(GluedVertex {
                 beneath,

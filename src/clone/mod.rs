@@ -6,7 +6,6 @@
 //! move or a deformation costs only constraint switches, one multi-RHS back-substitution
 //! and the raster.
 
-mod beneath;
 mod boundary_data;
 mod cloner;
 mod error;
@@ -16,7 +15,7 @@ mod membrane;
 mod patch_mesh;
 mod placement;
 
-pub use beneath::{find_beneath, Beneath, CandidateGrid};
+pub use crate::raster::Beneath;
 pub use boundary_data::{BoundaryData, BoundarySampler, HAT_SAMPLE_SPACING};
 pub use cloner::{CloneMode, CloneOptions, CloneStats, PatchCloner};
 pub use error::CloneError;

@@ -1,21 +1,37 @@
-//! The coverage query: takes the placed mesh, per-vertex depth and candidate (boundary)
-//! vertices and gives those lying under the patch's own front layer — strictly inside a
-//! placed triangle that does not contain the vertex (strictly inside its bounding box, and
-//! all three edge functions of the triangle's sign), whose interpolated depth there is
-//! strictly greater than the vertex's own. Independent of the pixel grid; candidates are
-//! reported in the order given, so the answer is deterministic.
+//! The layer queries: take the placed mesh, per-vertex depth and candidate (boundary)
+//! vertices, and give those lying under the patch's own front layer (*covered*: strictly
+//! inside a placed triangle that does not contain the vertex — strictly inside its bounding
+//! box, and all three edge functions of the triangle's sign — whose interpolated depth there
+//! is strictly greater than the vertex's own) and, for each candidate not covered that lies
+//! over a lower layer, that layer's triangle and the candidate's barycentric weights in it
+//! (*beneath*: the topmost — largest interpolated depth, on equal depth the later triangle,
+//! as the raster draws — of the triangles under the same rule whose depth there is strictly
+//! smaller). Independent of the pixel grid; candidates are reported in the order given, so the
+//! answer is deterministic.
 //!
 //! A uniform grid over the candidates ([`PointGrid`]) lets each triangle look only at the
 //! candidates near it: a few slice look-ups plus a box test per nearby candidate. The candidates
 //! are about a fifth of the vertices and sit along the boundary, so this visits far fewer
 //! (candidate, triangle) pairs than a grid over the triangles queried per candidate, and a
-//! candidate found covered is not tested again. The predicate of each pair is unchanged, so
-//! the answer is too.
+//! candidate found covered is not tested again. Both answers come from one sweep: they test
+//! the same pairs and differ only in the depth comparison. The predicate of each pair is
+//! unchanged, so the answer is too.
 
 use glam::DVec2;
 
 use super::point_grid::PointGrid;
 use super::RasterError;
+
+/// A candidate over a lower layer: the triangle beneath it and its weights there.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Beneath {
+    pub vertex: u32,
+    /// The candidate's slot: its index in the candidates given to [`boundary_layers`].
+    pub slot: u32,
+    pub triangle: [u32; 3],
+    /// Barycentric weights of the vertex's placed point in `triangle`'s placed corners.
+    pub weights: [f64; 3],
+}
 
 /// Reusable buffers of the candidates' grid.
 #[derive(Default, Debug)]
@@ -23,6 +39,8 @@ pub struct CoverageGrid {
     grid: PointGrid,
     /// Per slot: found covered.
     covered: Vec<bool>,
+    /// Per slot: the topmost lower triangle so far and its depth there.
+    lower: Vec<Option<(f64, Beneath)>>,
 }
 
 impl CoverageGrid {
@@ -30,21 +48,27 @@ impl CoverageGrid {
         CoverageGrid::default()
     }
 
-    /// Buckets the candidates' placed positions (the grid covers their bounding box).
-    fn build(&mut self, placed: &[DVec2], candidates: &[u32]) {
-        self.grid
-            .build(candidates.iter().map(|&v| placed[v as usize]));
+    /// Empties the per-slot answers for `candidates` and, unless there is nothing to sweep,
+    /// buckets their placed positions (the grid covers their bounding box).
+    fn build(&mut self, placed: &[DVec2], candidates: &[u32], sweeping: bool) {
+        if sweeping {
+            self.grid
+                .build(candidates.iter().map(|&v| placed[v as usize]));
+        }
         self.covered.clear();
         self.covered.resize(candidates.len(), false);
+        self.lower.clear();
+        self.lower.resize(candidates.len(), None);
     }
 
-    /// Marks the candidates that triangle `tri` covers (see the module doc).
+    /// Marks the candidates that triangle `tri` covers and, when `query.lower`, offers it
+    /// as the layer beneath the others (see the module doc).
     fn sweep_triangle(&mut self, query: &Query, tri: [u32; 3]) {
         let corners = tri.map(|i| query.placed[i as usize]);
         let [a, b, c] = corners;
         let (min, max) = (a.min(b).min(c), a.max(b).max(c));
         let depth = tri.map(|i| query.depth[i as usize]);
-        let covered = &mut self.covered;
+        let (covered, lower) = (&mut self.covered, &mut self.lower);
         self.grid.near_box(min, max, |slot| {
             if covered[slot] {
                 return;
@@ -52,10 +76,25 @@ impl CoverageGrid {
             let v = query.candidates[slot];
             let p = query.placed[v as usize];
             let in_box = p.x > min.x && p.y > min.y && p.x < max.x && p.y < max.y;
-            covered[slot] = in_box
-                && !tri.contains(&v)
-                && depth_if_strictly_inside(corners, depth, p)
-                    .is_some_and(|d| d > f64::from(query.depth[v as usize]));
+            if !in_box || tri.contains(&v) {
+                return;
+            }
+            let Some(weights) = weights_if_strictly_inside(corners, p) else {
+                return;
+            };
+            let [wa, wb, wc] = weights;
+            let d = wa * f64::from(depth[0]) + wb * f64::from(depth[1]) + wc * f64::from(depth[2]);
+            let own = f64::from(query.depth[v as usize]);
+            if d > own {
+                covered[slot] = true;
+            } else if query.lower && d < own {
+                // Triangles come in index order, so `>=` keeps the later one on equal depth.
+                if lower[slot].is_none_or(|(top, _)| d >= top) {
+                    let slot32 = slot as u32;
+                    let hit = Beneath { vertex: v, slot: slot32, triangle: tri, weights };
+                    lower[slot] = Some((d, hit));
+                }
+            }
         });
     }
 }
@@ -65,6 +104,8 @@ struct Query<'a> {
     placed: &'a [DVec2],
     depth: &'a [f32],
     candidates: &'a [u32],
+    /// Whether the layer beneath each candidate is wanted too.
+    lower: bool,
 }
 
 /// Writes into `out` (cleared first) the candidates covered by the patch's front layer.
@@ -76,30 +117,60 @@ pub fn covered_boundary_vertices(
     grid: &mut CoverageGrid,
     out: &mut Vec<u32>,
 ) -> Result<(), RasterError> {
+    let geometry = (placed, triangles, depth);
+    sweep(geometry, candidates, false, grid)?;
+    collect_covered(candidates, grid, out);
+    Ok(())
+}
+
+/// Writes into `covered` (cleared first) the candidates covered by the patch's front layer,
+/// and into `beneath` (cleared first) every other candidate that lies over a lower layer,
+/// with the triangle beneath it, in the candidates' order: both answers of the module doc
+/// from one sweep.
+pub fn boundary_layers(
+    (placed, triangles, depth): (&[DVec2], &[[u32; 3]], &[f32]),
+    candidates: &[u32],
+    grid: &mut CoverageGrid,
+    covered: &mut Vec<u32>,
+    beneath: &mut Vec<Beneath>,
+) -> Result<(), RasterError> {
+    sweep((placed, triangles, depth), candidates, true, grid)?;
+    collect_covered(candidates, grid, covered);
+    beneath.clear();
+    let lower = grid.lower.iter().zip(&grid.covered);
+    beneath.extend(lower.filter(|(_, &hit)| !hit).filter_map(|(found, _)| found.map(|(_, b)| b)));
+    Ok(())
+}
+
+/// Validates the input and runs every triangle past the candidates' grid.
+fn sweep(
+    (placed, triangles, depth): (&[DVec2], &[[u32; 3]], &[f32]),
+    candidates: &[u32],
+    lower: bool,
+    grid: &mut CoverageGrid,
+) -> Result<(), RasterError> {
     validate(placed, triangles, depth, candidates)?;
-    out.clear();
-    if triangles.is_empty() || candidates.is_empty() {
+    let sweeping = !(triangles.is_empty() || candidates.is_empty());
+    grid.build(placed, candidates, sweeping);
+    if !sweeping {
         return Ok(());
     }
-    grid.build(placed, candidates);
     let query = Query {
         placed,
         depth,
         candidates,
+        lower,
     };
     for &tri in triangles {
         grid.sweep_triangle(&query, tri);
     }
-    let covered = candidates.iter().zip(&grid.covered);
-    out.extend(covered.filter(|(_, &hit)| hit).map(|(&v, _)| v));
     Ok(())
 }
 
-/// Interpolated depth at `p` when it lies strictly inside the (either-oriented) triangle.
-#[inline]
-fn depth_if_strictly_inside(corners: [DVec2; 3], depth: [f32; 3], p: DVec2) -> Option<f64> {
-    let [wa, wb, wc] = weights_if_strictly_inside(corners, p)?;
-    Some(wa * f64::from(depth[0]) + wb * f64::from(depth[1]) + wc * f64::from(depth[2]))
+fn collect_covered(candidates: &[u32], grid: &CoverageGrid, out: &mut Vec<u32>) {
+    out.clear();
+    let covered = candidates.iter().zip(&grid.covered);
+    out.extend(covered.filter(|(_, &hit)| hit).map(|(&v, _)| v));
 }
 
 /// Barycentric weights of `p` when it lies strictly inside the (either-oriented) triangle:

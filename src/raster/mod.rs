@@ -44,7 +44,9 @@ mod shade;
 mod triangles;
 
 pub use crate::pixels::PixelRect;
-pub use covered::{covered_boundary_vertices, weights_if_strictly_inside, CoverageGrid};
+pub use covered::{
+    boundary_layers, covered_boundary_vertices, weights_if_strictly_inside, Beneath, CoverageGrid,
+};
 pub use point_grid::PointGrid;
 pub use draw::{draw_patch, RasterOptions, RasterStats};
 pub use error::RasterError;

@@ -1,12 +1,43 @@
-//! The coverage query: boundary vertices under the patch's own front layer, compared with a
-//! brute-force check over all triangles on random folded meshes (fixed seed).
+//! The layer queries: boundary vertices under the patch's own front layer and the lower
+//! layer beneath the others, compared with a brute-force check over all triangles on random
+//! folded meshes (fixed seed).
 
 use crate::raster_meshes;
 
 use glam::DVec2;
-use lapclone::raster::{covered_boundary_vertices, CoverageGrid};
+use lapclone::raster::{boundary_layers, covered_boundary_vertices, Beneath, CoverageGrid};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed};
+
+/// The interpolated depth at `v`'s placed point in `tri` when it lies strictly inside it and
+/// is not one of its corners, with the weights there.
+fn depth_inside(placed: &[DVec2], depth: &[f32], tri: [u32; 3], v: u32) -> Option<(f64, [f64; 3])> {
+    if tri.contains(&v) {
+        return None;
+    }
+    let p = placed[v as usize];
+    let [a, b, c] = tri.map(|i| placed[i as usize]);
+    // Strictly inside the triangle implies strictly inside its bounding box; the query
+    // rejects by the box first, which also overrules edge functions that rounding pushed
+    // inside near a degenerate triangle's corner.
+    let (min, max) = (a.min(b).min(c), a.max(b).max(c));
+    if !(p.x > min.x && p.y > min.y && p.x < max.x && p.y < max.y) {
+        return None;
+    }
+    let area = (b - a).perp_dot(c - a);
+    if area == 0.0 {
+        return None;
+    }
+    let w = [
+        (c - b).perp_dot(p - b) / area,
+        (a - c).perp_dot(p - c) / area,
+        (b - a).perp_dot(p - a) / area,
+    ];
+    let d: f64 = (0..3)
+        .map(|k| w[k] * f64::from(depth[tri[k] as usize]))
+        .sum();
+    w.iter().all(|&x| x > 0.0).then_some((d, w))
+}
 
 fn brute_force(
     placed: &[DVec2],
@@ -18,35 +49,50 @@ fn brute_force(
         .iter()
         .copied()
         .filter(|&v| {
-            let p = placed[v as usize];
-            triangles.iter().any(|tri| {
-                if tri.contains(&v) {
-                    return false;
-                }
-                let [a, b, c] = tri.map(|i| placed[i as usize]);
-                // Strictly inside the triangle implies strictly inside its bounding box; the
-                // query rejects by the box first, which also overrules edge functions that
-                // rounding pushed inside near a degenerate triangle's corner.
-                let (min, max) = (a.min(b).min(c), a.max(b).max(c));
-                if !(p.x > min.x && p.y > min.y && p.x < max.x && p.y < max.y) {
-                    return false;
-                }
-                let area = (b - a).perp_dot(c - a);
-                if area == 0.0 {
-                    return false;
-                }
-                let w = [
-                    (c - b).perp_dot(p - b) / area,
-                    (a - c).perp_dot(p - c) / area,
-                    (b - a).perp_dot(p - a) / area,
-                ];
-                let d: f64 = (0..3)
-                    .map(|k| w[k] * f64::from(depth[tri[k] as usize]))
-                    .sum();
-                w.iter().all(|&x| x > 0.0) && d > f64::from(depth[v as usize])
-            })
+            let own = f64::from(depth[v as usize]);
+            triangles
+                .iter()
+                .any(|&tri| depth_inside(placed, depth, tri, v).is_some_and(|(d, _)| d > own))
         })
         .collect()
+}
+
+/// The topmost lower triangle under each candidate not covered (the later one on equal
+/// depth), in the candidates' order.
+fn brute_force_beneath(
+    placed: &[DVec2],
+    triangles: &[[u32; 3]],
+    depth: &[f32],
+    candidates: &[u32],
+) -> Vec<Beneath> {
+    let covered = brute_force(placed, triangles, depth, candidates);
+    let mut found = Vec::new();
+    for (slot, &v) in candidates.iter().enumerate() {
+        if covered.contains(&v) {
+            continue;
+        }
+        let own = f64::from(depth[v as usize]);
+        let mut best: Option<(f64, Beneath)> = None;
+        for &tri in triangles {
+            let Some((d, weights)) = depth_inside(placed, depth, tri, v) else {
+                continue;
+            };
+            if d < own && best.is_none_or(|(top, _)| d >= top) {
+                let slot = slot as u32;
+                best = Some((
+                    d,
+                    Beneath {
+                        vertex: v,
+                        slot,
+                        triangle: tri,
+                        weights,
+                    },
+                ));
+            }
+        }
+        found.extend(best.map(|(_, b)| b));
+    }
+    found
 }
 
 #[test]
@@ -128,5 +174,22 @@ proptest! {
         let mut all = Vec::new();
         covered_boundary_vertices(&placed, &mesh.triangles, &depth, &everyone, &mut grid, &mut all).unwrap();
         prop_assert_eq!(all, brute_force(&placed, &mesh.triangles, &depth, &everyone));
+    }
+
+    #[test]
+    fn one_sweep_gives_the_covered_and_the_layer_beneath_the_others(
+        moves in proptest::collection::vec((-6.0f64..6.0, -6.0f64..6.0, 0.0f32..3.0), 49)
+    ) {
+        let mesh = raster_meshes::grid(DVec2::ZERO, 2.0, 6, 6);
+        let placed: Vec<DVec2> = mesh.positions.iter().zip(&moves).map(|(&p, &(dx, dy, _))| p + DVec2::new(dx, dy)).collect();
+        let depth: Vec<f32> = moves.iter().map(|m| m.2).collect();
+        let everyone: Vec<u32> = (0..placed.len() as u32).map(|k| (k * 17) % placed.len() as u32).collect();
+        for candidates in [&mesh.loops[0].vertices, &everyone] {
+            let (mut covered, mut beneath) = (Vec::new(), Vec::new());
+            let geometry = (&placed[..], &mesh.triangles[..], &depth[..]);
+            boundary_layers(geometry, candidates, &mut CoverageGrid::new(), &mut covered, &mut beneath).unwrap();
+            prop_assert_eq!(covered, brute_force(&placed, &mesh.triangles, &depth, candidates));
+            prop_assert_eq!(beneath, brute_force_beneath(&placed, &mesh.triangles, &depth, candidates));
+        }
     }
 }
