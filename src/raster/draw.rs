@@ -3,6 +3,8 @@
 //! inside the patch's bounding box: per-triangle setup and silhouette coverage, exact
 //! pixel-centre ownership with the depth test, then shading row by row.
 
+use std::sync::Mutex;
+
 use super::feather::apply_feather;
 use super::prepare::prepare;
 use super::setup::MAX_COORDINATE;
@@ -88,6 +90,9 @@ pub fn draw_patch(
 
 /// Fewer rows than this per thread are shaded on the caller's thread alone.
 const MIN_ROWS_PER_THREAD: usize = 64;
+
+/// Rows per band the shading threads take in turn (see `Frame::in_parts`).
+const ROWS_PER_BAND: usize = 40;
 
 /// One draw's rectangles and canvas width.
 struct Frame<'a> {
@@ -207,10 +212,13 @@ impl Frame<'_> {
         })
     }
 
-    /// Runs `shade` over `rows` of the canvas split into row ranges, one per thread (the
-    /// caller's last); `shade` gets a range and the canvas from that range's first row on,
-    /// and gives (centre hits, pixels written), summed here. Rows shade independently, so
-    /// the pixels are the same for any split.
+    /// Runs `shade` over `rows` of the canvas in bands of [`ROWS_PER_BAND`] rows, which the
+    /// caller's thread and up to `threads − 1` scoped ones take in turn until none is left;
+    /// `shade` gets a band and the canvas from that band's first row on, and gives (centre
+    /// hits, pixels written), summed here. Rows shade independently, so the pixels are the
+    /// same for any split. Bands are taken rather than halves given out because a helper
+    /// starts 50–60 µs late (its spawn) and may share its core: the caller does not wait
+    /// for a fixed half that started late.
     fn in_parts<T: Texel + Send>(
         &self,
         rows: PixelRect,
@@ -219,30 +227,33 @@ impl Frame<'_> {
     ) -> (usize, usize) {
         let mut canvas_rows = &mut canvas[rows.y0.max(0) as usize * self.width..];
         let height = rows.height();
-        let parts = self.threads.min(height / MIN_ROWS_PER_THREAD).max(1);
-        if parts == 1 {
+        let helpers = self.threads.min(height / MIN_ROWS_PER_THREAD).max(1) - 1;
+        if helpers == 0 {
             return shade(rows, canvas_rows);
         }
-        let per_part = height.div_ceil(parts) as i32;
-        std::thread::scope(|scope| {
-            let mut parts = Vec::new();
-            let mut y0 = rows.y0;
-            while y0 < rows.y1 {
-                let y1 = (y0 + per_part).min(rows.y1);
-                let len = ((y1 - y0) as usize * self.width).min(canvas_rows.len());
-                let (part, rest) = std::mem::take(&mut canvas_rows).split_at_mut(len);
-                canvas_rows = rest;
-                parts.push((PixelRect { y0, y1, ..rows }, part));
-                y0 = y1;
+        let mut bands = Vec::with_capacity(height.div_ceil(ROWS_PER_BAND));
+        let mut y0 = rows.y0;
+        while y0 < rows.y1 {
+            let y1 = (y0 + ROWS_PER_BAND as i32).min(rows.y1);
+            let len = ((y1 - y0) as usize * self.width).min(canvas_rows.len());
+            let (band, rest) = std::mem::take(&mut canvas_rows).split_at_mut(len);
+            canvas_rows = rest;
+            bands.push((PixelRect { y0, y1, ..rows }, band));
+            y0 = y1;
+        }
+        let bands = Mutex::new(bands.into_iter());
+        let take_bands = || {
+            let mut sum = (0, 0);
+            // A poisoned lock means another thread panicked, which the join below reports.
+            while let Some((band_rows, band)) = bands.lock().ok().and_then(|mut b| b.next()) {
+                let (h, w) = shade(band_rows, band);
+                sum = (sum.0 + h, sum.1 + w);
             }
-            // invariant: `rows` is not empty (parts ≥ 1), so there is a last part.
-            let (last_rows, last) = parts.pop().expect("a part");
-            let shade = &shade;
-            let spawned: Vec<_> = parts
-                .into_iter()
-                .map(|(part_rows, part)| scope.spawn(move || shade(part_rows, part)))
-                .collect();
-            let mine = shade(last_rows, last);
+            sum
+        };
+        std::thread::scope(|scope| {
+            let spawned: Vec<_> = (0..helpers).map(|_| scope.spawn(take_bands)).collect();
+            let mine = take_bands();
             spawned.into_iter().fold(mine, |(h, w), handle| {
                 // invariant: shading does not panic on validated input; a panic is a bug
                 // to surface, not to hide.
