@@ -3,11 +3,13 @@
 //! inside the patch's bounding box: per-triangle setup and silhouette coverage, exact
 //! pixel-centre ownership with the depth test, then shading row by row.
 
-use std::sync::Mutex;
+use std::sync::mpsc;
 
+use super::bands::{join_sum, Bands};
+use super::coverage::Silhouette;
 use super::feather::apply_feather;
-use super::prepare::prepare;
-use super::setup::MAX_COORDINATE;
+use super::prepare::{prepare, prepare_setups, prepare_silhouette};
+use super::setup::{TriangleSetup, MAX_COORDINATE};
 use super::shade::{shade_and_composite, CoverageTexel, ShadeInput};
 use super::triangles::{rasterise_triangles, NO_TRIANGLE};
 use super::{Patch, PixelRect, RasterError, RasterScratch};
@@ -61,15 +63,6 @@ pub fn draw_patch(
     let Some(work) = work_rect(patch, canvas, options.feather) else {
         return Ok(RasterStats::default());
     };
-    prepare(patch, work, options.anti_alias, scratch);
-    let use_depth = patch.depth.is_some();
-    scratch.ids.resize(work.area(), 0);
-    if use_depth {
-        scratch.depths.resize(work.area(), 0.0);
-    }
-    let all = 0..scratch.setups.len() as u32;
-    let (ids, depths) = (&mut scratch.ids, &mut scratch.depths);
-    rasterise_triangles(&scratch.setups, all, work, use_depth, ids, depths);
     let frame = Frame {
         patch,
         work,
@@ -77,9 +70,20 @@ pub fn draw_patch(
         width: canvas.width() as usize,
         threads: options.threads,
     };
-    let (centre_hits, written) = match canvas.pixels_mut() {
-        CanvasPixels::Eight(p) => frame.shade(options, scratch, p),
-        CanvasPixels::Sixteen(p) => frame.shade(options, scratch, p),
+    let overlap = options.anti_alias && options.feather == 0.0;
+    let overlap = overlap && frame.helpers(frame.target) > 0;
+    let (centre_hits, written) = match (canvas.pixels_mut(), overlap) {
+        (CanvasPixels::Eight(p), true) => frame.draw_overlapped(scratch, p),
+        (CanvasPixels::Sixteen(p), true) => frame.draw_overlapped(scratch, p),
+        (pixels, false) => {
+            prepare(patch, work, options.anti_alias, scratch);
+            let (setups, ids, depths) = (&scratch.setups, &mut scratch.ids, &mut scratch.depths);
+            frame.rasterise(setups, ids, depths);
+            match pixels {
+                CanvasPixels::Eight(p) => frame.shade(options, scratch, p),
+                CanvasPixels::Sixteen(p) => frame.shade(options, scratch, p),
+            }
+        }
     };
     Ok(RasterStats {
         work,
@@ -90,9 +94,6 @@ pub fn draw_patch(
 
 /// Fewer rows than this per thread are shaded on the caller's thread alone.
 const MIN_ROWS_PER_THREAD: usize = 64;
-
-/// Rows per band the shading threads take in turn (see `Frame::in_parts`).
-const ROWS_PER_BAND: usize = 40;
 
 /// One draw's rectangles and canvas width.
 struct Frame<'a> {
@@ -107,6 +108,69 @@ struct Frame<'a> {
 }
 
 impl Frame<'_> {
+    /// Fills `ids` (and `depths`, with depth) over the work rectangle from `setups`.
+    fn rasterise(&self, setups: &[TriangleSetup], ids: &mut Vec<u32>, depths: &mut Vec<f32>) {
+        let use_depth = self.patch.depth.is_some();
+        ids.resize(self.work.area(), 0);
+        if use_depth {
+            depths.resize(self.work.area(), 0.0);
+        }
+        let all = 0..setups.len() as u32;
+        rasterise_triangles(setups, all, self.work, use_depth, ids, depths);
+    }
+
+    /// The anti-aliased, unfeathered draw on several threads: a helper fills the silhouette
+    /// while the caller sets up the triangles and rasterises their ids (the two depend only
+    /// on the patch), then every thread shades [`Bands`]. One spawn per draw: the helper's
+    /// start-up overlaps the caller's work instead of delaying the shading.
+    fn draw_overlapped<T: Texel + Send>(
+        &self,
+        scratch: &mut RasterScratch,
+        canvas: &mut [[T; 4]],
+    ) -> (usize, usize) {
+        let RasterScratch {
+            setups,
+            snapped,
+            ids,
+            depths,
+            silhouette,
+            folds,
+            ..
+        } = scratch;
+        let (patch, work, rows) = (self.patch, self.work, self.target);
+        let canvas = &mut canvas[rows.y0.max(0) as usize * self.width..];
+        let bands = &Bands::new(rows, self.width, canvas);
+        let (to_helper, from_caller) = mpsc::channel::<(&[TriangleSetup], &[u32])>();
+        let (to_caller, from_helper) = mpsc::channel::<&Silhouette>();
+        std::thread::scope(|scope| {
+            let first = scope.spawn(move || {
+                prepare_silhouette(patch, work, folds, silhouette);
+                let silhouette: &Silhouette = silhouette;
+                let _ = to_caller.send(silhouette);
+                // Nothing comes only when the caller panicked, which its scope reports.
+                let Ok((setups, ids)) = from_caller.recv() else {
+                    return (0, 0);
+                };
+                bands.shade(|part, canvas| self.shade_strips((setups, ids, silhouette), part, canvas))
+            });
+            prepare_setups(patch, snapped, setups);
+            self.rasterise(setups, ids, depths);
+            let (setups, ids): (&[TriangleSetup], &[u32]) = (setups, ids);
+            let _ = to_helper.send((setups, ids));
+            // Nothing comes only when the helper panicked, which its join reports.
+            let Ok(silhouette) = from_helper.recv() else {
+                return join_sum((0, 0), vec![first]);
+            };
+            let drawn = (setups, ids, silhouette);
+            let shade = move |part, canvas: &mut [[T; 4]]| self.shade_strips(drawn, part, canvas);
+            let mut spawned = vec![first];
+            for _ in 1..self.helpers(rows) {
+                spawned.push(scope.spawn(move || bands.shade(shade)));
+            }
+            join_sum(bands.shade(shade), spawned)
+        })
+    }
+
     /// Shades the target rectangle with the coverage the options ask for; gives (centre
     /// hits, pixels written).
     fn shade<T: Texel + Send>(
@@ -151,32 +215,41 @@ impl Frame<'_> {
             scratch.centres = coverage;
             return totals;
         }
-        // Each strip of the silhouette shades the target rows it holds from its own mask;
-        // threads split the target's rows, whatever the strips.
-        let scratch = &*scratch;
+        let drawn = (&scratch.setups[..], &scratch.ids[..], &scratch.silhouette);
         self.in_parts(self.target, canvas, |part, canvas| {
-            let mut totals = (0, 0);
-            for strip in scratch.silhouette.strips() {
-                let rows = part.intersect(&strip.rect());
-                if !rows.is_empty() {
-                    let canvas = &mut canvas[(rows.y0 - part.y0) as usize * self.width..];
-                    let input = self.input(scratch, strip.coverage());
-                    let (h, w) = shade_and_composite(&input, rows, canvas, self.width);
-                    totals = (totals.0 + h, totals.1 + w);
-                }
-            }
-            totals
+            self.shade_strips(drawn, part, canvas)
         })
+    }
+
+    /// Shades the canvas rows `part` (`canvas` from its first row on): each strip of the
+    /// silhouette the rows it holds, from its own mask, whatever the bands.
+    fn shade_strips<T: Texel>(
+        &self,
+        (setups, ids, silhouette): (&[TriangleSetup], &[u32], &Silhouette),
+        part: PixelRect,
+        canvas: &mut [[T; 4]],
+    ) -> (usize, usize) {
+        let mut totals = (0, 0);
+        for strip in silhouette.strips() {
+            let rows = part.intersect(&strip.rect());
+            if !rows.is_empty() {
+                let canvas = &mut canvas[(rows.y0 - part.y0) as usize * self.width..];
+                let input = self.input((setups, ids), strip.coverage());
+                let (h, w) = shade_and_composite(&input, rows, canvas, self.width);
+                totals = (totals.0 + h, totals.1 + w);
+            }
+        }
+        totals
     }
 
     fn input<'a, C>(
         &'a self,
-        scratch: &'a RasterScratch,
+        (setups, ids): (&'a [TriangleSetup], &'a [u32]),
         (coverage, coverage_stride, coverage_origin): (&'a [C], usize, (i32, i32)),
     ) -> ShadeInput<'a, C> {
         ShadeInput {
-            setups: &scratch.setups,
-            ids: &scratch.ids,
+            setups,
+            ids,
             ids_rect: self.work,
             coverage,
             coverage_stride,
@@ -206,61 +279,38 @@ impl Frame<'_> {
         rows: PixelRect,
         canvas: &mut [[T; 4]],
     ) -> (usize, usize) {
-        let input = self.input(scratch, coverage);
+        let input = self.input((&scratch.setups, &scratch.ids), coverage);
         self.in_parts(rows, canvas, |part, canvas| {
             shade_and_composite(&input, part, canvas, self.width)
         })
     }
 
-    /// Runs `shade` over `rows` of the canvas in bands of [`ROWS_PER_BAND`] rows, which the
-    /// caller's thread and up to `threads − 1` scoped ones take in turn until none is left;
-    /// `shade` gets a band and the canvas from that band's first row on, and gives (centre
-    /// hits, pixels written), summed here. Rows shade independently, so the pixels are the
-    /// same for any split. Bands are taken rather than halves given out because a helper
-    /// starts 50–60 µs late (its spawn) and may share its core: the caller does not wait
-    /// for a fixed half that started late.
+    /// Runs `shade` over `rows` of the canvas on the caller's thread and up to `threads −
+    /// 1` scoped ones, which take [`Bands`] in turn; `shade` gets a band and the canvas from
+    /// its first row on, and gives (centre hits, pixels written), summed here.
     fn in_parts<T: Texel + Send>(
         &self,
         rows: PixelRect,
         canvas: &mut [[T; 4]],
         shade: impl Fn(PixelRect, &mut [[T; 4]]) -> (usize, usize) + Sync,
     ) -> (usize, usize) {
-        let mut canvas_rows = &mut canvas[rows.y0.max(0) as usize * self.width..];
-        let height = rows.height();
-        let helpers = self.threads.min(height / MIN_ROWS_PER_THREAD).max(1) - 1;
+        let canvas_rows = &mut canvas[rows.y0.max(0) as usize * self.width..];
+        let helpers = self.helpers(rows);
         if helpers == 0 {
             return shade(rows, canvas_rows);
         }
-        let mut bands = Vec::with_capacity(height.div_ceil(ROWS_PER_BAND));
-        let mut y0 = rows.y0;
-        while y0 < rows.y1 {
-            let y1 = (y0 + ROWS_PER_BAND as i32).min(rows.y1);
-            let len = ((y1 - y0) as usize * self.width).min(canvas_rows.len());
-            let (band, rest) = std::mem::take(&mut canvas_rows).split_at_mut(len);
-            canvas_rows = rest;
-            bands.push((PixelRect { y0, y1, ..rows }, band));
-            y0 = y1;
-        }
-        let bands = Mutex::new(bands.into_iter());
-        let take_bands = || {
-            let mut sum = (0, 0);
-            // A poisoned lock means another thread panicked, which the join below reports.
-            while let Some((band_rows, band)) = bands.lock().ok().and_then(|mut b| b.next()) {
-                let (h, w) = shade(band_rows, band);
-                sum = (sum.0 + h, sum.1 + w);
-            }
-            sum
-        };
+        let bands = Bands::new(rows, self.width, canvas_rows);
+        let (bands, shade) = (&bands, &shade);
         std::thread::scope(|scope| {
-            let spawned: Vec<_> = (0..helpers).map(|_| scope.spawn(take_bands)).collect();
-            let mine = take_bands();
-            spawned.into_iter().fold(mine, |(h, w), handle| {
-                // invariant: shading does not panic on validated input; a panic is a bug
-                // to surface, not to hide.
-                let (h2, w2) = handle.join().expect("a shading thread");
-                (h + h2, w + w2)
-            })
+            let spawned = (0..helpers).map(|_| scope.spawn(move || bands.shade(shade)));
+            let spawned: Vec<_> = spawned.collect();
+            join_sum(bands.shade(shade), spawned)
         })
+    }
+
+    /// Scoped threads besides the caller's to shade `rows` on.
+    fn helpers(&self, rows: PixelRect) -> usize {
+        self.threads.min(rows.height() / MIN_ROWS_PER_THREAD).max(1) - 1
     }
 }
 

@@ -26,6 +26,7 @@
 //! [`RasterScratch`] and [`CoverageGrid`]; a frame re-does the per-triangle setup (cheap) and
 //! allocates nothing once the buffers have grown to the patch's size.
 
+mod bands;
 mod clip;
 mod coverage;
 mod covered;

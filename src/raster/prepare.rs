@@ -1,8 +1,9 @@
 //! The per-frame work before the pixels: takes a placed patch with its membrane and the
 //! work rectangle, and fills the raster scratch's per-triangle setups and (anti-aliased)
-//! silhouette strips.
+//! silhouette strips: two independent halves, which a threaded draw runs side by side.
 
-use super::coverage::{rest_loop_orientation, SilhouetteInput};
+use super::coverage::{rest_loop_orientation, Silhouette, SilhouetteInput};
+use super::folds::FoldOutline;
 use super::setup::{SnappedVertex, TriangleSetup};
 use super::{Patch, PixelRect, RasterScratch};
 
@@ -15,11 +16,22 @@ pub(crate) fn prepare(
     anti_alias: bool,
     scratch: &mut RasterScratch,
 ) {
-    let snapped = &mut scratch.snapped;
+    prepare_setups(patch, &mut scratch.snapped, &mut scratch.setups);
+    if anti_alias {
+        prepare_silhouette(patch, work, &mut scratch.folds, &mut scratch.silhouette);
+    }
+}
+
+/// Fills `setups` (one per triangle of `patch`), snapping the placed vertices into `snapped`.
+pub(crate) fn prepare_setups(
+    patch: &Patch,
+    snapped: &mut Vec<SnappedVertex>,
+    setups: &mut Vec<TriangleSetup>,
+) {
     snapped.clear();
     snapped.extend(patch.placed.iter().map(|&p| SnappedVertex::new(p)));
-    scratch.setups.clear();
-    scratch.setups.extend(patch.triangles.iter().map(|tri| {
+    setups.clear();
+    setups.extend(patch.triangles.iter().map(|tri| {
         let [a, b, c] = tri.map(|v| v as usize);
         TriangleSetup::from_snapped(
             [patch.placed[a], patch.placed[b], patch.placed[c]],
@@ -29,20 +41,26 @@ pub(crate) fn prepare(
             patch.depth.map_or([0.0; 3], |d| [d[a], d[b], d[c]]),
         )
     }));
-    if !anti_alias {
-        return;
-    }
+}
+
+/// Fills the anti-aliased silhouette's strips over `work` (and the fold outline they read).
+pub(crate) fn prepare_silhouette(
+    patch: &Patch,
+    work: PixelRect,
+    folds: &mut FoldOutline,
+    silhouette: &mut Silhouette,
+) {
     let loop_orientation = rest_loop_orientation(patch);
     match loop_orientation != 0.0 {
-        true => scratch.folds.build(patch, loop_orientation),
-        false => scratch.folds.clear(),
+        true => folds.build(patch, loop_orientation),
+        false => folds.clear(),
     }
     let input = SilhouetteInput {
         patch,
         loop_orientation,
-        folds: &scratch.folds,
+        folds,
     };
-    for strip in scratch.silhouette.layout(work) {
+    for strip in silhouette.layout(work) {
         strip.fill(input);
     }
 }
