@@ -61,8 +61,8 @@ impl CoverageGrid {
         self.lower.resize(candidates.len(), None);
     }
 
-    /// Marks the candidates that triangle `tri` covers and, when `query.lower`, offers it
-    /// as the layer beneath the others (see the module doc).
+    /// Marks the candidates that triangle `tri` covers and offers it as the layer beneath
+    /// the others (see the module doc).
     fn sweep_triangle(&mut self, query: &Query, tri: [u32; 3]) {
         let corners = tri.map(|i| query.placed[i as usize]);
         let [a, b, c] = corners;
@@ -87,7 +87,7 @@ impl CoverageGrid {
             let own = f64::from(query.depth[v as usize]);
             if d > own {
                 covered[slot] = true;
-            } else if query.lower && d < own {
+            } else if d < own {
                 // Triangles come in index order, so `>=` keeps the later one on equal depth.
                 if lower[slot].is_none_or(|(top, _)| d >= top) {
                     let slot32 = slot as u32;
@@ -104,11 +104,10 @@ struct Query<'a> {
     placed: &'a [DVec2],
     depth: &'a [f32],
     candidates: &'a [u32],
-    /// Whether the layer beneath each candidate is wanted too.
-    lower: bool,
 }
 
-/// Writes into `out` (cleared first) the candidates covered by the patch's front layer.
+/// Writes into `out` (cleared first) the candidates covered by the patch's front layer:
+/// [`boundary_layers`]' first answer alone.
 pub fn covered_boundary_vertices(
     placed: &[DVec2],
     triangles: &[[u32; 3]],
@@ -118,9 +117,7 @@ pub fn covered_boundary_vertices(
     out: &mut Vec<u32>,
 ) -> Result<(), RasterError> {
     let geometry = (placed, triangles, depth);
-    sweep(geometry, candidates, false, grid)?;
-    collect_covered(candidates, grid, out);
-    Ok(())
+    boundary_layers(geometry, candidates, grid, out, &mut Vec::new())
 }
 
 /// Writes into `covered` (cleared first) the candidates covered by the patch's front layer,
@@ -134,8 +131,10 @@ pub fn boundary_layers(
     covered: &mut Vec<u32>,
     beneath: &mut Vec<Beneath>,
 ) -> Result<(), RasterError> {
-    sweep((placed, triangles, depth), candidates, true, grid)?;
-    collect_covered(candidates, grid, covered);
+    sweep((placed, triangles, depth), candidates, grid)?;
+    covered.clear();
+    let hits = candidates.iter().zip(&grid.covered);
+    covered.extend(hits.filter(|(_, &hit)| hit).map(|(&v, _)| v));
     beneath.clear();
     let lower = grid.lower.iter().zip(&grid.covered);
     beneath.extend(lower.filter(|(_, &hit)| !hit).filter_map(|(found, _)| found.map(|(_, b)| b)));
@@ -146,7 +145,6 @@ pub fn boundary_layers(
 fn sweep(
     (placed, triangles, depth): (&[DVec2], &[[u32; 3]], &[f32]),
     candidates: &[u32],
-    lower: bool,
     grid: &mut CoverageGrid,
 ) -> Result<(), RasterError> {
     validate(placed, triangles, depth, candidates)?;
@@ -159,18 +157,11 @@ fn sweep(
         placed,
         depth,
         candidates,
-        lower,
     };
     for &tri in triangles {
         grid.sweep_triangle(&query, tri);
     }
     Ok(())
-}
-
-fn collect_covered(candidates: &[u32], grid: &CoverageGrid, out: &mut Vec<u32>) {
-    out.clear();
-    let covered = candidates.iter().zip(&grid.covered);
-    out.extend(covered.filter(|(_, &hit)| hit).map(|(&v, _)| v));
 }
 
 /// Barycentric weights of `p` when it lies strictly inside the (either-oriented) triangle:

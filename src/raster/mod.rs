@@ -16,8 +16,9 @@
 //! - Composite: straight-alpha source-over; over an opaque canvas that is
 //!   `out = cov·α·patch + (1 − cov·α)·canvas`.
 //!
-//! [`covered_boundary_vertices`] answers, independently of pixels, which boundary vertices
-//! lie under the patch's own front layer (the clone stage switches their constraints off).
+//! [`boundary_layers`] answers, independently of pixels, which boundary vertices lie under
+//! the patch's own front layer (the clone stage switches their constraints off) and which
+//! lie over a lower layer of it (the clone stage glues them).
 //!
 //! A draw is one sequential pass on the calling thread (callers draw different patches or
 //! frames in parallel if they wish); every pixel depends only on the draw's inputs.
