@@ -42,6 +42,10 @@ pub(crate) struct SpanSetup {
     pub texel_x: [f32; 3],
     pub texel_y: [f32; 3],
     pub membrane: MembraneSpan,
+    /// `Some(s)` when the triangle is its rest triangle moved by the whole pixels `s`
+    /// ([`whole_pixel_shift`]): the texel maps are then exactly `pixel − s`, so every sample
+    /// is a source texel, which the eight-lane shader reads directly.
+    pub shift: Option<[i32; 2]>,
 }
 
 /// The membrane part of [`SpanSetup`].
@@ -105,6 +109,30 @@ impl MembraneSpan {
         }
     }
 
+}
+
+/// How far (px) a placed vertex may lie from its rest position moved by whole pixels and
+/// still count as moved by them: placements put placed points on a 2⁻¹⁶-px grid
+/// (`clone::PLACED_GRID`), so a whole-pixel move leaves each off by at most half of that.
+const WHOLE_PIXEL_TOLERANCE: f64 = 1.0 / 65536.0;
+
+/// The whole pixels `s` a placed triangle is its rest triangle moved by, each vertex within
+/// [`WHOLE_PIXEL_TOLERANCE`]. Sampling `pixel − s` exactly instead of the placed map moves a
+/// sample by at most that, and keeps a pasted patch's texels unresampled (the promise of a
+/// whole-pixel placement), wherever the mesh's vertices lie between grid points.
+pub(crate) fn whole_pixel_shift(placed: [DVec2; 3], rest: [DVec2; 3]) -> Option<[i32; 2]> {
+    let s = (placed[0] - rest[0]).round();
+    // With placed points within 2²⁰ px (drawable), `pixel − s` then stays below 2²⁴, where
+    // the f32 texel maps hold it exactly.
+    let limit = f64::from(1 << 22);
+    if !(s.abs().max_element() <= limit) {
+        return None;
+    }
+    let close = placed
+        .iter()
+        .zip(&rest)
+        .all(|(&p, &r)| (p - r - s).abs().max_element() <= WHOLE_PIXEL_TOLERANCE);
+    close.then_some([s.x as i32, s.y as i32])
 }
 
 /// `⌊v⌋` for `|v| ≤ MAX_COORDINATE` (NaN gives 0), without the libm call `f64::floor`
@@ -172,6 +200,11 @@ impl TriangleSetup {
         }
         let drawable = in_range && fixed_area != 0 && det != 0.0 && det.is_finite();
         let frame = LocalFrame::new(placed, drawable);
+        let shift = if drawable {
+            whole_pixel_shift(placed, rest)
+        } else {
+            None
+        };
         let (r1, r2) = (rest[1] - rest[0], rest[2] - rest[0]);
         let texel = |at_a: f64, edge1: f64, edge2: f64| {
             let gradient = frame.gradient(edge1, edge2);
@@ -187,10 +220,18 @@ impl TriangleSetup {
         };
         TriangleSetup {
             span: SpanSetup {
-                texel_x: texel(rest[0].x, r1.x, r2.x),
-                texel_y: texel(rest[0].y, r1.y, r2.y),
-                // The texel maps share the membrane's origin.
+                // The texel maps share the membrane's origin. A whole-pixel move maps the
+                // centre of pixel `origin` to the texel centre `origin − s`, exactly.
+                texel_x: match shift {
+                    Some(s) => [(frame.origin[0] - s[0]) as f32, 1.0, 0.0],
+                    None => texel(rest[0].x, r1.x, r2.x),
+                },
+                texel_y: match shift {
+                    Some(s) => [(frame.origin[1] - s[1]) as f32, 0.0, 1.0],
+                    None => texel(rest[0].y, r1.y, r2.y),
+                },
                 membrane: MembraneSpan::new(&frame, membrane),
+                shift,
             },
             fixed,
             drawable,
@@ -321,6 +362,47 @@ mod tests {
             assert_eq!(floor_to_i32(v), v.floor() as i32, "{v}");
         }
         assert_eq!(floor_to_i32(f64::NAN), 0);
+    }
+
+    /// A triangle placed as a placement places it (on the 2⁻¹⁶-px grid) is a whole-pixel
+    /// shift exactly when the move is whole pixels; its texel maps then give `pixel − s`.
+    #[test]
+    fn only_whole_pixel_moves_are_shifts() {
+        let grid = |p: DVec2| (p * 65536.0).round() / 65536.0;
+        let rest = [
+            DVec2::new(10.123_456_7, 20.987_654_3),
+            DVec2::new(13.3, 20.1),
+            DVec2::new(11.71, 24.02),
+        ];
+        let (mut shifts, mut others) = (0, 0);
+        for (k, dx) in [-37.0, -1.0, 0.0, 2.0, 500.0, 0.5, 3.25, 1.0 + 1e-3].iter().enumerate() {
+            let dy = [4.0, -3.0, 0.0, 7.0, 1.0, -2.5, 0.0, 2.0][k];
+            let move_by = DVec2::new(*dx, dy);
+            let placed = rest.map(|r| grid(r + move_by));
+            let setup = TriangleSetup::new(placed, rest, [[0.0; 3]; 3], [0.0; 3]);
+            let whole = move_by.fract() == DVec2::ZERO;
+            if whole {
+                shifts += 1;
+                assert_eq!(setup.span.shift, Some([*dx as i32, dy as i32]), "{move_by}");
+                let maps = setup.span.along_row(30);
+                for x in 40..60 {
+                    let (tx, ty, _) = maps.at(x);
+                    assert_eq!([tx, ty], [(x as f64 - dx) as f32, (30.0 - dy) as f32]);
+                }
+            } else {
+                others += 1;
+                assert_eq!(setup.span.shift, None, "{move_by}");
+            }
+        }
+        // Scaled or turned by a hair more than the grid: not a shift.
+        for placed in [
+            rest.map(|r| grid(r * 1.000_01)),
+            rest.map(|r| grid(DVec2::from_angle(1e-5).rotate(r))),
+        ] {
+            others += 1;
+            assert_eq!(TriangleSetup::new(placed, rest, [[0.0; 3]; 3], [0.0; 3]).span.shift, None);
+        }
+        assert_eq!((shifts, others), (5, 5));
     }
 
     #[test]

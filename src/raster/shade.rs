@@ -276,10 +276,17 @@ fn shade_eight<S: SourceTexel, C: CoverageTexel>(
     out: &mut [[u8; 4]],
 ) -> usize {
     let setups = input.setups;
-    let lane_ids = std::array::from_fn(|lane| ids[lane]);
-    let (levels, opaque) = wide.shade_opaque(&source, span.x0, lane_ids, |id| {
-        setups[id as usize].span.along_row(span.y).affine()
-    });
+    let lane_ids: [u32; 8] = std::array::from_fn(|lane| ids[lane]);
+    let maps = |id: u32| setups[id as usize].span.along_row(span.y).affine();
+    // A patch moved by whole pixels: the eight samples are eight texels of one source row.
+    let shift = setups[lane_ids[0] as usize].span.shift;
+    let texels = shift
+        .filter(|_| lane_ids.iter().all(|&id| setups[id as usize].span.shift == shift))
+        .and_then(|[sx, sy]| source.run_start(span.x0 - sx, span.y - sy, 8));
+    let (levels, opaque) = match texels {
+        Some(first) => wide.shade_texels(&source, first, span.x0, lane_ids, maps),
+        None => wide.shade_opaque(&source, span.x0, lane_ids, maps),
+    };
     if opaque == u8::MAX {
         out.copy_from_slice(&levels);
         return 8;
@@ -525,13 +532,25 @@ mod tests {
         let changed = std::cell::Cell::new(0usize);
         // Stretches the eight lanes must have taken (on a CPU with them).
         let stretches = std::cell::Cell::new(0usize);
+        // Those of them in patches moved by whole pixels (the lanes' direct texel reads).
+        let shifted = std::cell::Cell::new(0usize);
         TestRunner::new(config)
             .run(&any::<u64>(), |seed| {
                 let mut rng = Rng(seed | 1);
                 // Half the cases are wide and mostly covered, so the eight-lane path runs
                 // (across triangle edges too); the rest stress the fringe and coverage.
                 let interior = rng.next() % 2 == 0;
-                let (w, h) = (2 + rng.next() % 9, 2 + rng.next() % 7);
+                // A third of those move every triangle by the same whole pixels (each vertex
+                // up to the placement grid's rounding off), over a source wide enough for
+                // the lanes' direct texel reads.
+                let shift = (interior && rng.next() % 3 == 0).then(|| {
+                    let mut whole = || (rng.next() % 9) as f64 - 4.0;
+                    DVec2::new(whole(), whole())
+                });
+                let (w, h) = match shift {
+                    Some(_) => (16 + rng.next() % 40, 4 + rng.next() % 12),
+                    None => (2 + rng.next() % 9, 2 + rng.next() % 7),
+                };
                 let opaque = rng.next() % 2 == 0;
                 let levels: Vec<[u8; 4]> = (0..w * h)
                     .map(|_| {
@@ -565,7 +584,12 @@ mod tests {
                         let mut point = |lo: f64, hi: f64| {
                             DVec2::new(rng.range(lo, hi), rng.range(lo, hi))
                         };
-                        let rest = [point(-3.0, 12.0), point(-3.0, 12.0), point(-3.0, 12.0)];
+                        let mut rest = [point(-3.0, 12.0), point(-3.0, 12.0), point(-3.0, 12.0)];
+                        if let Some(s) = shift {
+                            let mut off = || f64::from(rng.next() as u8 % 3) - 1.0;
+                            let grid = 1.0 / 131_072.0;
+                            rest = placed.map(|p| p - s + DVec2::new(off(), off()) * grid);
+                        }
                         let mut m = || rng.range(-0.7, 0.7) as f32;
                         let membrane = [[m(), m(), m()], [m(), m(), m()], [m(), m(), m()]];
                         TriangleSetup::new(placed, rest, membrane, [0.0; 3])
@@ -583,7 +607,11 @@ mod tests {
                     })
                     .collect();
                 if opaque && source.eight_bit_view().is_some() {
-                    stretches.set(stretches.get() + eight_lane_stretches(&ids, &coverage, rect));
+                    let eights = eight_lane_stretches(&ids, &coverage, rect);
+                    stretches.set(stretches.get() + eights);
+                    if shift.is_some() {
+                        shifted.set(shifted.get() + eights);
+                    }
                 }
                 let canvas: Vec<[u8; 4]> = (0..rect.area())
                     .map(|_| {
@@ -625,6 +653,7 @@ mod tests {
             .unwrap();
         assert!(changed.get() > 3_000, "{} pixels shaded", changed.get());
         assert!(stretches.get() > 200, "{} eight-lane stretches", stretches.get());
+        assert!(shifted.get() > 50, "{} shifted eight-lane stretches", shifted.get());
     }
 
     /// Stretches of 16 pixels in a row, all inside triangles and fully covered: the row walk

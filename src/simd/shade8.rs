@@ -40,6 +40,16 @@ impl<'a> LevelSource<'a> {
             last_f32,
         })
     }
+
+    /// The index of texel `(x, y)` when it and the `count − 1` texels right of it lie in the
+    /// source's row `y`: there the plain sampler reads those texels unclamped.
+    #[inline(always)]
+    pub fn run_start(&self, x: i32, y: i32, count: i32) -> Option<usize> {
+        let inside = (0..=self.last_row).contains(&y)
+            && x >= 0
+            && x.checked_add(count).is_some_and(|end| end <= self.width);
+        inside.then(|| y as usize * self.width as usize + x as usize)
+    }
 }
 
 /// A triangle's maps along one row, each `[at origin, d/dx, d/dy · dy]`: the source
@@ -72,6 +82,17 @@ impl Wide {
     pub fn shade_opaque(
         self,
         _: &LevelSource,
+        _: i32,
+        _: [u32; 8],
+        _: impl Fn(u32) -> (RowAffine, i32),
+    ) -> Levels8 {
+        match self {}
+    }
+
+    pub fn shade_texels(
+        self,
+        _: &LevelSource,
+        _: usize,
         _: i32,
         _: [u32; 8],
         _: impl Fn(u32) -> (RowAffine, i32),
@@ -128,7 +149,35 @@ mod x86 {
                 self.pairs(source.bytes, avx2._mm256_add_epi32(top_row, x0), step);
             let top = self.lerp(self.channels(top_left), self.channels(top_right), tx);
             let bottom = self.lerp(self.channels(low_left), self.channels(low_right), tx);
-            let mut sample = self.lerp(top, bottom, ty);
+            self.finish(self.lerp(top, bottom, ty), membrane)
+        }
+
+        /// [`shade_opaque`](Self::shade_opaque) where every lane's triangle is moved by the
+        /// same whole pixels and the eight samples are the source texels from index `first`
+        /// on ([`LevelSource::run_start`]): the plain code's taps then have fraction 0, and
+        /// its lerps `a + (b − a) · 0` give the texel `a` itself, so one load gives the
+        /// samples.
+        #[inline(always)]
+        pub fn shade_texels(
+            self,
+            source: &LevelSource,
+            first: usize,
+            x0: i32,
+            ids: [u32; 8],
+            maps: impl Fn(u32) -> (RowAffine, i32),
+        ) -> Levels8 {
+            let (_, membrane) = self.maps_per_lane(x0, ids, maps);
+            let eight = source.bytes.get(4 * first..).and_then(<[u8]>::first_chunk::<32>);
+            // invariant: `run_start` gave `first` for eight texels inside the source.
+            let words: __m256i = pulp::cast(*eight.expect("eight texels inside the source"));
+            self.finish(self.channels(words), membrane)
+        }
+
+        /// Samples (0–255 per channel) to levels: divided by 255, the membrane added, each
+        /// channel rounded; the pixels and which samples were opaque.
+        #[inline(always)]
+        fn finish(self, mut sample: Channels, membrane: Channels) -> Levels8 {
+            let (avx, avx2) = (self.0.avx, self.0.avx2);
             let mut levels = [avx._mm256_setzero_si256(); 4];
             for c in 0..4 {
                 sample[c] = avx._mm256_div_ps(sample[c], avx._mm256_set1_ps(255.0));
