@@ -105,6 +105,7 @@ pub use script::{
 };
 pub use simd::{levels_to_rgb8, rgb8_to_levels};
 pub use solve::{FactorMethod, LaplacianKind, PenaltyOptions, SolveError, SwitchStats};
+pub use util::available_cores;
 
 /// Opens a scene file as `lapclone render` does: loads and runs it ([`load_scene`]), then
 /// [`build_renderer`].

@@ -71,7 +71,9 @@ impl Patch {
             let bbox = (patch.bbox_min, patch.bbox_max, patch.default_drag_radius());
             let triangles = patch.result.mesh.triangles.len();
             let mut cloner = PatchCloner::new(source, patch.result.mesh, options).map_err(to_py)?;
-            cloner.set_raster_threads(threads.unwrap_or_else(cores));
+            // Unless told otherwise every core, as `lapclone clone` uses (the pixels are the same
+            // for any count); looked up once per process, since the look-up reads cgroup files.
+            cloner.set_raster_threads(threads.unwrap_or_else(lapclone::available_cores));
             let state = PatchState {
                 cloner,
                 laplacian: options.laplacian,
@@ -140,12 +142,6 @@ fn lock(mutex: &Mutex<PatchState>) -> MutexGuard<'_, PatchState> {
     mutex
         .lock()
         .unwrap_or_else(|poisoned| poisoned.into_inner())
-}
-
-/// Threads a clone shades on unless told otherwise: every core, as `lapclone clone` uses (the
-/// pixels are the same for any count).
-fn cores() -> usize {
-    std::thread::available_parallelism().map_or(1, |n| n.get())
 }
 
 impl PatchState {
