@@ -280,9 +280,11 @@ fn shade_eight<S: SourceTexel, C: CoverageTexel>(
     let maps = |id: u32| setups[id as usize].span.along_row(span.y).affine();
     // A patch moved by whole pixels: the eight samples are eight texels of one source row.
     let shift = setups[lane_ids[0] as usize].span.shift;
-    let texels = shift
-        .filter(|_| lane_ids.iter().all(|&id| setups[id as usize].span.shift == shift))
-        .and_then(|[sx, sy]| source.run_start(span.x0 - sx, span.y - sy, 8));
+    let same = |shift| lane_ids.iter().all(|&id| setups[id as usize].span.shift == shift);
+    let texels = shift.filter(|_| same(shift)).and_then(|[sx, sy]| {
+        let (x, y) = (span.x0.checked_sub(sx)?, span.y.checked_sub(sy)?);
+        source.run_start(x, y, 8)
+    });
     let (levels, opaque) = match texels {
         Some(first) => wide.shade_texels(&source, first, span.x0, lane_ids, maps),
         None => wide.shade_opaque(&source, span.x0, lane_ids, maps),
