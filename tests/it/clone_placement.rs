@@ -110,3 +110,55 @@ fn whole_pixel_moves_shift_every_placed_point_exactly() {
         assert_eq!(exact, rest.len(), "shift {shift}");
     }
 }
+
+/// A patch pasted by whole pixels onto a target holding its own source moved by the same
+/// pixels: the membrane is zero and every pixel the clone writes is the source's texel,
+/// copied, not resampled, so the canvas comes back as it went in (interior and fringe
+/// alike, for moves in every direction).
+#[test]
+fn a_whole_pixel_paste_copies_the_source_texels() {
+    use lapclone::{mesh_from_mask, BitMask, Canvas, CanvasPixels, MeshOptions};
+    use lapclone::{FloatImage, PatchCloner};
+    let assets = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets");
+    let source = FloatImage::load(&assets.join("chelsea.png")).unwrap();
+    let mask = BitMask::load(&assets.join("masks/chelsea_face.png"), 0.5).unwrap();
+    let (w, h) = (source.width(), source.height());
+    let patch = mesh_from_mask(&mask, None, (w, h), &MeshOptions::default()).unwrap();
+    let centre = (patch.bbox_min + patch.bbox_max) / 2.0;
+    let mut cloner =
+        PatchCloner::new(source.clone(), patch.result.mesh, &Default::default()).unwrap();
+    let levels = match Canvas::from_image(&source).pixels() {
+        CanvasPixels::Eight(levels) => levels.clone(),
+        CanvasPixels::Sixteen(_) => panic!("chelsea.png is 8-bit"),
+    };
+    let mut written = 0;
+    for shift in [[17, 11], [-23, 4], [0, -9], [31, 0]] {
+        // The target: the source moved by `shift`, on a grey margin.
+        let (tw, th) = (w + 64, h + 64);
+        let target: Vec<[u8; 4]> = (0..tw * th)
+            .map(|k| {
+                let (x, y) = (
+                    (k % tw) as i64 - 32 - shift[0],
+                    (k / tw) as i64 - 32 - shift[1],
+                );
+                let inside = (0..w as i64).contains(&x) && (0..h as i64).contains(&y);
+                match inside {
+                    true => levels[(y * w as i64 + x) as usize],
+                    false => [128, 128, 128, 255],
+                }
+            })
+            .collect();
+        let mut canvas = Canvas::from_rgba8(tw, th, target.clone()).unwrap();
+        let moved = DVec2::new(32.0 + shift[0] as f64, 32.0 + shift[1] as f64);
+        let stats = cloner
+            .clone_onto(&mut canvas, &Placement::translate(centre, centre + moved))
+            .unwrap();
+        written += stats.raster.written;
+        let CanvasPixels::Eight(out) = canvas.pixels() else {
+            panic!("an 8-bit canvas stays 8-bit")
+        };
+        let differ = out.iter().zip(&target).filter(|(a, b)| a != b).count();
+        assert_eq!(differ, 0, "{shift:?}: {differ} pixels differ");
+    }
+    assert!(written > 4 * 40_000, "{written} pixels written");
+}
