@@ -179,7 +179,7 @@ body { margin: 0; background: #222; }
 #overlay { position: absolute; left: 0; top: 0; width: 100%; height: 100%; }
 </style></head><body><div id="stage"><canvas id="frame" width="1920" height="1080"></canvas>
 <canvas id="overlay" width="1920" height="1080"></canvas></div><script>
-const ctx = document.getElementById('frame').getContext('2d');
+const ctx = document.getElementById('frame').getContext('2d', { desynchronized: true });
 const block = new ImageData(240, 225);
 const timings = (window.lapcloneTimings = []), paintedAt = (window.lapclonePaintedAt = []);
 let n = 0, down = false;

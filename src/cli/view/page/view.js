@@ -7,7 +7,7 @@
   // `overlay` covers the frame and takes the pointer; what it shows is drawn into `marks`, a
   // canvas only as large as the box the handles, pins and outlines need (see drawOverlay).
   const frame = $("frame"), overlay = $("overlay"), marks = $("marks");
-  const fctx = frame.getContext("2d"), mctx = marks.getContext("2d");
+  const fctx = frame.getContext("2d", { desynchronized: true }), mctx = marks.getContext("2d");
   // While drawOverlay measures, drawing goes nowhere; then it goes to `marks`.
   const nowhere = new Proxy({}, { get: () => () => {}, set: () => true });
   let octx = nowhere;
