@@ -125,7 +125,7 @@ pub(crate) fn whole_pixel_shift(placed: [DVec2; 3], rest: [DVec2; 3]) -> Option<
     // With placed points within 2²⁰ px (drawable), `pixel − s` then stays below 2²⁴, where
     // the f32 texel maps hold it exactly.
     let limit = f64::from(1 << 22);
-    if !(s.abs().max_element() <= limit) {
+    if !s.is_finite() || s.abs().max_element() > limit {
         return None;
     }
     let close = placed
