@@ -91,6 +91,26 @@ impl LocalFrame {
     fn at_origin(&self, at_a: f64, gradient: DVec2) -> f64 {
         at_a + gradient.dot(self.offset)
     }
+
+    /// The texel maps x and y of a triangle with these rest corners, as [`SpanSetup`] holds
+    /// them (they share the membrane's origin). A triangle moved by the whole pixels `shift`
+    /// maps the centre of pixel `origin` to the texel centre `origin − s`, exactly.
+    fn texel_maps(&self, rest: [DVec2; 3], shift: Option<[i32; 2]>) -> [[f32; 3]; 2] {
+        if let Some(s) = shift {
+            let [x, y] = [0, 1].map(|k| (self.origin[k] - s[k]) as f32);
+            return [[x, 1.0, 0.0], [y, 0.0, 1.0]];
+        }
+        let (r1, r2) = (rest[1] - rest[0], rest[2] - rest[0]);
+        let texel = |at_a: f64, edge1: f64, edge2: f64| {
+            let gradient = self.gradient(edge1, edge2);
+            [
+                (self.at_origin(at_a, gradient) - 0.5) as f32,
+                gradient.x as f32,
+                gradient.y as f32,
+            ]
+        };
+        [texel(rest[0].x, r1.x, r2.x), texel(rest[0].y, r1.y, r2.y)]
+    }
 }
 
 impl MembraneSpan {
@@ -205,31 +225,15 @@ impl TriangleSetup {
         } else {
             None
         };
-        let (r1, r2) = (rest[1] - rest[0], rest[2] - rest[0]);
-        let texel = |at_a: f64, edge1: f64, edge2: f64| {
-            let gradient = frame.gradient(edge1, edge2);
-            [
-                (frame.at_origin(at_a, gradient) - 0.5) as f32,
-                gradient.x as f32,
-                gradient.y as f32,
-            ]
-        };
+        let [texel_x, texel_y] = frame.texel_maps(rest, shift);
         let affine = |at_a: f64, edge1: f64, edge2: f64| {
             let gradient = frame.gradient(edge1, edge2);
             [at_a - gradient.dot(a), gradient.x, gradient.y]
         };
         TriangleSetup {
             span: SpanSetup {
-                // The texel maps share the membrane's origin. A whole-pixel move maps the
-                // centre of pixel `origin` to the texel centre `origin − s`, exactly.
-                texel_x: match shift {
-                    Some(s) => [(frame.origin[0] - s[0]) as f32, 1.0, 0.0],
-                    None => texel(rest[0].x, r1.x, r2.x),
-                },
-                texel_y: match shift {
-                    Some(s) => [(frame.origin[1] - s[1]) as f32, 0.0, 1.0],
-                    None => texel(rest[0].y, r1.y, r2.y),
-                },
+                texel_x,
+                texel_y,
                 membrane: MembraneSpan::new(&frame, membrane),
                 shift,
             },
