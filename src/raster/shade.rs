@@ -226,6 +226,13 @@ fn shade_row<S: SourceTexel, T: Texel, C: CoverageTexel>(
 ) -> (usize, usize) {
     let (mut hits, mut written, mut start) = (0, 0, 0);
     while start < ids.len() {
+        // Outside the silhouette and every triangle (most of a bounding box): nothing to do.
+        let outside = ids[start..].iter().zip(&span.coverage[start..]);
+        let outside = outside.take_while(|&(&id, c)| id == NO_TRIANGLE && !c.is_covered());
+        start += outside.count();
+        if start == ids.len() {
+            break;
+        }
         let end = ids.len().min(start + 8);
         let x0 = span.x0 + start as i32;
         let lanes = Span {
