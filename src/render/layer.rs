@@ -162,8 +162,13 @@ impl Layer {
     }
 
     /// After [`prepare`](Self::prepare): clones onto `canvas` (the composite of the layers
-    /// below).
-    pub fn composite(&mut self, canvas: &mut Canvas) -> Result<CloneStats, RenderError> {
+    /// below), shading on `raster_threads` threads.
+    pub fn composite(
+        &mut self,
+        canvas: &mut Canvas,
+        raster_threads: usize,
+    ) -> Result<CloneStats, RenderError> {
+        self.cloner.set_raster_threads(raster_threads);
         let depth = self.deforms().then_some(&self.deformed.depth[..]);
         let result = self.cloner.clone_prepared(canvas, depth);
         result.map_err(|source| self.clone_error(source))

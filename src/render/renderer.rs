@@ -91,6 +91,8 @@ pub struct Renderer {
     below: Option<Canvas>,
     /// Background footage, and the scene frame whose plate `background` holds.
     plates: Option<(FootageReader, u64)>,
+    /// Threads each patch's raster shades on (see [`Renderer::set_raster_threads`]).
+    raster_threads: usize,
 }
 
 impl Renderer {
@@ -122,7 +124,16 @@ impl Renderer {
             dirty_valid: true,
             below: None,
             plates,
+            raster_threads: 1,
         })
+    }
+
+    /// Shades each patch on `threads` threads (the caller's and scoped ones; 1 by default,
+    /// at least 1): the pixels are the same for any count. One thread suits a scene render,
+    /// whose other cores encode frames; an interactive session that waits on each frame
+    /// gives it every core.
+    pub fn set_raster_threads(&mut self, threads: usize) {
+        self.raster_threads = threads.max(1);
     }
 
     /// The scene being rendered.
@@ -201,7 +212,7 @@ impl Renderer {
                     .get_or_insert_with(|| frame.clone())
                     .copy_from(frame);
             }
-            let clone = self.layers[index].composite(&mut self.frame)?;
+            let clone = self.layers[index].composite(&mut self.frame, self.raster_threads)?;
             if let Some(below) = self.below.as_ref().filter(|_| opacity < 1.0) {
                 blend_over_below(&mut self.frame, below, clone.raster.work, opacity);
             }

@@ -8,6 +8,7 @@ use std::time::Instant;
 
 use anyhow::Context as _;
 use lapclone::render::{RenderError, Renderer, SceneUpdate};
+use lapclone::scene::Scene;
 use lapclone::script::LoadedScene;
 use rhai::{Dynamic, Scope, AST};
 
@@ -99,7 +100,7 @@ impl Session {
         let started = Instant::now();
         let update = match self.renderer.as_mut() {
             Some(renderer) => renderer.set_scene(loaded.scene.clone()),
-            None => Renderer::new(loaded.scene.clone()).map(|renderer| {
+            None => session_renderer(loaded.scene.clone()).map(|renderer| {
                 let update = SceneUpdate {
                     rebuilt: loaded.scene.patches.len(),
                     ..SceneUpdate::default()
@@ -154,6 +155,14 @@ impl Session {
         }
         self.warned = warnings;
     }
+}
+
+/// The session's renderer for `scene`: someone waits on each of its frames (the live view,
+/// the preview file), and nothing encodes beside it, so every core shades.
+pub(super) fn session_renderer(scene: Scene) -> Result<Renderer, RenderError> {
+    let mut renderer = Renderer::new(scene)?;
+    renderer.set_raster_threads(lapclone::util::available_cores());
+    Ok(renderer)
 }
 
 /// A render error (it names its patch; no source position, as the scene may come from many

@@ -5,10 +5,10 @@
 use std::path::Path;
 
 use anyhow::Context as _;
-use lapclone::render::Renderer;
 use lapclone::script::Draft;
 use rhai::Scope;
 
+use super::eval::session_renderer;
 use super::Session;
 
 /// The state an `:undo` (or a failed entry) goes back to. Functions and imports are kept:
@@ -59,7 +59,7 @@ impl Session {
                 .engine
                 .scene(Path::new("<undo>"))
                 .map_err(|e| anyhow::anyhow!("{e}"))?;
-            self.renderer = Some(Renderer::new(scene).map_err(|e| anyhow::anyhow!("{e}"))?);
+            self.renderer = Some(session_renderer(scene).map_err(|e| anyhow::anyhow!("{e}"))?);
         }
         self.show_frame()
     }
