@@ -95,7 +95,7 @@ pub use pixels::{
     Canvas, CanvasPixels, ColorKind, Depth, FloatImage, FootageError, PixelError, PixelFormat,
     PixelRect,
 };
-pub use raster::{RasterError, RasterStats};
+pub use raster::{RasterError, RasterStats, MAX_RASTER_THREADS};
 pub use render::{DrawnRegion, FrameStats, RenderError, Renderer, SceneUpdate};
 /// The scene language's engine: [`SceneError::position`] is its [`rhai::Position`].
 pub use rhai;

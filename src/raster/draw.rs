@@ -24,6 +24,7 @@ pub struct RasterOptions {
     pub anti_alias: bool,
     /// Threads that shade (row ranges, the caller's thread and scoped ones); the pixels are
     /// the same for any count. 1 by default: a scene render's other cores encode frames.
+    /// At most [`MAX_RASTER_THREADS`], and one per 64 rows of the patch, are started.
     pub threads: usize,
 }
 
@@ -94,6 +95,10 @@ pub fn draw_patch(
 
 /// Fewer rows than this per thread are shaded on the caller's thread alone.
 const MIN_ROWS_PER_THREAD: usize = 64;
+
+/// The most threads one draw shades on, whatever a caller asks for: a bound on what a
+/// caller's number can start, well above the cores shading can use.
+pub const MAX_RASTER_THREADS: usize = 64;
 
 /// One draw's rectangles and canvas width.
 struct Frame<'a> {
@@ -310,7 +315,8 @@ impl Frame<'_> {
 
     /// Scoped threads besides the caller's to shade `rows` on.
     fn helpers(&self, rows: PixelRect) -> usize {
-        self.threads.min(rows.height() / MIN_ROWS_PER_THREAD).max(1) - 1
+        let threads = self.threads.min(MAX_RASTER_THREADS);
+        threads.min(rows.height() / MIN_ROWS_PER_THREAD).max(1) - 1
     }
 }
 

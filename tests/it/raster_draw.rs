@@ -619,7 +619,8 @@ fn threads_shade_the_same_pixels() {
             .map(|p| DVec2::new(p.x * 0.97 + 0.3 * p.y.sin(), p.y + 0.2) * scale)
             .collect();
         let (width, height) = if scale > 1.0 { (520, 460) } else { (280, 300) };
-        let canvases: Vec<Canvas> = [1, 2, 3]
+        // Any count asked for is taken: far more than the rows can use are capped.
+        let canvases: Vec<Canvas> = [1, 2, 3, usize::MAX]
             .into_iter()
             .map(|threads| {
                 let mut canvas = opaque_canvas(width, height, 0.4);
