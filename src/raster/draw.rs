@@ -1,9 +1,10 @@
 //! Drawing one patch: takes a [`Patch`] with its solved membrane, options and a
-//! [`RasterScratch`] and composites the patch over a [`Canvas`], in one sequential pass
-//! inside the patch's bounding box: per-triangle setup and silhouette coverage, exact
-//! pixel-centre ownership with the depth test, then shading row by row.
+//! [`RasterScratch`] and composites the patch over a [`Canvas`] inside the patch's bounding
+//! box: per-triangle setup and silhouette coverage, exact pixel-centre ownership with the
+//! depth test, then shading row by row; on one thread, or with `RasterOptions::threads` on
+//! several (the same pixels).
 
-use std::sync::mpsc;
+use std::sync::{mpsc, Mutex};
 
 use super::bands::{join_sum, Bands};
 use super::coverage::Silhouette;
@@ -11,7 +12,7 @@ use super::feather::apply_feather;
 use super::prepare::{prepare, prepare_setups, prepare_silhouette};
 use super::setup::{TriangleSetup, MAX_COORDINATE};
 use super::shade::{shade_and_composite, CoverageTexel, ShadeInput};
-use super::triangles::{rasterise_triangles, NO_TRIANGLE};
+use super::triangles::{bands, rasterise_triangles, Band, TriangleBins, NO_TRIANGLE};
 use super::{Patch, PixelRect, RasterError, RasterScratch};
 use crate::pixels::{Canvas, CanvasPixels, Texel};
 
@@ -78,8 +79,8 @@ pub fn draw_patch(
         (CanvasPixels::Sixteen(p), true) => frame.draw_overlapped(scratch, p),
         (pixels, false) => {
             prepare(patch, work, options.anti_alias, scratch);
-            let (setups, ids, depths) = (&scratch.setups, &mut scratch.ids, &mut scratch.depths);
-            frame.rasterise(setups, ids, depths);
+            let buffers = (&mut scratch.ids, &mut scratch.depths);
+            frame.rasterise(&scratch.setups, buffers, &mut scratch.bins);
             match pixels {
                 CanvasPixels::Eight(p) => frame.shade(options, scratch, p),
                 CanvasPixels::Sixteen(p) => frame.shade(options, scratch, p),
@@ -92,6 +93,12 @@ pub fn draw_patch(
         written,
     })
 }
+
+/// Patches with fewer triangles draw their ids on the caller's thread alone: a second spawn
+/// and join per draw (about 50 µs) would eat what sharing their ownership pass saves. The
+/// folding horse (4,600 triangles, a 1.3 ms pass) gains about a millisecond a frame from
+/// sharing it; the README's cat (1,068) keeps its one spawn.
+const SHARED_IDS_TRIANGLES: usize = 2048;
 
 /// Fewer rows than this per thread are shaded on the caller's thread alone.
 const MIN_ROWS_PER_THREAD: usize = 64;
@@ -114,21 +121,83 @@ struct Frame<'a> {
 
 impl Frame<'_> {
     /// Fills `ids` (and `depths`, with depth) over the work rectangle from `setups`.
-    fn rasterise(&self, setups: &[TriangleSetup], ids: &mut Vec<u32>, depths: &mut Vec<f32>) {
+    fn rasterise(&self, setups: &[TriangleSetup], buffers: IdBuffers, bins: &mut TriangleBins) {
+        let use_depth = self.sized((&mut *buffers.0, &mut *buffers.1));
+        rasterise_triangles(setups, self.work, use_depth, (buffers.0, buffers.1), bins);
+    }
+
+    /// Sizes `ids` (and `depths`, with depth) to the work rectangle; whether with depth.
+    fn sized(&self, (ids, depths): IdBuffers) -> bool {
         let use_depth = self.patch.depth.is_some();
         ids.resize(self.work.area(), 0);
         if use_depth {
             depths.resize(self.work.area(), 0.0);
         }
-        let all = 0..setups.len() as u32;
-        rasterise_triangles(setups, all, self.work, use_depth, ids, depths);
+        use_depth
     }
 
-    /// The anti-aliased, unfeathered draw on several threads: a helper fills the silhouette
-    /// while the caller sets up the triangles and rasterises their ids (the two depend only
-    /// on the patch), then every thread shades [`Bands`]. One spawn per draw: the helper's
-    /// start-up overlaps the caller's work instead of delaying the shading.
+    /// The anti-aliased, unfeathered draw on several threads, in two parts. First a helper
+    /// fills the silhouette while the caller sets up the triangles and bins them by row
+    /// band, then both draw the bands' ids in turn (the three depend only on the patch); then
+    /// every thread shades [`Bands`]. The helper's start-up overlaps the caller's work
+    /// instead of delaying the rest. A patch with fewer than [`SHARED_IDS_TRIANGLES`]
+    /// triangles draws its ids on the caller alone, with one spawn instead of two.
     fn draw_overlapped<T: Texel + Send>(
+        &self,
+        scratch: &mut RasterScratch,
+        canvas: &mut [[T; 4]],
+    ) -> (usize, usize) {
+        if self.patch.triangles.len() < SHARED_IDS_TRIANGLES {
+            return self.draw_overlapped_ids_on_caller(scratch, canvas);
+        }
+        self.prepare_shared(scratch);
+        let drawn = (&scratch.setups[..], &scratch.ids[..], &scratch.silhouette);
+        self.in_parts(self.target, canvas, |part, canvas| {
+            self.shade_strips(drawn, part, canvas)
+        })
+    }
+
+    /// The first part of [`draw_overlapped`](Self::draw_overlapped): the helper fills the
+    /// silhouette, the caller sets up and bins the triangles, then both draw id bands.
+    fn prepare_shared(&self, scratch: &mut RasterScratch) {
+        let use_depth = self.sized((&mut scratch.ids, &mut scratch.depths));
+        let RasterScratch {
+            setups,
+            snapped,
+            ids,
+            depths,
+            silhouette,
+            folds,
+            bins,
+            ..
+        } = scratch;
+        let (patch, work) = (self.patch, self.work);
+        let id_bands = Mutex::new(bands(work, ids, depths, use_depth));
+        let (to_helper, from_caller) = mpsc::channel::<(&[TriangleSetup], &TriangleBins)>();
+        std::thread::scope(|scope| {
+            let id_bands = &id_bands;
+            let helper = scope.spawn(move || {
+                prepare_silhouette(patch, work, folds, silhouette);
+                // Nothing comes only when the caller panicked, which its scope reports.
+                if let Ok((setups, bins)) = from_caller.recv() {
+                    draw_bands(setups, bins, id_bands);
+                }
+            });
+            prepare_setups(patch, snapped, setups);
+            bins.fill(setups, work);
+            let _ = to_helper.send((setups, bins));
+            draw_bands(setups, bins, id_bands);
+            helper
+                .join()
+                .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+        });
+    }
+
+    /// [`draw_overlapped`](Self::draw_overlapped) of a patch with few triangles, with one
+    /// spawn per draw: a helper fills the silhouette while the caller sets up the triangles
+    /// and rasterises their ids (the two depend only on the patch), then every thread shades
+    /// [`Bands`].
+    fn draw_overlapped_ids_on_caller<T: Texel + Send>(
         &self,
         scratch: &mut RasterScratch,
         canvas: &mut [[T; 4]],
@@ -140,6 +209,7 @@ impl Frame<'_> {
             depths,
             silhouette,
             folds,
+            bins,
             ..
         } = scratch;
         let (patch, work, rows) = (self.patch, self.work, self.target);
@@ -159,7 +229,7 @@ impl Frame<'_> {
                 bands.shade(|part, canvas| self.shade_strips((setups, ids, silhouette), part, canvas))
             });
             prepare_setups(patch, snapped, setups);
-            self.rasterise(setups, ids, depths);
+            self.rasterise(setups, (ids, depths), bins);
             let (setups, ids): (&[TriangleSetup], &[u32]) = (setups, ids);
             let _ = to_helper.send((setups, ids));
             // Nothing comes only when the helper panicked, which its join reports.
@@ -317,6 +387,21 @@ impl Frame<'_> {
     fn helpers(&self, rows: PixelRect) -> usize {
         let threads = self.threads.min(MAX_RASTER_THREADS);
         threads.min(rows.height() / MIN_ROWS_PER_THREAD).max(1) - 1
+    }
+}
+
+/// The per-pixel ids and depths of the work rectangle.
+type IdBuffers<'a> = (&'a mut Vec<u32>, &'a mut Vec<f32>);
+
+/// Draws the triangles of the bands left in `left` until none is.
+fn draw_bands<'a>(
+    setups: &[TriangleSetup],
+    bins: &TriangleBins,
+    left: &Mutex<impl Iterator<Item = Band<'a>>>,
+) {
+    // A poisoned lock means the other thread panicked, which its join reports.
+    while let Some(band) = left.lock().ok().and_then(|mut left| left.next()) {
+        bins.rasterise(setups, band);
     }
 }
 

@@ -6,6 +6,7 @@
 use super::coverage::Silhouette;
 use super::folds::FoldOutline;
 use super::setup::{SnappedVertex, TriangleSetup};
+use super::triangles::TriangleBins;
 
 /// Scratch buffers for [`draw_patch`](super::draw_patch); the caller keeps one (per patch,
 /// or per thread) and passes it every frame.
@@ -18,6 +19,8 @@ pub struct RasterScratch {
     pub(crate) ids: Vec<u32>,
     /// Per work pixel: the owner's depth (drawn with depth only).
     pub(crate) depths: Vec<f32>,
+    /// The triangles of each row band, for drawing the ids band by band.
+    pub(crate) bins: TriangleBins,
     /// Pixel-centre coverage when not anti-aliasing.
     pub(crate) centres: Vec<u8>,
     /// The feathered coverage of the work rectangle.

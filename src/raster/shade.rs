@@ -605,8 +605,8 @@ mod tests {
                     })
                     .collect();
                 let mut ids = vec![0; rect.area()];
-                let all = 0..setups.len() as u32;
-                rasterise_triangles(&setups, all, rect, false, &mut ids, &mut []);
+                let mut bins = Default::default();
+                rasterise_triangles(&setups, rect, false, (&mut ids, &mut []), &mut bins);
                 let coverage: Vec<u8> = (0..rect.area())
                     .map(|_| match (interior, rng.next() % 16) {
                         (_, 0) => 0,
