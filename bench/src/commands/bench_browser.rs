@@ -6,8 +6,9 @@
 //! the display's frame and none waiting for the page, as a mouse's reports come. Gives, from
 //! the page's own timings (`window.lapcloneTimings`: pointer event → the frame showing the
 //! answer painted), the median, 95th percentile, updates painted per second and the medians
-//! of where the time went (table or JSON). Without chromium it reports the drags as skipped,
-//! saying why.
+//! of where the time went (table or JSON); and chromium's floor, a page that paints each
+//! move itself, at once or a set delay after it (`--floor-after`). Without chromium it
+//! reports the drags as skipped, saying why.
 
 use std::path::Path;
 use std::time::{Duration, Instant};
@@ -33,6 +34,11 @@ pub struct BrowserBenchArgs {
     /// not wait); the figures it gives depend on where the moves fall in the frame.
     #[arg(long)]
     pub acked: bool,
+    /// Chromium's floor is also measured with each move answered this many ms after it
+    /// (comma-separated; 0 paints in the pointer handler itself), as if a server with no
+    /// other cost answered then: what a round trip of that length leaves at best.
+    #[arg(long, value_delimiter = ',', default_value = "0,4,8")]
+    pub floor_after: Vec<f64>,
 }
 
 /// The browser window: a full-HD screen (the 1920×1080 canvas is shown scaled to fit).
@@ -53,7 +59,9 @@ struct Pacing {
 
 #[derive(serde::Serialize)]
 struct Drag {
-    scene: &'static str,
+    scene: String,
+    /// The floor's answer delay, ms (the floors only).
+    answer_after_ms: Option<f64>,
     steps: usize,
     /// Pointer events dispatched per second (60 unless the browser held the dispatch back).
     pointer_hz: f64,
@@ -76,6 +84,11 @@ pub fn run(args: BrowserBenchArgs) -> anyhow::Result<()> {
     if !(1.0..=1000.0).contains(&args.pointer_hz) {
         return Err(super::UsageError("--pointer-hz must be within 1 to 1000".into()).into());
     }
+    if !args.floor_after.iter().all(|ms| (0.0..=100.0).contains(ms)) {
+        return Err(
+            super::UsageError("--floor-after takes delays within 0 to 100 ms".into()).into(),
+        );
+    }
     let report = match find_chromium() {
         Some(chromium) => json!({ "drags": drags(&args, &chromium)?, "skipped": null }),
         None => json!({
@@ -94,7 +107,7 @@ pub fn run(args: BrowserBenchArgs) -> anyhow::Result<()> {
     println!("live view drag in headless chromium, pointer event → pixels painted (1920×1080):");
     for d in report["drags"].as_array().into_iter().flatten() {
         println!(
-            "  {:<6} {} steps at {:.0} Hz: median {:.1} ms, p95 {:.1} ms, max {:.1} ms, {:.1} updates/s ({} painted)   ({})",
+            "  {:<7} {} steps at {:.0} Hz: median {:.1} ms, p95 {:.1} ms, max {:.1} ms, {:.1} updates/s ({} painted)   ({})",
             d["scene"].as_str().unwrap_or(""),
             d["steps"],
             d["pointer_hz"].as_f64().unwrap_or(f64::NAN),
@@ -103,10 +116,12 @@ pub fn run(args: BrowserBenchArgs) -> anyhow::Result<()> {
             d["max_ms"].as_f64().unwrap_or(f64::NAN),
             d["updates_per_s"].as_f64().unwrap_or(f64::NAN),
             d["painted"],
-            if d["scene"] == "floor" {
-                "chromium alone: the page paints each move itself, no server"
-            } else {
-                "targets ≤ 16, ≤ 33 ms, ≥ 50/s"
+            match d["answer_after_ms"].as_f64() {
+                Some(ms) if ms > 0.0 => format!(
+                    "chromium alone, each move painted {ms} ms after it: no server, as if one answered then"
+                ),
+                Some(_) => "chromium alone: the page paints each move itself, no server".into(),
+                None => "targets ≤ 16, ≤ 33 ms, ≥ 50/s".into(),
             },
         );
         if let Some(parts) = d["parts_median_ms"].as_array() {
@@ -161,8 +176,11 @@ fn drags(args: &BrowserBenchArgs, chromium: &Path) -> anyhow::Result<Vec<Drag>> 
             pacing,
             |scene, i| place(&scene["patches"][0], horse_target(i, steps)),
         )?;
-        let floor = floor_drag(chromium, &dir, pacing)?;
-        Ok::<_, anyhow::Error>(vec![cat, horse, floor])
+        let mut drags = vec![cat, horse];
+        for &after in &args.floor_after {
+            drags.push(floor_drag(chromium, &dir, pacing, after)?);
+        }
+        Ok::<_, anyhow::Error>(drags)
     })();
     let _ = std::fs::remove_dir_all(&dir);
     result
@@ -170,8 +188,9 @@ fn drags(args: &BrowserBenchArgs, chromium: &Path) -> anyhow::Result<Vec<Drag>> 
 
 /// Chromium's own floor for the same measure: a page with the live view's two canvases,
 /// scaled the same way, that paints a cat-sized rectangle (216 kB, what a cat preview
-/// carries) on every pointer move itself (the same pointer event the live view reads), with
-/// no server, timed as the live view times.
+/// carries) for every pointer move itself (the same pointer event the live view reads),
+/// with no server, timed as the live view times: in the pointer handler, or `ANSWER_AFTER`
+/// ms after the move from a timer task, as a server's answer would come.
 const FLOOR_PAGE: &str = r#"<!doctype html><html><head><style>
 body { margin: 0; background: #222; }
 #stage { position: relative; display: inline-block; margin: 10px; }
@@ -190,22 +209,29 @@ overlay.addEventListener('pointerup', () => { down = false; window.lapcloneRelea
 const move = 'onpointerrawupdate' in window ? 'pointerrawupdate' : 'pointermove';
 overlay.addEventListener(move, (e) => {
   if (!down) return;
-  block.data.fill(n++ & 255);
-  ctx.putImageData(block, 600 + (n % 400), 400);
   const from = e.timeStamp;
-  requestAnimationFrame(() => setTimeout(() => {
-    const now = performance.now();
-    timings.push(now - from); paintedAt.push(now);
-  }, 0));
+  const answer = () => {
+    block.data.fill(n++ & 255);
+    ctx.putImageData(block, 600 + (n % 400), 400);
+    requestAnimationFrame(() => setTimeout(() => {
+      const now = performance.now();
+      timings.push(now - from); paintedAt.push(now);
+    }, 0));
+  };
+  if (ANSWER_AFTER > 0) setTimeout(answer, ANSWER_AFTER); else answer();
 });
 window.lapcloneReady = true;
 </script></body></html>"#;
 
-fn floor_drag(chromium: &Path, dir: &Path, pacing: Pacing) -> anyhow::Result<Drag> {
+/// One drag over the floor page, each move answered `after` ms after it (0: at once).
+fn floor_drag(chromium: &Path, dir: &Path, pacing: Pacing, after: f64) -> anyhow::Result<Drag> {
     let steps = pacing.steps;
-    let page = dir.join("floor.html");
-    std::fs::write(&page, FLOOR_PAGE)?;
-    let profile = dir.join("profile-floor");
+    let page = dir.join(format!("floor-{after}.html"));
+    std::fs::write(
+        &page,
+        FLOOR_PAGE.replace("ANSWER_AFTER", &after.to_string()),
+    )?;
+    let profile = dir.join(format!("profile-floor-{after}"));
     let url = format!("file://{}", page.display());
     let mut browser = Browser::launch(chromium, &profile, WINDOW, &url)?;
     browser.wait_for("window.lapcloneReady === true", PAGE_TIMEOUT)?;
@@ -216,7 +242,14 @@ fn floor_drag(chromium: &Path, dir: &Path, pacing: Pacing) -> anyhow::Result<Dra
     )?;
     let timings = numbers(&browser.eval("window.lapcloneTimings")?);
     let painted_at = numbers(&browser.eval("window.lapclonePaintedAt")?);
-    summary("floor", steps, dispatched, timings, &painted_at)
+    let name = if after > 0.0 {
+        format!("floor+{after}")
+    } else {
+        "floor".into()
+    };
+    let mut drag = summary(name, steps, dispatched, timings, &painted_at)?;
+    drag.answer_after_ms = Some(after);
+    Ok(drag)
 }
 
 /// Canvas point of a patch's source point `q`, from the page's scene message (the page's
@@ -274,7 +307,7 @@ fn drag(
     let parts = browser.eval("window.lapcloneTimingParts")?;
     drop(browser);
     drop(server);
-    let mut drag = summary(name, steps, dispatched, timings, &painted_at)?;
+    let mut drag = summary(name.into(), steps, dispatched, timings, &painted_at)?;
     drag.parts_median_ms = Some(part_medians(&parts));
     Ok(drag)
 }
@@ -328,7 +361,7 @@ fn canvas_on_page(browser: &mut Browser) -> anyhow::Result<[f64; 4]> {
 
 /// The figures of one drag from the page's timings and paint times (ms, page clock).
 fn summary(
-    name: &'static str,
+    name: String,
     steps: usize,
     dispatched: Duration,
     mut timings: Vec<f64>,
@@ -344,6 +377,7 @@ fn summary(
     let (median_ms, p95_ms, max_ms) = spread(&mut timings);
     Ok(Drag {
         scene: name,
+        answer_after_ms: None,
         steps,
         pointer_hz: steps as f64 / dispatched.as_secs_f64(),
         painted,
