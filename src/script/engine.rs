@@ -207,11 +207,16 @@ pub fn load_scene(path: &Path) -> Result<LoadedScene, SceneError> {
 /// [`load_scene`], also giving the module files the scene imported (directly or through
 /// other modules): with the scene and its images, what a render reads.
 pub fn load_scene_and_imports(path: &Path) -> Result<(LoadedScene, Vec<PathBuf>), SceneError> {
-    // A FIFO or a device would be read until it ends, which may be never.
-    let text = crate::util::check_input_file(path)
-        .and_then(|()| std::fs::read_to_string(path))
-        .map_err(|e| SceneError::in_file(ErrorKind::Io, path, format!("cannot read scene: {e}")))?;
+    let text = read_scene_text(path)?;
     run_scene(&text, path, &ScriptOptions::for_scene_file(path))
+}
+
+/// The text of the scene file at `path`, which must be a regular file: a FIFO or a device
+/// would be read until it ends, which may be never.
+pub fn read_scene_text(path: &Path) -> Result<String, SceneError> {
+    crate::util::check_input_file(path)
+        .and_then(|()| std::fs::read_to_string(path))
+        .map_err(|e| SceneError::in_file(ErrorKind::Io, path, format!("cannot read scene: {e}")))
 }
 
 /// Runs scene source `text` (named `file`) with `options` and finishes the scene.

@@ -768,6 +768,76 @@ fn unicode_paths_render() {
     assert_eq!(sorted_names(&out).len(), 3);
 }
 
+/// A FIFO or a device named as the REPL's scene, or loaded into a session, is refused at once
+/// like `check` refuses it, and the session goes on (it would otherwise read until the
+/// FIFO's writer or the device ends, which may be never).
+#[cfg(unix)]
+#[test]
+fn the_repl_refuses_special_files_as_scenes_at_once() {
+    let world = World::new();
+    assert!(Command::new("mkfifo")
+        .arg(world.path("fifo.rhai"))
+        .status()
+        .unwrap()
+        .success());
+    world.scene("fine.rhai", "");
+    let within = |args: &[&str], input: &[u8]| {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_lapclone"))
+            .arg("repl")
+            .args(args)
+            .args(["--preview", "preview.png"])
+            .current_dir(world.root.path())
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        use std::io::Write as _;
+        child.stdin.take().unwrap().write_all(input).unwrap();
+        let deadline = std::time::Instant::now() + std::time::Duration::from_secs(60);
+        while child.try_wait().unwrap().is_none() {
+            if std::time::Instant::now() > deadline {
+                child.kill().unwrap();
+                panic!("`lapclone repl {args:?}` still waits after 60 s");
+            }
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+        child.wait_with_output().unwrap()
+    };
+    for scene in ["fifo.rhai", "/dev/zero"] {
+        let output = within(&[scene], b"");
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(1), "{scene}: {stderr}");
+        assert!(
+            stderr.contains("cannot read scene: it is not a regular file"),
+            "{stderr}"
+        );
+    }
+    let output = within(
+        &[],
+        b":load fifo.rhai\n:load /dev/zero\n:load fine.rhai\n:list\n",
+    );
+    let all = format!(
+        "{}{}",
+        String::from_utf8_lossy(&output.stdout),
+        String::from_utf8_lossy(&output.stderr)
+    );
+    assert_eq!(output.status.code(), Some(1), "{all}");
+    assert!(
+        all.contains("fifo.rhai: cannot read scene: it is not a regular file (a FIFO)"),
+        "{all}"
+    );
+    assert!(
+        all.contains("/dev/zero: cannot read scene: it is not a regular file (a device)"),
+        "{all}"
+    );
+    assert!(all.contains("2 failed entries"), "{all}");
+    assert!(
+        all.contains("fine.rhai") && all.contains("patch \"p\""),
+        "the session did not go on: {all}"
+    );
+}
+
 #[test]
 fn the_repl_survives_loading_an_import_cycle() {
     let world = World::new();

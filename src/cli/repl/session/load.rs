@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use anyhow::Context as _;
-use lapclone::script::{validate_scene, LoadedScene, SceneEngine, ScriptOptions};
+use lapclone::script::{read_scene_text, validate_scene, LoadedScene, SceneEngine, ScriptOptions};
 use rhai::Scope;
 
 use super::eval::import_statements;
@@ -16,8 +16,7 @@ impl Session {
         let file = path
             .canonicalize()
             .with_context(|| format!("cannot open scene {}", path.display()))?;
-        let text = std::fs::read_to_string(&file)
-            .with_context(|| format!("cannot read scene {}", file.display()))?;
+        let text = read_scene_text(&file).map_err(|e| anyhow::anyhow!("{e}"))?;
         let options = ScriptOptions {
             cancel: self.cancel.clone(),
             ..ScriptOptions::for_scene_file(&file)
