@@ -69,7 +69,9 @@ impl World {
             .unwrap()
     }
 
-    /// `lapclone repl ARGS --preview …` in the world, fed `input`, its stdout to `stdout`.
+    /// `lapclone repl ARGS --preview …` in the world, fed `input`, its stdout to `stdout`;
+    /// a session still running after 60 s is killed and the test fails (a hang, not a
+    /// stuck test run).
     fn repl(&self, args: &[&str], input: &[u8], stdout: Stdio) -> Output {
         let mut child = Command::new(env!("CARGO_BIN_EXE_lapclone"))
             .arg("repl")
@@ -85,7 +87,16 @@ impl World {
             .unwrap();
         use std::io::Write as _;
         child.stdin.take().unwrap().write_all(input).unwrap();
-        child.wait_with_output().unwrap()
+        let pid = child.id().to_string();
+        let (tx, rx) = std::sync::mpsc::channel();
+        std::thread::spawn(move || tx.send(child.wait_with_output()));
+        match rx.recv_timeout(std::time::Duration::from_secs(60)) {
+            Ok(output) => output.unwrap(),
+            Err(_) => {
+                let _ = Command::new("kill").args(["-9", &pid]).status();
+                panic!("`lapclone repl {args:?}` still waits after 60 s");
+            }
+        }
     }
 
     fn names(&self) -> Vec<String> {
@@ -396,11 +407,7 @@ fn streams_are_written_through_and_other_special_files_never_replaced() {
         .is_char_device());
     // A FIFO is written through: its reader gets the whole GIF and it stays a FIFO.
     let fifo = world.path("pipe.gif");
-    assert!(Command::new("mkfifo")
-        .arg(&fifo)
-        .status()
-        .unwrap()
-        .success());
+    make_fifo(&fifo);
     let reader = {
         let fifo = fifo.clone();
         std::thread::spawn(move || std::fs::read(fifo).unwrap())
@@ -443,16 +450,8 @@ fn streams_are_written_through_and_other_special_files_never_replaced() {
 #[test]
 fn special_files_as_inputs_fail_at_once_instead_of_waiting() {
     let world = World::new();
-    assert!(Command::new("mkfifo")
-        .arg(world.path("fifo.png"))
-        .status()
-        .unwrap()
-        .success());
-    assert!(Command::new("mkfifo")
-        .arg(world.path("fifo.rhai"))
-        .status()
-        .unwrap()
-        .success());
+    make_fifo(&world.path("fifo.png"));
+    make_fifo(&world.path("fifo.rhai"));
     std::fs::create_dir(world.path("folder.png")).unwrap();
     let clone = |source: &str| {
         world.run(&[
@@ -491,11 +490,7 @@ fn special_files_as_inputs_fail_at_once_instead_of_waiting() {
     );
     world.write("pipe.rhai", "");
     std::fs::remove_file(world.path("pipe.rhai")).unwrap();
-    assert!(Command::new("mkfifo")
-        .arg(world.path("pipe.rhai"))
-        .status()
-        .unwrap()
-        .success());
+    make_fifo(&world.path("pipe.rhai"));
     let scene = world.scene("imp.rhai", "import \"pipe\" as pipe;\n");
     expect(
         &world.run(&["check", scene.to_str().unwrap()]),
@@ -514,6 +509,12 @@ fn special_files_as_inputs_fail_at_once_instead_of_waiting() {
         1,
         "the output folder bg.png is not a folder",
     );
+}
+
+/// Makes a FIFO at `path`.
+#[cfg(unix)]
+fn make_fifo(path: &Path) {
+    assert!(Command::new("mkfifo").arg(path).status().unwrap().success());
 }
 
 fn clone_into(world: &World, output: &str) -> Output {
@@ -775,37 +776,10 @@ fn unicode_paths_render() {
 #[test]
 fn the_repl_refuses_special_files_as_scenes_at_once() {
     let world = World::new();
-    assert!(Command::new("mkfifo")
-        .arg(world.path("fifo.rhai"))
-        .status()
-        .unwrap()
-        .success());
+    make_fifo(&world.path("fifo.rhai"));
     world.scene("fine.rhai", "");
-    let within = |args: &[&str], input: &[u8]| {
-        let mut child = Command::new(env!("CARGO_BIN_EXE_lapclone"))
-            .arg("repl")
-            .args(args)
-            .args(["--preview", "preview.png"])
-            .current_dir(world.root.path())
-            .stdin(Stdio::piped())
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap();
-        use std::io::Write as _;
-        child.stdin.take().unwrap().write_all(input).unwrap();
-        let deadline = std::time::Instant::now() + std::time::Duration::from_secs(60);
-        while child.try_wait().unwrap().is_none() {
-            if std::time::Instant::now() > deadline {
-                child.kill().unwrap();
-                panic!("`lapclone repl {args:?}` still waits after 60 s");
-            }
-            std::thread::sleep(std::time::Duration::from_millis(20));
-        }
-        child.wait_with_output().unwrap()
-    };
     for scene in ["fifo.rhai", "/dev/zero"] {
-        let output = within(&[scene], b"");
+        let output = world.repl(&[scene], b"", Stdio::piped());
         let stderr = String::from_utf8_lossy(&output.stderr);
         assert_eq!(output.status.code(), Some(1), "{scene}: {stderr}");
         assert!(
@@ -813,9 +787,10 @@ fn the_repl_refuses_special_files_as_scenes_at_once() {
             "{stderr}"
         );
     }
-    let output = within(
+    let output = world.repl(
         &[],
         b":load fifo.rhai\n:load /dev/zero\n:load fine.rhai\n:list\n",
+        Stdio::piped(),
     );
     let all = format!(
         "{}{}",
