@@ -99,6 +99,15 @@ impl World {
         }
     }
 
+    /// A piped `lapclone repl` session with no scene, fed `input`: its exit code, and its
+    /// standard output and error together.
+    fn session(&self, input: &[u8]) -> (Option<i32>, String) {
+        let output = self.repl(&[], input, Stdio::piped());
+        let stdout = String::from_utf8_lossy(&output.stdout);
+        let all = format!("{stdout}{}", String::from_utf8_lossy(&output.stderr));
+        (output.status.code(), all)
+    }
+
     fn names(&self) -> Vec<String> {
         sorted_names(self.root.path())
     }
@@ -787,17 +796,8 @@ fn the_repl_refuses_special_files_as_scenes_at_once() {
             "{stderr}"
         );
     }
-    let output = world.repl(
-        &[],
-        b":load fifo.rhai\n:load /dev/zero\n:load fine.rhai\n:list\n",
-        Stdio::piped(),
-    );
-    let all = format!(
-        "{}{}",
-        String::from_utf8_lossy(&output.stdout),
-        String::from_utf8_lossy(&output.stderr)
-    );
-    assert_eq!(output.status.code(), Some(1), "{all}");
+    let (code, all) = world.session(b":load fifo.rhai\n:load /dev/zero\n:load fine.rhai\n:list\n");
+    assert_eq!(code, Some(1), "{all}");
     assert!(
         all.contains("fifo.rhai: cannot read scene: it is not a regular file (a FIFO)"),
         "{all}"
@@ -820,18 +820,9 @@ fn the_repl_survives_loading_an_import_cycle() {
     world.write("b.rhai", "import \"a\" as a;\n");
     world.scene("cycle.rhai", "import \"a\" as a;\n");
     world.scene("fine.rhai", "");
-    let output = world.repl(
-        &[],
-        b":load cycle.rhai\n:load fine.rhai\n:list\n",
-        Stdio::piped(),
-    );
-    let all = format!(
-        "{}{}",
-        String::from_utf8_lossy(&output.stdout),
-        String::from_utf8_lossy(&output.stderr)
-    );
+    let (code, all) = world.session(b":load cycle.rhai\n:load fine.rhai\n:list\n");
     // Exit 1 only because a piped session reports its failed entry at the end.
-    assert_eq!(output.status.code(), Some(1), "{all}");
+    assert_eq!(code, Some(1), "{all}");
     assert!(all.contains("1 failed entry"), "{all}");
     assert!(
         all.contains("import cycle: a.rhai → b.rhai → a.rhai"),
