@@ -549,72 +549,20 @@ mod tests {
                 // Half the cases are wide and mostly covered, so the eight-lane path runs
                 // (across triangle edges too); the rest stress the fringe and coverage.
                 let interior = rng.next() % 2 == 0;
-                // A third of those move every triangle by the same whole pixels (each vertex
-                // up to the placement grid's rounding off), over a source wide enough for
-                // the lanes' direct texel reads.
-                let shift = (interior && rng.next() % 3 == 0).then(|| {
-                    let mut whole = || (rng.next() % 9) as f64 - 4.0;
-                    DVec2::new(whole(), whole())
-                });
-                let (w, h) = match shift {
-                    Some(_) => (16 + rng.next() % 40, 4 + rng.next() % 12),
-                    None => (2 + rng.next() % 9, 2 + rng.next() % 7),
-                };
+                let (shift, w, h) = random_shift(&mut rng, interior);
                 let opaque = rng.next() % 2 == 0;
-                let levels: Vec<[u8; 4]> = (0..w * h)
-                    .map(|_| {
-                        let a = if opaque { 255 } else { rng.byte() };
-                        [rng.byte(), rng.byte(), rng.byte(), a]
-                    })
-                    .collect();
-                let (w, h) = (w as u32, h as u32);
-                let source = match rng.next() % 3 {
-                    0 => FloatImage::from_fn(w, h, PixelFormat::RGBA16, |i, j| {
-                        levels[(j * w + i) as usize].map(|v| f32::from(v) / 255.0 * 0.999)
-                    }),
-                    _ => FloatImage::from_levels(w, h, levels.clone(), PixelFormat::RGBA8),
-                }
-                .unwrap();
+                let source = random_source(&mut rng, w, h, opaque);
                 let rect = PixelRect {
                     x0: 0,
                     y0: 0,
                     x1: if interior { 43 } else { 13 },
                     y1: 11,
                 };
-                let right = f64::from(rect.x1) + 2.0;
-                let setups: Vec<TriangleSetup> = (0..1 + rng.next() % 6)
-                    .map(|k| {
-                        let mut placed = [0; 3]
-                            .map(|_| DVec2::new(rng.range(-2.0, right), rng.range(-2.0, 15.0)));
-                        if interior && k == 0 {
-                            // Under the others, over the whole rectangle: long covered rows.
-                            placed = [[-9.0, -9.0], [99.0, -9.0], [-9.0, 40.0]].map(DVec2::from);
-                        }
-                        let mut point = |lo: f64, hi: f64| {
-                            DVec2::new(rng.range(lo, hi), rng.range(lo, hi))
-                        };
-                        let mut rest = [point(-3.0, 12.0), point(-3.0, 12.0), point(-3.0, 12.0)];
-                        if let Some(s) = shift {
-                            let mut off = || f64::from(rng.next() as u8 % 3) - 1.0;
-                            let grid = 1.0 / 131_072.0;
-                            rest = placed.map(|p| p - s + DVec2::new(off(), off()) * grid);
-                        }
-                        let mut m = || rng.range(-0.7, 0.7) as f32;
-                        let membrane = [[m(), m(), m()], [m(), m(), m()], [m(), m(), m()]];
-                        TriangleSetup::new(placed, rest, membrane, [0.0; 3])
-                    })
-                    .collect();
+                let setups = random_setups(&mut rng, rect, interior, shift);
                 let mut ids = vec![0; rect.area()];
                 let mut bins = Default::default();
                 rasterise_triangles(&setups, rect, false, (&mut ids, &mut []), &mut bins);
-                let coverage: Vec<u8> = (0..rect.area())
-                    .map(|_| match (interior, rng.next() % 16) {
-                        (_, 0) => 0,
-                        (true, 1) | (false, 1..=4) => rng.byte(),
-                        (true, _) | (false, 5..=11) => u8::MAX,
-                        (false, _) => 0,
-                    })
-                    .collect();
+                let coverage = random_coverage(&mut rng, rect, interior);
                 if opaque && source.eight_bit_view().is_some() {
                     let eights = eight_lane_stretches(&ids, &coverage, rect);
                     stretches.set(stretches.get() + eights);
@@ -622,12 +570,7 @@ mod tests {
                         shifted.set(shifted.get() + eights);
                     }
                 }
-                let canvas: Vec<[u8; 4]> = (0..rect.area())
-                    .map(|_| {
-                        let a = if rng.next() % 3 == 0 { rng.byte() } else { 255 };
-                        [rng.byte(), rng.byte(), rng.byte(), a]
-                    })
-                    .collect();
+                let canvas = random_canvas(&mut rng, rect);
                 let input = ShadeInput {
                     setups: &setups,
                     ids: &ids,
@@ -637,24 +580,11 @@ mod tests {
                     coverage_origin: (0, 0),
                     source: &source,
                 };
-                let mut expected = canvas.clone();
-                for y in rect.y0..rect.y1 {
-                    for x in rect.x0..rect.x1 {
-                        let pixel = &mut expected[y as usize * rect.width() + x as usize];
-                        reference_pixel(&input, x, y, pixel);
-                    }
-                }
+                let expected = reference_shading(&input, rect, &canvas);
                 let differ = expected.iter().zip(&canvas).filter(|(a, b)| a != b).count();
                 changed.set(changed.get() + differ);
                 for path in [Path::Vector, Path::Portable] {
-                    let mut shaded = canvas.clone();
-                    path.run(Shade {
-                        input: &input,
-                        rows: rect,
-                        canvas: &mut shaded,
-                        canvas_width: rect.width(),
-                        wide: Wide::detect(path),
-                    });
+                    let shaded = shade_on(path, &input, rect, &canvas);
                     prop_assert_eq!(&shaded, &expected, "{:?}", path);
                 }
                 Ok(())
@@ -663,6 +593,118 @@ mod tests {
         assert!(changed.get() > 3_000, "{} pixels shaded", changed.get());
         assert!(stretches.get() > 200, "{} eight-lane stretches", stretches.get());
         assert!(shifted.get() > 50, "{} shifted eight-lane stretches", shifted.get());
+    }
+
+    /// For a third of the `interior` cases, a whole-pixel move of every triangle (each vertex
+    /// up to the placement grid's rounding off) over a source wide enough for the lanes'
+    /// direct texel reads; then the source's size.
+    fn random_shift(rng: &mut Rng, interior: bool) -> (Option<DVec2>, u64, u64) {
+        let shift = (interior && rng.next() % 3 == 0).then(|| {
+            let mut whole = || (rng.next() % 9) as f64 - 4.0;
+            DVec2::new(whole(), whole())
+        });
+        let (w, h) = match shift {
+            Some(_) => (16 + rng.next() % 40, 4 + rng.next() % 12),
+            None => (2 + rng.next() % 9, 2 + rng.next() % 7),
+        };
+        (shift, w, h)
+    }
+
+    /// `canvas` (covering `rect`) shaded by the loop on `path`'s instruction set.
+    fn shade_on(path: Path, input: &ShadeInput<u8>, rect: PixelRect, canvas: &[[u8; 4]]) -> Vec<[u8; 4]> {
+        let mut shaded = canvas.to_vec();
+        path.run(Shade {
+            input,
+            rows: rect,
+            canvas: &mut shaded,
+            canvas_width: rect.width(),
+            wide: Wide::detect(path),
+        });
+        shaded
+    }
+
+    /// `canvas` (covering `rect`) shaded pixel by pixel by the scalar reference.
+    fn reference_shading(input: &ShadeInput<u8>, rect: PixelRect, canvas: &[[u8; 4]]) -> Vec<[u8; 4]> {
+        let mut expected = canvas.to_vec();
+        for y in rect.y0..rect.y1 {
+            for x in rect.x0..rect.x1 {
+                let pixel = &mut expected[y as usize * rect.width() + x as usize];
+                reference_pixel(input, x, y, pixel);
+            }
+        }
+        expected
+    }
+
+    /// A random canvas over `rect`, a third of its pixels translucent.
+    fn random_canvas(rng: &mut Rng, rect: PixelRect) -> Vec<[u8; 4]> {
+        (0..rect.area())
+            .map(|_| {
+                let a = if rng.next() % 3 == 0 { rng.byte() } else { 255 };
+                [rng.byte(), rng.byte(), rng.byte(), a]
+            })
+            .collect()
+    }
+
+    /// A `w`×`h` source of random levels (alpha 255 when `opaque`), in 8 or 16 bits.
+    fn random_source(rng: &mut Rng, w: u64, h: u64, opaque: bool) -> FloatImage {
+        let levels: Vec<[u8; 4]> = (0..w * h)
+            .map(|_| {
+                let a = if opaque { 255 } else { rng.byte() };
+                [rng.byte(), rng.byte(), rng.byte(), a]
+            })
+            .collect();
+        let (w, h) = (w as u32, h as u32);
+        match rng.next() % 3 {
+            0 => FloatImage::from_fn(w, h, PixelFormat::RGBA16, |i, j| {
+                levels[(j * w + i) as usize].map(|v| f32::from(v) / 255.0 * 0.999)
+            }),
+            _ => FloatImage::from_levels(w, h, levels.clone(), PixelFormat::RGBA8),
+        }
+        .unwrap()
+    }
+
+    /// One to six random triangles around `rect` with random rest points and membranes; with
+    /// `interior`, the first covers all of `rect` under the others; with `shift`, every rest
+    /// point is its placed point moved by those whole pixels (up to the placement grid).
+    fn random_setups(
+        rng: &mut Rng,
+        rect: PixelRect,
+        interior: bool,
+        shift: Option<DVec2>,
+    ) -> Vec<TriangleSetup> {
+        let right = f64::from(rect.x1) + 2.0;
+        (0..1 + rng.next() % 6)
+            .map(|k| {
+                let mut placed =
+                    [0; 3].map(|_| DVec2::new(rng.range(-2.0, right), rng.range(-2.0, 15.0)));
+                if interior && k == 0 {
+                    placed = [[-9.0, -9.0], [99.0, -9.0], [-9.0, 40.0]].map(DVec2::from);
+                }
+                let mut point = |lo: f64, hi: f64| DVec2::new(rng.range(lo, hi), rng.range(lo, hi));
+                let mut rest = [point(-3.0, 12.0), point(-3.0, 12.0), point(-3.0, 12.0)];
+                if let Some(s) = shift {
+                    let mut off = || f64::from(rng.next() as u8 % 3) - 1.0;
+                    let grid = 1.0 / 131_072.0;
+                    rest = placed.map(|p| p - s + DVec2::new(off(), off()) * grid);
+                }
+                let mut m = || rng.range(-0.7, 0.7) as f32;
+                let membrane = [[m(), m(), m()], [m(), m(), m()], [m(), m(), m()]];
+                TriangleSetup::new(placed, rest, membrane, [0.0; 3])
+            })
+            .collect()
+    }
+
+    /// Coverage over `rect`: mostly full with `interior` (long covered rows), else a mix of
+    /// empty, partial and full pixels that stresses the fringe.
+    fn random_coverage(rng: &mut Rng, rect: PixelRect, interior: bool) -> Vec<u8> {
+        (0..rect.area())
+            .map(|_| match (interior, rng.next() % 16) {
+                (_, 0) => 0,
+                (true, 1) | (false, 1..=4) => rng.byte(),
+                (true, _) | (false, 5..=11) => u8::MAX,
+                (false, _) => 0,
+            })
+            .collect()
     }
 
     /// Stretches of 16 pixels in a row, all inside triangles and fully covered: the row walk
