@@ -216,60 +216,17 @@ fn bench_spiral(
     let mut canvas = background.clone();
     let centre = DVec2::new(f64::from(target.width()), f64::from(target.height())) * 0.5;
     let placement = Placement::translate(DVec2::splat(size as f64 * 0.5), centre);
-
-    let mut best_first = f64::INFINITY;
-    let mut first = (0.0, 0.0, CloneStats::default());
-    let mut cloner = None;
-    for _ in 0..repeats {
-        canvas.copy_from(&background);
-        // The cloner owns its source; copying it is the caller's business, not timed.
-        let owned_source = source.clone();
-        let started = Instant::now();
-        let patch = mesh_from_mask(&mask, None, (source.width(), source.height()), mesh_options)?;
-        let meshed = Instant::now();
-        let mut fresh = PatchCloner::new(owned_source, patch.result.mesh, clone_options)?;
-        let factored = Instant::now();
-        let stats = fresh.clone_onto(&mut canvas, &placement)?;
-        let total = millis(started.elapsed());
-        if total < best_first {
-            best_first = total;
-            // The Laplacian is assembled and factored by `new`.
-            let factor_ms = millis(factored - meshed);
-            first = (millis(meshed - started), factor_ms, stats);
-        }
-        cloner = Some(fresh);
-    }
-    let mut cloner = cloner.ok_or_else(|| anyhow::anyhow!("no repeat ran"))?;
-
-    let mut best_reclone = f64::INFINITY;
-    let mut reclone = CloneStats::default();
-    // Like the scene renderer, each reclone restores only what the previous clone drew.
-    let mut dirty = None;
-    let mut reclones = Vec::with_capacity(reclone_count(repeats));
-    for k in 0..reclone_count(repeats) {
-        let shift = if k % 2 == 0 {
-            DVec2::new(3.0, 2.0)
-        } else {
-            DVec2::ZERO
-        };
-        let moved = Placement {
-            at: centre + shift,
-            ..placement
-        };
-        match dirty {
-            Some(rect) => canvas.copy_rect_from(&background, rect)?,
-            None => canvas.copy_from(&background),
-        }
-        let started = Instant::now();
-        let stats = cloner.clone_onto(&mut canvas, &moved)?;
-        let elapsed = millis(started.elapsed());
-        dirty = Some(stats.raster.work);
-        reclones.push(elapsed);
-        if elapsed < best_reclone {
-            best_reclone = elapsed;
-            reclone = stats;
-        }
-    }
+    let job = FirstClones {
+        mask: &mask,
+        source: &source,
+        background: &background,
+        placement: &placement,
+        mesh_options,
+        clone_options,
+    };
+    let (first, mut cloner) = job.time(&mut canvas, repeats)?;
+    let (reclone, mut reclones) =
+        time_reclones(&mut cloner, &mut canvas, &background, &placement, repeats)?;
     let opencv = OPENCV_MS
         .iter()
         .find(|(s, _)| *s == size)
@@ -278,13 +235,13 @@ fn bench_spiral(
         size,
         vertices: cloner.mesh().vertex_count(),
         boundary_vertices: cloner.membrane().boundary_vertices().len(),
-        first_ms: best_first,
+        first_ms: first.total_ms,
         first_target_ms: opencv.map(|ms| ms / 10.0),
-        mesh_ms: first.0,
-        factor_ms: first.1,
-        solve_ms: first.2.solve_ms,
-        raster_ms: first.2.raster_ms,
-        reclone_ms: best_reclone,
+        mesh_ms: first.mesh_ms,
+        factor_ms: first.factor_ms,
+        solve_ms: first.stats.solve_ms,
+        raster_ms: first.stats.raster_ms,
+        reclone_ms: reclones.iter().copied().fold(f64::INFINITY, f64::min),
         reclone_median_ms: median(&mut reclones),
         reclone_count: reclones.len(),
         reclone_target_ms: opencv.map(|ms| ms / 100.0),
@@ -293,6 +250,102 @@ fn bench_spiral(
         reclone_switches: reclone.membrane.switches.updates + reclone.membrane.switches.downdates,
         opencv_ms: opencv,
     })
+}
+
+/// What a spiral's first clone (mesh, factor, clone) is timed on.
+struct FirstClones<'a> {
+    mask: &'a BitMask,
+    source: &'a FloatImage,
+    background: &'a Canvas,
+    placement: &'a Placement,
+    mesh_options: &'a MeshOptions,
+    clone_options: &'a CloneOptions,
+}
+
+/// The best of a spiral's first clones, and its parts.
+struct FirstClone {
+    total_ms: f64,
+    mesh_ms: f64,
+    /// The Laplacian assembled and factored by `PatchCloner::new`.
+    factor_ms: f64,
+    stats: CloneStats,
+}
+
+impl FirstClones<'_> {
+    /// Meshes, factors and clones `repeats` times onto `canvas`; gives the best run and the
+    /// last cloner, for the reclones.
+    fn time(
+        &self,
+        canvas: &mut Canvas,
+        repeats: usize,
+    ) -> anyhow::Result<(FirstClone, PatchCloner)> {
+        let mut best: Option<FirstClone> = None;
+        let mut cloner = None;
+        let size = (self.source.width(), self.source.height());
+        for _ in 0..repeats {
+            canvas.copy_from(self.background);
+            // The cloner owns its source; copying it is the caller's business, not timed.
+            let owned_source = self.source.clone();
+            let started = Instant::now();
+            let patch = mesh_from_mask(self.mask, None, size, self.mesh_options)?;
+            let meshed = Instant::now();
+            let mut fresh = PatchCloner::new(owned_source, patch.result.mesh, self.clone_options)?;
+            let factored = Instant::now();
+            let stats = fresh.clone_onto(canvas, self.placement)?;
+            let total_ms = millis(started.elapsed());
+            if best.as_ref().is_none_or(|b| total_ms < b.total_ms) {
+                let (mesh_ms, factor_ms) = (millis(meshed - started), millis(factored - meshed));
+                best = Some(FirstClone {
+                    total_ms,
+                    mesh_ms,
+                    factor_ms,
+                    stats,
+                });
+            }
+            cloner = Some(fresh);
+        }
+        best.zip(cloner)
+            .ok_or_else(|| anyhow::anyhow!("no repeat ran"))
+    }
+}
+
+/// Re-clones `cloner`, alternately moved by (3, 2) px and back; gives the fastest one's
+/// stats and every time, ms.
+fn time_reclones(
+    cloner: &mut PatchCloner,
+    canvas: &mut Canvas,
+    background: &Canvas,
+    placement: &Placement,
+    repeats: usize,
+) -> anyhow::Result<(CloneStats, Vec<f64>)> {
+    let mut best = (f64::INFINITY, CloneStats::default());
+    // Like the scene renderer, each reclone restores only what the previous clone drew.
+    let mut dirty = None;
+    let mut times = Vec::with_capacity(reclone_count(repeats));
+    for k in 0..reclone_count(repeats) {
+        let shift = if k % 2 == 0 {
+            DVec2::new(3.0, 2.0)
+        } else {
+            DVec2::ZERO
+        };
+        let moved = Placement {
+            at: placement.at + shift,
+            ..*placement
+        };
+        match dirty {
+            Some(rect) => canvas.copy_rect_from(background, rect)?,
+            None => canvas.copy_from(background),
+        }
+        let started = Instant::now();
+        let stats = cloner.clone_onto(canvas, &moved)?;
+        let elapsed = millis(started.elapsed());
+        dirty = Some(stats.raster.work);
+        times.push(elapsed);
+        if elapsed < best.0 {
+            best = (elapsed, stats);
+        }
+    }
+    Ok((best.1, times))
 }
 
 /// A disc mask whose default-density mesh has at least about `vertices` vertices.
@@ -327,67 +380,103 @@ fn bench_deform(
     let side = (max - min).max_element().ceil() as u32 + 2;
     let source = synthetic(side, side, 0.9)?;
     let background = Canvas::from_image(&synthetic(1920, 1080, 2.1)?);
-    let mut canvas = background.clone();
     let mut cloner = PatchCloner::new(source, mesh, clone_options)?;
     cloner.set_raster_threads(raster_threads);
-    let mut rig = DeformRig::new(cloner.mesh(), LaplacianKind::Combinatorial)?;
-    let mut deformed = Deformed::default();
+    let rig = DeformRig::new(cloner.mesh(), LaplacianKind::Combinatorial)?;
     let centre = (min + max) * 0.5;
     let radius = 0.5 * (max - min).max_element();
-    let placement = Placement::translate(centre, DVec2::new(960.0, 540.0));
-    let grab = centre + DVec2::new(0.6 * radius, 0.0);
-
-    let (mut frame, mut deform, mut solve, mut raster) = (vec![], vec![], vec![], vec![]);
-    let (mut switches, mut hidden_max, mut restore) = (0usize, 0usize, 0.0f64);
-    // Like the scene renderer, each frame restores only what the previous one drew.
-    let mut dirty = None;
-    for k in 0..frames + 5 {
-        // The handle circles around its grab point, reaching over the patch's centre.
-        let angle = k as f64 * 0.15;
-        let to = grab + 0.5 * radius * DVec2::new(angle.cos() - 1.0, angle.sin());
-        let handle = Handle::drag(grab, to, 0.5 * radius);
-        let restore_started = Instant::now();
-        match dirty {
-            Some(rect) => canvas.copy_rect_from(&background, rect)?,
-            None => canvas.copy_from(&background),
-        }
-        let restored = Instant::now();
-        rig.deform(&[handle], &[], &mut deformed)?;
-        let deformed_at = Instant::now();
-        let stats = cloner.clone_deformed(
-            &mut canvas,
-            &placement,
-            &deformed.positions,
-            Some(&deformed.depth),
-        )?;
-        let done = Instant::now();
-        dirty = Some(stats.raster.work);
-        if k < 5 {
-            continue; // warm-up: first factor touches, buffer growth
-        }
-        restore += millis(restored - restore_started);
-        frame.push(millis(done - restored));
-        deform.push(millis(deformed_at - restored));
-        solve.push(stats.solve_ms);
-        raster.push(stats.raster_ms);
-        switches += stats.membrane.switches.updates + stats.membrane.switches.downdates;
-        hidden_max = hidden_max.max(stats.membrane.hidden);
-    }
-    let best = frame.iter().copied().fold(f64::INFINITY, f64::min);
+    let mut case = DeformCase {
+        canvas: background.clone(),
+        background,
+        cloner,
+        rig,
+        placement: Placement::translate(centre, DVec2::new(960.0, 540.0)),
+        grab: centre + DVec2::new(0.6 * radius, 0.0),
+        radius,
+    };
+    let mut t = case.time(frames)?;
+    let best = t.frame.iter().copied().fold(f64::INFINITY, f64::min);
     Ok(DeformRow {
-        vertices: cloner.mesh().vertex_count(),
-        boundary_vertices: cloner.membrane().boundary_vertices().len(),
+        vertices: case.cloner.mesh().vertex_count(),
+        boundary_vertices: case.cloner.membrane().boundary_vertices().len(),
         canvas: [1920, 1080],
-        frame_median_ms: median(&mut frame),
+        frame_median_ms: median(&mut t.frame),
         frame_best_ms: best,
         frame_target_ms: 4.0,
-        deform_median_ms: median(&mut deform),
-        solve_median_ms: median(&mut solve),
-        raster_median_ms: median(&mut raster),
-        switches_per_frame: switches as f64 / frames as f64,
-        hidden_max,
-        restore_ms: restore / frames as f64,
+        deform_median_ms: median(&mut t.deform),
+        solve_median_ms: median(&mut t.solve),
+        raster_median_ms: median(&mut t.raster),
+        switches_per_frame: t.switches as f64 / frames as f64,
+        hidden_max: t.hidden_max,
+        restore_ms: t.restore_ms / frames as f64,
     })
+}
+
+/// A disc patch on a 1920×1080 canvas, deformed by one handle that circles around `grab`.
+struct DeformCase {
+    background: Canvas,
+    canvas: Canvas,
+    cloner: PatchCloner,
+    rig: DeformRig,
+    placement: Placement,
+    grab: DVec2,
+    radius: f64,
+}
+
+/// Per-frame times of the deform case, ms, and its totals.
+#[derive(Default)]
+struct DeformTimes {
+    frame: Vec<f64>,
+    deform: Vec<f64>,
+    solve: Vec<f64>,
+    raster: Vec<f64>,
+    switches: usize,
+    hidden_max: usize,
+    restore_ms: f64,
+}
+
+impl DeformCase {
+    /// Deforms and clones `frames` frames (after five of warm-up: the first factor touches,
+    /// buffer growth).
+    fn time(&mut self, frames: usize) -> anyhow::Result<DeformTimes> {
+        let mut t = DeformTimes::default();
+        let mut deformed = Deformed::default();
+        // Like the scene renderer, each frame restores only what the previous one drew.
+        let mut dirty = None;
+        for k in 0..frames + 5 {
+            // The handle circles around its grab point, reaching over the patch's centre.
+            let angle = k as f64 * 0.15;
+            let to = self.grab + 0.5 * self.radius * DVec2::new(angle.cos() - 1.0, angle.sin());
+            let handle = Handle::drag(self.grab, to, 0.5 * self.radius);
+            let restore_started = Instant::now();
+            match dirty {
+                Some(rect) => self.canvas.copy_rect_from(&self.background, rect)?,
+                None => self.canvas.copy_from(&self.background),
+            }
+            let restored = Instant::now();
+            self.rig.deform(&[handle], &[], &mut deformed)?;
+            let deformed_at = Instant::now();
+            let stats = self.cloner.clone_deformed(
+                &mut self.canvas,
+                &self.placement,
+                &deformed.positions,
+                Some(&deformed.depth),
+            )?;
+            let done = Instant::now();
+            dirty = Some(stats.raster.work);
+            if k < 5 {
+                continue;
+            }
+            t.restore_ms += millis(restored - restore_started);
+            t.frame.push(millis(done - restored));
+            t.deform.push(millis(deformed_at - restored));
+            t.solve.push(stats.solve_ms);
+            t.raster.push(stats.raster_ms);
+            t.switches += stats.membrane.switches.updates + stats.membrane.switches.downdates;
+            t.hidden_max = t.hidden_max.max(stats.membrane.hidden);
+        }
+        Ok(t)
+    }
 }
 
 /// Reclones per spiral: cheap next to a first clone, so many more of them (alternately moved

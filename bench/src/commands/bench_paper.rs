@@ -531,38 +531,12 @@ fn density_for_vertices(experiment: &Experiment, wanted: usize) -> anyhow::Resul
 
 fn run_sweep(args: &PaperBenchArgs, run_options: &RunOptions) -> anyhow::Result<Vec<SweepRow>> {
     let experiment = load_experiment(&args.assets, if args.quick { "mouth" } else { "spiral" })?;
-    let densities: &[f64] = if args.quick {
-        &SWEEP_DENSITIES[..2]
-    } else {
-        &SWEEP_DENSITIES
-    };
     let run_options = RunOptions {
         mvc_max_weights: 0,
         ..*run_options
     };
-    let quality: &[SweepConfig] = if args.quick {
-        &SWEEP_QUALITY[QUICK_QUALITY]
-    } else {
-        &SWEEP_QUALITY
-    };
-    let configurations = densities
-        .iter()
-        .map(|&density| MeshOptions {
-            density,
-            ..MeshOptions::default()
-        })
-        .chain(quality.iter().map(
-            |&(boundary, density, min_angle_deg, max_area, relax_sweeps)| MeshOptions {
-                density,
-                boundary,
-                min_angle_deg,
-                max_area,
-                relax_sweeps,
-                ..MeshOptions::default()
-            },
-        ));
     let mut rows = Vec::new();
-    for options in configurations {
+    for options in sweep_configurations(args.quick) {
         let density = options.density;
         let run = experiment.run(&options, &run_options)?;
         let reclone = reclone_ms(
@@ -601,6 +575,37 @@ fn run_sweep(args: &PaperBenchArgs, run_options: &RunOptions) -> anyhow::Result<
             .with_context(|| format!("writing {}", args.sweep_out.display()))?;
     }
     Ok(rows)
+}
+
+/// The sweep's mesh options: each density alone, then the quality configurations (fewer of
+/// both with `quick`).
+fn sweep_configurations(quick: bool) -> impl Iterator<Item = MeshOptions> {
+    let densities: &[f64] = if quick {
+        &SWEEP_DENSITIES[..2]
+    } else {
+        &SWEEP_DENSITIES
+    };
+    let quality: &[SweepConfig] = if quick {
+        &SWEEP_QUALITY[QUICK_QUALITY]
+    } else {
+        &SWEEP_QUALITY
+    };
+    densities
+        .iter()
+        .map(|&density| MeshOptions {
+            density,
+            ..MeshOptions::default()
+        })
+        .chain(quality.iter().map(
+            |&(boundary, density, min_angle_deg, max_area, relax_sweeps)| MeshOptions {
+                density,
+                boundary,
+                min_angle_deg,
+                max_area,
+                relax_sweeps,
+                ..MeshOptions::default()
+            },
+        ))
 }
 
 fn sweep_markdown(rows: &[SweepRow]) -> String {

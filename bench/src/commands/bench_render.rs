@@ -131,72 +131,43 @@ fn print_table(r: &Report) {
 }
 
 /// Two disc patches (≈2,500 vertices each) crossing a 1920×1080 canvas, each with a drag
-/// swinging back and forth and a pin.
+/// swinging back and forth.
 fn bench_scene(assets: &Path, frames: u64) -> Scene {
     let fps = 24.0;
     let duration = frames as f64 / fps;
-    let mut patches = Vec::new();
-    for (k, (source, centre, from, to)) in [
+    let discs = [
         (
             "astronaut.png",
-            DVec2::new(256.0, 256.0),
-            DVec2::new(400.0, 900.0),
-            DVec2::new(1500.0, 300.0),
+            [256.0, 256.0],
+            [400.0, 900.0],
+            [1500.0, 300.0],
         ),
         (
             "chelsea.png",
-            DVec2::new(225.0, 150.0),
-            DVec2::new(1500.0, 850.0),
-            DVec2::new(400.0, 250.0),
+            [225.0, 150.0],
+            [1500.0, 850.0],
+            [400.0, 250.0],
         ),
-    ]
-    .into_iter()
-    .enumerate()
-    {
-        let radius = 150.0;
-        let outer = (0..160)
-            .map(|i| {
-                let a = std::f64::consts::TAU * i as f64 / 160.0;
-                centre + radius * DVec2::new(a.cos(), a.sin())
-            })
-            .collect();
-        let mut patch = Patch::new(
-            format!("disc{k}"),
-            assets.join(source),
-            Shape::Polygons(vec![Polygon {
-                outer,
-                holes: Vec::new(),
-            }]),
-        );
-        patch.density = Some(1.0);
-        push_keys(
-            &mut patch.placement.position,
-            &[(0.0, from), (duration, to)],
-        );
-        push_keys(
-            &mut patch.placement.rotation,
-            &[(0.0, -15.0), (duration, 15.0)],
-        );
-        let grab = centre + DVec2::new(radius * 0.6, 0.0);
-        let mut to_track = Track::new();
-        let swing = [grab, grab + DVec2::new(-40.0, 60.0)];
-        let mut t = 0.0;
-        let mut i = 0;
-        while t <= duration {
-            let _ = to_track.push(t, swing[i % 2], Easing::EaseInOut);
-            t += 1.0;
-            i += 1;
-        }
-        patch.handles.push(Handle {
-            from: grab,
-            to: to_track,
-            radius: 70.0,
-            depth: Some(1.0),
-            pivot: None,
-            rotation: Track::new(),
-        });
-        patches.push(patch);
-    }
+    ];
+    let patches = discs
+        .into_iter()
+        .enumerate()
+        .map(|(k, (source, centre, from, to))| {
+            let mut patch = disc_patch(k, assets.join(source), DVec2::from(centre));
+            push_keys(
+                &mut patch.placement.position,
+                &[(0.0, DVec2::from(from)), (duration, DVec2::from(to))],
+            );
+            push_keys(
+                &mut patch.placement.rotation,
+                &[(0.0, -15.0), (duration, 15.0)],
+            );
+            patch
+                .handles
+                .push(swinging_handle(DVec2::from(centre), duration));
+            patch
+        })
+        .collect();
     Scene {
         canvas: SceneCanvas {
             width: 1920,
@@ -207,6 +178,48 @@ fn bench_scene(assets: &Path, frames: u64) -> Scene {
         },
         patches,
         golden: None,
+    }
+}
+
+/// The bench's disc radius, px.
+const DISC_RADIUS: f64 = 150.0;
+
+/// Patch `disc{k}`: a 160-gon of [`DISC_RADIUS`] about `centre` of `source`, at density 1.
+fn disc_patch(k: usize, source: std::path::PathBuf, centre: DVec2) -> Patch {
+    let outer = (0..160)
+        .map(|i| {
+            let a = std::f64::consts::TAU * i as f64 / 160.0;
+            centre + DISC_RADIUS * DVec2::new(a.cos(), a.sin())
+        })
+        .collect();
+    let polygon = Polygon {
+        outer,
+        holes: Vec::new(),
+    };
+    let mut patch = Patch::new(format!("disc{k}"), source, Shape::Polygons(vec![polygon]));
+    patch.density = Some(1.0);
+    patch
+}
+
+/// A depth handle right of `centre` whose target swings back and forth once a second.
+fn swinging_handle(centre: DVec2, duration: f64) -> Handle {
+    let grab = centre + DVec2::new(DISC_RADIUS * 0.6, 0.0);
+    let mut to_track = Track::new();
+    let swing = [grab, grab + DVec2::new(-40.0, 60.0)];
+    let mut t = 0.0;
+    let mut i = 0;
+    while t <= duration {
+        let _ = to_track.push(t, swing[i % 2], Easing::EaseInOut);
+        t += 1.0;
+        i += 1;
+    }
+    Handle {
+        from: grab,
+        to: to_track,
+        radius: 70.0,
+        depth: Some(1.0),
+        pivot: None,
+        rotation: Track::new(),
     }
 }
 

@@ -168,7 +168,26 @@ fn measure(
         factor.solve_in_place(&mut work, 3);
     });
     let kernels = kernel_ms(&factor, &rhs);
-    // One switch = a downdate plus the update restoring it, halved.
+    let (update_ms, switch100_ms) = switch_ms(&mut factor, constrained, runs);
+    Ok(Timings {
+        n: l.n,
+        nnz_factor: factor.nnz_factor(),
+        analyze_ms,
+        factor_ms,
+        solve3_ms,
+        solve3_dense_ms,
+        solve3_kernel_ms: kernels.vector,
+        solve3_portable_ms: kernels.portable,
+        solve3_column_ms: kernels.column,
+        update_ms,
+        switch100_ms,
+        refactor_ms: factor_ms,
+    })
+}
+
+/// Best-of times, ms, of one constraint switch (a downdate plus the update restoring it,
+/// halved) and of 100 switched off and back on (halved).
+fn switch_ms(factor: &mut PenaltyFactor, constrained: &[usize], runs: usize) -> (f64, f64) {
     let probe = constrained.get(constrained.len() / 2).copied().unwrap_or(0);
     let update_ms = best_ms(RUNS * 4, || {
         let _ = factor.switch(&[(probe, !factor.is_constrained(probe))]);
@@ -188,20 +207,7 @@ fn measure(
             let _ = factor.switch(&[(v, true)]);
         }
     }) / 2.0;
-    Ok(Timings {
-        n: l.n,
-        nnz_factor: factor.nnz_factor(),
-        analyze_ms,
-        factor_ms,
-        solve3_ms,
-        solve3_dense_ms,
-        solve3_kernel_ms: kernels.vector,
-        solve3_portable_ms: kernels.portable,
-        solve3_column_ms: kernels.column,
-        update_ms,
-        switch100_ms,
-        refactor_ms: factor_ms,
-    })
+    (update_ms, switch100_ms)
 }
 
 /// Best-of timings of the solve kernels, ms.
