@@ -337,18 +337,40 @@ const TRACKS: [&str; 5] = ["at", "scale", "rotate", "depth", "opacity"];
 
 /// The Rhai entry for `edit` against `scene` as it is now (`None`: nothing to edit).
 fn entry(edit: &Edit, scene: &lapclone::script::Draft) -> Option<String> {
-    let patches = &scene.patches;
-    let pick = |i: usize| (!patches.is_empty()).then(|| i % patches.len());
-    let patch = |i: usize| {
-        pick(i).map(|p| {
-            format!(
-                "get_patch({})",
-                lapclone::scene::rhai_string_literal(&patches[p].name)
-            )
-        })
+    let on = Drafted {
+        patches: &scene.patches,
     };
-    let times = |p: usize| -> Vec<f64> {
-        let pl = &patches[p].placement;
+    match edit {
+        Edit::Key { .. } | Edit::Opacity { .. } | Edit::RemoveKey { .. } | Edit::MoveKey { .. } => {
+            key_entry(edit, &on)
+        }
+        _ => structure_entry(edit, &on),
+    }
+}
+
+/// The patches an entry is written against.
+struct Drafted<'a> {
+    patches: &'a [lapclone::scene::Patch],
+}
+
+impl Drafted<'_> {
+    /// The patch index `i` stands for, if there is any patch.
+    fn pick(&self, i: usize) -> Option<usize> {
+        (!self.patches.is_empty()).then(|| i % self.patches.len())
+    }
+
+    /// The Rhai expression for the patch `i` stands for.
+    fn patch(&self, i: usize) -> Option<String> {
+        let name = &self.patches[self.pick(i)?].name;
+        Some(format!(
+            "get_patch({})",
+            lapclone::scene::rhai_string_literal(name)
+        ))
+    }
+
+    /// Every key time of patch `p`, over all its tracks, sorted and unique.
+    fn times(&self, p: usize) -> Vec<f64> {
+        let pl = &self.patches[p].placement;
         let mut all: Vec<f64> = pl
             .position
             .times()
@@ -360,8 +382,27 @@ fn entry(edit: &Edit, scene: &lapclone::script::Draft) -> Option<String> {
         all.sort_by(f64::total_cmp);
         all.dedup();
         all
-    };
-    let literal = |v: f64| format!("{v:?}");
+    }
+
+    /// Whether patch `p`'s track `name` has a key at `t`.
+    fn has_key(&self, p: usize, name: &str, t: f64) -> bool {
+        let pl = &self.patches[p].placement;
+        match name {
+            "at" => pl.position.has_key_at(t),
+            "scale" => pl.scale.has_key_at(t),
+            "rotate" => pl.rotation.has_key_at(t),
+            "depth" => pl.depth.has_key_at(t),
+            _ => pl.opacity.has_key_at(t),
+        }
+    }
+}
+
+fn literal(v: f64) -> String {
+    format!("{v:?}")
+}
+
+/// The entries that key, unkey or move keys.
+fn key_entry(edit: &Edit, on: &Drafted) -> Option<String> {
     Some(match edit {
         Edit::Key {
             patch: p,
@@ -371,7 +412,7 @@ fn entry(edit: &Edit, scene: &lapclone::script::Draft) -> Option<String> {
             value,
             easing,
         } => {
-            let known = times(pick(*p)?);
+            let known = on.times(on.pick(*p)?);
             let t = match existing {
                 Some(k) if !known.is_empty() => known[k % known.len()],
                 _ => *t,
@@ -381,101 +422,93 @@ fn entry(edit: &Edit, scene: &lapclone::script::Draft) -> Option<String> {
                 "scale" => literal(value.abs() + 0.1),
                 _ => literal(*value),
             };
-            format!(
-                "{}.{}({}, {value}, \"{}\");",
-                patch(*p)?,
-                TRACKS[*track],
-                literal(t),
-                easing.name()
-            )
+            let (patch, track, easing) = (on.patch(*p)?, TRACKS[*track], easing.name());
+            format!("{patch}.{track}({}, {value}, \"{easing}\");", literal(t))
         }
         Edit::Opacity { patch: p, t, value } => {
-            format!(
-                "{}.key({}, #{{ opacity: {} }});",
-                patch(*p)?,
-                literal(*t),
-                literal(*value)
-            )
+            let (patch, t, value) = (on.patch(*p)?, literal(*t), literal(*value));
+            format!("{patch}.key({t}, #{{ opacity: {value} }});")
         }
         Edit::RemoveKey {
             patch: p,
             key,
             one_track,
         } => {
-            let known = times(pick(*p)?);
+            let known = on.times(on.pick(*p)?);
             let t = *known.get(key % known.len().max(1))?;
-            let pl = &patches[pick(*p)?].placement;
+            let patch = on.patch(*p)?;
             match one_track {
                 Some(k) => {
                     let name = TRACKS[*k];
-                    let has = match name {
-                        "at" => pl.position.has_key_at(t),
-                        "scale" => pl.scale.has_key_at(t),
-                        "rotate" => pl.rotation.has_key_at(t),
-                        "depth" => pl.depth.has_key_at(t),
-                        _ => pl.opacity.has_key_at(t),
-                    };
-                    has.then(|| {
-                        format!(
-                            "{}.remove_key({}, \"{name}\");",
-                            patch(*p).unwrap(),
-                            literal(t)
-                        )
-                    })?
+                    on.has_key(on.pick(*p)?, name, t)
+                        .then(|| format!("{patch}.remove_key({}, \"{name}\");", literal(t)))?
                 }
-                None => format!("{}.remove_key({});", patch(*p)?, literal(t)),
+                None => format!("{patch}.remove_key({});", literal(t)),
             }
         }
         Edit::MoveKey { patch: p, key, to } => {
-            let known = times(pick(*p)?);
+            let known = on.times(on.pick(*p)?);
             let t = *known.get(key % known.len().max(1))?;
-            format!("{}.move_key({}, {});", patch(*p)?, literal(t), literal(*to))
+            format!(
+                "{}.move_key({}, {});",
+                on.patch(*p)?,
+                literal(t),
+                literal(*to)
+            )
         }
+        _ => return None,
+    })
+}
+
+/// The entries that remove handles, pins or patches, rename or reorder.
+fn structure_entry(edit: &Edit, on: &Drafted) -> Option<String> {
+    let patches = on.patches;
+    Some(match edit {
         Edit::RemoveHandle {
             patch: p,
             handle,
             by_value,
         } => {
-            let handles = patches[pick(*p)?].handles.len();
+            let handles = patches[on.pick(*p)?].handles.len();
             let h = (handles > 0).then(|| handle % handles)?;
             if *by_value {
                 // The handle value a user kept from `drag`: here a fresh one, appended.
-                format!("{0}.remove_handle({0}.drag([1.0, 2.0], 3.0));", patch(*p)?)
+                format!(
+                    "{0}.remove_handle({0}.drag([1.0, 2.0], 3.0));",
+                    on.patch(*p)?
+                )
             } else {
-                format!("{}.remove_handle({h});", patch(*p)?)
+                format!("{}.remove_handle({h});", on.patch(*p)?)
             }
         }
         Edit::RemovePin { patch: p, pin } => {
-            let pins = &patches[pick(*p)?].pins;
+            let pins = &patches[on.pick(*p)?].pins;
             let i = (!pins.is_empty()).then(|| pin % pins.len())?;
             let at = pins[i].at;
             if i % 2 == 0 {
-                format!(
-                    "{}.remove_pin([{}, {}]);",
-                    patch(*p)?,
-                    literal(at.x),
-                    literal(at.y)
-                )
+                let (x, y) = (literal(at.x), literal(at.y));
+                format!("{}.remove_pin([{x}, {y}]);", on.patch(*p)?)
             } else {
-                format!("{}.remove_pin({i});", patch(*p)?)
+                format!("{}.remove_pin({i});", on.patch(*p)?)
             }
         }
         Edit::Rename { patch: p, name } => {
-            let target = patch(*p)?;
+            let target = on.patch(*p)?;
             let taken = patches.iter().any(|q| &q.name == name);
             (!taken).then(|| format!("{target}.rename(\"{name}\");"))?
         }
         Edit::Reorder { patch: p, front } => {
             let call = if *front { "to_front" } else { "to_back" };
-            format!("{}.{call}();", patch(*p)?)
+            format!("{}.{call}();", on.patch(*p)?)
         }
         Edit::RemovePatch { patch: p } => {
-            let name = &patches[pick(*p)?].name;
+            let name = &patches[on.pick(*p)?].name;
             format!(
                 "remove_patch({});",
                 lapclone::scene::rhai_string_literal(name)
             )
         }
+        _ => return None,
     })
 }
 
