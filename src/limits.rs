@@ -21,6 +21,9 @@ pub const MAX_IMAGE_PIXELS: u64 = 64 * 1024 * 1024;
 pub const MAX_MESH_VERTICES: usize = 2_000_000;
 /// Most frames a scene may have (`check` evaluates every one of them).
 pub const MAX_FRAMES: u64 = 1_000_000;
+/// Widest feather, px: four times the widest canvas, so any feather that can matter fits,
+/// and the raster's integer margins around a patch cannot overflow.
+pub const MAX_FEATHER: f64 = 65_536.0;
 /// Heap the image decoder may allocate for one image: an RGBA 16-bit image at the pixel
 /// limit (8 bytes per pixel) plus slack for the decoder's own buffers.
 pub(crate) const MAX_DECODER_ALLOC: u64 = MAX_IMAGE_PIXELS * 8 + (64 << 20);
@@ -58,6 +61,12 @@ pub fn check_image_size(width: u64, height: u64) -> Result<(), LimitError> {
         return Err(LimitError::ImageTooLarge { width, height });
     }
     Ok(())
+}
+
+/// Whether `feather` (px) is a width lapclone accepts: finite, at least 0 and at most
+/// [`MAX_FEATHER`]. Every place that takes a feather asks this.
+pub fn feather_in_range(feather: f64) -> bool {
+    (0.0..=MAX_FEATHER).contains(&feather)
 }
 
 /// Refuses scenes with more than [`MAX_FRAMES`] frames.

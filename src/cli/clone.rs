@@ -324,8 +324,13 @@ fn check_arguments(args: &CloneArgs) -> anyhow::Result<()> {
         ))
         .into());
     }
-    if args.feather < 0.0 {
-        return Err(UsageError(format!("--feather must be ≥ 0, not {}", args.feather)).into());
+    if !lapclone::limits::feather_in_range(args.feather) {
+        return Err(UsageError(format!(
+            "--feather must lie in [0, {}], not {:?}",
+            lapclone::limits::MAX_FEATHER,
+            args.feather
+        ))
+        .into());
     }
     if let Some(density) = args.density {
         if density <= 0.0 {

@@ -106,9 +106,10 @@ impl PatchCloner {
     /// Assembles and factors the patch's Laplacian and samples the source along the rest
     /// boundary.
     pub fn new(source: FloatImage, mesh: Mesh, options: &CloneOptions) -> Result<Self, CloneError> {
-        if !(options.feather.is_finite() && options.feather >= 0.0) {
+        if !crate::limits::feather_in_range(f64::from(options.feather)) {
             return Err(CloneError::BadOption(format!(
-                "feather must be a finite number ≥ 0, not {}",
+                "feather must lie in [0, {}], not {:?}",
+                crate::limits::MAX_FEATHER,
                 options.feather
             )));
         }

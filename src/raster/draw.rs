@@ -59,7 +59,7 @@ pub fn draw_patch(
     scratch: &mut RasterScratch,
 ) -> Result<RasterStats, RasterError> {
     patch.validate()?;
-    if !(options.feather.is_finite() && options.feather >= 0.0) {
+    if !crate::limits::feather_in_range(f64::from(options.feather)) {
         return Err(RasterError::Feather(options.feather));
     }
     let Some(work) = work_rect(patch, canvas, options.feather) else {

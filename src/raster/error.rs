@@ -28,6 +28,6 @@ pub enum RasterError {
     CandidateIndex { vertex: u32, vertex_count: usize },
     #[error("{what}[{index}] is not finite")]
     NonFinite { what: &'static str, index: usize },
-    #[error("feather must be finite and ≥ 0, got {0}")]
+    #[error("feather must lie in [0, {max}], got {0:?}", max = crate::limits::MAX_FEATHER)]
     Feather(f32),
 }

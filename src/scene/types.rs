@@ -329,10 +329,11 @@ impl Patch {
                 return Err(fail(format!("density {d} must be finite and > 0")));
             }
         }
-        if !(self.feather.is_finite() && self.feather >= 0.0) {
+        if !crate::limits::feather_in_range(self.feather) {
             return Err(fail(format!(
-                "feather {} must be finite and ≥ 0",
-                self.feather
+                "feather {:?} must lie in [0, {}]",
+                self.feather,
+                crate::limits::MAX_FEATHER
             )));
         }
         if let Shape::Polygons(polygons) = &self.shape {

@@ -396,7 +396,8 @@ fn every_numeric_flag_refuses_nan_infinity_and_bad_signs() {
             2,
             "--threshold must lie in [0, 1]",
         ),
-        clone_case(&[("--feather", "-1")], 2, "--feather must be ≥ 0"),
+        clone_case(&[("--feather", "-1")], 2, "--feather must lie in [0, 65536]"),
+        clone_case(&[("--feather", "4e9")], 2, "--feather must lie in [0, 65536]"),
         clone_case(&[("--density", "0.01")], 2, "density"),
         clone_case(&[("--at", "3")], 2, "is not a point"),
         clone_case(&[("--drag", "1,2")], 2, "is not a drag"),
@@ -615,6 +616,7 @@ fn hostile_scenes_fail_at_a_position_without_output() {
         ("nan_polygon", "canvas(8, 8);\npatch(\"p\", #{ source: \"../in/src.png\", polygons: [[[1, 1], [0.0 / 0.0, 1], [1, 6]]] });\n".into(), "finite"),
         ("far_polygon", "canvas(8, 8);\npatch(\"p\", #{ source: \"../in/src.png\", polygons: [[[1, 1], [1e308, 1], [1, 6]]] });\n".into(), "beyond"),
         ("long_polygon", "canvas(8, 8);\npatch(\"p\", #{ source: \"../in/src.png\", density: 0.05, polygons: [[[1, 1], [1.6e7, 1], [1, 6]]] });\n".into(), "vertex budget"),
+        ("huge_feather", "canvas(8, 8);\npatch(\"p\", #{ source: \"../in/src.png\", feather: 1e10, polygons: [[[1, 1], [6, 1], [1, 6]]] });\n".into(), "feather 10000000000.0 must lie in [0, 65536]"),
         ("duplicate_patch", with_head("patch(\"p\", #{ source: \"../in/src.png\", mask: \"../in/mask.png\" });\n"), "already exists"),
         ("wrong_types", with_head("p.at(\"soon\", [1, 2]);\n"), "must be a number"),
         ("throw", with_head("throw \"custom failure\";\n"), "custom failure"),
@@ -1023,6 +1025,8 @@ fn extreme_finite_numbers_work_or_fail_cleanly() {
                     || image::open(&output_file).is_ok_and(|i| i.width() == 32 && i.height() == 28)
             }
             Some(1) => !output_file.exists() && stderr.contains("error"),
+            // A value past a documented bound is a usage error naming the bound.
+            Some(2) => !output_file.exists() && stderr.contains("must lie in"),
             _ => false,
         };
         if !fine || stderr.contains("panicked") {
