@@ -21,6 +21,9 @@ pub const MAX_IMAGE_PIXELS: u64 = 64 * 1024 * 1024;
 pub const MAX_MESH_VERTICES: usize = 2_000_000;
 /// Most frames a scene may have (`check` evaluates every one of them).
 pub const MAX_FRAMES: u64 = 1_000_000;
+/// Largest scene or module file, bytes: far beyond any hand-written or generated scene, and
+/// small enough that its text, its errors and the REPL's copy of it stay cheap.
+pub const MAX_SCENE_BYTES: u64 = 16 << 20;
 /// Widest feather, px: four times the widest canvas, so any feather that can matter fits,
 /// and the raster's integer margins around a patch cannot overflow.
 pub const MAX_FEATHER: f64 = 65_536.0;

@@ -211,12 +211,37 @@ pub fn load_scene_and_imports(path: &Path) -> Result<(LoadedScene, Vec<PathBuf>)
     run_scene(&text, path, &ScriptOptions::for_scene_file(path))
 }
 
-/// The text of the scene file at `path`, which must be a regular file: a FIFO or a device
-/// would be read until it ends, which may be never.
+/// The text of the scene file at `path`, which must be a regular file (a FIFO or a device
+/// would be read until it ends, which may be never) of at most
+/// [`MAX_SCENE_BYTES`](crate::limits::MAX_SCENE_BYTES).
 pub fn read_scene_text(path: &Path) -> Result<String, SceneError> {
-    crate::util::check_input_file(path)
-        .and_then(|()| std::fs::read_to_string(path))
+    read_source(path)
         .map_err(|e| SceneError::in_file(ErrorKind::Io, path, format!("cannot read scene: {e}")))
+}
+
+/// The text of a scene or module file: a regular file of at most
+/// [`MAX_SCENE_BYTES`](crate::limits::MAX_SCENE_BYTES), read no further than that even if it
+/// grows meanwhile.
+pub(super) fn read_source(path: &Path) -> std::io::Result<String> {
+    use std::io::Read as _;
+    crate::util::check_input_file(path)?;
+    let limit = crate::limits::MAX_SCENE_BYTES;
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)?
+        .take(limit + 1)
+        .read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > limit {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            format!("it is larger than {} MiB, the limit for scene files", limit >> 20),
+        ));
+    }
+    String::from_utf8(bytes).map_err(|_| {
+        std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            "stream did not contain valid UTF-8",
+        )
+    })
 }
 
 /// Runs scene source `text` (named `file`) with `options` and finishes the scene.

@@ -96,7 +96,7 @@ impl SceneError {
         let text = match text {
             Some(t) => t,
             None => {
-                let Ok(t) = std::fs::read_to_string(&self.file) else {
+                let Ok(t) = super::engine::read_source(&self.file) else {
                     return;
                 };
                 from_disk = t;
@@ -191,13 +191,37 @@ impl fmt::Display for SceneError {
             _ => return write!(f, "{file}: {}", self.message),
         }
         if let Some(source) = &self.source_line {
-            write!(f, "\n{source}")?;
-            if let Some(col) = self.position.position() {
-                write!(f, "\n{}^", caret_indent(source, col))?;
+            let (shown, col) = excerpt(source, self.position.position());
+            write!(f, "\n{shown}")?;
+            if let Some(col) = col {
+                write!(f, "\n{}^", caret_indent(&shown, col))?;
             }
         }
         Ok(())
     }
+}
+
+/// Characters of a source line shown on each side of the column: a scene line can be
+/// megabytes long, and the message must stay readable.
+const EXCERPT_SIDE: usize = 60;
+
+/// `source` as printed under a message, with the column the caret goes under: the whole line
+/// when it is short, else the characters around `col` between `…` marks.
+fn excerpt(source: &str, col: Option<usize>) -> (String, Option<usize>) {
+    let length = source.chars().count();
+    if length <= 4 * EXCERPT_SIDE {
+        return (source.to_string(), col);
+    }
+    let centre = col.unwrap_or(1).saturating_sub(1).min(length);
+    let first = centre.saturating_sub(EXCERPT_SIDE);
+    let last = (centre + EXCERPT_SIDE).min(length);
+    let mut shown: String = if first > 0 { "…".into() } else { String::new() };
+    shown.extend(source.chars().skip(first).take(last - first));
+    if last < length {
+        shown.push('…');
+    }
+    let col = col.map(|c| c - first + usize::from(first > 0));
+    (shown, col)
 }
 
 /// Whitespace that lines a caret up under column `col` (1-based), keeping tabs as tabs.
@@ -224,5 +248,29 @@ mod tests {
         );
         e.load_source_line(Some("first\n\tab(cd);\n"));
         assert_eq!(e.to_string(), "s.rhai:2:5: bad\n\tab(cd);\n\t   ^");
+    }
+
+    /// A line of megabytes is shown as the characters around the column, and the caret
+    /// still sits under the column's character.
+    #[test]
+    fn a_long_line_is_shown_around_the_column() {
+        // Rhai's columns are 16-bit, so the line is as long as they reach.
+        let line = format!("{}@{}", "a".repeat(30_000), "b".repeat(30_000));
+        for (col, marks) in [(30_001u16, 2), (5, 1), (60_001, 1)] {
+            let mut e = SceneError::new(
+                ErrorKind::Syntax,
+                Path::new("s.rhai"),
+                Position::new(1, col),
+                "bad",
+            );
+            e.load_source_line(Some(&line));
+            let text = e.to_string();
+            assert!(text.len() < 400, "{} bytes", text.len());
+            let lines: Vec<&str> = text.lines().collect();
+            assert_eq!(lines[1].matches('…').count(), marks, "{}", lines[1]);
+            let under = lines[2].chars().count() - 1;
+            let expected = line.chars().nth(usize::from(col) - 1).unwrap();
+            assert_eq!(lines[1].chars().nth(under), Some(expected), "col {col}");
+        }
     }
 }

@@ -240,7 +240,7 @@ impl SandboxResolver {
         file: &Path,
         pos: Position,
     ) -> Result<SharedModule, Box<EvalAltResult>> {
-        let text = std::fs::read_to_string(file).map_err(|e| {
+        let text = super::engine::read_source(file).map_err(|e| {
             EvalAltResult::ErrorRuntime(
                 format!("cannot read module {}: {e}", file.display()).into(),
                 pos,

@@ -723,6 +723,9 @@ fn more_hostile_scenes_fail_cleanly_or_work() {
     let long_line = format!("let x = 1{};\n", " + 1".repeat(200_000));
     let big_literal = format!("let s = \"{}\";\n", "y".repeat(2 << 20));
     let nested = format!("let a = {}1{};\n", "[".repeat(5000), "]".repeat(5000));
+    // Past the 16 MiB limit for scene and module files.
+    let oversized = format!("{head}// {}\n", "z".repeat(17 << 20));
+    world.write("big_module.rhai", &oversized);
     let table: Vec<(&str, String, i32, &str)> = vec![
         ("negative_fps", "canvas(40, 30, #{ fps: -5 });\n".into(), 1, "fps"),
         ("nan_fps", "canvas(40, 30, #{ fps: 0.0 / 0.0 });\n".into(), 1, "fps"),
@@ -731,6 +734,8 @@ fn more_hostile_scenes_fail_cleanly_or_work() {
         ("deep_arrays", format!("{head}{nested}"), 1, "nested_arrays.rhai:"),
         ("long_line", format!("{head}{long_line}"), 1, "long_line.rhai:"),
         ("big_literal", format!("{head}{big_literal}"), 1, "big_literal.rhai:"),
+        ("oversized", oversized.clone(), 1, "larger than 16 MiB"),
+        ("oversized_module", format!("{head}import \"big_module\" as m;\n"), 1, "larger than 16 MiB"),
         ("huge_time", format!("{head}let p = patch(\"p\", #{{ source: \"src.png\", mask: \"mask.png\" }});\np.at(1e300, [1, 1]);\n"), 0, ""),
     ];
     for (name, text, code, message) in &table {
@@ -751,6 +756,8 @@ fn more_hostile_scenes_fail_cleanly_or_work() {
             !stderr.contains("panicked") && !stderr.contains("overflowed"),
             "{name}: {stderr}"
         );
+        // A megabyte line is shown around its column, not whole.
+        assert!(stderr.len() < 2_000, "{name}: {} bytes of errors", stderr.len());
     }
 }
 
