@@ -396,8 +396,16 @@ fn every_numeric_flag_refuses_nan_infinity_and_bad_signs() {
             2,
             "--threshold must lie in [0, 1]",
         ),
-        clone_case(&[("--feather", "-1")], 2, "--feather must lie in [0, 65536]"),
-        clone_case(&[("--feather", "4e9")], 2, "--feather must lie in [0, 65536]"),
+        clone_case(
+            &[("--feather", "-1")],
+            2,
+            "--feather must lie in [0, 65536]",
+        ),
+        clone_case(
+            &[("--feather", "4e9")],
+            2,
+            "--feather must lie in [0, 65536]",
+        ),
         clone_case(&[("--density", "0.01")], 2, "density"),
         clone_case(&[("--at", "3")], 2, "is not a point"),
         clone_case(&[("--drag", "1,2")], 2, "is not a drag"),

@@ -757,7 +757,11 @@ fn more_hostile_scenes_fail_cleanly_or_work() {
             "{name}: {stderr}"
         );
         // A megabyte line is shown around its column, not whole.
-        assert!(stderr.len() < 2_000, "{name}: {} bytes of errors", stderr.len());
+        assert!(
+            stderr.len() < 2_000,
+            "{name}: {} bytes of errors",
+            stderr.len()
+        );
     }
 }
 
