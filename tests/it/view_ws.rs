@@ -331,6 +331,38 @@ fn escape_leaves_no_trace_and_stale_edits_are_refused() {
     assert!(repl.finish().success());
 }
 
+/// A preview lasts only until the session runs an entry: one that shows nothing (a plain
+/// `let`) or a commit that changes nothing still puts the committed scene back on every page.
+#[test]
+fn no_preview_outlives_an_entry_that_shows_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = cat_scene(dir.path());
+    let mut repl = ViewRepl::start(dir.path(), &scene);
+    let mut page = repl.page();
+    let mut other = repl.page();
+    let before = page.frame.clone();
+    let rev = page.rev();
+    let preview = json!({"type": "edit", "rev": rev, "commit": false, "edit": {"op": "scale", "patch": "cat", "value": 0.8}});
+    page.send(&preview);
+    page.until_scene();
+    assert!(page.frame != before, "the preview changed nothing");
+    repl.type_line("let unrelated = 1;");
+    page.until_scene();
+    assert!(page.frame == before, "a typed line left the preview on the page");
+    page.send(&preview);
+    page.until_scene();
+    assert!(page.frame != before);
+    // The other page commits the value the scene already has: one line, no change.
+    other.send(&json!({"type": "edit", "rev": rev, "commit": true, "edit": {"op": "scale", "patch": "cat", "value": 0.42}}));
+    page.until(|v| v["type"] == "line" && v["text"] == "cat.scale(0, 0.42);");
+    assert!(page.frame == before, "a commit that changed nothing left the preview");
+    page.send(&json!({"type": "seek", "t": 0}));
+    page.until_scene();
+    assert!(page.frame == before, "the preview outlived the commit");
+    assert_eq!(page.rev(), rev);
+    assert!(repl.finish().success());
+}
+
 #[test]
 fn wrong_tokens_foreign_origins_and_malformed_messages_change_nothing() {
     let dir = tempfile::tempdir().unwrap();

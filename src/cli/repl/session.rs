@@ -74,6 +74,8 @@ pub struct Session {
     revision: u64,
     /// Whether the renderer holds a page gesture's uncommitted preview.
     previewing: bool,
+    /// Frames sent to the pages so far, so an entry knows whether it showed them one.
+    published: std::cell::Cell<u64>,
     /// How many of `edits` the loaded file holds (it was `:save`d over since the load).
     saved_edits: usize,
 }
@@ -119,6 +121,7 @@ impl Session {
             from_view: false,
             revision: 0,
             previewing: false,
+            published: std::cell::Cell::new(0),
             saved_edits: 0,
         };
         session.refresh_words();
@@ -138,13 +141,25 @@ impl Session {
 
     /// Runs one entry and gives its error instead of printing it.
     fn run_entry(&mut self, text: &str) -> anyhow::Result<Step> {
-        if std::mem::take(&mut self.previewing) {
+        let dropped = std::mem::take(&mut self.previewing);
+        if dropped {
             // A page gesture left its preview in the renderer: the entry starts from the
             // committed scene.
             if let (Ok(scene), Some(renderer)) = (self.current_scene(), self.renderer.as_mut()) {
                 let _ = renderer.set_scene(scene);
             }
         }
+        let published = self.published.get();
+        let step = self.run_entry_text(text);
+        if dropped && self.published.get() == published {
+            // The entry showed the pages nothing (`:list`, a failed line, an edit that
+            // changed nothing): they still show the preview, so show them the scene.
+            let _ = self.as_page(|s| s.show_frame());
+        }
+        step
+    }
+
+    fn run_entry_text(&mut self, text: &str) -> anyhow::Result<Step> {
         self.cancel.store(false, Ordering::Relaxed);
         let trimmed = text.trim();
         if trimmed.is_empty() {

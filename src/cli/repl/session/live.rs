@@ -58,11 +58,11 @@ impl Session {
                 .then(|| scene_message(renderer, &head, true)),
         };
         hub.publish(renderer.frame(), renderer.drawn_region(), scene);
+        self.published.set(self.published.get() + 1);
     }
 
     /// Runs `line` as an entry, printing it first as the page's.
     fn view_line(&mut self, line: &str) -> Result<(), String> {
-        self.previewing = false;
         self.say_from_view(format!("(view) {line}"));
         self.from_view = true;
         let result = self.run_entry(line);
@@ -81,9 +81,6 @@ impl Session {
             Err(error) => {
                 let message = crate::cli::describe(&error);
                 self.say_from_view(message.clone());
-                // The renderer may still hold a preview: show the committed scene again.
-                self.previewing = true;
-                let _ = self.view_cancel();
                 Err(message)
             }
         }
@@ -95,7 +92,7 @@ impl Session {
         self.from_view = false;
     }
 
-    fn as_page(&mut self, run: impl FnOnce(&mut Self) -> anyhow::Result<()>) -> Result<(), String> {
+    pub(super) fn as_page(&mut self, run: impl FnOnce(&mut Self) -> anyhow::Result<()>) -> Result<(), String> {
         self.from_view = true;
         let result = run(self);
         self.from_view = false;
