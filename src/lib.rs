@@ -82,7 +82,7 @@ pub use clone::{
     CloneStats, GlueStats, MembraneStats, PatchCloner, PatchMesh, Placement,
 };
 pub use deform::{DeformError, DeformOptions, DeformRig, DeformStats, Deformed, Handle, Pin};
-pub use limits::LimitError;
+pub use limits::{check_image_size, LimitError, MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE};
 pub use mesh::{
     BitMask, BoundaryLoop, BoundaryPlacement, LoopKind, Mesh, MeshError, MeshOptions, MeshResult,
     MeshStats, Polygon, SanityError, MASK_THRESHOLD,

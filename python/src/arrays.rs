@@ -117,10 +117,17 @@ pub fn layout_of(object: &Bound<'_, PyAny>, what: &str, allow_bool: bool) -> PyR
             "{what} is empty ({height}×{width} pixels)"
         )));
     }
-    let too_large = u32::try_from(height).is_err() || u32::try_from(width).is_err();
-    if too_large {
+    // The limits of every image lapclone reads, before anything of that size is allocated.
+    let (w, h) = (width as u64, height as u64);
+    lapclone::check_image_size(w, h).map_err(|e| PyValueError::new_err(format!("{what}: {e}")))?;
+    // A view into packed records (a uint16 field after a byte) steps by part of a sample;
+    // numpy's strides in bytes would be read as whole samples.
+    let itemsize = array.dtype().itemsize() as isize;
+    if array.strides().iter().any(|s| s % itemsize != 0) {
         return Err(PyValueError::new_err(format!(
-            "{what} is {height}×{width} pixels: larger than an image can be"
+            "{what} steps by fractions of a sample (strides {:?} bytes for {itemsize}-byte \
+             samples); pass numpy.ascontiguousarray({what})",
+            array.strides()
         )));
     }
     Ok(Layout {
@@ -572,6 +579,27 @@ fn write_row<T: Copy, const C: usize>(dst: &mut [T], row: &[T], channel: impl Fn
             d[channel(k)] = value;
         }
     }
+}
+
+/// Checks that `object` still has `layout`: Python code run during a call (a number's
+/// `__float__`, another thread between the call's steps) may have reshaped it.
+pub fn check_unchanged(object: &Bound<'_, PyAny>, layout: &Layout, what: &str) -> PyResult<()> {
+    if layout_of(object, what, false)? != *layout {
+        return Err(PyValueError::new_err(format!(
+            "{what} changed shape or dtype during the call"
+        )));
+    }
+    Ok(())
+}
+
+/// A copy of the array `object` as a plain numpy array (not a subclass, whose `copy` could
+/// run any code).
+pub fn plain_copy<'py>(object: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+    let py = object.py();
+    let order = pyo3::types::PyDict::new(py);
+    order.set_item("order", "C")?;
+    py.import("numpy")?
+        .call_method("array", (object,), Some(&order))
 }
 
 /// Checks that `out` is a writable array of exactly `layout`.

@@ -11,7 +11,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use crate::arrays::{self, Layout};
-use crate::errors::to_py;
+use crate::errors::{to_py, InRange};
 use crate::patch::{Patch, Pose, MASK_THRESHOLD};
 
 /// `cv2.NORMAL_CLONE`.
@@ -50,8 +50,9 @@ impl Cloner {
         feather: f64,
         boundary_data: &str,
         bgr: bool,
-        threads: Option<usize>,
+        threads: Option<InRange<usize>>,
     ) -> PyResult<Self> {
+        let threads = threads.map(|t| t.0);
         if threads == Some(0) {
             return Err(PyValueError::new_err("threads must be at least 1"));
         }
@@ -65,11 +66,6 @@ impl Cloner {
                 "mode must be 'normal' or 'monochrome', not {mode:?}"
             ))
         })?;
-        if !(feather.is_finite() && feather >= 0.0) {
-            return Err(PyValueError::new_err(format!(
-                "feather must be a finite number ≥ 0, not {feather}"
-            )));
-        }
         let boundary_data: BoundaryData = boundary_data.parse().map_err(PyValueError::new_err)?;
         let options = CloneOptions {
             laplacian,
@@ -86,14 +82,14 @@ impl Cloner {
     /// writes it into `out` (which may be `target`) and returns that. The same pixels as
     /// `lapclone clone` with the same images and flags. The GIL is released while it
     /// computes.
-    #[pyo3(signature = (target, at, *, scale=1.0, rotate=0.0, drags=Vec::new(), pins=Vec::new(), anchor="centre", out=None))]
+    #[pyo3(signature = (target, at, *, scale=InRange(1.0), rotate=InRange(0.0), drags=Vec::new(), pins=Vec::new(), anchor="centre", out=None))]
     #[allow(clippy::too_many_arguments)]
     fn clone<'py>(
         &self,
         target: &Bound<'py, PyAny>,
         at: &Bound<'py, PyAny>,
-        scale: f64,
-        rotate: f64,
+        scale: InRange<f64>,
+        rotate: InRange<f64>,
         drags: Vec<Bound<'py, PyAny>>,
         pins: Vec<Bound<'py, PyAny>>,
         anchor: &str,
@@ -110,6 +106,7 @@ impl Cloner {
             }
         };
         let at = point(at, "at")?;
+        let (scale, rotate) = (scale.0, rotate.0);
         if !(scale.is_finite() && scale > 0.0) {
             return Err(PyValueError::new_err(format!(
                 "scale must be a finite number > 0, not {scale}"
@@ -289,15 +286,16 @@ fn pixel(value: &Bound<'_, PyAny>) -> PyResult<[i64; 2]> {
 /// are allowed, and the mask is not eroded (the blend's boundary runs through the centres of
 /// the first outside pixels). Returns a new array like `dst`.
 #[pyfunction]
-#[pyo3(signature = (src, dst, mask, p, flags=NORMAL_CLONE))]
+#[pyo3(signature = (src, dst, mask, p, flags=InRange(NORMAL_CLONE)))]
 pub fn seamless_clone<'py>(
     py: Python<'py>,
     src: &Bound<'py, PyAny>,
     dst: &Bound<'py, PyAny>,
     mask: &Bound<'py, PyAny>,
     p: &Bound<'py, PyAny>,
-    flags: i64,
+    flags: InRange<i64>,
 ) -> PyResult<Bound<'py, PyAny>> {
+    let flags = flags.0;
     let mode = match flags {
         NORMAL_CLONE => CloneMode::Normal,
         MONOCHROME_TRANSFER => CloneMode::Monochrome,

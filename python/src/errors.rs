@@ -6,7 +6,8 @@
 
 use lapclone::OutputError;
 use pyo3::exceptions::{
-    PyFileNotFoundError, PyIsADirectoryError, PyNotADirectoryError, PyOSError, PyValueError,
+    PyFileNotFoundError, PyIndexError, PyIsADirectoryError, PyNotADirectoryError, PyOSError,
+    PyOverflowError, PyValueError,
 };
 use pyo3::prelude::*;
 
@@ -22,6 +23,38 @@ pyo3::create_exception!(
 /// arrays): a `ValueError`.
 pub fn to_py(error: impl std::fmt::Display) -> PyErr {
     PyValueError::new_err(error.to_string())
+}
+
+/// A number argument of type `T` whose value outside `T`'s range (a negative thread count,
+/// `2**1024` as a scale) is a `ValueError` like any other bad value, not an `OverflowError`.
+pub struct InRange<T>(pub T);
+
+impl<'py, T: FromPyObject<'py>> FromPyObject<'py> for InRange<T> {
+    fn extract_bound(object: &Bound<'py, PyAny>) -> PyResult<Self> {
+        T::extract_bound(object)
+            .map(InRange)
+            .map_err(|e| overflow_as(object.py(), e, PyValueError::new_err))
+    }
+}
+
+/// A frame index: one outside any integer lapclone holds is past the end, an `IndexError`.
+pub struct FrameIndex(pub i64);
+
+impl<'py> FromPyObject<'py> for FrameIndex {
+    fn extract_bound(object: &Bound<'py, PyAny>) -> PyResult<Self> {
+        i64::extract_bound(object)
+            .map(FrameIndex)
+            .map_err(|e| overflow_as(object.py(), e, PyIndexError::new_err))
+    }
+}
+
+/// `error`, or when it is an `OverflowError`, `make` of its message.
+fn overflow_as(py: Python<'_>, error: PyErr, make: fn(String) -> PyErr) -> PyErr {
+    if error.is_instance_of::<PyOverflowError>(py) {
+        make(format!("a number is out of range: {}", error.value(py)))
+    } else {
+        error
+    }
 }
 
 /// A scene error as `lapclone.SceneError` with its position attributes.

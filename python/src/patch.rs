@@ -113,19 +113,29 @@ impl Patch {
             // Waited for without the GIL, so a thread holding the lock can always take it.
             let mut state = lock(&self.state);
             let rect = state.prepare(pose, layout)?;
-            Python::with_gil(|py| state.load_target(shared.bind(py), layout, bgr, rect))?;
+            // Each time the GIL is taken back the arrays are checked again: other threads ran
+            // meanwhile. No code but numpy's runs while the lock is held, so a clone called
+            // from inside that code cannot wait for this one.
+            Python::with_gil(|py| {
+                let target = shared.bind(py);
+                arrays::check_unchanged(target, layout, "target")?;
+                state.load_target(target, layout, bgr, rect)
+            })?;
             state.draw()?;
             // The result from the drawn canvas directly (no copy of the rectangle between).
             Python::with_gil(|py| {
                 let target = shared.bind(py);
+                arrays::check_unchanged(target, layout, "target")?;
                 let result = match &out {
                     Some(out) => {
                         let out = out.bind(py);
+                        arrays::check_out(out, layout)?;
                         arrays::copy_into(target, out, layout)?;
                         out.clone()
                     }
-                    None => target.call_method0("copy")?,
+                    None => arrays::plain_copy(target)?,
                 };
+                arrays::check_unchanged(&result, layout, "the result")?;
                 // invariant: `load_target` left a canvas.
                 let canvas = state.canvas.as_ref().expect("loaded before drawing");
                 arrays::write_canvas_rect(&result, layout, bgr, canvas, rect)?;

@@ -12,7 +12,7 @@ use pyo3::exceptions::{PyFileNotFoundError, PyIndexError, PyRuntimeError};
 use pyo3::prelude::*;
 
 use crate::arrays::{self, Dtype, Layout};
-use crate::errors::{output_error, scene_error, to_py};
+use crate::errors::{output_error, scene_error, to_py, FrameIndex};
 
 /// Scene(path, *, bgr=False)
 ///
@@ -94,7 +94,8 @@ impl Scene {
     }
 
     /// Frame `index` (from 0; negative counts from the end) as an H×W×4 array.
-    fn frame<'py>(&self, py: Python<'py>, index: i64) -> PyResult<Bound<'py, PyAny>> {
+    fn frame<'py>(&self, py: Python<'py>, index: FrameIndex) -> PyResult<Bound<'py, PyAny>> {
+        let index = index.0;
         let frames = self.frames as i64;
         let i = if index < 0 { index + frames } else { index };
         if !(0..frames).contains(&i) {
@@ -152,7 +153,7 @@ impl Scene {
         }
     }
 
-    fn __getitem__<'py>(&self, py: Python<'py>, index: i64) -> PyResult<Bound<'py, PyAny>> {
+    fn __getitem__<'py>(&self, py: Python<'py>, index: FrameIndex) -> PyResult<Bound<'py, PyAny>> {
         self.frame(py, index)
     }
 
@@ -205,7 +206,7 @@ impl SceneFrames {
         if self.next >= scene.frames {
             return Ok(None);
         }
-        let frame = scene.frame(py, self.next as i64)?;
+        let frame = scene.frame(py, FrameIndex(self.next as i64))?;
         self.next += 1;
         Ok(Some(frame))
     }

@@ -171,3 +171,87 @@ def test_random_inputs_never_crash():
     outcomes = eval(done.stdout.strip().splitlines()[-1])
     assert sum(outcomes.values()) == 1000
     assert outcomes["ok"] > 50 and outcomes["ValueError"] > 50, outcomes
+
+
+def test_arrays_past_the_image_limits_raise_value_error():
+    # Zero strides declare a huge array without its memory: refused from the shape alone.
+    huge = np.broadcast_to(np.uint8(255), (10**6, 10**6))
+    for call in [
+        lambda: lapclone.mesh(huge),
+        lambda: lapclone.Cloner(SRC, huge),
+        lambda: lapclone.seamless_clone(SRC, huge, MASK, (35, 30)),
+        lambda: lapclone.mesh(np.full((16385, 1), 255, np.uint8)),
+    ]:
+        with pytest.raises(ValueError, match="size limit"):
+            call()
+
+
+def test_a_view_stepping_by_part_of_a_sample_is_refused():
+    # A uint16 field of packed records: its strides are not whole samples.
+    records = np.zeros((60, 70, 3), [("pad", "u1"), ("v", "<u2")])
+    view = records["v"]
+    assert view.strides[1] % view.itemsize != 0
+    with pytest.raises(ValueError, match="ascontiguousarray"):
+        lapclone.Cloner(SRC, MASK).clone(view, (35, 30))
+
+
+def test_a_feather_past_the_limit_raises_value_error():
+    with pytest.raises(ValueError, match="feather"):
+        lapclone.Cloner(SRC, MASK, feather=4e9)
+
+
+@pytest.mark.parametrize(
+    "call, error",
+    [
+        (lambda: lapclone.Cloner(SRC, MASK, threads=-1), ValueError),
+        (lambda: lapclone.Cloner(SRC, MASK, threads=2**64), ValueError),
+        (lambda: lapclone.seamless_clone(SRC, DST, MASK, (35, 30), 2**63), ValueError),
+        (lambda: lapclone.Cloner(SRC, MASK).clone(DST, (35, 30), scale=2**1024), ValueError),
+        (lambda: lapclone.Cloner(SRC, MASK).clone(DST, (35, 30), rotate=-(2**1024)), ValueError),
+        (lambda: lapclone.Scene(ROOT / "scenes" / "cat_in_coffee.rhai").frame(2**63), IndexError),
+        (lambda: lapclone.Scene(ROOT / "scenes" / "cat_in_coffee.rhai")[-(2**64)], IndexError),
+    ],
+)
+def test_numbers_out_of_range_raise_the_documented_errors(call, error):
+    with pytest.raises(error, match="out of range"):
+        call()
+
+
+def test_a_target_reshaped_during_the_call_raises_value_error():
+    target = DST.copy()
+
+    class Reshaping:
+        def __float__(self):
+            target.shape = (70, 60, 3)
+            return 35.0
+
+    with pytest.raises(ValueError, match="changed shape"):
+        lapclone.Cloner(SRC, MASK).clone(target, (Reshaping(), 30.0))
+
+
+def test_a_subclass_copy_runs_no_code_inside_the_clone():
+    # A subclass's own copy() would run while the clone holds its lock: a clone from there
+    # waited for itself. The result is a plain array copied by numpy.
+    cloner = lapclone.Cloner(SRC, MASK)
+    calls = []
+
+    class Reentrant(np.ndarray):
+        def copy(self, *args, **kwargs):
+            calls.append(cloner.clone(np.asarray(self), (1.0, 1.0)))
+            return np.ndarray.copy(self)
+
+    result = cloner.clone(DST.view(Reentrant), (35, 30))
+    assert type(result) is np.ndarray and not calls
+    assert np.array_equal(result, cloner.clone(DST, (35, 30)))
+
+
+def test_a_scene_error_shows_its_line_around_the_column(tmp_path):
+    path = tmp_path / "long.rhai"
+    path.write_text("canvas(16, 16);\nlet s = 1 " + "+ 1 " * 50_000 + "@ 2;\n")
+    with pytest.raises(lapclone.SceneError) as caught:
+        lapclone.Scene(path)
+    assert len(str(caught.value)) < 1000
+    big = tmp_path / "big.rhai"
+    big.write_text("canvas(16, 16);\n//" + "x" * (17 << 20) + "\n")
+    with pytest.raises(lapclone.SceneError, match="larger than 16 MiB"):
+        lapclone.Scene(big)
