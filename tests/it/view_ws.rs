@@ -348,14 +348,20 @@ fn no_preview_outlives_an_entry_that_shows_nothing() {
     assert!(page.frame != before, "the preview changed nothing");
     repl.type_line("let unrelated = 1;");
     page.until_scene();
-    assert!(page.frame == before, "a typed line left the preview on the page");
+    assert!(
+        page.frame == before,
+        "a typed line left the preview on the page"
+    );
     page.send(&preview);
     page.until_scene();
     assert!(page.frame != before);
     // The other page commits the value the scene already has: one line, no change.
     other.send(&json!({"type": "edit", "rev": rev, "commit": true, "edit": {"op": "scale", "patch": "cat", "value": 0.42}}));
     page.until(|v| v["type"] == "line" && v["text"] == "cat.scale(0, 0.42);");
-    assert!(page.frame == before, "a commit that changed nothing left the preview");
+    assert!(
+        page.frame == before,
+        "a commit that changed nothing left the preview"
+    );
     page.send(&json!({"type": "seek", "t": 0}));
     page.until_scene();
     assert!(page.frame == before, "the preview outlived the commit");

@@ -6,7 +6,7 @@
 //! Between two frames over the same background only the union of their drawn regions can
 //! differ, so only that part is converted and compared.
 
-use std::sync::mpsc::{Receiver, Sender};
+use std::sync::mpsc::{Receiver, SyncSender};
 use std::sync::Mutex;
 
 use lapclone::pixels::{Canvas, CanvasPixels, PixelFormat, PixelRect};
@@ -43,9 +43,14 @@ pub enum Outgoing {
     Text(Utf8Bytes),
 }
 
+/// Messages queued for one page before it counts as gone: a page that stops reading would
+/// otherwise hold every frame published since (a gigabyte a minute during a drag). A page
+/// that reads keeps one or two in its queue.
+pub const PAGE_QUEUE: usize = 64;
+
 struct Client {
     id: u64,
-    tx: Sender<Outgoing>,
+    tx: SyncSender<Outgoing>,
     /// Whether this page shows the mesh overlay (its scene messages carry the meshes).
     mesh: bool,
 }
@@ -82,7 +87,7 @@ pub struct Hub {
 
 impl Hub {
     /// Registers a page; it is sent the whole last frame and scene message first.
-    pub fn connect(&self, tx: Sender<Outgoing>) -> u64 {
+    pub fn connect(&self, tx: SyncSender<Outgoing>) -> u64 {
         let mut state = lock(&self.state);
         state.next_id += 1;
         let id = state.next_id;
@@ -94,10 +99,10 @@ impl Hub {
         }) = &state.frame
         {
             let message = frame_message(*w, *h, rgba, [0, 0, *w, *h]);
-            let _ = tx.send(Outgoing::Binary(message.into()));
+            let _ = tx.try_send(Outgoing::Binary(message.into()));
         }
         if let Some((plain, _)) = &state.scene {
-            let _ = tx.send(Outgoing::Text(plain.clone()));
+            let _ = tx.try_send(Outgoing::Text(plain.clone()));
         }
         state.clients.push(Client {
             id,
@@ -109,6 +114,12 @@ impl Hub {
 
     pub fn disconnect(&self, id: u64) {
         lock(&self.state).clients.retain(|c| c.id != id);
+    }
+
+    /// Whether page `id` is still served: false once it left or fell [`PAGE_QUEUE`]
+    /// messages behind.
+    pub fn serves(&self, id: u64) -> bool {
+        lock(&self.state).clients.iter().any(|c| c.id == id)
     }
 
     /// Whether any page wants the meshes (so the session builds that form).
@@ -156,8 +167,8 @@ impl Hub {
                 (Some(m), true) => m.clone(),
                 _ => plain.clone(),
             };
-            c.tx.send(Outgoing::Binary(frame.clone())).is_ok()
-                && c.tx.send(Outgoing::Text(text)).is_ok()
+            c.tx.try_send(Outgoing::Binary(frame.clone())).is_ok()
+                && c.tx.try_send(Outgoing::Text(text)).is_ok()
         });
         state.scene = Some((plain, with_mesh));
     }
@@ -167,7 +178,7 @@ impl Hub {
         let text = Utf8Bytes::from(text);
         lock(&self.state)
             .clients
-            .retain(|c| c.tx.send(Outgoing::Text(text.clone())).is_ok());
+            .retain(|c| c.tx.try_send(Outgoing::Text(text.clone())).is_ok());
     }
 }
 
@@ -264,8 +275,8 @@ fn compared_region(
 }
 
 /// A channel for one page's messages.
-pub fn channel() -> (Sender<Outgoing>, Receiver<Outgoing>) {
-    std::sync::mpsc::channel()
+pub fn channel() -> (SyncSender<Outgoing>, Receiver<Outgoing>) {
+    std::sync::mpsc::sync_channel(PAGE_QUEUE)
 }
 
 /// The binary frame message ([`RECT`]) for `rect` of the `width`×`height` frame `rgba`.
@@ -375,6 +386,37 @@ mod tests {
             panic!("no frame");
         };
         assert_eq!(&m[FRAME_HEADER..], canvas(&[]).samples(PixelFormat::RGBA8));
+    }
+
+    /// A page that stops reading is dropped once its queue is full; one that reads is not.
+    #[test]
+    fn a_page_that_stops_reading_is_dropped_at_its_queue_bound() {
+        let hub = Hub::default();
+        let (tx, stuck) = channel();
+        let stuck_id = hub.connect(tx);
+        let (tx, reader) = channel();
+        let reader_id = hub.connect(tx);
+        let mut published = 0;
+        while hub.serves(stuck_id) {
+            hub.publish(
+                &canvas(&[(published % 30, [published as u8, 0, 0, 255])]),
+                None,
+                scene(),
+            );
+            published += 1;
+            assert!(
+                published <= PAGE_QUEUE,
+                "still served after {published} frames"
+            );
+            while reader.try_recv().is_ok() {}
+        }
+        // Two messages a frame fill the queue; the next frame finds it full.
+        assert_eq!(published, PAGE_QUEUE / 2 + 1);
+        assert!(hub.serves(reader_id));
+        hub.broadcast("{}".into());
+        assert!(matches!(reader.try_recv(), Ok(Outgoing::Text(_))));
+        // What was queued for the dropped page stays bounded.
+        assert_eq!(stuck.try_iter().count(), PAGE_QUEUE);
     }
 
     /// The pixels a message carries, written into `frame` (6 px wide) as a page does.

@@ -21,6 +21,8 @@ use super::{error_message, lock};
 const MAX_CONNECTIONS: usize = 32;
 /// How often a page's thread looks for frames to send while it waits for messages.
 const POLL: Duration = Duration::from_millis(5);
+/// How long a write to a page may block before the page counts as gone.
+const WRITE_TIMEOUT: Duration = Duration::from_secs(10);
 
 const PAGE: &str = include_str!("page/index.html");
 const SCRIPT: &str = include_str!("page/view.js");
@@ -131,7 +133,12 @@ fn serve(
 
 /// Serves one page until it closes: its messages in, frames and replies out.
 fn page_loop(mut socket: WebSocket<TcpStream>, session: &Mutex<dyn LiveSession>, hub: &Hub) {
-    if socket.get_mut().set_read_timeout(Some(POLL)).is_err() {
+    // A page that stops reading fails the write after a while, instead of blocking its
+    // connection (one of MAX_CONNECTIONS) for good.
+    let stream = socket.get_mut();
+    if stream.set_read_timeout(Some(POLL)).is_err()
+        || stream.set_write_timeout(Some(WRITE_TIMEOUT)).is_err()
+    {
         return;
     }
     let _ = socket.get_mut().set_nodelay(true);
@@ -140,10 +147,10 @@ fn page_loop(mut socket: WebSocket<TcpStream>, session: &Mutex<dyn LiveSession>,
     loop {
         match socket.read() {
             Ok(Message::Text(text)) => handle(text.as_str(), id, session, hub, &|m| {
-                let _ = tx.send(Outgoing::Text(m.into()));
+                let _ = tx.try_send(Outgoing::Text(m.into()));
             }),
             Ok(Message::Binary(_)) => {
-                let _ = tx.send(Outgoing::Text(
+                let _ = tx.try_send(Outgoing::Text(
                     error_message("binary messages are not accepted").into(),
                 ));
             }
@@ -155,13 +162,13 @@ fn page_loop(mut socket: WebSocket<TcpStream>, session: &Mutex<dyn LiveSession>,
                     std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
                 ) => {}
             Err(tungstenite::Error::Capacity(e)) => {
-                let _ = tx.send(Outgoing::Text(
+                let _ = tx.try_send(Outgoing::Text(
                     error_message(&format!("refused: {e}")).into(),
                 ));
             }
             Err(_) => break,
         }
-        if !flush(&mut socket, &rx) {
+        if !flush(&mut socket, &rx) || !hub.serves(id) {
             break;
         }
     }

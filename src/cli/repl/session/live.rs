@@ -92,7 +92,10 @@ impl Session {
         self.from_view = false;
     }
 
-    pub(super) fn as_page(&mut self, run: impl FnOnce(&mut Self) -> anyhow::Result<()>) -> Result<(), String> {
+    pub(super) fn as_page(
+        &mut self,
+        run: impl FnOnce(&mut Self) -> anyhow::Result<()>,
+    ) -> Result<(), String> {
         self.from_view = true;
         let result = run(self);
         self.from_view = false;
