@@ -90,7 +90,7 @@ pub fn run(args: ReplArgs) -> anyhow::Result<()> {
         let (watched, reloaded) = (session.clone(), session.clone());
         crate::cli::view::watch(
             move || lock(&watched).watched_files(),
-            move || lock(&reloaded).watch_reload(),
+            move |changed| lock(&reloaded).watch_reload(changed),
         );
     }
     if interactive {

@@ -610,7 +610,19 @@ fn watch_reloads_a_changed_file_keeping_the_playhead_unless_edits_are_unsaved() 
     assert_eq!(page.scene["t"], 1.0, "the playhead moved");
     repl.type_line("cat.rotate(0, 10);");
     page.until(|v| v["type"] == "scene" && v["patches"][0]["rotation"] == 10.0);
-    std::fs::write(&scene, text).unwrap();
+    std::fs::write(&scene, &text).unwrap();
+    repl.wait_line(|l| l.contains("not reloaded: the session has unsaved edits"));
+    // The session's own `:save` of the loaded file is no change to reload: its history stays.
+    repl.type_line(&format!(":save {}", scene.display()));
+    repl.wait_line(|l| l.starts_with("saved "));
+    std::thread::sleep(Duration::from_millis(1500));
+    repl.type_line(":undo");
+    let line = repl.wait_line(|l| l.starts_with("undone") || l.starts_with("loaded "));
+    assert!(line.starts_with("undone"), "the save was reloaded: {line}");
+    // As many edits as were saved, but not the saved ones: still unsaved.
+    repl.type_line("cat.rotate(0, 20);");
+    page.until(|v| v["type"] == "scene" && v["patches"][0]["rotation"] == 20.0);
+    std::fs::write(&scene, text.replace("0.42", "0.45")).unwrap();
     repl.wait_line(|l| l.contains("not reloaded: the session has unsaved edits"));
     assert!(repl.finish().success());
 }

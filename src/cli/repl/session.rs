@@ -76,8 +76,11 @@ pub struct Session {
     previewing: bool,
     /// Frames sent to the pages so far, so an entry knows whether it showed them one.
     published: std::cell::Cell<u64>,
-    /// How many of `edits` the loaded file holds (it was `:save`d over since the load).
-    saved_edits: usize,
+    /// The scene's revision the loaded file holds (as loaded, or `:save`d over since).
+    saved_revision: u64,
+    /// The loaded file's text as this session last read or wrote it, so `--watch` knows its
+    /// own `:save` from a change made elsewhere.
+    file_text: Option<String>,
 }
 
 impl Session {
@@ -122,7 +125,8 @@ impl Session {
             revision: 0,
             previewing: false,
             published: std::cell::Cell::new(0),
-            saved_edits: 0,
+            saved_revision: 0,
+            file_text: None,
         };
         session.refresh_words();
         session

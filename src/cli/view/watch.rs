@@ -1,7 +1,7 @@
 //! `--watch`: takes two callbacks, one giving the files to watch (the loaded scene file and
 //! the modules its `import` lines name) and one reloading the scene, and gives a thread
 //! that polls those files (twice a second, by modification time and size) and calls the
-//! reload when one changes. What a reload does (refuse over unsaved edits, keep the
+//! reload with the files that changed. What a reload does (refuse over unsaved edits, keep the
 //! playhead) is the caller's: this file knows no session.
 
 use std::path::PathBuf;
@@ -14,7 +14,7 @@ type Stamp = Vec<(PathBuf, Option<(SystemTime, u64)>)>;
 /// Starts the watching thread; the files as they are now are the baseline.
 pub fn watch(
     files: impl Fn() -> Vec<PathBuf> + Send + 'static,
-    reload: impl Fn() + Send + 'static,
+    reload: impl Fn(&[PathBuf]) + Send + 'static,
 ) {
     let mut last = stamp(&files);
     let spawned = std::thread::Builder::new()
@@ -22,10 +22,16 @@ pub fn watch(
         .spawn(move || loop {
             std::thread::sleep(POLL);
             let now = stamp(&files);
-            let changed = last != now && same_files(&last, &now);
+            let changed: Vec<PathBuf> = match same_files(&last, &now) {
+                true => (last.iter().zip(&now))
+                    .filter(|(a, b)| a.1 != b.1)
+                    .map(|(_, b)| b.0.clone())
+                    .collect(),
+                false => Vec::new(),
+            };
             last = now;
-            if changed {
-                reload();
+            if !changed.is_empty() {
+                reload(&changed);
                 last = stamp(&files);
             }
         });

@@ -148,12 +148,17 @@ impl Session {
     }
 
     /// A watched file changed: reloads unless the session has edits not saved to it.
-    pub fn watch_reload(&mut self) {
+    pub fn watch_reload(&mut self, changed: &[PathBuf]) {
         let Some(file) = self.file.clone() else {
             return;
         };
+        let own_write = changed == [file.clone()]
+            && lapclone::script::read_scene_text(&file).ok() == self.file_text;
+        if own_write {
+            return; // this session's `:save`: what it holds is what the file says
+        }
         self.from_view = true;
-        if self.edits.len() != self.saved_edits {
+        if self.revision != self.saved_revision {
             self.say(format!(
                 "{} changed on disk; not reloaded: the session has unsaved edits (:save it, or \
                  :reload to drop them)",

@@ -41,9 +41,10 @@ impl Session {
         self.scope = scope;
         self.functions = ast.clone_functions_only();
         self.imports = import_statements(&text);
+        self.file_text = Some(text.clone());
         self.base_text = Some(text);
         self.edits.clear();
-        self.saved_edits = 0;
+        self.saved_revision = self.revision;
         self.warned.clear();
         self.undo.clear();
         self.file = Some(file.clone());

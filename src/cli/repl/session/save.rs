@@ -17,7 +17,8 @@ impl Session {
         lapclone::util::write_atomic(path, text.as_bytes())
             .with_context(|| format!("writing {}", path.display()))?;
         if path.canonicalize().ok() == self.file {
-            self.saved_edits = self.edits.len();
+            self.saved_revision = self.revision;
+            self.file_text = Some(text);
         }
         match form {
             SaveForm::Script => self.say(format!("saved {}", path.display())),
