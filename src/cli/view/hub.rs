@@ -6,7 +6,7 @@
 //! Between two frames over the same background only the union of their drawn regions can
 //! differ, so only that part is converted and compared.
 
-use std::sync::mpsc::{Receiver, SyncSender};
+use std::sync::mpsc::{Receiver, SyncSender, TrySendError};
 use std::sync::Mutex;
 
 use lapclone::pixels::{Canvas, CanvasPixels, PixelFormat, PixelRect};
@@ -43,14 +43,17 @@ pub enum Outgoing {
     Text(Utf8Bytes),
 }
 
-/// Messages queued for one page before it counts as gone: a page that stops reading would
-/// otherwise hold every frame published since (a gigabyte a minute during a drag). A page
-/// that reads keeps one or two in its queue.
+/// Messages queued for one page: a page that stops reading would otherwise hold every frame
+/// published since (a gigabyte a minute during a drag). A page whose queue fills is sent
+/// nothing more until it has read the queue, then the whole frame as it is by then.
 pub const PAGE_QUEUE: usize = 64;
 
 struct Client {
     id: u64,
     tx: SyncSender<Outgoing>,
+    /// Whether this page's queue filled: it missed updates, so the next thing it is sent is
+    /// the whole frame ([`Hub::catch_up`]).
+    behind: bool,
     /// Whether this page shows the mesh overlay (its scene messages carry the meshes).
     mesh: bool,
 }
@@ -91,23 +94,14 @@ impl Hub {
         let mut state = lock(&self.state);
         state.next_id += 1;
         let id = state.next_id;
-        if let Some(Published {
-            width: w,
-            height: h,
-            rgba,
-            ..
-        }) = &state.frame
-        {
-            let message = frame_message(*w, *h, rgba, [0, 0, *w, *h]);
-            let _ = tx.try_send(Outgoing::Binary(message.into()));
-        }
-        if let Some((plain, _)) = &state.scene {
-            let _ = tx.try_send(Outgoing::Text(plain.clone()));
+        for message in state.whole(false) {
+            let _ = tx.try_send(message);
         }
         state.clients.push(Client {
             id,
             tx,
             mesh: false,
+            behind: false,
         });
         id
     }
@@ -116,10 +110,21 @@ impl Hub {
         lock(&self.state).clients.retain(|c| c.id != id);
     }
 
-    /// Whether page `id` is still served: false once it left or fell [`PAGE_QUEUE`]
-    /// messages behind.
-    pub fn serves(&self, id: u64) -> bool {
-        lock(&self.state).clients.iter().any(|c| c.id == id)
+    /// For page `id` once it has read its queue: if updates were dropped for it, queues the
+    /// whole last frame and scene message, so it shows what every other page shows.
+    pub fn catch_up(&self, id: u64) {
+        let mut state = lock(&self.state);
+        let Some(c) = state.clients.iter().find(|c| c.id == id && c.behind) else {
+            return;
+        };
+        let messages = state.whole(c.mesh);
+        // invariant: found just above, under the same lock.
+        let c = state
+            .clients
+            .iter_mut()
+            .find(|c| c.id == id)
+            .expect("found");
+        c.behind = !messages.into_iter().all(|m| c.tx.try_send(m).is_ok());
     }
 
     /// Whether any page wants the meshes (so the session builds that form).
@@ -162,13 +167,12 @@ impl Hub {
         let frame = Bytes::from(message);
         let plain = Utf8Bytes::from(scene.plain);
         let with_mesh = scene.with_mesh.map(Utf8Bytes::from);
-        state.clients.retain(|c| {
+        state.clients.retain_mut(|c| {
             let text = match (&with_mesh, c.mesh) {
                 (Some(m), true) => m.clone(),
                 _ => plain.clone(),
             };
-            c.tx.try_send(Outgoing::Binary(frame.clone())).is_ok()
-                && c.tx.try_send(Outgoing::Text(text)).is_ok()
+            c.offer(Outgoing::Binary(frame.clone())) && c.offer(Outgoing::Text(text))
         });
         state.scene = Some((plain, with_mesh));
     }
@@ -178,7 +182,51 @@ impl Hub {
         let text = Utf8Bytes::from(text);
         lock(&self.state)
             .clients
-            .retain(|c| c.tx.try_send(Outgoing::Text(text.clone())).is_ok());
+            .retain_mut(|c| c.offer(Outgoing::Text(text.clone())));
+    }
+}
+
+impl State {
+    /// The whole last frame and scene message (with the meshes for `mesh`), as a page that
+    /// knows nothing yet is sent them.
+    fn whole(&self, mesh: bool) -> Vec<Outgoing> {
+        let mut messages = Vec::new();
+        if let Some(Published {
+            width: w,
+            height: h,
+            rgba,
+            ..
+        }) = &self.frame
+        {
+            let message = frame_message(*w, *h, rgba, [0, 0, *w, *h]);
+            messages.push(Outgoing::Binary(message.into()));
+        }
+        if let Some((plain, with_mesh)) = &self.scene {
+            let text = match (with_mesh, mesh) {
+                (Some(m), true) => m,
+                _ => plain,
+            };
+            messages.push(Outgoing::Text(text.clone()));
+        }
+        messages
+    }
+}
+
+impl Client {
+    /// Queues `message` unless the page is behind; marks it behind when its queue is full.
+    /// False once the page is gone.
+    fn offer(&mut self, message: Outgoing) -> bool {
+        if self.behind {
+            return true;
+        }
+        match self.tx.try_send(message) {
+            Ok(()) => true,
+            Err(TrySendError::Full(_)) => {
+                self.behind = true;
+                true
+            }
+            Err(TrySendError::Disconnected(_)) => false,
+        }
     }
 }
 
@@ -388,35 +436,35 @@ mod tests {
         assert_eq!(&m[FRAME_HEADER..], canvas(&[]).samples(PixelFormat::RGBA8));
     }
 
-    /// A page that stops reading is dropped once its queue is full; one that reads is not.
+    /// A page that stops reading is queued at most [`PAGE_QUEUE`] messages; once it reads
+    /// them it is sent the whole frame as it is then. A page that reads misses nothing.
     #[test]
-    fn a_page_that_stops_reading_is_dropped_at_its_queue_bound() {
+    fn a_page_that_stops_reading_holds_a_bounded_queue_then_catches_up() {
         let hub = Hub::default();
         let (tx, stuck) = channel();
         let stuck_id = hub.connect(tx);
         let (tx, reader) = channel();
-        let reader_id = hub.connect(tx);
-        let mut published = 0;
-        while hub.serves(stuck_id) {
-            hub.publish(
-                &canvas(&[(published % 30, [published as u8, 0, 0, 255])]),
-                None,
-                scene(),
-            );
-            published += 1;
-            assert!(
-                published <= PAGE_QUEUE,
-                "still served after {published} frames"
-            );
-            while reader.try_recv().is_ok() {}
+        hub.connect(tx);
+        let mut read = 0;
+        let frames = 3 * PAGE_QUEUE;
+        let mut last = canvas(&[]);
+        for k in 0..frames {
+            last = canvas(&[(k % 30, [k as u8, 0, 0, 255])]);
+            hub.publish(&last, None, scene());
+            read += reader.try_iter().count();
         }
-        // Two messages a frame fill the queue; the next frame finds it full.
-        assert_eq!(published, PAGE_QUEUE / 2 + 1);
-        assert!(hub.serves(reader_id));
-        hub.broadcast("{}".into());
-        assert!(matches!(reader.try_recv(), Ok(Outgoing::Text(_))));
-        // What was queued for the dropped page stays bounded.
-        assert_eq!(stuck.try_iter().count(), PAGE_QUEUE);
+        hub.catch_up(stuck_id); // its queue is still full: nothing more
+        assert_eq!(read, 2 * frames, "the reading page missed updates");
+        let queued: Vec<Outgoing> = stuck.try_iter().collect();
+        assert_eq!(queued.len(), PAGE_QUEUE);
+        hub.catch_up(stuck_id);
+        let caught: Vec<Outgoing> = stuck.try_iter().collect();
+        let [Outgoing::Binary(m), Outgoing::Text(_)] = &caught[..] else {
+            panic!("not the whole frame and the scene after catching up: {caught:?}");
+        };
+        assert_eq!(&m[FRAME_HEADER..], last.samples(PixelFormat::RGBA8));
+        hub.catch_up(stuck_id);
+        assert_eq!(stuck.try_iter().count(), 0, "caught up twice");
     }
 
     /// The pixels a message carries, written into `frame` (6 px wide) as a page does.

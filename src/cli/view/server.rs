@@ -168,9 +168,10 @@ fn page_loop(mut socket: WebSocket<TcpStream>, session: &Mutex<dyn LiveSession>,
             }
             Err(_) => break,
         }
-        if !flush(&mut socket, &rx) || !hub.serves(id) {
+        if !flush(&mut socket, &rx) {
             break;
         }
+        hub.catch_up(id);
     }
     hub.disconnect(id);
 }
