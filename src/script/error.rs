@@ -96,7 +96,7 @@ impl SceneError {
         let text = match text {
             Some(t) => t,
             None => {
-                let Ok(t) = super::engine::read_source(&self.file) else {
+                let Ok(t) = super::source::read_source(&self.file) else {
                     return;
                 };
                 from_disk = t;

@@ -14,6 +14,7 @@ mod follow_api;
 mod memory;
 mod footage_options;
 mod sandbox;
+mod source;
 mod validate;
 mod values;
 

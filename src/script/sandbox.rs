@@ -240,7 +240,7 @@ impl SandboxResolver {
         file: &Path,
         pos: Position,
     ) -> Result<SharedModule, Box<EvalAltResult>> {
-        let text = super::engine::read_source(file).map_err(|e| {
+        let text = super::source::read_source(file).map_err(|e| {
             EvalAltResult::ErrorRuntime(
                 format!("cannot read module {}: {e}", file.display()).into(),
                 pos,

@@ -114,17 +114,14 @@ impl Hub {
     /// whole last frame and scene message, so it shows what every other page shows.
     pub fn catch_up(&self, id: u64) {
         let mut state = lock(&self.state);
-        let Some(c) = state.clients.iter().find(|c| c.id == id && c.behind) else {
+        let behind = state.clients.iter().find(|c| c.id == id && c.behind);
+        let Some(mesh) = behind.map(|c| c.mesh) else {
             return;
         };
-        let messages = state.whole(c.mesh);
-        // invariant: found just above, under the same lock.
-        let c = state
-            .clients
-            .iter_mut()
-            .find(|c| c.id == id)
-            .expect("found");
-        c.behind = !messages.into_iter().all(|m| c.tx.try_send(m).is_ok());
+        let messages = state.whole(mesh);
+        if let Some(c) = state.clients.iter_mut().find(|c| c.id == id) {
+            c.behind = !messages.into_iter().all(|m| c.tx.try_send(m).is_ok());
+        }
     }
 
     /// Whether any page wants the meshes (so the session builds that form).
