@@ -369,6 +369,47 @@ fn no_preview_outlives_an_entry_that_shows_nothing() {
     assert!(repl.finish().success());
 }
 
+/// A gesture's keys go at the playhead it began at, even when another page seeks while it
+/// runs: its values were measured in that frame.
+#[test]
+fn a_seek_from_another_page_mid_gesture_leaves_the_gestures_keys_where_it_began() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = cat_scene(dir.path());
+    let mut repl = ViewRepl::start(dir.path(), &scene);
+    let mut page = repl.page();
+    let mut other = repl.page();
+    repl.type_line(":t 1.25");
+    page.until(|v| v["type"] == "scene" && v["t"] == 1.25);
+    let rev = page.rev();
+    let [x, y] = page.cat_at().map(f64::round);
+    let edit = |value: [f64; 2], commit: bool| {
+        json!({"type": "edit", "rev": rev, "commit": commit, "t": 1.25,
+               "edit": {"op": "at", "patch": "cat", "value": value}})
+    };
+    page.send(&edit([x + 10.0, y], false));
+    page.until_scene();
+    other.send(&json!({"type": "seek", "t": 0.5}));
+    page.until(|v| v["type"] == "scene" && v["t"] == 0.5);
+    page.send(&edit([x + 20.0, y], false));
+    page.until_scene();
+    page.send(&edit([x + 20.0, y], true));
+    let line = page.until(|v| v["type"] == "line");
+    let expected = format!("cat.at(1.25, [{}, {}]);", x + 20.0, y);
+    assert_eq!(line["text"], expected.as_str());
+    // The session stays where the other page put it, showing the committed scene there (the
+    // frame and scene message come before the line).
+    assert_eq!(page.scene["t"], 0.5);
+    let saved = dir.path().join("saved.rhai");
+    repl.type_line(&format!(":save {}", saved.display()));
+    repl.wait_line(|l| l.starts_with("saved "));
+    let reference = preview_png(dir.path(), &saved, 0.5);
+    assert!(
+        page.frame == reference.as_raw()[..],
+        "frame differs from preview at 0.5"
+    );
+    assert!(repl.finish().success());
+}
+
 #[test]
 fn wrong_tokens_foreign_origins_and_malformed_messages_change_nothing() {
     let dir = tempfile::tempdir().unwrap();

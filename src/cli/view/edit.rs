@@ -23,8 +23,17 @@ pub enum Request {
     /// Where a canvas point falls: the patch on top there and its source coordinates.
     Locate { x: f64, y: f64 },
     /// A scene edit made against revision `rev`: previewed while a gesture runs
-    /// (`commit: false`), run as one REPL line when it ends (`commit: true`).
-    Edit { rev: u64, commit: bool, edit: Edit },
+    /// (`commit: false`), run as one REPL line when it ends (`commit: true`). `t` is the
+    /// playhead the page showed when the gesture began, where its keys go (the gesture's
+    /// values were measured there, even if another page has moved the playhead since);
+    /// without it, the session's playhead.
+    Edit {
+        rev: u64,
+        commit: bool,
+        edit: Edit,
+        #[serde(default)]
+        t: Option<f64>,
+    },
     /// Escape: drop the gesture's preview.
     Cancel,
     /// Ctrl+Z: `:undo`.
@@ -134,7 +143,10 @@ pub fn parse_request(text: &str) -> Result<Request, String> {
             bounded(*x)?;
             bounded(*y)?;
         }
-        Request::Edit { edit, .. } => check_edit(edit)?,
+        Request::Edit { edit, t, .. } => {
+            t.map_or(Ok(()), time)?;
+            check_edit(edit)?
+        }
         _ => {}
     }
     Ok(request)
@@ -468,11 +480,26 @@ mod tests {
             r#"{"type":"edit","rev":1,"commit":true,"edit":{"op":"remove_key","patch":"c","handle":0,"track":"scale","t":1}}"#,
             r#"{"type":"edit","rev":1,"commit":true,"edit":{"op":"handle_radius","patch":"c","handle":0,"value":0}}"#,
             r#"{"type":"edit","rev":1,"commit":true,"edit":{"op":"handle_radius","patch":"c","handle":-1,"value":3}}"#,
+            r#"{"type":"edit","rev":1,"commit":true,"t":-0.5,"edit":{"op":"at","patch":"c","value":[1,2]}}"#,
+            r#"{"type":"edit","rev":1,"commit":true,"t":1e7,"edit":{"op":"at","patch":"c","value":[1,2]}}"#,
+            r#"{"type":"edit","rev":1,"commit":true,"t":"1","edit":{"op":"at","patch":"c","value":[1,2]}}"#,
             "not json",
         ] {
             assert!(parse_request(text).is_err(), "{text}");
         }
         assert!(parse_request(&" ".repeat(MAX_MESSAGE_BYTES + 1)).is_err());
+    }
+
+    #[test]
+    fn an_edit_carries_the_playhead_its_gesture_began_at_or_none() {
+        let with = r#"{"type":"edit","rev":1,"commit":false,"t":0.75,"edit":{"op":"at","patch":"c","value":[1,2]}}"#;
+        let without = r#"{"type":"edit","rev":1,"commit":false,"edit":{"op":"at","patch":"c","value":[1,2]}}"#;
+        let t = |text| match parse_request(text) {
+            Ok(Request::Edit { t, .. }) => t,
+            other => panic!("{other:?}"),
+        };
+        assert_eq!(t(with), Some(0.75));
+        assert_eq!(t(without), None);
     }
 
     #[test]

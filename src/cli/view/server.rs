@@ -43,8 +43,15 @@ pub trait LiveSession: Send {
     fn view_seek(&mut self, t: f64) -> Result<(), String>;
     /// The `located` reply for canvas point (x, y).
     fn view_locate(&self, x: f64, y: f64) -> String;
-    /// Previews (`commit` false) or commits a page edit made against revision `rev`.
-    fn view_edit(&mut self, rev: u64, commit: bool, edit: &Edit) -> Result<(), String>;
+    /// Previews (`commit` false) or commits a page edit made against revision `rev`, keyed
+    /// at `t` (the playhead the gesture began at) or, without it, at the session's playhead.
+    fn view_edit(
+        &mut self,
+        rev: u64,
+        commit: bool,
+        edit: &Edit,
+        t: Option<f64>,
+    ) -> Result<(), String>;
     /// Escape: back to the committed scene's frame.
     fn view_cancel(&mut self) -> Result<(), String>;
     /// Ctrl+Z in a page.
@@ -211,7 +218,12 @@ fn handle(
             reply(session.view_locate(x, y));
             Ok(())
         }
-        Request::Edit { rev, commit, edit } => session.view_edit(rev, commit, &edit),
+        Request::Edit {
+            rev,
+            commit,
+            edit,
+            t,
+        } => session.view_edit(rev, commit, &edit, t),
         Request::Cancel => session.view_cancel(),
         Request::Undo => session.view_undo(),
         Request::Save { rev } => session.view_save(rev),

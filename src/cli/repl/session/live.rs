@@ -213,8 +213,16 @@ impl LiveSession for Session {
             .to_string()
     }
 
-    /// Previews (`commit` false) or commits a page edit made against revision `rev`.
-    fn view_edit(&mut self, rev: u64, commit: bool, edit: &Edit) -> Result<(), String> {
+    /// Previews (`commit` false) or commits a page edit made against revision `rev`, keyed
+    /// at `t` (the playhead the gesture began at) or, without it, at the session's playhead.
+    fn view_edit(
+        &mut self,
+        rev: u64,
+        commit: bool,
+        edit: &Edit,
+        t: Option<f64>,
+    ) -> Result<(), String> {
+        let t = t.unwrap_or(self.time);
         if rev != self.revision {
             self.publish();
             return Err(format!(
@@ -232,18 +240,14 @@ impl LiveSession for Session {
             return Err(format!("no patch {:?}", edit.patch()));
         }
         if commit {
-            let line = edit.line(
-                self.time,
-                &self.receiver(edit.patch()),
-                &self.new_handle_name(),
-            );
+            let line = edit.line(t, &self.receiver(edit.patch()), &self.new_handle_name());
             return self.view_line(&line);
         }
         if !edit.previews() {
             return Err("this edit has no preview".into());
         }
         let mut scene = self.current_scene().map_err(|e| e.to_string())?;
-        edit.apply_key(&mut scene, self.time)?;
+        edit.apply_key(&mut scene, t)?;
         let renderer = self.renderer.as_mut().ok_or("no scene to preview")?;
         renderer.set_scene(scene).map_err(|e| e.to_string())?;
         self.previewing = true;

@@ -14,6 +14,7 @@
   const token = new URLSearchParams(location.search).get("token") || "";
   const TRACK_COLOURS = { at: "#f0c674", scale: "#81a2be", rotate: "#b294bb", depth: "#8abeb7", opacity: "#de935f" };
   let ws = null, scene = null, located = null, gesture = null, selected = null;
+  // pendingEdit: { edit, t }, t being the playhead its gesture began at.
   let pendingEdit = null, inFlight = false, locating = false, nextLocate = null;
   let playing = false, meshOn = false, scrubbing = false;
   // Pointer event → pixels painted, ms, per preview: from the earliest pointer event the
@@ -333,8 +334,8 @@
   }
 
   // One preview in flight at a time; the newest waiting one replaces older ones.
-  function queueEdit(edit) {
-    pendingEdit = edit;
+  function queueEdit(edit, t) {
+    pendingEdit = { edit, t };
     flushEdit();
   }
   function flushEdit() {
@@ -343,7 +344,7 @@
     sentAt = pointerAt || sendAt;
     pointerAt = 0;
     inFlight = true;
-    send({ type: "edit", rev: scene.rev, commit: false, edit: pendingEdit });
+    send({ type: "edit", rev: scene.rev, commit: false, t: pendingEdit.t, edit: pendingEdit.edit });
     pendingEdit = null;
   }
 
@@ -370,7 +371,7 @@
       gesture.last = editFor(gesture, q);
       if (gesture.last) {
         if (!pointerAt) pointerAt = e.timeStamp;
-        queueEdit(gesture.last);
+        queueEdit(gesture.last, gesture.t);
       }
     }
   }
@@ -385,9 +386,12 @@
       return;
     }
     if (!hit) { gesture = { kind: "none", start: q, shift: e.shiftKey }; return; }
+    // A gesture edits the frame it grabbed: playback stops, and its keys go at this playhead
+    // (its values are measured here) even if another page seeks meanwhile.
+    if (playing) togglePlay();
     const base = JSON.parse(JSON.stringify(patchNamed(hit.patch)));
     const mode = e.shiftKey ? "rotate" : e.altKey ? "scale" : "move";
-    gesture = { kind: hit.kind, patch: hit.patch, index: hit.index, base, start: q, mode, moved: false, shift: e.shiftKey };
+    gesture = { kind: hit.kind, patch: hit.patch, index: hit.index, base, start: q, mode, moved: false, shift: e.shiftKey, t: scene.t };
     if (hit.kind === "handle" || hit.kind === "pin") { selected = hit; drawOverlay(); }
     overlay.setPointerCapture(e.pointerId);
   });
@@ -416,7 +420,7 @@
     const edit = editFor(g, q);
     pendingEdit = null;
     pointerAt = 0;
-    if (edit) send({ type: "edit", rev: scene.rev, commit: true, edit });
+    if (edit) send({ type: "edit", rev: scene.rev, commit: true, t: g.t, edit });
   });
 
   function copyPair(q, source) {
