@@ -52,6 +52,7 @@ pub fn run(args: TrackArgs) -> anyhow::Result<()> {
     check_arguments(&args)?;
     let footage = Footage::open(&args.footage, args.start, false, "hold")
         .with_context(|| format!("opening {}", args.footage.display()))?;
+    lapclone::output::refuse_footage_input(&args.output, &footage)?;
     let reader = FootageReader::new(footage, args.fps);
     let available = available_frames(&reader, args.fps)?;
     let range = args.frames.unwrap_or(FrameRange {
@@ -64,12 +65,6 @@ pub fn run(args: TrackArgs) -> anyhow::Result<()> {
             range.first, range.last
         ))
         .into());
-    }
-    if let FootageSource::Sequence { pattern, start } = &reader.footage().source {
-        let mut frame_files = (range.first - 1..range.last).map(|i| pattern.path(start + i));
-        if frame_files.any(|file| same_file(&file, &args.output)) {
-            return Err(UsageError("-o must not name a frame of the footage".into()).into());
-        }
     }
     let options = TrackOptions {
         size: args.size,
@@ -149,20 +144,10 @@ fn check_arguments(args: &TrackArgs) -> anyhow::Result<()> {
     if args.fps <= 0.0 || args.fps > 1000.0 {
         return Err(UsageError(format!("--fps {} must be in (0, 1000]", args.fps)).into());
     }
-    if same_file(&args.footage, &args.output) {
-        return Err(UsageError("-o must not name the footage".into()).into());
-    }
     if args.output.is_dir() {
         return Err(UsageError(format!("-o {} is a folder", args.output.display())).into());
     }
     Ok(lapclone::output::check_output_folder(&args.output)?)
-}
-
-fn same_file(a: &std::path::Path, b: &std::path::Path) -> bool {
-    match (a.canonicalize(), b.canonicalize()) {
-        (Ok(a), Ok(b)) => a == b,
-        _ => false,
-    }
 }
 
 /// How many frames the footage has: the unbroken run of files from the start, or a

@@ -12,14 +12,11 @@ use crate::scene::{Background, Footage, FootageSource, Shape};
 use crate::script::LoadedScene;
 use crate::util::{folder_of, same_file};
 
-/// Something a render reads: a file, or the files of a numbered sequence it shows.
+/// Something a command reads: a file, or the files of a numbered sequence (every file its
+/// pattern names is footage, including plates outside the frames one command reads).
 enum Input {
     File(PathBuf),
-    Sequence {
-        pattern: Pattern,
-        first: u64,
-        count: u64,
-    },
+    Sequence(Pattern),
 }
 
 impl Input {
@@ -27,17 +24,12 @@ impl Input {
     fn covers(&self, path: &Path) -> bool {
         match self {
             Input::File(file) => same_file(file, path),
-            Input::Sequence {
-                pattern,
-                first,
-                count,
-            } => {
+            Input::Sequence(pattern) => {
                 let Some(name) = path.file_name() else {
                     return false;
                 };
-                same_file(folder_of(&pattern.path(*first)), folder_of(path))
-                    && (*first..first.saturating_add(*count))
-                        .any(|n| pattern.path(n).file_name() == Some(name))
+                pattern.number_of(&name.to_string_lossy()).is_some()
+                    && same_file(folder_of(&pattern.path(0)), folder_of(path))
             }
         }
     }
@@ -45,40 +37,41 @@ impl Input {
     fn describe(&self) -> String {
         match self {
             Input::File(file) => file.display().to_string(),
-            Input::Sequence { pattern, .. } => pattern.text().to_string(),
+            Input::Sequence(pattern) => pattern.text().to_string(),
         }
     }
 }
 
-/// Every file the scene's render reads: the scene, its imports, images, plates, videos.
+/// What `footage` reads: its video, or every plate its pattern names.
+fn footage_input(footage: &Footage) -> Input {
+    match &footage.source {
+        FootageSource::Sequence { pattern, .. } => Input::Sequence(pattern.clone()),
+        FootageSource::Video(path) => Input::File(path.clone()),
+    }
+}
+
+/// Every file the scene's render reads: the scene, its imports, images, plates, videos and
+/// the track files patches follow.
 fn scene_inputs(loaded: &LoadedScene, imports: &[PathBuf]) -> Vec<Input> {
     let scene = &loaded.scene;
-    let count = scene.canvas.frame_count();
     let mut inputs: Vec<Input> = std::iter::once(loaded.file.clone())
         .chain(imports.iter().cloned())
         .map(Input::File)
         .collect();
-    let footage = |f: &Footage| match &f.source {
-        FootageSource::Sequence { pattern, start } => Input::Sequence {
-            pattern: pattern.clone(),
-            first: *start,
-            count,
-        },
-        FootageSource::Video(path) => Input::File(path.clone()),
-    };
     match &scene.canvas.background {
         Background::Image(path) => inputs.push(Input::File(path.clone())),
-        Background::Footage(f) => inputs.push(footage(f)),
+        Background::Footage(f) => inputs.push(footage_input(f)),
         Background::Colour(_) => {}
     }
     for patch in &scene.patches {
         inputs.push(Input::File(patch.source.clone()));
         if let Some(f) = &patch.footage {
-            inputs.push(footage(f));
+            inputs.push(footage_input(f));
         }
         if let Shape::Mask(mask) = &patch.shape {
             inputs.push(Input::File(mask.clone()));
         }
+        inputs.extend(patch.follows.iter().map(|f| Input::File(f.file.clone())));
     }
     inputs
 }
@@ -126,6 +119,15 @@ fn refuse_replacing(
         }
     }
     Ok(())
+}
+
+/// Refuses an output that is `footage`'s video or any plate its pattern names.
+pub fn refuse_footage_input(output: &Path, footage: &Footage) -> Result<(), OutputError> {
+    let input = footage_input(footage);
+    match output.exists() && input.covers(output) {
+        true => Err(overwrite(output, &input.describe())),
+        false => Ok(()),
+    }
 }
 
 /// Refuses an output that is one of `inputs` (a command's input files).

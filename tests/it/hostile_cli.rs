@@ -327,6 +327,8 @@ fn an_output_that_is_an_input_is_refused() {
     world.write("lib.rhai", "fn width() { 40 }\n");
     let scene = world.scene("victim.rhai", "import \"lib\" as lib;\n");
     let original = std::fs::read(&scene).unwrap();
+    world.write("face.csv", "frame,x,y\n1,20,15\n2,21,15\n3,22,16\n");
+    world.scene("follows.rhai", "p.follow(\"face.csv\");\n");
     #[cfg(unix)]
     {
         std::os::unix::fs::symlink(world.path("lib.rhai"), world.path("lib_link.gif")).unwrap();
@@ -358,6 +360,16 @@ fn an_output_that_is_an_input_is_refused() {
             "20,15", "-o", "bg.png",
         ],
         vec!["mesh", "mask.png", "-o", "mask.png"],
+        // A followed track file is an input too.
+        vec![
+            "render",
+            "follows.rhai",
+            "-o",
+            "face.csv",
+            "--format",
+            "gif",
+        ],
+        vec!["preview", "follows.rhai", "-o", "face.csv"],
     ];
     #[cfg(unix)]
     cases.extend([
@@ -393,6 +405,33 @@ fn an_output_that_is_an_input_is_refused() {
     assert_eq!(
         sorted_names(&world.path("out")),
         ["frame_0001.png", "frame_0002.png"]
+    );
+    // Every plate a pattern names is footage, also outside the frames one run reads.
+    std::fs::copy(world.path("bg.png"), world.path("out/frame_0009.png")).unwrap();
+    let plate = std::fs::read(world.path("out/frame_0009.png")).unwrap();
+    let track = [
+        "track",
+        "out/frame_%04d.png",
+        "--point",
+        "20,15",
+        "--frames",
+        "1..2",
+        "-o",
+    ];
+    for output in ["out/frame_0009.png", "out/frame_0002.png"] {
+        let args: Vec<&str> = track.iter().copied().chain([output]).collect();
+        expect(&world.run(&args), 1, "would replace an input");
+    }
+    let args = [
+        "preview",
+        plates.to_str().unwrap(),
+        "-o",
+        "out/frame_0009.png",
+    ];
+    expect(&world.run(&args), 1, "would replace an input");
+    assert_eq!(
+        std::fs::read(world.path("out/frame_0009.png")).unwrap(),
+        plate
     );
 }
 

@@ -57,7 +57,7 @@ impl Pattern {
     }
 
     /// The number in `name` if it is one of this pattern's file names.
-    fn number_of(&self, name: &str) -> Option<u64> {
+    pub fn number_of(&self, name: &str) -> Option<u64> {
         let middle = name
             .strip_prefix(&self.prefix)?
             .strip_suffix(&self.suffix)?;
