@@ -59,16 +59,19 @@ pub struct EntriesFailed(pub usize);
 
 pub fn run(args: ReplArgs) -> anyhow::Result<()> {
     let interactive = args.script.is_none() && std::io::stdin().is_terminal();
-    let preview_path = args.preview.clone().unwrap_or_else(default_preview_path);
+    // The default preview's folder is this process's own: removed when the session ends.
+    let (preview_path, _cleanup) = match &args.preview {
+        Some(path) => (path.clone(), None),
+        None => default_preview_path().map(|(path, folder)| (path, Some(folder)))?,
+    };
     lapclone::output::check_output_folder(&preview_path)?;
     let cancel = Arc::new(AtomicBool::new(false));
     let words = Arc::new(Mutex::new(completion::Words::default()));
-    // The default preview is this process's own temp file: removed when the session ends.
-    let _cleanup = args
-        .preview
-        .is_none()
-        .then(|| RemoveOnExit(preview_path.clone()));
-    let preview = Preview::new(preview_path, interactive, Inline::detect(interactive));
+    let preview = Preview::new(
+        preview_path.clone(),
+        interactive,
+        Inline::detect(interactive),
+    );
     let session = Arc::new(Mutex::new(Session::new(
         cancel.clone(),
         preview,
@@ -81,7 +84,13 @@ pub fn run(args: ReplArgs) -> anyhow::Result<()> {
     }
     let mut failures = 0;
     if let Some(scene) = &args.scene {
-        if let Err(error) = lock(&session).load(scene) {
+        let loaded = lock(&session).load(scene);
+        // A preview that would replace what the scene reads ends the session before it
+        // starts, instead of failing every entry.
+        lock(&session)
+            .refuse_input(&preview_path, false)
+            .context("--preview")?;
+        if let Err(error) = loaded {
             eprintln!("{}", super::describe(&error));
             failures += 1;
         }
@@ -136,14 +145,6 @@ fn start_view(
 }
 
 /// Removes its file when dropped (a file that was never written is no error).
-struct RemoveOnExit(PathBuf);
-
-impl Drop for RemoveOnExit {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_file(&self.0);
-    }
-}
-
 /// Splits `input` into entries as the interactive validator would (unfinished Rhai goes on
 /// on the next line) and runs them; gives the number of failed entries.
 fn script_loop(session: &Mutex<Session>, input: Box<dyn BufRead>) -> anyhow::Result<usize> {
@@ -210,7 +211,10 @@ fn interactive_loop(
     }
     add_page_lines(printer, editor.history_mut());
     if let Some(path) = &history {
-        save_history(&mut editor, path);
+        match lock(session).refuse_input(path, false) {
+            Ok(()) => save_history(&mut editor, path),
+            Err(error) => eprintln!("warning: history not written: {}", super::describe(&error)),
+        }
     }
     Ok(())
 }

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 
 use super::{foreign_frames, OutputError, OutputKind};
 use crate::pixels::footage::Pattern;
-use crate::scene::{Background, Footage, FootageSource, Shape};
+use crate::scene::{Background, Footage, FootageSource, Scene, Shape};
 use crate::script::LoadedScene;
 use crate::util::{folder_of, same_file};
 
@@ -50,14 +50,17 @@ fn footage_input(footage: &Footage) -> Input {
     }
 }
 
-/// Every file the scene's render reads: the scene, its imports, images, plates, videos and
-/// the track files patches follow.
+/// Every file the scene's render reads: the scene file, then [`scene_reads`].
 fn scene_inputs(loaded: &LoadedScene, imports: &[PathBuf]) -> Vec<Input> {
-    let scene = &loaded.scene;
-    let mut inputs: Vec<Input> = std::iter::once(loaded.file.clone())
-        .chain(imports.iter().cloned())
-        .map(Input::File)
-        .collect();
+    let mut inputs = vec![Input::File(loaded.file.clone())];
+    inputs.extend(scene_reads(&loaded.scene, imports));
+    inputs
+}
+
+/// The files `scene` reads and its `imports`: images, plates, videos and the track files
+/// patches follow.
+fn scene_reads(scene: &Scene, imports: &[PathBuf]) -> Vec<Input> {
+    let mut inputs: Vec<Input> = imports.iter().cloned().map(Input::File).collect();
     match &scene.canvas.background {
         Background::Image(path) => inputs.push(Input::File(path.clone())),
         Background::Footage(f) => inputs.push(footage_input(f)),
@@ -119,6 +122,23 @@ fn refuse_replacing(
         }
     }
     Ok(())
+}
+
+/// Refuses an output that is a file `scene` reads (an image, a plate, a video, a track
+/// file) or one of its `imports`. The scene text's own file is not among them: a session
+/// saving its scene writes that file.
+pub fn refuse_scene_reads(
+    output: &Path,
+    scene: &Scene,
+    imports: &[PathBuf],
+) -> Result<(), OutputError> {
+    if !output.exists() {
+        return Ok(());
+    }
+    match scene_reads(scene, imports).iter().find(|i| i.covers(output)) {
+        Some(input) => Err(overwrite(output, &input.describe())),
+        None => Ok(()),
+    }
 }
 
 /// Refuses an output that is `footage`'s video or any plate its pattern names.

@@ -35,7 +35,9 @@ pub use gif_palette::{Palette, PaletteMap};
 pub use png_sequence::{
     foreign_frames, frame_digits, frame_file_name, write_png_file, PngSequenceWriter,
 };
-pub use inputs::{refuse_footage_input, refuse_input, refuse_render_input, refuse_scene_input};
+pub use inputs::{
+    refuse_footage_input, refuse_input, refuse_render_input, refuse_scene_input, refuse_scene_reads,
+};
 pub use scene_render::{render_frames, render_scene, RenderOptions, RenderProgress, Rendered};
 pub use request::{check_output_folder, FrameRange, SinkSettings};
 pub use sink::{FrameSink, SinkPlan};

@@ -894,9 +894,12 @@ fn the_repl_refuses_to_render_over_its_own_inputs() {
         std::fs::read(&scene).unwrap(),
         std::fs::read(world.path("lib.rhai")).unwrap(),
     );
+    let src_before = std::fs::read(world.path("src.png")).unwrap();
+    // `:save` may write the loaded scene file (here: the same text), nothing it reads.
     let output = world.repl(
         &["victim.rhai"],
-        b":gif victim.rhai\n:gif lib.rhai\n:gif out.gif\n",
+        b":gif victim.rhai\n:gif lib.rhai\n:save src.png\n:save lib.rhai\n:gif out.gif\n\
+          :save victim.rhai\n",
         Stdio::piped(),
     );
     let all = format!(
@@ -905,11 +908,26 @@ fn the_repl_refuses_to_render_over_its_own_inputs() {
         String::from_utf8_lossy(&output.stderr)
     );
     assert_eq!(output.status.code(), Some(1), "{all}");
-    assert!(all.contains("2 failed entries"), "{all}");
-    assert_eq!(all.matches("would replace an input").count(), 2, "{all}");
+    assert!(all.contains("4 failed entries"), "{all}");
+    assert_eq!(all.matches("would replace an input").count(), 4, "{all}");
+    assert!(all.contains("saved victim.rhai"), "{all}");
     assert_eq!(std::fs::read(&scene).unwrap(), scene_before);
     assert_eq!(std::fs::read(world.path("lib.rhai")).unwrap(), lib_before);
     assert!(world.path("out.gif").is_file(), "{all}");
+    // A preview file that is the scene or something it reads ends the session at once.
+    for preview in ["victim.rhai", "src.png", "lib.rhai"] {
+        let output = Command::new(env!("CARGO_BIN_EXE_lapclone"))
+            .args(["repl", "victim.rhai", "--preview", preview])
+            .current_dir(world.root.path())
+            .stdin(Stdio::null())
+            .output()
+            .unwrap();
+        expect(&output, 1, "--preview");
+        expect(&output, 1, "would replace an input");
+    }
+    assert_eq!(std::fs::read(&scene).unwrap(), scene_before);
+    assert_eq!(std::fs::read(world.path("src.png")).unwrap(), src_before);
+    assert_eq!(std::fs::read(world.path("lib.rhai")).unwrap(), lib_before);
 }
 
 #[cfg(target_os = "linux")]

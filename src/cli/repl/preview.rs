@@ -149,8 +149,15 @@ pub fn show_picture(picture: &image::RgbaImage) -> bool {
 }
 
 /// The default preview file: one per process in the system temp folder.
-pub fn default_preview_path() -> PathBuf {
-    std::env::temp_dir().join(format!("lapclone-preview-{}.png", std::process::id()))
+/// The default preview: `preview.png` in a folder of its own under the system temp folder,
+/// with a random name and readable by this user only, so nothing another process planted
+/// there (a link, a FIFO) can be followed. The folder goes when the guard is dropped.
+pub fn default_preview_path() -> anyhow::Result<(PathBuf, tempfile::TempDir)> {
+    let folder = tempfile::Builder::new()
+        .prefix("lapclone-preview-")
+        .tempdir()
+        .context("creating the preview's temporary folder")?;
+    Ok((folder.path().join("preview.png"), folder))
 }
 
 fn print_inline(protocol: Inline, png: &[u8]) {

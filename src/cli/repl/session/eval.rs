@@ -141,6 +141,7 @@ impl Session {
             return Ok(());
         }
         let renderer = self.renderer.as_ref().context("no scene yet")?;
+        self.refuse_input(&self.preview.path, false)?;
         self.preview.update(renderer)
     }
 

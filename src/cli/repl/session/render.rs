@@ -27,6 +27,7 @@ impl Session {
             let imports = self.engine.module_files().files();
             refuse_render_input(format, output, loaded, &imports)?;
         }
+        self.refuse_input(output, false)?;
         let started = Instant::now();
         let plan = SinkPlan::new(format, output, Default::default())?;
         let mut renderer = Renderer::new(scene).map_err(|e| anyhow::anyhow!("{e}"))?;

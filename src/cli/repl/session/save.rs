@@ -13,6 +13,7 @@ impl Session {
     pub(super) fn save(&mut self, path: &Path) -> anyhow::Result<()> {
         let scene = self.current_scene()?;
         lapclone::output::check_output_folder(path)?;
+        self.refuse_input(path, true)?;
         let (text, form) = saved_text(&scene, self.base_text.as_deref(), &self.edits, path);
         lapclone::util::write_atomic(path, text.as_bytes())
             .with_context(|| format!("writing {}", path.display()))?;
@@ -29,5 +30,19 @@ impl Session {
             )),
         }
         Ok(())
+    }
+
+    /// Refuses `output` when the live scene reads it or imports it, or when it is the loaded
+    /// scene file, unless `scene_file_ok` (`:save` writes that file).
+    pub fn refuse_input(&self, output: &Path, scene_file_ok: bool) -> anyhow::Result<()> {
+        if let Some(renderer) = &self.renderer {
+            let imports = self.engine.module_files().files();
+            lapclone::output::refuse_scene_reads(output, renderer.scene(), &imports)?;
+        }
+        let file = self.file.as_deref().filter(|_| !scene_file_ok);
+        Ok(lapclone::output::refuse_input(
+            output,
+            &file.into_iter().collect::<Vec<_>>(),
+        )?)
     }
 }
