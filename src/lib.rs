@@ -188,6 +188,14 @@ macro_rules! stage_modules {
     )*};
 }
 
+/// `eprintln!` that never panics: a line to a closed or full standard error is dropped (the
+/// standard macro panics then), and the exit code still says how the run went.
+macro_rules! eprint_line {
+    ($($arg:tt)*) => {
+        $crate::util::stderr_line(format_args!($($arg)*))
+    };
+}
+
 stage_modules!(
     clone, deform, golden, limits, mesh, output, pixels, png_bands, process, raster, render, scene,
     script, simd, solve, track, util,
@@ -217,10 +225,10 @@ pub fn run_cli() -> i32 {
         Ok(()) => 0,
         Err(err) => {
             if let Some(usage) = err.downcast_ref::<cli::UsageError>() {
-                eprintln!("lapclone: {usage}");
+                eprint_line!("lapclone: {usage}");
                 return 2;
             }
-            eprintln!("lapclone: error: {}", cli::describe(&err));
+            eprint_line!("lapclone: error: {}", cli::describe(&err));
             1
         }
     }

@@ -40,6 +40,12 @@ pub fn find_program_in(name: &str, search: &std::ffi::OsStr) -> Option<PathBuf> 
     which::which_in(name, Some(search), cwd).ok()
 }
 
+/// Writes `line` and a newline to standard error, dropping them when it is closed or full:
+/// a message is not worth a crash. Called through `eprint_line!`.
+pub fn stderr_line(line: std::fmt::Arguments) {
+    let _ = writeln!(std::io::stderr().lock(), "{line}");
+}
+
 /// Writes `bytes` to `path` by the one output rule ([`TempOutput`]).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     write_atomic_with(path, |file| file.write_all(bytes))

@@ -32,7 +32,7 @@ pub fn run_check(args: CheckArgs) -> anyhow::Result<()> {
         .into_iter()
         .chain(renderer.point_warnings())
     {
-        eprintln!("warning: {warning}");
+        eprint_line!("warning: {warning}");
     }
     Ok(())
 }

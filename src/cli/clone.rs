@@ -260,7 +260,7 @@ fn build_cloner(
     mesh_ms: f64,
 ) -> anyhow::Result<Prepared> {
     for warning in &patch.result.warnings {
-        eprintln!("lapclone: warning: {warning}");
+        eprint_line!("lapclone: warning: {warning}");
     }
     let anchor = match args.anchor {
         AnchorArg::Centre => Anchor::Centre,
@@ -396,9 +396,9 @@ fn time_reclone(
 
 fn report_clone_warnings(stats: &CloneStats) {
     if stats.membrane.constrained == 0 && stats.raster.written == 0 {
-        eprintln!("lapclone: warning: the patch lies entirely outside the target; the output is the target");
+        eprint_line!("lapclone: warning: the patch lies entirely outside the target; the output is the target");
     } else if stats.membrane.constrained == 0 {
-        eprintln!("lapclone: warning: no boundary vertex lies inside the target; the patch is pasted without blending");
+        eprint_line!("lapclone: warning: no boundary vertex lies inside the target; the patch is pasted without blending");
     }
 }
 

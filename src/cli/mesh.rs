@@ -65,7 +65,7 @@ pub fn run(args: MeshArgs) -> anyhow::Result<()> {
     }
     let mesh_ms = started.elapsed().as_secs_f64() * 1e3;
     for warning in &result.warnings {
-        eprintln!("lapclone: warning: {warning}");
+        eprint_line!("lapclone: warning: {warning}");
     }
     if let Some(path) = &args.output {
         write_picture(&result.mesh, &mask, path)?;

@@ -42,7 +42,7 @@ pub fn jobs(asked: Option<usize>, useful: usize) -> Result<usize, UsageError> {
             "--jobs {n}: at most {MAX_JOBS} (this machine has {useful} cores to use)"
         ))),
         Some(n) if n > useful => {
-            eprintln!("note: --jobs {n} lowered to {useful}, the cores this process may use");
+            eprint_line!("note: --jobs {n} lowered to {useful}, the cores this process may use");
             Ok(useful)
         }
         Some(n) => Ok(n),

@@ -21,7 +21,7 @@ pub fn run_render(args: RenderArgs) -> anyhow::Result<()> {
     let plan = SinkPlan::new(kind, &args.output, args.sink_settings())?;
     let (loaded, imports, mut renderer) = load_renderer(&args.scene)?;
     for warning in renderer.point_warnings() {
-        eprintln!("warning: {warning}");
+        eprint_line!("warning: {warning}");
     }
     refuse_render_input(kind, &args.output, &loaded, &imports)?;
     let range = args.range(renderer.frame_count())?;
@@ -34,7 +34,7 @@ pub fn run_render(args: RenderArgs) -> anyhow::Result<()> {
     let summary = summary(&rendered, started, renderer.factorisations());
     // Standard output may be the video stream itself.
     if args.output.as_os_str() == "-" {
-        eprintln!("{summary}");
+        eprint_line!("{summary}");
     } else {
         super::say(summary)?;
     }

@@ -91,7 +91,7 @@ pub fn run(args: ReplArgs) -> anyhow::Result<()> {
             .refuse_input(&preview_path, false)
             .context("--preview")?;
         if let Err(error) = loaded {
-            eprintln!("{}", super::describe(&error));
+            eprint_line!("{}", super::describe(&error));
             failures += 1;
         }
     }
@@ -131,7 +131,7 @@ fn start_view(
     lock(session).attach_view(hub.clone(), printer);
     let server = crate::cli::view::start(args.bind, args.port.unwrap_or(0), session.clone(), hub)?;
     if args.bind.is_some_and(|ip| !ip.is_loopback()) {
-        eprintln!(
+        eprint_line!(
             "warning: the live view listens on {}: anyone who can reach it and has the URL's \
              token can edit this session",
             server.addr
@@ -213,7 +213,7 @@ fn interactive_loop(
     if let Some(path) = &history {
         match lock(session).refuse_input(path, false) {
             Ok(()) => save_history(&mut editor, path),
-            Err(error) => eprintln!("warning: history not written: {}", super::describe(&error)),
+            Err(error) => eprint_line!("warning: history not written: {}", super::describe(&error)),
         }
     }
     Ok(())
@@ -238,7 +238,7 @@ fn line_editor(
     // the editor: rustyline takes SIGINT for itself when it is created.
     let flag = cancel.clone();
     if ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed)).is_err() {
-        eprintln!("warning: Ctrl-C cannot cancel evaluations in this session");
+        eprint_line!("warning: Ctrl-C cannot cancel evaluations in this session");
     }
     editor.set_helper(Some(ReplHelper::new(words)));
     if args.view.view {
@@ -250,7 +250,7 @@ fn line_editor(
                     let _ = external.print(format!("{text}\n"));
                 }));
             }
-            Err(error) => eprintln!("warning: page edits print through the prompt: {error}"),
+            Err(error) => eprint_line!("warning: page edits print through the prompt: {error}"),
         }
     }
     Ok(editor)
@@ -267,7 +267,7 @@ fn add_page_lines(printer: &crate::cli::view::Printer, history: &mut impl Histor
 fn default_history_path() -> Option<PathBuf> {
     let dir = dirs::data_dir()?.join("lapclone");
     if let Err(error) = std::fs::create_dir_all(&dir) {
-        eprintln!(
+        eprint_line!(
             "warning: no history: cannot create {}: {error}",
             dir.display()
         );
@@ -278,7 +278,7 @@ fn default_history_path() -> Option<PathBuf> {
 
 fn save_history(editor: &mut Editor<ReplHelper, FileHistory>, path: &std::path::Path) {
     if let Err(error) = editor.save_history(path) {
-        eprintln!("warning: cannot write history {}: {error}", path.display());
+        eprint_line!("warning: cannot write history {}: {error}", path.display());
     }
 }
 

@@ -58,7 +58,7 @@ pub(crate) struct TerminalProgress(pub ProgressBar);
 
 impl RenderProgress for TerminalProgress {
     fn note(&mut self, message: &str) {
-        eprintln!("note: {message}");
+        eprint_line!("note: {message}");
     }
 
     fn frame_done(&mut self, _number: u64) {
@@ -71,6 +71,6 @@ pub(crate) struct NotesOnly;
 
 impl RenderProgress for NotesOnly {
     fn note(&mut self, message: &str) {
-        eprintln!("note: {message}");
+        eprint_line!("note: {message}");
     }
 }

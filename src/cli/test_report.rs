@@ -14,7 +14,7 @@ use super::UsageError;
 /// Prints a finished scene's results: a line (or, with `json`, an object) per frame.
 pub fn print_scene(result: &SceneResult, json: bool) {
     if let Some(failure) = &result.failure {
-        eprintln!("ERROR {}", failure.message);
+        eprint_line!("ERROR {}", failure.message);
     }
     // A failed write here is reported by the summary line, written the same way.
     for frame in &result.frames {
@@ -89,8 +89,8 @@ pub fn finish(args: &TestArgs, results: &[SceneResult], seconds: f64) -> anyhow:
     let summary = summary_line(&counts, seconds);
     let notes = notes(report.filter(|_| !shown.is_empty()), results);
     if args.json {
-        eprintln!("{summary}");
-        notes.iter().for_each(|n| eprintln!("{n}"));
+        eprint_line!("{summary}");
+        notes.iter().for_each(|n| eprint_line!("{n}"));
     } else {
         super::say(&summary)?;
         for note in &notes {

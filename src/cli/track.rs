@@ -79,7 +79,7 @@ pub fn run(args: TrackArgs) -> anyhow::Result<()> {
         out.flush()
     })
     .with_context(|| format!("writing {}", args.output.display()))?;
-    eprintln!(
+    eprint_line!(
         "tracked {} point{} through frames {}..{} into {}",
         points.len(),
         if points.len() == 1 { "" } else { "s" },
@@ -183,7 +183,7 @@ fn warn_lost(frames: &[TrackedFrame]) {
                 } else {
                     format!("frames {a}–{b}")
                 };
-                eprintln!(
+                eprint_line!(
                     "lapclone: warning: point {} lost at {span} ({why}; confidence down to {worst:.2}); its last sure position is kept there",
                     point + 1
                 );

@@ -80,8 +80,8 @@ pub fn sandboxed_engine(
         }
     });
     // Script output goes to stderr so stdout stays machine-readable.
-    engine.on_print(|text| eprintln!("{text}"));
-    engine.on_debug(|text, _, pos| eprintln!("[{pos}] {text}"));
+    engine.on_print(|text| eprint_line!("{text}"));
+    engine.on_debug(|text, _, pos| eprint_line!("[{pos}] {text}"));
     engine
 }
 

@@ -965,3 +965,43 @@ fn accepting_goldens_into_a_failing_output_is_exit_1_instead_of_a_panic() {
         .unwrap();
     expect(&output, 1, "writing to standard output");
 }
+
+/// Standard error on a full device (as in `lapclone … 2>&1 | head -1` once `head` has gone):
+/// messages are dropped, the exit code still tells, and a REPL session runs to its end.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_full_standard_error_drops_messages_instead_of_a_panic() {
+    let world = World::new();
+    world.scene("fine.rhai", "");
+    let full = || {
+        std::fs::OpenOptions::new()
+            .write(true)
+            .open("/dev/full")
+            .unwrap()
+    };
+    let run = |args: &[&str], input: &[u8]| {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_lapclone"))
+            .args(args)
+            .current_dir(world.root.path())
+            .env("RUST_BACKTRACE", "0")
+            .stdin(Stdio::piped())
+            .stdout(Stdio::null())
+            .stderr(full())
+            .spawn()
+            .unwrap();
+        use std::io::Write as _;
+        child.stdin.take().unwrap().write_all(input).unwrap();
+        child.wait().unwrap().code()
+    };
+    assert_eq!(run(&["check", "missing.rhai"], b""), Some(1));
+    assert_eq!(run(&["render", "fine.rhai", "--jobs", "0"], b""), Some(2));
+    let session = b":bogus\nlet x = ;\n:save after.rhai\n";
+    assert_eq!(
+        run(&["repl", "fine.rhai", "--preview", "p.png"], session),
+        Some(1)
+    );
+    assert!(
+        world.path("after.rhai").is_file(),
+        "the session stopped early"
+    );
+}

@@ -137,7 +137,7 @@ impl Session {
         match self.run_entry(text) {
             Ok(step) => step,
             Err(error) => {
-                eprintln!("{}", crate::cli::describe(&error));
+                eprint_line!("{}", crate::cli::describe(&error));
                 Step::Failed
             }
         }

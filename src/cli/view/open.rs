@@ -23,7 +23,7 @@ pub fn open_in_browser(url: &str) {
                 let _ = std::thread::Builder::new()
                     .name("view-open".into())
                     .spawn(move || match child.wait() {
-                        Ok(status) if !status.success() => eprintln!(
+                        Ok(status) if !status.success() => eprint_line!(
                             "warning: the browser program {program} ended with {status}; \
                              open the URL above"
                         ),
@@ -34,7 +34,7 @@ pub fn open_in_browser(url: &str) {
             Err(error) => tried.push(format!("{program}: {error}")),
         }
     }
-    eprintln!(
+    eprint_line!(
         "warning: cannot open a browser ({}); open the URL above",
         tried.join("; ")
     );

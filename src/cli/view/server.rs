@@ -133,7 +133,7 @@ fn serve(
                 open.fetch_sub(1, Ordering::SeqCst);
             });
         if spawned.is_err() {
-            eprintln!("warning: the view cannot serve another page");
+            eprint_line!("warning: the view cannot serve another page");
         }
     }
 }

@@ -36,7 +36,7 @@ pub fn watch(
             }
         });
     if let Err(error) = spawned {
-        eprintln!("warning: --watch is off: {error}");
+        eprint_line!("warning: --watch is off: {error}");
     }
 }
 

@@ -152,7 +152,7 @@ impl Session {
         };
         let warnings = scene.warnings();
         for warning in warnings.iter().filter(|w| !self.warned.contains(w)) {
-            eprintln!("warning: {warning}");
+            eprint_line!("warning: {warning}");
         }
         self.warned = warnings;
     }
