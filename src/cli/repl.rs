@@ -106,10 +106,7 @@ pub fn run(args: ReplArgs) -> anyhow::Result<()> {
         interactive_loop(&session, &args, cancel, words, &printer)
     } else {
         let input: Box<dyn BufRead> = match &args.script {
-            Some(path) => Box::new(std::io::BufReader::new(
-                std::fs::File::open(path)
-                    .with_context(|| format!("cannot open script {}", path.display()))?,
-            )),
+            Some(path) => Box::new(std::io::BufReader::new(open_script(path)?)),
             None => Box::new(std::io::stdin().lock()),
         };
         failures += script_loop(&session, input)?;
@@ -144,15 +141,24 @@ fn start_view(
     Ok(())
 }
 
-/// Removes its file when dropped (a file that was never written is no error).
 /// Splits `input` into entries as the interactive validator would (unfinished Rhai goes on
 /// on the next line) and runs them; gives the number of failed entries.
-fn script_loop(session: &Mutex<Session>, input: Box<dyn BufRead>) -> anyhow::Result<usize> {
+fn script_loop(session: &Mutex<Session>, mut input: Box<dyn BufRead>) -> anyhow::Result<usize> {
     let validator = InputValidator::new();
     let mut failures = 0;
     let mut buffer = String::new();
-    for line in input.lines() {
-        let line = line.context("reading input")?;
+    let mut number = 0;
+    while let Some(line) = next_line(&mut input, &mut number)? {
+        let Ok(line) = line else {
+            // The entry this line was part of cannot be run: it is dropped with it.
+            eprint_line!("input line {number}: not valid UTF-8; this entry is skipped");
+            failures += 1;
+            buffer.clear();
+            continue;
+        };
+        if buffer.len() + line.len() > MAX_ENTRY_BYTES {
+            anyhow::bail!("input line {number}: the entry is over {MAX_ENTRY_BYTES} bytes");
+        }
         if buffer.is_empty() && line.trim().is_empty() {
             continue;
         }
@@ -175,6 +181,48 @@ fn script_loop(session: &Mutex<Session>, input: Box<dyn BufRead>) -> anyhow::Res
         failures += 1;
     }
     Ok(failures)
+}
+
+/// Opens a `--script`: a regular file or a FIFO (commands piped through one are a normal
+/// use), not a folder or a device (`/dev/zero` never ends a line).
+fn open_script(path: &std::path::Path) -> anyhow::Result<std::fs::File> {
+    let what = lapclone::util::not_a_file(path);
+    if let Some(what) = what.filter(|w| !w.contains("FIFO")) {
+        anyhow::bail!("cannot open script {}: it {what}", path.display());
+    }
+    std::fs::File::open(path).with_context(|| format!("cannot open script {}", path.display()))
+}
+
+/// Longest entry a piped session reads, as long as a scene file may be.
+const MAX_ENTRY_BYTES: usize = lapclone::limits::MAX_SCENE_BYTES as usize;
+
+/// The next line of `input` without its line ending (`Err` inside: not UTF-8), counting
+/// lines in `number`; `None` at the end. A line over [`MAX_ENTRY_BYTES`] is an error: the
+/// reading stops there rather than hold it or look for its end (`/dev/zero` has none).
+fn next_line(
+    input: &mut dyn BufRead,
+    number: &mut usize,
+) -> anyhow::Result<Option<Result<String, std::string::FromUtf8Error>>> {
+    use std::io::Read as _;
+    let mut bytes = Vec::new();
+    let limit = MAX_ENTRY_BYTES as u64 + 1;
+    let read = input
+        .take(limit)
+        .read_until(b'\n', &mut bytes)
+        .context("reading input")?;
+    if read == 0 {
+        return Ok(None);
+    }
+    *number += 1;
+    if bytes.len() > MAX_ENTRY_BYTES {
+        anyhow::bail!("input line {number} is over {MAX_ENTRY_BYTES} bytes");
+    }
+    for end in [b'\n', b'\r'] {
+        if bytes.last() == Some(&end) {
+            bytes.pop();
+        }
+    }
+    Ok(Some(String::from_utf8(bytes)))
 }
 
 fn interactive_loop(
