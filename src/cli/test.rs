@@ -21,8 +21,9 @@ use lapclone::render::Renderer;
 
 use super::render::{default_jobs, positioned};
 use super::test_args::{
-    find_scenes, golden_dir, is_ci, overrides, pending_path, remove_if_present, write_file,
-    FramePaths, FrameResult, Outcome, Pictures, SceneFailure, SceneResult, Status, TestArgs,
+    check_golden_dirs, check_own_file, find_scenes, golden_dir, is_ci, overrides, pending_path,
+    remove_if_present, write_file, FramePaths, FrameResult, Outcome, Pictures, SceneFailure,
+    SceneResult, Status, TestArgs,
 };
 use super::test_report;
 use super::UsageError;
@@ -56,12 +57,16 @@ pub fn run(args: TestArgs) -> anyhow::Result<()> {
     for path in args.junit.iter().chain(&args.out).chain(&args.goldens) {
         lapclone::output::check_output_folder(path)?;
     }
+    if let Some(junit) = &args.junit {
+        test_report::refuse_replacing_other_than_junit(junit)?;
+    }
     let scenes = find_scenes(&paths, &args.out_dir())?;
     if scenes.is_empty() {
         return Err(
             UsageError(format!("no scene files (*.rhai) found in {}", list(&paths))).into(),
         );
     }
+    check_golden_dirs(&scenes, args.goldens.as_deref())?;
     check_all(&args, &scenes, jobs.min(scenes.len()))
 }
 
@@ -278,6 +283,9 @@ fn judge(
     actual: &GoldenFrame,
     thresholds: &Thresholds,
 ) -> (Outcome, Option<GoldenFrame>) {
+    if let Err(error) = check_own_file(golden) {
+        return (Outcome::Unreadable(super::describe(&error)), None);
+    }
     if !golden.is_file() {
         let folder = golden.parent().is_some_and(Path::is_dir);
         return (Outcome::Missing { folder }, None);

@@ -190,6 +190,35 @@ pub fn golden_dir(scene: &Path, root: Option<&Path>) -> PathBuf {
     }
 }
 
+/// Each scene's goldens folder must be its own and inside the goldens root: a scene named
+/// `...rhai` (stem `..`) would keep them in the folder above, and two scenes of one name
+/// under `--goldens` would overwrite each other's.
+pub fn check_golden_dirs(scenes: &[PathBuf], root: Option<&Path>) -> anyhow::Result<()> {
+    let mut seen: std::collections::HashMap<PathBuf, &Path> = Default::default();
+    for scene in scenes {
+        let stem = scene.file_stem().unwrap_or_default();
+        if stem.is_empty() || stem == "." || stem == ".." {
+            return Err(UsageError(format!(
+                "{}: a scene's name must make a folder name for its goldens; rename it",
+                scene.display()
+            ))
+            .into());
+        }
+        let dir = golden_dir(scene, root);
+        if let Some(other) = seen.insert(dir.clone(), scene) {
+            return Err(UsageError(format!(
+                "{} and {} would share the goldens in {}: give them separate --goldens runs \
+                 or different names",
+                other.display(),
+                scene.display(),
+                dir.display()
+            ))
+            .into());
+        }
+    }
+    Ok(())
+}
+
 /// What happened to one frame.
 #[derive(Debug)]
 pub enum Outcome {
@@ -292,8 +321,11 @@ fn walk(dir: &Path, out: &Path, scenes: &mut Vec<PathBuf>) -> anyhow::Result<()>
     for path in entries {
         let name = path.file_name().unwrap_or_default().to_string_lossy();
         if path.is_dir() {
+            // A linked folder is not followed (as ripgrep does not): a link back up the tree
+            // would find every scene again, or forever.
             let skipped = name.starts_with('.')
                 || ["scripts", "goldens", "target"].contains(&name.as_ref())
+                || is_link(&path)
                 || same_path(&path, out);
             if !skipped {
                 walk(&path, out, scenes)?;
@@ -303,6 +335,11 @@ fn walk(dir: &Path, out: &Path, scenes: &mut Vec<PathBuf>) -> anyhow::Result<()>
         }
     }
     Ok(())
+}
+
+/// Whether `path` itself is a symbolic link.
+pub fn is_link(path: &Path) -> bool {
+    std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink())
 }
 
 fn same_path(a: &Path, b: &Path) -> bool {
@@ -326,6 +363,7 @@ pub fn overrides(args: &TestArgs, base: Thresholds) -> Thresholds {
 
 /// Writes `bytes` atomically, creating the folder first.
 pub fn write_file(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
+    check_own_file(path)?;
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
@@ -333,10 +371,33 @@ pub fn write_file(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
 }
 
 pub fn remove_if_present(path: &Path) -> anyhow::Result<()> {
+    check_own_file(path)?;
     match std::fs::remove_file(path) {
         Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
             Err(e).with_context(|| format!("removing {}", path.display()))
         }
         _ => Ok(()),
     }
+}
+
+/// A file `lapclone test` keeps (a golden, a pending frame, a failure picture) must be a
+/// regular file when it exists: it is never written through a link (which could lead to a
+/// scene or an asset), into a FIFO (which would wait) or over a folder, and nothing else is
+/// ever removed in its place. Missing is fine.
+pub fn check_own_file(path: &Path) -> anyhow::Result<()> {
+    let meta = match std::fs::symlink_metadata(path) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
+        Err(e) => return Err(e).with_context(|| format!("reading {}", path.display())),
+        Ok(meta) => meta,
+    };
+    let what = match meta.file_type() {
+        t if t.is_file() => return Ok(()),
+        t if t.is_symlink() => "is a symbolic link",
+        t if t.is_dir() => "is a folder",
+        _ => lapclone::util::not_a_file(path).unwrap_or("is not a regular file"),
+    };
+    anyhow::bail!(
+        "{} {what}: lapclone test reads, writes and removes only regular files there; move it away",
+        path.display()
+    )
 }

@@ -9,7 +9,10 @@ use std::path::{Path, PathBuf};
 use anyhow::Context as _;
 use lapclone::golden::{compare, triptych, GoldenFrame, Thresholds};
 
-use super::test_args::{find_scenes, golden_dir, remove_if_present, write_file, TestArgs};
+use super::test_args::{
+    check_golden_dirs, check_own_file, find_scenes, golden_dir, is_link, remove_if_present,
+    write_file, TestArgs,
+};
 use super::test_report::scene_slug;
 
 pub fn run(args: &TestArgs, paths: &[PathBuf]) -> anyhow::Result<()> {
@@ -55,14 +58,17 @@ fn is_pending_name(name: &str) -> bool {
         .is_some_and(|digits| !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit()))
 }
 
-/// Pending files in the golden folders of the scenes under `paths` and anywhere under the
-/// folders given, sorted.
+/// Pending files in the golden folders of the scenes under `paths` and in any other
+/// `goldens/<name>/` folder under the folders given (a renamed scene's), sorted. Nowhere
+/// else: a `frame_0001.new.png` among a scene's assets is not lapclone's to accept.
 fn find_pending(args: &TestArgs, paths: &[PathBuf]) -> anyhow::Result<Vec<PathBuf>> {
     let mut found = Vec::new();
     for path in paths.iter().filter(|p| p.is_dir()) {
         walk(path, &args.out_dir(), &mut found)?;
     }
-    for scene in find_scenes(paths, &args.out_dir())? {
+    let scenes = find_scenes(paths, &args.out_dir())?;
+    check_golden_dirs(&scenes, args.goldens.as_deref())?;
+    for scene in scenes {
         let dir = golden_dir(&scene, args.goldens.as_deref());
         if dir.is_dir() {
             collect_in(&dir, &mut found)?;
@@ -85,11 +91,15 @@ fn collect_in(dir: &Path, found: &mut Vec<PathBuf>) -> anyhow::Result<()> {
 }
 
 fn walk(dir: &Path, out: &Path, found: &mut Vec<PathBuf>) -> anyhow::Result<()> {
-    collect_in(dir, found)?;
+    let parent = dir.parent().and_then(Path::file_name);
+    if parent.is_some_and(|p| p == "goldens") {
+        collect_in(dir, found)?;
+    }
     for entry in std::fs::read_dir(dir).with_context(|| format!("reading {}", dir.display()))? {
         let path = entry?.path();
         let name = path.file_name().unwrap_or_default().to_string_lossy();
-        let skipped = name.starts_with('.') || name == "target" || tidy(&path) == tidy(out);
+        let skipped =
+            name.starts_with('.') || name == "target" || is_link(&path) || tidy(&path) == tidy(out);
         if path.is_dir() && !skipped {
             walk(&path, out, found)?;
         }
@@ -106,6 +116,8 @@ fn tidy(path: &Path) -> PathBuf {
 
 fn accept(pending: &Path) -> anyhow::Result<()> {
     let golden = golden_of(pending);
+    check_own_file(pending)?;
+    check_own_file(&golden)?;
     std::fs::rename(pending, &golden)
         .with_context(|| format!("renaming {} to {}", pending.display(), golden.display()))
 }

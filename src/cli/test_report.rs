@@ -5,6 +5,8 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
+use anyhow::Context as _;
+
 use lapclone::golden::Figures;
 use serde_json::json;
 
@@ -289,11 +291,47 @@ pub fn scene_slug(scene: &Path) -> String {
         .collect()
 }
 
+/// `--junit PATH` replaces only an earlier report: an existing file that is not JUnit XML
+/// (a scene, an asset, a golden named by mistake) is refused before anything is written.
+pub fn refuse_replacing_other_than_junit(path: &Path) -> anyhow::Result<()> {
+    use std::io::Read as _;
+    if !path.is_file() {
+        return Ok(());
+    }
+    let mut head = Vec::new();
+    std::fs::File::open(path)
+        .and_then(|f| f.take(256).read_to_end(&mut head))
+        .with_context(|| format!("reading {}", path.display()))?;
+    let text = String::from_utf8_lossy(&head);
+    let junit = text.trim_start().starts_with("<?xml") && text.contains("<testsuites");
+    if head.is_empty() || junit {
+        return Ok(());
+    }
+    Err(UsageError(format!(
+        "--junit {}: the file exists and is not a JUnit report; lapclone replaces only its own \
+         reports",
+        path.display()
+    ))
+    .into())
+}
+
+/// `text` as XML and HTML text: markup characters escaped, and control characters (which
+/// XML 1.0 cannot hold at all, even escaped; a scene error can echo them from its source
+/// line) shown as `U+001B`.
 fn escape(text: &str) -> String {
-    text.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-        .replace('"', "&quot;")
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\t' | '\n' | '\r' => out.push(c),
+            c if c.is_control() => out.push_str(&format!("U+{:04X}", c as u32)),
+            c => out.push(c),
+        }
+    }
+    out
 }
 
 /// The HTML report: each failing or pending frame's triptych (path relative to the report)

@@ -1032,3 +1032,69 @@ fn piped_repl_input_is_bounded_and_survives_bytes_that_are_not_utf8() {
         expect(&output, 1, "it is not a regular file (a device)");
     }
 }
+
+/// `lapclone test` reads, writes and removes only regular files in its goldens folders, only
+/// pending frames inside `goldens/<name>/`, and never replaces a file that is not its own.
+#[cfg(unix)]
+#[test]
+fn lapclone_test_touches_only_its_own_regular_files() {
+    let world = World::new();
+    world.scene("fine.rhai", "");
+    expect(&world.run(&["test", "fine.rhai", "--update"]), 0, "");
+    let goldens = world.path("goldens/fine");
+    let first = sorted_names(&goldens)[0].clone();
+    let src = std::fs::read(world.path("src.png")).unwrap();
+    // A golden that links to an asset is not written through.
+    let golden = goldens.join(&first);
+    std::fs::remove_file(&golden).unwrap();
+    std::os::unix::fs::symlink(world.path("src.png"), &golden).unwrap();
+    let output = world.run(&["test", "fine.rhai", "--update"]);
+    assert!(String::from_utf8_lossy(&output.stdout).contains("is a symbolic link"));
+    assert_eq!(output.status.code(), Some(1));
+    assert_eq!(std::fs::read(world.path("src.png")).unwrap(), src);
+    // A FIFO golden is named, not waited on.
+    std::fs::remove_file(&golden).unwrap();
+    let made = Command::new("mkfifo").arg(&golden).status().unwrap();
+    assert!(made.success());
+    let output = world.run(&["test", "fine.rhai"]);
+    assert!(String::from_utf8_lossy(&output.stdout).contains("(a FIFO)"));
+    assert_eq!(output.status.code(), Some(1));
+    std::fs::remove_file(&golden).unwrap();
+    // A pending-looking file among the assets is not accepted.
+    std::fs::create_dir(world.path("assets")).unwrap();
+    std::fs::write(world.path("assets/frame_0001.png"), b"asset").unwrap();
+    std::fs::write(world.path("assets/frame_0001.new.png"), b"stray").unwrap();
+    expect(&world.run(&["test", "--accept", "."]), 0, "");
+    assert_eq!(
+        std::fs::read(world.path("assets/frame_0001.png")).unwrap(),
+        b"asset"
+    );
+    // A JUnit path that is not an earlier report is refused before anything runs.
+    let scene = std::fs::read(world.path("fine.rhai")).unwrap();
+    expect(
+        &world.run(&["test", "fine.rhai", "--junit", "fine.rhai"]),
+        2,
+        "not a JUnit report",
+    );
+    assert_eq!(std::fs::read(world.path("fine.rhai")).unwrap(), scene);
+    // Goldens that would land above their folder, or be shared by two scenes.
+    world.scene("...rhai", "");
+    expect(
+        &world.run(&["test", "...rhai", "--update"]),
+        2,
+        "must make a folder name",
+    );
+    std::fs::create_dir_all(world.path("a")).unwrap();
+    std::fs::create_dir_all(world.path("b")).unwrap();
+    world.scene("a/same.rhai", "");
+    world.scene("b/same.rhai", "");
+    let shared = ["test", "a", "b", "--goldens", "g", "--update"];
+    expect(&world.run(&shared), 2, "would share the goldens");
+    // A linked folder back up the tree is not followed.
+    std::fs::create_dir(world.path("one")).unwrap();
+    std::fs::copy(world.path("fine.rhai"), world.path("one/fine.rhai")).unwrap();
+    std::os::unix::fs::symlink(world.path("one"), world.path("one/loop")).unwrap();
+    let output = world.run(&["test", "one", "--update"]);
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(stdout.contains("in 1 scenes"), "{stdout}");
+}
