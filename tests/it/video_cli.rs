@@ -570,3 +570,70 @@ fn a_scene_failing_after_ffmpeg_started_leaves_nothing() {
         }
     }
 }
+
+/// A video stored turned a quarter (a phone's: a rotation in its display matrix) is read
+/// upright at the size ffmpeg decodes it to, not as rows of the stored size (which gave
+/// scrambled frames of the same byte count).
+#[test]
+fn a_video_with_a_quarter_turn_is_read_upright() {
+    if !has_ffmpeg() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let stored = plate(0, 48, 32);
+    stored.save(dir.path().join("plate.png")).unwrap();
+    let ffmpeg = |args: &[&str]| {
+        let status = Command::new("ffmpeg")
+            .args(["-y", "-v", "error"])
+            .args(args)
+            .current_dir(dir.path())
+            .status()
+            .unwrap();
+        assert!(status.success(), "ffmpeg {args:?}");
+    };
+    let lossless = ["-c:v", "libx264", "-crf", "0", "-pix_fmt", "yuv444p"];
+    let mut args = vec![
+        "-loop",
+        "1",
+        "-i",
+        "plate.png",
+        "-frames:v",
+        "6",
+        "-r",
+        "24",
+    ];
+    args.extend(lossless);
+    args.push("flat.mp4");
+    ffmpeg(&args);
+    ffmpeg(&[
+        "-i",
+        "flat.mp4",
+        "-c",
+        "copy",
+        "-metadata:s:v:0",
+        "rotate=90",
+        "turned.mp4",
+    ]);
+    let scene = write_scene(
+        dir.path(),
+        "canvas(32, 48, #{ fps: 24, duration: 0.125, background: \"turned.mp4\" });",
+        "",
+    );
+    let out = dir.path().join("p.png");
+    let o = lapclone(&[os("preview"), scene.as_os_str(), os("-o"), out.as_os_str()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let frame = rgba(&out);
+    assert_eq!(frame.dimensions(), (32, 48));
+    // rotate=90 shows the stored picture turned a quarter counter-clockwise.
+    let upright = image::imageops::rotate270(&stored);
+    let worst = frame
+        .pixels()
+        .zip(upright.pixels())
+        .flat_map(|(a, b)| (0..3).map(move |c| a[c].abs_diff(b[c])))
+        .max()
+        .unwrap();
+    assert!(
+        worst <= 8,
+        "largest difference {worst} from the upright plate"
+    );
+}

@@ -32,10 +32,11 @@ pub(super) fn video_error(path: &Path, message: String) -> FootageError {
     }
 }
 
+/// ffprobe's `key=value` lines for `entry` of the first video stream.
 fn ffprobe_entry(path: &Path, entry: &str) -> Result<String, FootageError> {
     let mut child = spawn("ffprobe", path, |c| {
         c.args(["-v", "error", "-select_streams", "v:0", "-show_entries", entry])
-            .args(["-of", "default=noprint_wrappers=1:nokey=1"])
+            .args(["-of", "default=noprint_wrappers=1"])
             .arg(path)
             .stdin(Stdio::null())
             .stdout(Stdio::piped())
@@ -52,21 +53,32 @@ fn ffprobe_entry(path: &Path, entry: &str) -> Result<String, FootageError> {
     Ok(text)
 }
 
-/// The size of the video's first stream.
+/// The value of `key` in ffprobe's `key=value` lines.
+fn value<T: std::str::FromStr>(text: &str, key: &str) -> Option<T> {
+    text.lines()
+        .find_map(|l| l.trim().strip_prefix(key)?.strip_prefix('='))
+        .and_then(|v| v.trim().parse().ok())
+}
+
+/// The size of the video's first stream as ffmpeg decodes it: a stream stored turned a
+/// quarter (a phone's, with a rotation in its display matrix) comes out upright, its width
+/// and height swapped.
 pub(super) fn probe_video(path: &Path) -> Result<(u32, u32), FootageError> {
-    let text = ffprobe_entry(path, "stream=width,height")?;
-    let mut numbers = text.lines().filter_map(|l| l.trim().parse::<u32>().ok());
-    match (numbers.next(), numbers.next()) {
-        (Some(w), Some(h)) if w > 0 && h > 0 => Ok((w, h)),
-        _ => Err(video_error(path, format!("no frame size in `{text}`"))),
+    let text = ffprobe_entry(path, "stream=width,height:stream_side_data=rotation")?;
+    let size = (value::<u32>(&text, "width"), value::<u32>(&text, "height"));
+    let (Some(w), Some(h)) = size else {
+        return Err(video_error(path, format!("no frame size in `{text}`")));
+    };
+    if w == 0 || h == 0 {
+        return Err(video_error(path, format!("no frame size in `{text}`")));
     }
+    let rotation = value::<f64>(&text, "rotation").unwrap_or(0.0);
+    let quarter = (rotation / 90.0).round().rem_euclid(2.0) == 1.0;
+    Ok(if quarter { (h, w) } else { (w, h) })
 }
 
 /// The video's duration in seconds, if the container states one.
 pub(super) fn probe_duration(path: &Path) -> Result<Option<f64>, FootageError> {
     let text = ffprobe_entry(path, "format=duration")?;
-    Ok(text
-        .lines()
-        .find_map(|l| l.trim().parse::<f64>().ok())
-        .filter(|d| d.is_finite() && *d > 0.0))
+    Ok(value::<f64>(&text, "duration").filter(|d| d.is_finite() && *d > 0.0))
 }
