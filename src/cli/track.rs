@@ -29,19 +29,22 @@ pub struct TrackArgs {
           allow_hyphen_values = true)]
     pub points: Vec<[f64; 2]>,
     /// Side of the square matched around each point, in pixels.
-    #[arg(long, value_name = "PX", default_value_t = TrackOptions::default().size)]
+    #[arg(long, value_name = "PX", default_value_t = TrackOptions::default().size,
+          allow_hyphen_values = true)]
     pub size: u32,
     /// How far a point may move from one frame to the next, in pixels.
-    #[arg(long, value_name = "PX", default_value_t = TrackOptions::default().search)]
+    #[arg(long, value_name = "PX", default_value_t = TrackOptions::default().search,
+          allow_hyphen_values = true)]
     pub search: u32,
     /// Frames to track, A..B (numbered as `render` numbers them, from 1); default: all.
     #[arg(long, value_name = "A..B", value_parser = frame_range)]
     pub frames: Option<FrameRange>,
     /// The file number of frame 1 of a pattern (default: the lowest number with a file).
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", allow_hyphen_values = true)]
     pub start: Option<u64>,
     /// The rate a video is decoded at, frames per second (as the scene's `fps`).
-    #[arg(long, default_value_t = 24.0, value_parser = super::finite_f64)]
+    #[arg(long, default_value_t = 24.0, value_parser = super::finite_f64,
+          allow_hyphen_values = true)]
     pub fps: f64,
     /// The track CSV to write.
     #[arg(short, long)]
@@ -50,28 +53,33 @@ pub struct TrackArgs {
 
 pub fn run(args: TrackArgs) -> anyhow::Result<()> {
     check_arguments(&args)?;
-    let footage = Footage::open(&args.footage, args.start, false, "hold")
+    // `track` has no setting that holds a last frame: its messages suggest none.
+    let footage = Footage::open(&args.footage, args.start, false, "")
         .with_context(|| format!("opening {}", args.footage.display()))?;
     lapclone::output::refuse_footage_input(&args.output, &footage)?;
     let reader = FootageReader::new(footage, args.fps);
-    let available = available_frames(&reader, args.fps)?;
-    let range = args.frames.unwrap_or(FrameRange {
-        first: 1,
-        last: available,
-    });
-    if range.last > available {
-        return Err(UsageError(format!(
-            "--frames {}..{}: the footage has {available} frames",
-            range.first, range.last
-        ))
-        .into());
-    }
-    let options = TrackOptions {
-        size: args.size,
-        search: args.search,
+    let available = available_frames(&reader, args.fps, args.frames)?;
+    let range = match (args.frames, available) {
+        (Some(range), Some(available)) if range.last > available => {
+            return Err(UsageError(format!(
+                "--frames {}..{}: the footage has {available} frames",
+                range.first, range.last
+            ))
+            .into())
+        }
+        (Some(range), _) => range,
+        (None, available) => FrameRange {
+            first: 1,
+            last: available.unwrap_or(lapclone::limits::MAX_FRAMES),
+        },
     };
     let points: Vec<DVec2> = args.points.iter().map(|p| DVec2::from_array(*p)).collect();
-    let frames = track_frames(&reader, range, &points, options, args.fps)?;
+    let to_end = args.frames.is_none();
+    let frames = track_frames(&reader, range, &points, options(&args), args.fps, to_end)?;
+    let range = FrameRange {
+        last: frames.last().map_or(range.last, |f| f.frame),
+        ..range
+    };
     warn_lost(&frames);
     lapclone::util::write_atomic_with(&args.output, |file| {
         let mut out = std::io::BufWriter::new(file);
@@ -90,20 +98,30 @@ pub fn run(args: TrackArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Every frame of `range` tracked, in order, with the pair's motion for two points.
+fn options(args: &TrackArgs) -> TrackOptions {
+    TrackOptions {
+        size: args.size,
+        search: args.search,
+    }
+}
+
+/// Every frame of `range` tracked, in order, with the pair's motion for two points. With
+/// `to_end` (no `--frames`), a video that ends before `range` (its length is only
+/// estimated, or unknown) ends the track there.
 fn track_frames(
     reader: &FootageReader,
     range: FrameRange,
     points: &[DVec2],
     options: TrackOptions,
     fps: f64,
+    to_end: bool,
 ) -> anyhow::Result<Vec<TrackedFrame>> {
     let progress = progress_bar(range.last - range.first + 1);
     let mut tracker: Option<PointTracker> = None;
     let mut frames: Vec<TrackedFrame> = Vec::new();
     let threads = lapclone::util::available_cores();
     let indices = range.first - 1..=range.last - 1;
-    read_ahead(reader.footage(), fps, indices, threads, |index, frame| {
+    let read = read_ahead(reader.footage(), fps, indices, threads, |index, frame| {
         let number = index + 1;
         let estimates = match tracker.as_mut() {
             Some(t) => t.next(frame).with_context(|| format!("frame {number}"))?,
@@ -117,16 +135,36 @@ fn track_frames(
         let mut next = tracked(number, estimates, points);
         if let (Some(first), Some(previous)) = (frames.first(), frames.last()) {
             if let ([a0, b0, ..], [a, b, ..]) = (&first.points[..], &next.points[..]) {
-                let turned = previous.pair.map_or(0.0, |p| p.0);
-                next.pair = Some(pair_motion(a0.at, b0.at, a.at, b.at, turned));
+                // A lost point sits where it was last seen: the pair's motion holds too,
+                // rather than be measured against that stale position.
+                let held = previous.pair.unwrap_or((0.0, 1.0));
+                next.pair = Some(match a.lost.is_some() || b.lost.is_some() {
+                    true => held,
+                    false => pair_motion(a0.at, b0.at, a.at, b.at, held.0),
+                });
             }
         }
         frames.push(next);
         progress.inc(1);
         Ok::<(), anyhow::Error>(())
-    })?;
+    });
     progress.finish_and_clear();
-    Ok(frames)
+    let Err(error) = read else {
+        return Ok(frames);
+    };
+    match error.downcast_ref::<FootageError>() {
+        Some(FootageError::VideoTooShort { available, .. }) if *available > 0 => {
+            if to_end {
+                return Ok(frames);
+            }
+            Err(UsageError(format!(
+                "--frames {}..{}: the video has {available} frames at --fps {fps}",
+                range.first, range.last
+            ))
+            .into())
+        }
+        _ => Err(error),
+    }
 }
 
 fn tracked(frame: u64, points: Vec<Estimate>, starts: &[DVec2]) -> TrackedFrame {
@@ -147,26 +185,50 @@ fn check_arguments(args: &TrackArgs) -> anyhow::Result<()> {
     if args.output.is_dir() {
         return Err(UsageError(format!("-o {} is a folder", args.output.display())).into());
     }
+    if let Err(error) = options(args).check() {
+        return Err(UsageError(format!("--{error}")).into());
+    }
     Ok(lapclone::output::check_output_folder(&args.output)?)
 }
 
-/// How many frames the footage has: the unbroken run of files from the start, or a
-/// video's frames at `fps`.
-fn available_frames(reader: &FootageReader, fps: f64) -> anyhow::Result<u64> {
+/// How many frames the footage has: the unbroken run of plates from the start (a gap
+/// before later plates, or something other than a file in the run, is an error rather than
+/// a silent end), or a video's frames at `fps` (`None`: its container states no length).
+fn available_frames(
+    reader: &FootageReader,
+    fps: f64,
+    wanted: Option<FrameRange>,
+) -> anyhow::Result<Option<u64>> {
     let limit = lapclone::limits::MAX_FRAMES;
     match &reader.footage().source {
         FootageSource::Sequence { pattern, start } => {
             let count = (0..=limit)
                 .find(|i| !pattern.path(start + i).is_file())
                 .unwrap_or(limit);
-            Ok(count)
+            let missing = pattern.path(start + count);
+            if wanted.is_some_and(|r| r.last <= count) {
+                return Ok(Some(count));
+            }
+            if let Some(what) =
+                lapclone::util::not_a_file(&missing).filter(|w| *w != "does not exist")
+            {
+                anyhow::bail!("frame {} ({}) {what}", count + 1, missing.display());
+            }
+            if let Some(last) = pattern.highest_number().filter(|n| *n > start + count) {
+                return Err(UsageError(format!(
+                    "frame {} ({}) is missing, but plates up to number {last} follow: fill the \
+                     gap, or give --frames 1..{count}",
+                    count + 1,
+                    missing.display()
+                ))
+                .into());
+            }
+            Ok(Some(count))
         }
         FootageSource::Video(_) => match reader.footage().check_covers(limit, fps) {
-            Err(FootageError::VideoTooShort { available, .. }) => Ok(available),
+            Err(FootageError::VideoTooShort { available, .. }) => Ok(Some(available)),
             Err(other) => Err(other.into()),
-            Ok(()) => {
-                Err(UsageError("the video's length is unknown: give --frames A..B".into()).into())
-            }
+            Ok(()) => Ok(None),
         },
     }
 }

@@ -380,7 +380,14 @@ fn levels_for(half: i32, search: f64) -> usize {
 }
 
 fn check_options(options: TrackOptions) -> Result<(), TrackError> {
-    if !(5..=MAX_SIZE).contains(&options.size) {
+    options.check()
+}
+
+impl TrackOptions {
+    /// Whether these settings are in range: `size` 5 to 255 px, `search` 1 to 1024 px.
+    pub fn check(&self) -> Result<(), TrackError> {
+        let options = self;
+        if !(5..=MAX_SIZE).contains(&options.size) {
         return Err(TrackError::Options(format!(
             "size {} must be between 5 and {MAX_SIZE} pixels",
             options.size
@@ -391,8 +398,9 @@ fn check_options(options: TrackOptions) -> Result<(), TrackError> {
             "search {} must be between 1 and {MAX_SEARCH} pixels",
             options.search
         )));
+        }
+        Ok(())
     }
-    Ok(())
 }
 
 /// Rotation (degrees, continuing past ±180) and scale of the pair `(a, b)` relative to the

@@ -131,6 +131,20 @@ fn a_covered_point_is_reported_lost_and_found_again() {
             .then(|| (motion.truth(SIZE, k, start), 30.0))
     };
     write_footage(dir.path(), &motion, covered);
+    // A second point beside it: while the first is lost, the pair's motion holds (pure
+    // translation: no turn, no scale) instead of following the first's stale position.
+    let other = DVec2::new(230.0, 150.0);
+    let pair = track(dir.path(), &[start, other], &[]);
+    assert!(
+        pair.status.success(),
+        "{}",
+        String::from_utf8_lossy(&pair.stderr)
+    );
+    let file = TrackFile::load(&dir.path().join("track.csv")).unwrap();
+    for row in &file.points[1] {
+        let (rotate, scale) = (row.rotate.unwrap(), row.scale.unwrap());
+        assert!(rotate.abs() < 0.5 && (scale - 1.0).abs() < 0.005, "{row:?}");
+    }
     let out = track(dir.path(), &[start], &[]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{stderr}");
@@ -202,4 +216,59 @@ fn bad_points_and_ranges_are_usage_errors_that_write_nothing() {
         assert!(stderr.contains(message), "{args:?}: {stderr}");
         assert!(!dir.path().join("track.csv").exists(), "{args:?}");
     }
+}
+
+/// A gap in the plates is an error naming the missing one (not a silent end of the
+/// footage), unless `--frames` stays before it; flag values are checked before the footage
+/// is opened.
+#[test]
+fn a_gap_in_the_plates_is_named_and_flags_are_checked_first() {
+    let dir = tempfile::tempdir().unwrap();
+    for k in (1..=8).filter(|k| *k != 5) {
+        let shade = |x: u32, y: u32| ((x * 7 + y * 13 + k) % 251) as u8;
+        let plate = image::RgbImage::from_fn(64, 48, |x, y| image::Rgb([shade(x, y), 90, 40]));
+        plate
+            .save(dir.path().join(format!("f_{k:04}.png")))
+            .unwrap();
+    }
+    let run = |extra: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_lapclone"))
+            .args([
+                "track",
+                "f_%04d.png",
+                "--point",
+                "32,24",
+                "--size",
+                "9",
+                "--search",
+                "4",
+            ])
+            .args(extra)
+            .args(["-o", "t.csv"])
+            .current_dir(dir.path())
+            .output()
+            .unwrap()
+    };
+    let out = run(&[]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("frame 5 (f_0005.png) is missing, but plates up to number 8"));
+    assert!(!dir.path().join("t.csv").exists());
+    assert!(run(&["--frames", "1..4"]).status.success());
+    let out = Command::new(env!("CARGO_BIN_EXE_lapclone"))
+        .args([
+            "track",
+            "missing/f_%04d.png",
+            "--point",
+            "1,1",
+            "--size",
+            "0",
+            "-o",
+            "x.csv",
+        ])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--size 0 must be between 5"));
 }

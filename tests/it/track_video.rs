@@ -148,3 +148,56 @@ fn a_missing_or_broken_video_is_an_error_and_writes_nothing() {
         println!("{}: {}", footage.display(), message.trim());
     }
 }
+
+/// Without `--frames`, a track runs to the video's last decoded frame, whether its container
+/// states a length that rounds one frame too many (3.3 s at 25 fps: 83 estimated, 82
+/// decoded) or none at all (a piped Matroska); with `--frames` past the end, a usage error
+/// naming the frames there are.
+#[test]
+fn a_whole_video_is_tracked_to_its_last_decoded_frame() {
+    if !has_ffmpeg() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let ffmpeg = |args: &str| {
+        let out = Command::new("sh")
+            .arg("-c")
+            .arg(format!("ffmpeg -v error -y {args}"))
+            .current_dir(dir.path())
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "ffmpeg {args}: {}", stderr(&out));
+    };
+    ffmpeg("-f lavfi -i testsrc2=s=96x64:d=3.3:r=60 -c:v ffv1 r60.mkv");
+    ffmpeg("-f lavfi -i testsrc2=s=96x64:d=1:r=24 -c:v ffv1 -f matroska - > piped.mkv");
+    let run = |video: &str, extra: &[&str]| {
+        let mut args = vec![
+            "track", video, "--point", "48,32", "--size", "9", "--search", "8",
+        ];
+        args.extend(extra);
+        args.extend(["-o", "t.csv"]);
+        Command::new(env!("CARGO_BIN_EXE_lapclone"))
+            .args(&args)
+            .current_dir(dir.path())
+            .output()
+            .unwrap()
+    };
+    for (video, fps, frames) in [("r60.mkv", "25", 82), ("piped.mkv", "24", 24)] {
+        let out = run(video, &["--fps", fps]);
+        assert!(out.status.success(), "{video}: {}", stderr(&out));
+        assert!(
+            stderr(&out).contains(&format!("frames 1..{frames}")),
+            "{}",
+            stderr(&out)
+        );
+        let file = TrackFile::load(&dir.path().join("t.csv")).unwrap();
+        assert_eq!(file.points[0].len(), frames, "{video}");
+    }
+    let out = run("piped.mkv", &["--frames", "1..30"]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("the video has 24 frames"),
+        "{}",
+        stderr(&out)
+    );
+}

@@ -71,7 +71,7 @@ pub enum FootageError {
         message: String,
     },
     /// The video ends before the scene does and the footage does not hold its last frame.
-    #[error("video {}: has {available} frames at the scene's fps, frame {frame} is needed (add `{hold_key}: true` to hold the last one)", path.display())]
+    #[error("video {}: has {available} frames at the scene's fps, frame {frame} is needed{}", path.display(), hold_hint(hold_key, false))]
     VideoTooShort {
         /// The video file.
         path: PathBuf,
@@ -87,9 +87,12 @@ pub enum FootageError {
     Image(#[from] Box<PixelError>),
 }
 
-/// The end of a missing-frame message: how holding would help, unless it is already on.
+/// The end of a missing-frame message: how holding would help, unless it is already on
+/// (nothing where there is no such setting: an empty `hold_key`).
 fn hold_hint(hold_key: &str, held: bool) -> String {
-    if held {
+    if hold_key.is_empty() {
+        String::new()
+    } else if held {
         format!(" (`{hold_key}` holds the last file of the unbroken run from the first one; the first is missing)")
     } else {
         format!(" (add `{hold_key}: true` to hold the last one)")

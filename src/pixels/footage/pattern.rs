@@ -70,6 +70,21 @@ impl Pattern {
         (all_digits && padded_ok).then(|| middle.parse().ok())?
     }
 
+    /// The highest number any entry of the folder has under this pattern (a file or not),
+    /// if one has.
+    pub fn highest_number(&self) -> Option<u64> {
+        let folder = if self.folder.as_os_str().is_empty() {
+            Path::new(".")
+        } else {
+            &self.folder
+        };
+        std::fs::read_dir(folder)
+            .ok()?
+            .filter_map(|e| e.ok())
+            .filter_map(|e| self.number_of(&e.file_name().to_string_lossy()))
+            .max()
+    }
+
     /// The lowest frame number that has a file.
     pub fn lowest_number(&self) -> Result<u64, FootageError> {
         let folder = if self.folder.as_os_str().is_empty() {
