@@ -72,10 +72,26 @@ const COLUMNS: [(&str, Column); 8] = [
 
 type Failure = (usize, String);
 
-/// Each point's rows from CSV `text`.
+/// Most characters of a file's text an error quotes.
+const SHOWN: usize = 60;
+
+/// `text` as an error quotes it: at most [`SHOWN`] characters, control characters escaped.
+fn shown(text: &str) -> String {
+    let mut out: String = text.chars().take(SHOWN).flat_map(char::escape_debug).collect();
+    let length = text.chars().count();
+    if length > SHOWN {
+        out.push_str(&format!("… ({length} characters)"));
+    }
+    out
+}
+
+/// Each point's rows from CSV `text`: a byte-order mark (as spreadsheets write "CSV
+/// UTF-8") is skipped, and lines may end in `\n`, `\r\n` or a lone `\r`.
 pub(super) fn parse(text: &str) -> Result<Vec<Vec<TrackRow>>, Failure> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let ending = if text.contains('\n') { '\n' } else { '\r' };
     let mut lines = text
-        .lines()
+        .split(ending)
         .enumerate()
         .map(|(i, l)| (i + 1, l.trim()))
         .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
@@ -127,6 +143,7 @@ fn parse_header(line: usize, header: &str) -> Result<Vec<Column>, Failure> {
             .map(|(_, c)| *c)
             .ok_or_else(|| {
                 let known: Vec<&str> = COLUMNS.iter().map(|(n, _)| *n).collect();
+                let name = shown(name);
                 (line, format!("unknown column `{name}` (known: {})", known.join(", ")))
             })?;
         if columns.contains(&column) {
@@ -166,7 +183,7 @@ fn parse_row(line: usize, text: &str, columns: &[Column]) -> Result<(usize, Trac
             .parse()
             .ok()
             .filter(|v: &f64| v.is_finite())
-            .ok_or_else(|| (line, format!("column `{name}`: `{cell}` is not a number")))?;
+            .ok_or_else(|| (line, format!("column `{name}`: `{}` is not a number", shown(cell))))?;
         match column {
             Column::Frame => row.time = TrackTime::Frame(whole(line, name, value, u64::MAX)?),
             Column::Seconds if value < 0.0 => {
@@ -217,6 +234,20 @@ fn check_order(line: usize, point: usize, before: TrackTime, now: TrackTime) -> 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn spreadsheet_csv_reads_and_errors_quote_little() {
+        let plain = parse("frame,x,y\n1,2,3\n2,4,5\n").unwrap();
+        for text in ["\u{feff}frame,x,y\r\n1,2,3\r\n2,4,5\r\n", "frame,x,y\r1,2,3\r2,4,5\r"] {
+            assert_eq!(parse(text).unwrap(), plain, "{text:?}");
+        }
+        let (line, message) = parse("frame,x,y\r\n1,2,3\r\n2,4,5\u{1b}z\r\n").unwrap_err();
+        assert_eq!(line, 3);
+        assert!(message.contains("`5\\u{1b}z`"), "{message}");
+        let long = format!("frame,x,y\n1,2,{}\n", "7".repeat(100_000));
+        let (_, message) = parse(&long).unwrap_err();
+        assert!(message.len() < 200 && message.contains("(100000 characters)"), "{message}");
+    }
 
     #[test]
     fn written_csv_reads_back() {

@@ -129,8 +129,8 @@ impl TrackFile {
             source,
         };
         let meta = std::fs::metadata(path).map_err(read)?;
-        if !meta.is_file() {
-            return Err(read(std::io::Error::other("not a regular file")));
+        if let Some(what) = crate::util::not_a_file(path).filter(|_| !meta.is_file()) {
+            return Err(read(std::io::Error::other(format!("it {what}"))));
         }
         if meta.len() > MAX_FILE_BYTES {
             return Err(read(std::io::Error::other(format!(
