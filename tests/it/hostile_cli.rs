@@ -1098,3 +1098,22 @@ fn lapclone_test_touches_only_its_own_regular_files() {
     let stdout = String::from_utf8_lossy(&output.stdout);
     assert!(stdout.contains("in 1 scenes"), "{stdout}");
 }
+
+/// `:undo` keeps the last 500 steps, not every one since the start (each holds the whole
+/// scene and every variable).
+#[test]
+fn the_undo_history_is_bounded() {
+    let world = World::new();
+    world.scene("fine.rhai", "");
+    let mut input = String::new();
+    for i in 0..520 {
+        input.push_str(&format!("p.at(0.5, [{}, 15]);\n", 20 + i % 7));
+    }
+    input.push_str(&":undo\n".repeat(501));
+    let output = world.repl(&["fine.rhai"], input.as_bytes(), Stdio::piped());
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(stdout.contains("undone (499 more)"), "{stdout}");
+    assert!(stdout.contains("undone (0 more)"));
+    let stderr = expect(&output, 1, "nothing to undo");
+    assert!(stderr.contains("1 failed entry"), "{stderr}");
+}

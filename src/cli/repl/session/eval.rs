@@ -33,7 +33,7 @@ impl Session {
                 self.restore(before);
                 return Err(error);
             }
-            self.undo.push(before);
+            self.remember(before);
             self.warn();
         }
         self.edits.push(text.to_string());

@@ -18,14 +18,32 @@ pub(super) struct Snapshot {
     pub(super) scope: Scope<'static>,
     /// How many entries `edits` had.
     pub(super) edits: usize,
+    /// About how many bytes `scope` holds ([`scope_bytes`]).
+    bytes: usize,
 }
 
+/// Most entries `:undo` goes back.
+pub(super) const MAX_UNDO: usize = 500;
+/// Most bytes the kept scopes may hold together (estimated, see [`scope_bytes`]): each
+/// snapshot copies every variable, so a session holding large arrays keeps fewer steps.
+const MAX_UNDO_SCOPE_BYTES: usize = 512 << 20;
+
 impl Session {
+    /// Keeps `before` as the newest undo step, dropping the oldest past the bounds.
+    pub(super) fn remember(&mut self, before: Snapshot) {
+        self.undo.push(before);
+        let mut bytes: usize = self.undo.iter().map(|s| s.bytes).sum();
+        while self.undo.len() > MAX_UNDO || (bytes > MAX_UNDO_SCOPE_BYTES && self.undo.len() > 1) {
+            bytes -= self.undo.remove(0).bytes;
+        }
+    }
+
     pub(super) fn snapshot(&self) -> Snapshot {
         Snapshot {
             draft: self.engine.draft(),
             scope: self.scope.clone(),
             edits: self.edits.len(),
+            bytes: scope_bytes(&self.scope),
         }
     }
 
@@ -63,4 +81,30 @@ impl Session {
         }
         self.show_frame()
     }
+}
+
+/// About how many bytes a scope's values hold: strings and blobs by length, arrays and maps
+/// by their items, 16 bytes for anything else.
+fn scope_bytes(scope: &Scope) -> usize {
+    scope.iter_raw().map(|(_, _, v)| value_bytes(v)).sum()
+}
+
+fn value_bytes(value: &rhai::Dynamic) -> usize {
+    if let Some(text) = value.read_lock::<rhai::ImmutableString>() {
+        return 16 + text.len();
+    }
+    if let Some(array) = value.read_lock::<rhai::Array>() {
+        return 16 + array.iter().map(value_bytes).sum::<usize>();
+    }
+    if let Some(map) = value.read_lock::<rhai::Map>() {
+        return 16
+            + map
+                .iter()
+                .map(|(k, v)| k.len() + value_bytes(v))
+                .sum::<usize>();
+    }
+    if let Some(blob) = value.read_lock::<rhai::Blob>() {
+        return 16 + blob.len();
+    }
+    16
 }
