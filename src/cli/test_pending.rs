@@ -29,16 +29,26 @@ fn act(args: &TestArgs, paths: &[PathBuf]) -> anyhow::Result<()> {
     if args.review {
         return review(args, &pending);
     }
+    // A file that cannot be taken is reported and the others are still taken.
+    let mut failed = 0;
     for file in &pending {
-        if args.accept {
-            accept(file)?;
-            super::print_line(format_args!("accepted {}", golden_of(file).display()));
+        let done = if args.accept {
+            accept(file).map(|()| format!("accepted {}", golden_of(file).display()))
         } else {
-            remove_if_present(file)?;
-            super::print_line(format_args!("rejected {}", file.display()));
+            remove_if_present(file).map(|()| format!("rejected {}", file.display()))
+        };
+        match done {
+            Ok(line) => super::print_line(line),
+            Err(error) => {
+                eprint_line!("{}", super::describe(&error));
+                failed += 1;
+            }
         }
     }
-    Ok(())
+    match failed {
+        0 => Ok(()),
+        n => anyhow::bail!("{n} of {} pending frame(s) not taken", pending.len()),
+    }
 }
 
 fn list(paths: &[PathBuf]) -> String {
@@ -118,6 +128,8 @@ fn accept(pending: &Path) -> anyhow::Result<()> {
     let golden = golden_of(pending);
     check_own_file(pending)?;
     check_own_file(&golden)?;
+    // A golden must be a frame: a pending file that does not decode is not promoted.
+    GoldenFrame::load(pending).with_context(|| format!("not accepted: {}", pending.display()))?;
     std::fs::rename(pending, &golden)
         .with_context(|| format!("renaming {} to {}", pending.display(), golden.display()))
 }
@@ -134,12 +146,24 @@ fn review(args: &TestArgs, pending: &[PathBuf]) -> anyhow::Result<()> {
             pending.len(),
             file.display()
         ));
-        show(args, file)?;
+        if let Err(error) = show(args, file) {
+            // One unreadable pending file is reported and passed over, not the end of the
+            // review: the others may still be looked at.
+            super::print_line(format_args!("  skipped: {}", super::describe(&error)));
+            skipped += 1;
+            continue;
+        }
         let answer = loop {
             print!("accept, reject or skip? [a/r/s/q] ");
             let _ = std::io::stdout().flush();
-            let Some(line) = lines.next().transpose()? else {
+            let Some(line) = lines.next() else {
                 break "q".to_string();
+            };
+            let line = match line {
+                Ok(line) => line,
+                // An answer that is not UTF-8 is no answer (its bytes are read): ask again.
+                Err(e) if e.kind() == std::io::ErrorKind::InvalidData => continue,
+                Err(e) => return Err(e).context("reading the answer"),
             };
             if !std::io::stdin().is_terminal() {
                 super::print_line(format_args!("{}", line.trim()));

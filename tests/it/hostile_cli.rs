@@ -1117,3 +1117,46 @@ fn the_undo_history_is_bounded() {
     let stderr = expect(&output, 1, "nothing to undo");
     assert!(stderr.contains("1 failed entry"), "{stderr}");
 }
+
+/// A pending file that is not a PNG is never made a golden: `--accept` takes the others and
+/// exits 1 naming it; `--review` reports it and goes on to the next.
+#[test]
+fn an_unreadable_pending_frame_is_passed_over_not_accepted() {
+    let world = World::new();
+    world.scene("fine.rhai", "");
+    expect(&world.run(&["test", "fine.rhai", "--update"]), 0, "");
+    let goldens = world.path("goldens/fine");
+    let names = sorted_names(&goldens);
+    let (bad, good) = (&names[0], &names[1]);
+    let pending = |name: &str| goldens.join(name.replace(".png", ".new.png"));
+    let seed = || {
+        std::fs::write(pending(bad), b"not a png").unwrap();
+        std::fs::copy(goldens.join(good), pending(good)).unwrap();
+    };
+    seed();
+    let golden_before = std::fs::read(goldens.join(bad)).unwrap();
+    expect(
+        &world.run(&["test", "--accept", "fine.rhai"]),
+        1,
+        "1 of 2 pending frame(s) not taken",
+    );
+    assert_eq!(std::fs::read(goldens.join(bad)).unwrap(), golden_before);
+    assert!(!pending(good).exists(), "the readable one was not accepted");
+    seed();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_lapclone"))
+        .args(["test", "--review", "fine.rhai", "--out", "review"])
+        .current_dir(world.root.path())
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    use std::io::Write as _;
+    child.stdin.take().unwrap().write_all(b"\xff\na\n").unwrap();
+    let output = child.wait_with_output().unwrap();
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(stdout.contains("skipped:"), "{stdout}");
+    assert!(
+        stdout.contains("1 accepted, 0 rejected, 1 skipped"),
+        "{stdout}"
+    );
+}
