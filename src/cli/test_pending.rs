@@ -153,26 +153,7 @@ fn review(args: &TestArgs, pending: &[PathBuf]) -> anyhow::Result<()> {
             skipped += 1;
             continue;
         }
-        let answer = loop {
-            print!("accept, reject or skip? [a/r/s/q] ");
-            let _ = std::io::stdout().flush();
-            let Some(line) = lines.next() else {
-                break "q".to_string();
-            };
-            let line = match line {
-                Ok(line) => line,
-                // An answer that is not UTF-8 is no answer (its bytes are read): ask again.
-                Err(e) if e.kind() == std::io::ErrorKind::InvalidData => continue,
-                Err(e) => return Err(e).context("reading the answer"),
-            };
-            if !std::io::stdin().is_terminal() {
-                super::print_line(format_args!("{}", line.trim()));
-            }
-            let word = line.trim().to_lowercase();
-            if ["a", "r", "s", "q"].contains(&word.as_str()) {
-                break word;
-            }
-        };
+        let answer = ask(&mut lines)?;
         match answer.as_str() {
             "a" => {
                 accept(file)?;
@@ -196,6 +177,31 @@ fn review(args: &TestArgs, pending: &[PathBuf]) -> anyhow::Result<()> {
         "review: {accepted} accepted, {rejected} rejected, {skipped} skipped"
     ));
     Ok(())
+}
+
+/// The next answer (`a`, `r`, `s` or `q`) read from `lines`, asking until one comes; `q` at
+/// the end of the input.
+fn ask(lines: &mut impl Iterator<Item = std::io::Result<String>>) -> anyhow::Result<String> {
+    loop {
+        print!("accept, reject or skip? [a/r/s/q] ");
+        let _ = std::io::stdout().flush();
+        let Some(line) = lines.next() else {
+            return Ok("q".to_string());
+        };
+        let line = match line {
+            Ok(line) => line,
+            // An answer that is not UTF-8 is no answer (its bytes are read): ask again.
+            Err(e) if e.kind() == std::io::ErrorKind::InvalidData => continue,
+            Err(e) => return Err(e).context("reading the answer"),
+        };
+        if !std::io::stdin().is_terminal() {
+            super::print_line(format_args!("{}", line.trim()));
+        }
+        let word = line.trim().to_lowercase();
+        if ["a", "r", "s", "q"].contains(&word.as_str()) {
+            return Ok(word);
+        }
+    }
 }
 
 /// Prints the figures against the current golden and shows (or names) the triptych.
