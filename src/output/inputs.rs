@@ -53,6 +53,7 @@ fn footage_input(footage: &Footage) -> Input {
 /// Every file the scene's render reads: the scene file, then [`scene_reads`].
 fn scene_inputs(loaded: &LoadedScene, imports: &[PathBuf]) -> Vec<Input> {
     let mut inputs = vec![Input::File(loaded.file.clone())];
+    inputs.extend(loaded.origins.read.iter().cloned().map(Input::File));
     inputs.extend(scene_reads(&loaded.scene, imports));
     inputs
 }

@@ -24,6 +24,9 @@ pub struct Origins {
     pub patches: Vec<Origin>,
     /// `file:line:col: …` for each old spelling the script used.
     pub warnings: Vec<String>,
+    /// Track files read into plain values (`track_keys`): inputs of a render like the
+    /// files a patch follows, which the scene itself records.
+    pub read: Vec<PathBuf>,
 }
 
 /// Stable identities of the draft's patches and handles, so a script's `Patch` and `Handle`

@@ -182,7 +182,11 @@ fn follow_handle(ctx: &NativeCallContext, h: &mut HandleRef, file: &str, options
 /// `[#{ t, at, rotate?, scale? }, …]` for `keys(...)`.
 fn track_keys(ctx: &NativeCallContext, draft: &SharedDraft, file: &str, options: &Map) -> Fallible<Array> {
     let (base, fps) = context(draft);
-    let (_, _, keys) = load_keys(&base, fps, file, options).map_err(|m| fail(ctx, m))?;
+    let (path, _, keys) = load_keys(&base, fps, file, options).map_err(|m| fail(ctx, m))?;
+    let read = &mut draft.lock().origins.read;
+    if !read.contains(&path) {
+        read.push(path);
+    }
     Ok(keys
         .iter()
         .map(|k| {

@@ -330,6 +330,8 @@ fn an_output_that_is_an_input_is_refused() {
     let original = std::fs::read(&scene).unwrap();
     world.write("face.csv", "frame,x,y\n1,20,15\n2,21,15\n3,22,16\n");
     world.scene("follows.rhai", "p.follow(\"face.csv\");\n");
+    world.write("keys.csv", "frame,x,y\n1,20,15\n2,21,15\n");
+    world.scene("reads.rhai", "let keys = track_keys(\"keys.csv\");\n");
     #[cfg(unix)]
     {
         std::os::unix::fs::symlink(world.path("lib.rhai"), world.path("lib_link.gif")).unwrap();
@@ -371,6 +373,7 @@ fn an_output_that_is_an_input_is_refused() {
             "gif",
         ],
         vec!["preview", "follows.rhai", "-o", "face.csv"],
+        vec!["render", "reads.rhai", "-o", "keys.csv", "--format", "apng"],
     ];
     #[cfg(unix)]
     cases.extend([
