@@ -393,7 +393,6 @@ pub fn check_own_file(path: &Path) -> anyhow::Result<()> {
     let what = match meta.file_type() {
         t if t.is_file() => return Ok(()),
         t if t.is_symlink() => "is a symbolic link",
-        t if t.is_dir() => "is a folder",
         _ => lapclone::util::not_a_file(path).unwrap_or("is not a regular file"),
     };
     anyhow::bail!(

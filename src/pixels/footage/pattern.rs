@@ -73,35 +73,33 @@ impl Pattern {
     /// The highest number any entry of the folder has under this pattern (a file or not),
     /// if one has.
     pub fn highest_number(&self) -> Option<u64> {
-        let folder = if self.folder.as_os_str().is_empty() {
-            Path::new(".")
-        } else {
-            &self.folder
-        };
-        std::fs::read_dir(folder)
-            .ok()?
-            .filter_map(|e| e.ok())
-            .filter_map(|e| self.number_of(&e.file_name().to_string_lossy()))
-            .max()
+        self.numbers().ok()?.max()
     }
 
     /// The lowest frame number that has a file.
     pub fn lowest_number(&self) -> Result<u64, FootageError> {
-        let folder = if self.folder.as_os_str().is_empty() {
+        let no_files = || FootageError::NoFiles {
+            pattern: self.text.clone(),
+            folder: self.folder_or_here().to_path_buf(),
+        };
+        self.numbers().map_err(|_| no_files())?.min().ok_or_else(no_files)
+    }
+
+    /// The numbers of the folder's entries this pattern names.
+    fn numbers(&self) -> std::io::Result<impl Iterator<Item = u64> + '_> {
+        let entries = std::fs::read_dir(self.folder_or_here())?;
+        Ok(entries
+            .filter_map(|e| e.ok())
+            .filter_map(|e| self.number_of(&e.file_name().to_string_lossy())))
+    }
+
+    /// The pattern's folder, `.` for a bare file name.
+    fn folder_or_here(&self) -> &Path {
+        if self.folder.as_os_str().is_empty() {
             Path::new(".")
         } else {
             &self.folder
-        };
-        let no_files = || FootageError::NoFiles {
-            pattern: self.text.clone(),
-            folder: folder.to_path_buf(),
-        };
-        let entries = std::fs::read_dir(folder).map_err(|_| no_files())?;
-        entries
-            .filter_map(|e| e.ok())
-            .filter_map(|e| self.number_of(&e.file_name().to_string_lossy()))
-            .min()
-            .ok_or_else(no_files)
+        }
     }
 }
 
