@@ -33,7 +33,7 @@ pub(crate) use preview::show_picture;
 use preview::{default_preview_path, Inline, Preview};
 pub(crate) use session::Session;
 use session::Step;
-use validator::InputValidator;
+use validator::EntrySplitter;
 
 #[derive(clap::Args, Debug)]
 pub struct ReplArgs {
@@ -144,7 +144,7 @@ fn start_view(
 /// Splits `input` into entries as the interactive validator would (unfinished Rhai goes on
 /// on the next line) and runs them; gives the number of failed entries.
 fn script_loop(session: &Mutex<Session>, mut input: Box<dyn BufRead>) -> anyhow::Result<usize> {
-    let validator = InputValidator::new();
+    let mut splitter = EntrySplitter::default();
     let mut failures = 0;
     let mut buffer = String::new();
     let mut number = 0;
@@ -154,6 +154,7 @@ fn script_loop(session: &Mutex<Session>, mut input: Box<dyn BufRead>) -> anyhow:
             eprint_line!("input line {number}: not valid UTF-8; this entry is skipped");
             failures += 1;
             buffer.clear();
+            splitter.reset();
             continue;
         };
         if buffer.len() + line.len() > MAX_ENTRY_BYTES {
@@ -166,9 +167,10 @@ fn script_loop(session: &Mutex<Session>, mut input: Box<dyn BufRead>) -> anyhow:
             buffer.push('\n');
         }
         buffer.push_str(&line);
-        if validator.is_incomplete(&buffer) {
+        if splitter.needs_more(&buffer, &line) {
             continue;
         }
+        splitter.reset();
         let entry = std::mem::take(&mut buffer);
         super::stdout_failure()?;
         match lock(session).entry(&entry) {
