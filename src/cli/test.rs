@@ -41,6 +41,7 @@ pub fn run(args: TestArgs) -> anyhow::Result<()> {
     } else {
         args.paths.clone()
     };
+    args.check_out()?;
     if args.accept || args.reject || args.review {
         return super::test_pending::run(&args, &paths);
     }

@@ -150,6 +150,18 @@ impl TestArgs {
             .unwrap_or_else(|| PathBuf::from(DEFAULT_OUT))
     }
 
+    /// A usage error when `--out` names something that is not a folder: the pictures
+    /// would fail to write only after every scene had run.
+    pub fn check_out(&self) -> Result<(), UsageError> {
+        match &self.out {
+            Some(dir) if dir.exists() && !dir.is_dir() => Err(UsageError(format!(
+                "--out {}: not a folder (failure pictures and index.html go in a folder)",
+                dir.display()
+            ))),
+            _ => Ok(()),
+        }
+    }
+
     /// Where failure pictures and `index.html` go: none on CI unless `--out` was given, so a
     /// CI run writes nothing it was not asked for.
     pub fn report_dir(&self) -> Option<PathBuf> {

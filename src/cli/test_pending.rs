@@ -241,14 +241,19 @@ fn show(args: &TestArgs, file: &Path) -> anyhow::Result<()> {
         }
     }
     let sheet = triptych(expected.as_ref(), &actual, &thresholds);
-    if !super::repl::show_picture(&sheet) {
-        let name = format!("{}.png", scene_slug(&file.with_extension("")));
-        let path = args.out_dir().join("review").join(name);
-        write_file(&path, &lapclone::golden::encode_rgba_png(&sheet))?;
-        super::print_line(format_args!(
-            "  expected | difference | actual: {}",
-            path.display()
-        ));
+    if super::repl::show_picture(&sheet) {
+        return Ok(());
     }
+    let Some(dir) = args.report_dir() else {
+        super::print_line("  (no picture: CI is set and --out was not given)");
+        return Ok(());
+    };
+    let name = format!("{}.png", scene_slug(&file.with_extension("")));
+    let path = dir.join("review").join(name);
+    write_file(&path, &lapclone::golden::encode_rgba_png(&sheet))?;
+    super::print_line(format_args!(
+        "  expected | difference | actual: {}",
+        path.display()
+    ));
     Ok(())
 }

@@ -261,16 +261,18 @@ fn review_accepts_rejects_and_skips_from_its_input() {
         .collect();
     assert_eq!(pending.len(), 3);
     let golden_2 = std::fs::read(fixture.golden(2)).unwrap();
-    let mut child = Command::new(env!("CARGO_BIN_EXE_lapclone"))
-        .current_dir(&fixture.root)
-        .args(["test", "--review"])
-        .stdin(std::process::Stdio::piped())
-        .stdout(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    use std::io::Write as _;
-    child.stdin.take().unwrap().write_all(b"a\nr\ns\n").unwrap();
-    let output = child.wait_with_output().unwrap();
+    // Under CI a review shows no picture it cannot show inline, and writes nothing.
+    let before = fixture.files();
+    let ci = review(&fixture, b"s\ns\ns\n", &[("CI", "1")]);
+    assert_eq!(code(&ci), 0);
+    assert!(stdout(&ci).contains("0 accepted, 0 rejected, 3 skipped"));
+    assert!(
+        stdout(&ci).contains("no picture: CI is set"),
+        "{}",
+        stdout(&ci)
+    );
+    assert_eq!(fixture.files(), before, "nothing written under CI");
+    let output = review(&fixture, b"a\nr\ns\n", &[]);
     assert_eq!(code(&output), 0);
     let text = stdout(&output);
     assert!(text.contains("1 accepted, 1 rejected, 1 skipped"), "{text}");
@@ -278,6 +280,23 @@ fn review_accepts_rejects_and_skips_from_its_input() {
     assert!(!fixture.pending(1).exists() && !fixture.pending(2).exists());
     assert!(fixture.pending(4).is_file(), "skipped stays pending");
     assert_eq!(std::fs::read(fixture.golden(2)).unwrap(), golden_2);
+}
+
+/// `lapclone test --review` in the fixture, answering `answers`.
+fn review(fixture: &Fixture, answers: &[u8], env: &[(&str, &str)]) -> Output {
+    let mut command = Command::new(env!("CARGO_BIN_EXE_lapclone"));
+    command
+        .current_dir(&fixture.root)
+        .args(["test", "--review"]);
+    command.env_remove("CI").envs(env.iter().copied());
+    let mut child = command
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    use std::io::Write as _;
+    child.stdin.take().unwrap().write_all(answers).unwrap();
+    child.wait_with_output().unwrap()
 }
 
 #[test]
@@ -336,6 +355,16 @@ fn bad_inputs_give_clear_messages_and_exit_codes() {
     );
 
     assert_eq!(code(&fixture.run(&["--update"])), 0);
+    // An --out that is a file (here the scene) is a usage error before anything runs.
+    for mode in [&[][..], &["--review"], &["--accept"]] {
+        let out = fixture.run(&[mode, &["--out", "tiny.rhai"]].concat());
+        assert_eq!(code(&out), 2, "{mode:?}");
+        assert!(
+            stderr(&out).contains("--out tiny.rhai: not a folder"),
+            "{}",
+            stderr(&out)
+        );
+    }
     // A golden of another size.
     image::RgbImage::new(5, 3).save(fixture.golden(1)).unwrap();
     let size = fixture.run(&["--frames", "1"]);
