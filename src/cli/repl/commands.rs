@@ -110,12 +110,10 @@ pub fn parse_command(line: &str) -> Result<Command, String> {
             Err(usage())
         }
     };
-    let path = || {
-        if rest.is_empty() {
-            Err(usage())
-        } else {
-            Ok(PathBuf::from(unquote(rest)))
-        }
+    let path = || match unquote(rest) {
+        "" if rest.is_empty() => Err(usage()),
+        "" => Err(format!("{}: the FILE is empty", usage())),
+        file => Ok(PathBuf::from(file)),
     };
     match name {
         "help" => no_args(Command::Help),
@@ -147,11 +145,15 @@ pub fn parse_command(line: &str) -> Result<Command, String> {
 fn parse_render(rest: &str) -> Result<Command, String> {
     let mut range = None;
     let mut output = PathBuf::from("frames");
-    let mut words = rest.split_whitespace();
+    let words = words(rest)?;
+    let mut words = words.iter().map(String::as_str);
     while let Some(word) = words.next() {
         if word == "-o" {
-            let dir = words.next().ok_or("-o needs a folder")?;
-            output = PathBuf::from(unquote(dir));
+            match words.next() {
+                None => return Err("-o needs a folder".into()),
+                Some("") => return Err("the -o folder is empty".into()),
+                Some(dir) => output = PathBuf::from(dir),
+            }
         } else if range.is_none() && word.contains("..") {
             range = Some(frame_range(word)?);
         } else {
@@ -159,6 +161,29 @@ fn parse_render(rest: &str) -> Result<Command, String> {
         }
     }
     Ok(Command::Render { range, output })
+}
+
+/// Splits arguments at blanks; a word in double or single quotes keeps its blanks
+/// (`-o "my frames"`). No backslash escapes, so Windows paths read as typed.
+fn words(text: &str) -> Result<Vec<String>, String> {
+    let mut words = Vec::new();
+    let mut rest = text.trim_start();
+    while let Some(first) = rest.chars().next() {
+        let (word, after) = if first == '"' || first == '\'' {
+            let end = rest[1..]
+                .find(first)
+                .ok_or_else(|| format!("unclosed {first} in `{rest}`"))?;
+            (&rest[1..1 + end], &rest[2 + end..])
+        } else {
+            rest.split_at(rest.find(char::is_whitespace).unwrap_or(rest.len()))
+        };
+        if after.starts_with(|c: char| !c.is_whitespace()) {
+            return Err(format!("a quoted word runs into `{after}`"));
+        }
+        words.push(word.to_string());
+        rest = after.trim_start();
+    }
+    Ok(words)
 }
 
 /// Strips one pair of surrounding quotes, so `:save "my scene.rhai"` works.
@@ -236,6 +261,35 @@ mod tests {
         assert!(parse_command(":list extra").is_err());
         assert!(parse_command(":render 3..1").is_err());
         assert!(parse_command(":render -o").is_err());
+        for (line, message) in [
+            (":render -o \"my frames", "unclosed \""),
+            (":render -o \"a\"b", "runs into `b`"),
+            (":render -o ''", "the -o folder is empty"),
+            (":gif \"\"", "usage: :gif FILE: the FILE is empty"),
+            (":save ''", "the FILE is empty"),
+        ] {
+            let error = parse_command(line).unwrap_err();
+            assert!(error.contains(message), "{line}: {error}");
+        }
+    }
+
+    #[test]
+    fn quoted_words_keep_their_blanks() {
+        assert_eq!(
+            parse_command(":render -o \"my frames\" 1..2"),
+            Ok(Command::Render {
+                range: Some(FrameRange { first: 1, last: 2 }),
+                output: PathBuf::from("my frames")
+            })
+        );
+        assert_eq!(
+            parse_command(":render  'a \"b' "),
+            Err("usage: :render [A..B] [-o DIR]: unexpected `a \"b`".into())
+        );
+        assert_eq!(
+            words(r"-o C:\out\x 'it is'"),
+            Ok(vec!["-o".into(), r"C:\out\x".into(), "it is".into()])
+        );
     }
 
     #[test]
