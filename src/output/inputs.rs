@@ -50,7 +50,8 @@ fn footage_input(footage: &Footage) -> Input {
     }
 }
 
-/// Every file the scene's render reads: the scene file, then [`scene_reads`].
+/// Every file the scene's render reads: the scene file first, the files `track_keys` read,
+/// then [`scene_reads`].
 fn scene_inputs(loaded: &LoadedScene, imports: &[PathBuf]) -> Vec<Input> {
     let mut inputs = vec![Input::File(loaded.file.clone())];
     inputs.extend(loaded.origins.read.iter().cloned().map(Input::File));
@@ -125,18 +126,19 @@ fn refuse_replacing(
     Ok(())
 }
 
-/// Refuses an output that is a file `scene` reads (an image, a plate, a video, a track
-/// file) or one of its `imports`. The scene text's own file is not among them: a session
-/// saving its scene writes that file.
+/// Refuses an output that is a file the `loaded` scene reads (an image, a plate, a video,
+/// a track file, one read by `track_keys`) or one of its `imports`. The scene text's own
+/// file is not among them: a session saving its scene writes that file.
 pub fn refuse_scene_reads(
     output: &Path,
-    scene: &Scene,
+    loaded: &LoadedScene,
     imports: &[PathBuf],
 ) -> Result<(), OutputError> {
     if !output.exists() {
         return Ok(());
     }
-    match scene_reads(scene, imports).iter().find(|i| i.covers(output)) {
+    let inputs = scene_inputs(loaded, imports);
+    match inputs[1..].iter().find(|i| i.covers(output)) {
         Some(input) => Err(overwrite(output, &input.describe())),
         None => Ok(()),
     }

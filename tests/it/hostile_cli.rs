@@ -899,11 +899,14 @@ fn the_repl_refuses_to_render_over_its_own_inputs() {
         std::fs::read(world.path("lib.rhai")).unwrap(),
     );
     let src_before = std::fs::read(world.path("src.png")).unwrap();
-    // `:save` may write the loaded scene file (here: the same text), nothing it reads.
+    let keys = "frame,x,y\n1,20,15\n2,21,15\n";
+    world.write("keys.csv", keys);
+    // `:save` may write the loaded scene file (here: the same text), nothing it reads, not
+    // even a file an entry read through `track_keys`.
     let output = world.repl(
         &["victim.rhai"],
         b":gif victim.rhai\n:gif lib.rhai\n:save src.png\n:save lib.rhai\n:gif out.gif\n\
-          :save victim.rhai\n",
+          :save victim.rhai\nlet k = track_keys(\"keys.csv\");\n:gif keys.csv\n:save keys.csv\n",
         Stdio::piped(),
     );
     let all = format!(
@@ -912,9 +915,13 @@ fn the_repl_refuses_to_render_over_its_own_inputs() {
         String::from_utf8_lossy(&output.stderr)
     );
     assert_eq!(output.status.code(), Some(1), "{all}");
-    assert!(all.contains("4 failed entries"), "{all}");
-    assert_eq!(all.matches("would replace an input").count(), 4, "{all}");
+    assert!(all.contains("6 failed entries"), "{all}");
+    assert_eq!(all.matches("would replace an input").count(), 6, "{all}");
     assert!(all.contains("saved victim.rhai"), "{all}");
+    assert_eq!(
+        std::fs::read_to_string(world.path("keys.csv")).unwrap(),
+        keys
+    );
     assert_eq!(std::fs::read(&scene).unwrap(), scene_before);
     assert_eq!(std::fs::read(world.path("lib.rhai")).unwrap(), lib_before);
     assert!(world.path("out.gif").is_file(), "{all}");

@@ -35,9 +35,9 @@ impl Session {
     /// Refuses `output` when the live scene reads it or imports it, or when it is the loaded
     /// scene file, unless `scene_file_ok` (`:save` writes that file).
     pub fn refuse_input(&self, output: &Path, scene_file_ok: bool) -> anyhow::Result<()> {
-        if let Some(renderer) = &self.renderer {
+        if let (Some(_), Some(loaded)) = (&self.renderer, &self.installed) {
             let imports = self.engine.module_files().files();
-            lapclone::output::refuse_scene_reads(output, renderer.scene(), &imports)?;
+            lapclone::output::refuse_scene_reads(output, loaded, &imports)?;
         }
         let file = self.file.as_deref().filter(|_| !scene_file_ok);
         Ok(lapclone::output::refuse_input(
