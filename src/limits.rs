@@ -27,6 +27,29 @@ pub const MAX_SCENE_BYTES: u64 = 16 << 20;
 /// Widest feather, px: four times the widest canvas, so any feather that can matter fits,
 /// and the raster's integer margins around a patch cannot overflow.
 pub const MAX_FEATHER: f64 = 65_536.0;
+/// Largest |coordinate| of a place a scene puts something (a patch's `at`, a handle's rest
+/// point and target, a pin, a pivot; from calls or track files), px: a thousand times past
+/// the raster's reach, and far enough from overflow that placed vertices stay finite.
+pub const MAX_POSITION: f64 = 1e9;
+/// Largest scale a patch may take: the largest source at this scale spans 1.6·10¹⁰ px, far
+/// past any canvas, while its placed vertices stay finite (1e308 overflowed to ∞).
+pub const MAX_SCALE: f64 = 1e6;
+
+/// Why `v` cannot be a coordinate of a position ([`MAX_POSITION`]), if it cannot.
+pub fn position_error(v: f64) -> Option<String> {
+    let v_text = crate::util::number_text(v);
+    (v.abs() > MAX_POSITION).then(|| format!("{v_text} is past ±{MAX_POSITION:e} px"))
+}
+
+/// Why `v` cannot be a scale (positive, at most [`MAX_SCALE`]), if it cannot.
+pub fn scale_error(v: f64) -> Option<String> {
+    if v > 0.0 && v <= MAX_SCALE {
+        return None;
+    }
+    let v_text = crate::util::number_text(v);
+    Some(format!("{v_text} must be > 0 and at most {MAX_SCALE:e}"))
+}
+
 /// Heap the image decoder may allocate for one image: an RGBA 16-bit image at the pixel
 /// limit (8 bytes per pixel) plus slack for the decoder's own buffers.
 pub(crate) const MAX_DECODER_ALLOC: u64 = MAX_IMAGE_PIXELS * 8 + (64 << 20);

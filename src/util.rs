@@ -233,6 +233,17 @@ impl TempOutput {
     }
 }
 
+/// A number for a message: as written when short, in exponent form when huge or tiny (a
+/// scene's `1e308` is not shown as 309 digits).
+pub fn number_text(v: f64) -> String {
+    let magnitude = v.abs();
+    if magnitude != 0.0 && !(1e-4..1e7).contains(&magnitude) {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
+    }
+}
+
 /// What kind of thing `path` is, for a message about an input that cannot be read as a
 /// file: `None` for a regular file (also through links), else "does not exist", "is a
 /// folder, not a file" or "is not a regular file (a FIFO)" and the like.
@@ -292,5 +303,19 @@ pub fn same_file(a: &Path, b: &Path) -> bool {
     #[cfg(not(unix))]
     {
         matches!((a.canonicalize(), b.canonicalize()), (Ok(x), Ok(y)) if x == y)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::number_text;
+
+    #[test]
+    fn numbers_in_messages_stay_short() {
+        for (v, text) in [(1e308, "1e308"), (-2e9, "-2e9"), (0.5, "0.5"), (0.0, "0"), (1e-9, "1e-9")] {
+            assert_eq!(number_text(v), text);
+        }
+        assert_eq!(number_text(1234567.0), "1234567");
+        assert_eq!(number_text(f64::INFINITY), "inf");
     }
 }

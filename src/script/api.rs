@@ -422,7 +422,7 @@ impl PatchRef {
         self.edit_in_place(&ctx, |p| {
             values::check_keys(&options, &["depth", "pivot"], "drag")?;
             let handle = Handle {
-                from: values::point(&from, "drag rest point")?,
+                from: values::position(&from, "drag rest point")?,
                 to: Track::new(),
                 radius: values::positive(&radius, "drag radius")?,
                 depth: options
@@ -431,7 +431,7 @@ impl PatchRef {
                     .transpose()?,
                 pivot: options
                     .get("pivot")
-                    .map(|v| values::point(v, "pivot"))
+                    .map(|v| values::position(v, "pivot"))
                     .transpose()?,
                 rotation: Track::new(),
             };
@@ -460,7 +460,7 @@ impl PatchRef {
             if end.is_some_and(|e| e <= start) {
                 return Err(format!("pin `end` must be after `start` ({start})"));
             }
-            let at = values::point(&at, "pin point")?;
+            let at = values::position(&at, "pin point")?;
             p.pins.push(Pin { at, start, end });
             Ok(at)
         })?;
@@ -538,7 +538,7 @@ impl HandleRef {
         self.edit_in_place(&ctx, |h| {
             let t = values::time(&t)?;
             let easing = values::easing(easing)?;
-            h.to.push(t, values::point(&to, "handle target")?, easing)
+            h.to.push(t, values::position(&to, "handle target")?, easing)
                 .map_err(|e| e.to_string())
         })
     }
@@ -560,7 +560,7 @@ impl HandleRef {
                 values::check_keys(&m, &["t", "at", "rotate"], "handle key")?;
                 let t = values::time(m.get("t").ok_or("each key needs a time `t`")?)?;
                 if let Some(at) = m.get("at") {
-                    let at = values::point(at, "handle target")?;
+                    let at = values::position(at, "handle target")?;
                     h.to.push(t, at, easing).map_err(|e| e.to_string())?;
                 }
                 if let Some(r) = m.get("rotate") {

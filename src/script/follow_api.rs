@@ -52,7 +52,7 @@ fn settings(options: &Map) -> Result<FollowSettings, String> {
         s.point = whole(v, "point")? as usize;
     }
     if let Some(v) = options.get("offset") {
-        s.offset = values::point(v, "offset")?;
+        s.offset = values::position(v, "offset")?;
     }
     let flag = |name: &str| -> Result<Option<bool>, String> {
         options

@@ -79,8 +79,8 @@ impl Placed {
     ) -> Result<(), String> {
         let p = &mut patch.placement;
         let result = match self {
-            Placed::At => p.position.push(t, values::point(value, "`at`")?, easing),
-            Placed::Scale => p.scale.push(t, values::positive(value, "`scale`")?, easing),
+            Placed::At => p.position.push(t, values::position(value, "`at`")?, easing),
+            Placed::Scale => p.scale.push(t, values::scale(value, "`scale`")?, easing),
             Placed::Rotate => p.rotation.push(t, number(value, "`rotate`")?, easing),
             Placed::Depth => p.depth.push(t, number(value, "`depth`")?, easing),
             Placed::Opacity => p.opacity.push(t, values::unit(value, "`opacity`")?, easing),

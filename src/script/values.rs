@@ -34,7 +34,7 @@ pub(super) fn number_where(
     if ok(v) {
         Ok(v)
     } else {
-        Err(format!("{what} must be {rule}, got {v}"))
+        Err(format!("{what} must be {rule}, got {}", crate::util::number_text(v)))
     }
 }
 
@@ -79,6 +79,24 @@ pub fn point(value: &Dynamic, what: &str) -> Result<DVec2, String> {
         number(&array[0], what)?,
         number(&array[1], what)?,
     ))
+}
+
+/// A point a scene places something at: finite, within [`crate::limits::MAX_POSITION`].
+pub fn position(value: &Dynamic, what: &str) -> Result<DVec2, String> {
+    let p = point(value, what)?;
+    match [p.x, p.y].into_iter().find_map(crate::limits::position_error) {
+        Some(error) => Err(format!("{what}: {error}")),
+        None => Ok(p),
+    }
+}
+
+/// A patch's scale: > 0 and at most [`crate::limits::MAX_SCALE`].
+pub fn scale(value: &Dynamic, what: &str) -> Result<f64, String> {
+    let v = number(value, what)?;
+    match crate::limits::scale_error(v) {
+        Some(error) => Err(format!("{what}: {error}")),
+        None => Ok(v),
+    }
 }
 
 pub fn string(value: &Dynamic, what: &str) -> Result<String, String> {

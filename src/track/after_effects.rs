@@ -128,13 +128,18 @@ fn key_line(keys: &mut Keys, section: Section, number: usize, cells: &[&str]) ->
         ));
     }
     match section {
-        Section::Position => keys.position.push((frame, DVec2::new(values[1], values[2]), number)),
+        Section::Position => {
+            if let Some(error) = values[1..3].iter().find_map(|&v| crate::limits::position_error(v)) {
+                return Err((number, format!("position {error}")));
+            }
+            keys.position.push((frame, DVec2::new(values[1], values[2]), number))
+        }
         Section::Rotation => keys.rotation.push((frame, values[1])),
         _ => {
             let y = values.get(2).copied().unwrap_or(values[1]);
             let factor = (values[1] + y) / 200.0;
-            if factor <= 0.0 {
-                return Err((number, format!("scale {factor} must be positive")));
+            if let Some(error) = crate::limits::scale_error(factor) {
+                return Err((number, format!("scale {error}")));
             }
             keys.scale.push((frame, factor));
         }
@@ -202,5 +207,15 @@ mod tests {
         let (line, message) = parse(&bad).unwrap_err();
         assert_eq!(line, 12);
         assert!(message.contains("`abc`"), "{message}");
+    }
+
+    #[test]
+    fn a_far_position_or_a_huge_scale_names_its_line() {
+        let far = SAMPLE.replace("\t101.5\t", "\t1e308\t");
+        assert_eq!(parse(&far).unwrap_err(), (12, "position 1e308 is past ±1e9 px".into()));
+        let huge = SAMPLE.replace("\t0\t100\t100\t100\t", "\t0\t1e308\t1e308\t100\t");
+        let (line, message) = parse(&huge).unwrap_err();
+        assert_eq!(line, 21);
+        assert!(message.contains("scale inf must be > 0 and at most 1e6"), "{message}");
     }
 }

@@ -191,14 +191,17 @@ fn parse_row(line: usize, text: &str, columns: &[Column]) -> Result<(usize, Trac
             }
             Column::Seconds => row.time = TrackTime::Seconds(value),
             Column::Point => point = whole(line, name, value, MAX_POINTS as u64)? as usize,
-            Column::X => row.at.x = value,
-            Column::Y => row.at.y = value,
+            Column::X | Column::Y => match crate::limits::position_error(value) {
+                Some(error) => return Err((line, format!("column `{name}`: {error}"))),
+                None if *column == Column::X => row.at.x = value,
+                None => row.at.y = value,
+            },
             Column::Confidence => row.confidence = Some(value),
             Column::Rotate => row.rotate = Some(value),
-            Column::Scale if value <= 0.0 => {
-                return Err((line, format!("column `scale`: {value} must be positive")))
-            }
-            Column::Scale => row.scale = Some(value),
+            Column::Scale => match crate::limits::scale_error(value) {
+                Some(error) => return Err((line, format!("column `scale`: {error}"))),
+                None => row.scale = Some(value),
+            },
         }
     }
     Ok((point, row))
@@ -286,5 +289,12 @@ mod tests {
         assert_eq!(err("frame,x,y\n2,0,0\n\n1,0,0\n").0, 4);
         assert_eq!(err("frame,x,y\n").0, 2);
         assert!(err("frame,x\n").1.contains("`x` and `y`"));
+        // Finite but out of reach: the row is named, not the patch at render time.
+        let far = err("frame,x,y\n1,2,3\n2,-1e308,3\n");
+        assert_eq!(far, (3, "column `x`: -1e308 is past ±1e9 px".into()));
+        let huge = err("frame,x,y,scale\n1,2,3,1e308\n");
+        assert_eq!(huge, (2, "column `scale`: 1e308 must be > 0 and at most 1e6".into()));
+        assert!(err("frame,x,y,scale\n1,2,3,0\n").1.contains("0 must be > 0"));
+        assert!(parse("frame,x,y,scale\n1,1e9,-1e9,1e6\n").is_ok(), "the bounds themselves");
     }
 }

@@ -602,6 +602,11 @@ fn hostile_scenes_fail_at_a_position_without_output() {
         ("nan_position", with_head("p.at(0, [0.0 / 0.0, 2]);\n"), "finite"),
         ("inf_scale", with_head("p.scale(0, 1.0 / 0.0);\n"), "finite"),
         ("zero_scale", with_head("p.scale(0, 0);\n"), "must be > 0"),
+        // Finite but past reach: refused at the call, not when a render overflows.
+        ("huge_scale", with_head("p.scale(0, 1e308);\n"), "`scale`: 1e308 must be > 0 and at most 1e6"),
+        ("far_position", with_head("p.at(1, [5, -2e9]);\n"), "`at`: -2e9 is past ±1e9 px"),
+        ("far_target", with_head("p.drag([5, 5], 3).key(1, [1e300, 5]);\n"), "handle target: 1e300 is past"),
+        ("far_pin", with_head("p.pin([5, 1e10]);\n"), "pin point: 1e10 is past"),
         ("zero_radius", with_head("p.drag([5, 5], 0);\n"), "drag radius must be > 0"),
         ("import_parent", with_head("import \"../evil\" as e;\n"), "plain relative name"),
         ("import_absolute", with_head("import \"/etc/passwd\" as e;\n"), "plain relative name"),

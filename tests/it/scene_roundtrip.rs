@@ -27,7 +27,9 @@ fn awkward_f64() -> impl Strategy<Value = f64> {
         Just(0.1 + 0.2),
         Just(1e-300),
         Just(-0.0),
-        Just(1e20),
+        // The largest a scene may place something at (`limits::MAX_POSITION`).
+        Just(1e9),
+        Just(-999_999_999.75),
         (-1000i32..1000).prop_map(f64::from),
     ]
 }
