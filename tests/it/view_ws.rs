@@ -783,3 +783,42 @@ fn the_scene_message_carries_a_followed_tracks_path() {
     );
     assert!(repl.finish().success());
 }
+
+/// The page's HTTP answer, read whole.
+fn get_page(repl: &ViewRepl) -> String {
+    use std::io::Read as _;
+    let mut stream = TcpStream::connect(repl.host()).unwrap();
+    stream.set_read_timeout(Some(WAIT)).unwrap();
+    let path = repl.url.split_once(&repl.host()).unwrap().1.to_string();
+    let request = format!("GET {path} HTTP/1.1\r\nHost: {}\r\n\r\n", repl.host());
+    stream.write_all(request.as_bytes()).unwrap();
+    let mut answer = String::new();
+    stream.read_to_string(&mut answer).unwrap();
+    answer
+}
+
+#[test]
+fn a_connection_past_the_limit_is_told_why_and_a_closed_page_frees_its_place() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = cat_scene(dir.path());
+    let repl = ViewRepl::start(dir.path(), &scene);
+    let mut pages: Vec<Page> = (0..32).map(|_| repl.page()).collect();
+    let busy = get_page(&repl);
+    assert!(busy.starts_with("HTTP/1.1 503"), "{busy}");
+    assert!(
+        busy.contains("serves at most 32 connections at once"),
+        "{busy}"
+    );
+    drop(pages.pop());
+    // The closed page's thread notices within its read poll; then the page is served.
+    let served = (0..100).find_map(|_| {
+        std::thread::sleep(Duration::from_millis(50));
+        Some(get_page(&repl)).filter(|a| a.starts_with("HTTP/1.1 200"))
+    });
+    assert!(served.is_some(), "no place freed");
+    let mut last = repl.page();
+    last.send(&json!({"type": "seek", "t": 0.5}));
+    last.until(|v| v["type"] == "scene" && v["t"] == 0.5);
+    drop((pages, last));
+    assert!(repl.finish().success());
+}

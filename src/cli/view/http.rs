@@ -55,6 +55,31 @@ pub fn accept(mut stream: TcpStream, routes: &Routes) -> std::io::Result<Accepte
     }
 }
 
+/// Answers a connection past the server's page limit with 503 and why, instead of closing
+/// it unanswered (the browser would say only that the connection was reset). The request is
+/// read first, briefly, so that closing does not reset the answer away.
+pub fn refuse_busy(mut stream: TcpStream, limit: usize) {
+    let brief = Some(Duration::from_millis(200));
+    if stream.set_read_timeout(brief).is_err() || stream.set_write_timeout(brief).is_err() {
+        return;
+    }
+    let mut head = [0u8; 8192];
+    let _ = stream.read(&mut head);
+    let body = format!(
+        "the live view serves at most {limit} connections at once: close a page of this \
+         session, then reload this one"
+    );
+    let kind = "text/plain; charset=utf-8";
+    let _ = respond(
+        &mut stream,
+        "503 Service Unavailable",
+        kind,
+        body.as_bytes(),
+        &[],
+    );
+    let _ = stream.shutdown(std::net::Shutdown::Write);
+}
+
 /// The page, with headers that keep it out of frames and caches and its scripts its own.
 fn serve_page(stream: &mut TcpStream, routes: &Routes) -> std::io::Result<()> {
     let headers = [

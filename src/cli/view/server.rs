@@ -119,10 +119,11 @@ fn serve(
     for stream in listener.incoming() {
         let Ok(stream) = stream else { continue };
         if open.load(Ordering::SeqCst) >= MAX_CONNECTIONS {
-            continue; // dropped: the connection closes
+            super::http::refuse_busy(stream, MAX_CONNECTIONS);
+            continue;
         }
         open.fetch_add(1, Ordering::SeqCst);
-        let (routes, session, hub, open) =
+        let (routes, session, hub, slot) =
             (routes.clone(), session.clone(), hub.clone(), open.clone());
         let spawned = std::thread::Builder::new()
             .name("view-page".into())
@@ -130,9 +131,11 @@ fn serve(
                 if let Ok(Accepted::Socket(socket)) = accept(stream, &routes) {
                     page_loop(*socket, &session, &hub);
                 }
-                open.fetch_sub(1, Ordering::SeqCst);
+                slot.fetch_sub(1, Ordering::SeqCst);
             });
         if spawned.is_err() {
+            // The thread never ran to give its slot back.
+            open.fetch_sub(1, Ordering::SeqCst);
             eprint_line!("warning: the view cannot serve another page");
         }
     }
