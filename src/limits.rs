@@ -37,8 +37,8 @@ pub const MAX_SCALE: f64 = 1e6;
 
 /// Why `v` cannot be a coordinate of a position ([`MAX_POSITION`]), if it cannot.
 pub fn position_error(v: f64) -> Option<String> {
-    let v_text = crate::util::number_text(v);
-    (v.abs() > MAX_POSITION).then(|| format!("{v_text} is past ±{MAX_POSITION:e} px"))
+    (v.abs() > MAX_POSITION)
+        .then(|| format!("{} is past ±{MAX_POSITION:e} px", crate::util::number_text(v)))
 }
 
 /// Why `v` cannot be a scale (positive, at most [`MAX_SCALE`]), if it cannot.

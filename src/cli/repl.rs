@@ -146,32 +146,21 @@ fn start_view(
 fn script_loop(session: &Mutex<Session>, mut input: Box<dyn BufRead>) -> anyhow::Result<usize> {
     let mut splitter = EntrySplitter::default();
     let mut failures = 0;
-    let mut buffer = String::new();
     let mut number = 0;
     while let Some(line) = next_line(&mut input, &mut number)? {
         let Ok(line) = line else {
             // The entry this line was part of cannot be run: it is dropped with it.
             eprint_line!("input line {number}: not valid UTF-8; this entry is skipped");
             failures += 1;
-            buffer.clear();
-            splitter.reset();
+            splitter.drop_entry();
             continue;
         };
-        if buffer.len() + line.len() > MAX_ENTRY_BYTES {
+        if splitter.len() + line.len() > MAX_ENTRY_BYTES {
             anyhow::bail!("input line {number}: the entry is over {MAX_ENTRY_BYTES} bytes");
         }
-        if buffer.is_empty() && line.trim().is_empty() {
+        let Some(entry) = splitter.push(&line) else {
             continue;
-        }
-        if !buffer.is_empty() {
-            buffer.push('\n');
-        }
-        buffer.push_str(&line);
-        if splitter.needs_more(&buffer, &line) {
-            continue;
-        }
-        splitter.reset();
-        let entry = std::mem::take(&mut buffer);
+        };
         super::stdout_failure()?;
         match lock(session).entry(&entry) {
             Step::Ok => {}
@@ -179,8 +168,10 @@ fn script_loop(session: &Mutex<Session>, mut input: Box<dyn BufRead>) -> anyhow:
             Step::Quit => return Ok(failures),
         }
     }
-    if !buffer.trim().is_empty() && lock(session).entry(&buffer) == Step::Failed {
-        failures += 1;
+    if let Some(rest) = splitter.finish() {
+        if lock(session).entry(&rest) == Step::Failed {
+            failures += 1;
+        }
     }
     Ok(failures)
 }

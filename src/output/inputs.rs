@@ -50,11 +50,17 @@ fn footage_input(footage: &Footage) -> Input {
     }
 }
 
-/// Every file the scene's render reads: the scene file first, the files `track_keys` read,
-/// then [`scene_reads`].
+/// Every file the scene's render reads: the scene file, then [`script_reads`].
 fn scene_inputs(loaded: &LoadedScene, imports: &[PathBuf]) -> Vec<Input> {
     let mut inputs = vec![Input::File(loaded.file.clone())];
-    inputs.extend(loaded.origins.read.iter().cloned().map(Input::File));
+    inputs.extend(script_reads(loaded, imports));
+    inputs
+}
+
+/// What running the scene's text reads besides the text itself: the files `track_keys`
+/// read, then [`scene_reads`].
+fn script_reads(loaded: &LoadedScene, imports: &[PathBuf]) -> Vec<Input> {
+    let mut inputs: Vec<Input> = loaded.origins.read.iter().cloned().map(Input::File).collect();
     inputs.extend(scene_reads(&loaded.scene, imports));
     inputs
 }
@@ -137,8 +143,7 @@ pub fn refuse_scene_reads(
     if !output.exists() {
         return Ok(());
     }
-    let inputs = scene_inputs(loaded, imports);
-    match inputs[1..].iter().find(|i| i.covers(output)) {
+    match script_reads(loaded, imports).iter().find(|i| i.covers(output)) {
         Some(input) => Err(overwrite(output, &input.describe())),
         None => Ok(()),
     }

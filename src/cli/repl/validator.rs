@@ -75,6 +75,8 @@ fn at_end(text: &str, position: Position) -> bool {
 pub struct EntrySplitter {
     validator: InputValidator,
     brackets: Brackets,
+    /// The entry read so far, its lines joined by `\n`.
+    entry: String,
     lines: usize,
     parsed_at: usize,
     parses: usize,
@@ -84,11 +86,27 @@ pub struct EntrySplitter {
 const EXACT_LINES: usize = 64;
 
 impl EntrySplitter {
-    /// Whether `entry`, whose last line is `line`, needs more lines. Call once per line
-    /// added; [`EntrySplitter::reset`] when an entry ends or is dropped.
-    pub fn needs_more(&mut self, entry: &str, line: &str) -> bool {
+    /// Adds the next line; gives the entry it finishes. Blank lines between entries are
+    /// skipped.
+    pub fn push(&mut self, line: &str) -> Option<String> {
+        if self.entry.is_empty() && line.trim().is_empty() {
+            return None;
+        }
+        if !self.entry.is_empty() {
+            self.entry.push('\n');
+        }
+        self.entry.push_str(line);
         self.lines += 1;
         self.brackets.feed(line);
+        if self.needs_more() {
+            return None;
+        }
+        let entry = std::mem::take(&mut self.entry);
+        self.drop_entry();
+        Some(entry)
+    }
+
+    fn needs_more(&mut self) -> bool {
         let lines_since = self.lines - self.parsed_at;
         if self.brackets.surely_open() && self.lines >= EXACT_LINES && lines_since * 8 < self.lines
         {
@@ -96,13 +114,26 @@ impl EntrySplitter {
         }
         self.parsed_at = self.lines;
         self.parses += 1;
-        self.validator.is_incomplete(entry)
+        self.validator.is_incomplete(&self.entry)
     }
 
-    /// Starts a new entry.
-    pub fn reset(&mut self) {
+    /// Bytes of the entry read so far.
+    pub fn len(&self) -> usize {
+        self.entry.len()
+    }
+
+    /// Forgets the entry read so far (one of its lines could not be read).
+    pub fn drop_entry(&mut self) {
+        self.entry.clear();
         self.brackets = Brackets::default();
         (self.lines, self.parsed_at) = (0, 0);
+    }
+
+    /// At the end of the input: the unfinished entry, unless it is blank.
+    pub fn finish(&mut self) -> Option<String> {
+        let entry = std::mem::take(&mut self.entry);
+        self.drop_entry();
+        Some(entry).filter(|e| !e.trim().is_empty())
     }
 
     /// Parses run so far, over all entries.
@@ -273,21 +304,8 @@ mod tests {
     /// Entries as the piped reader splits `text`, and the parses it took.
     fn split(text: &str) -> (Vec<String>, usize) {
         let mut splitter = EntrySplitter::default();
-        let (mut entries, mut buffer) = (Vec::new(), String::new());
-        for line in text.lines() {
-            if buffer.is_empty() && line.trim().is_empty() {
-                continue;
-            }
-            if !buffer.is_empty() {
-                buffer.push('\n');
-            }
-            buffer.push_str(line);
-            if !splitter.needs_more(&buffer, line) {
-                splitter.reset();
-                entries.push(std::mem::take(&mut buffer));
-            }
-        }
-        entries.extend(Some(buffer).filter(|b| !b.is_empty()));
+        let mut entries: Vec<String> = text.lines().filter_map(|l| splitter.push(l)).collect();
+        entries.extend(splitter.finish());
         (entries, splitter.parses())
     }
 
