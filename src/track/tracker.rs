@@ -10,7 +10,7 @@
 use glam::DVec2;
 
 use super::lucas_kanade::Template;
-use super::pyramid::Pyramid;
+use super::pyramid::{window_area, FramePyramid, Pyramid};
 use super::TrackError;
 use crate::pixels::FloatImage;
 
@@ -146,6 +146,7 @@ impl PointTracker {
             points: Vec::with_capacity(points.len()),
         };
         let mut estimates = Vec::with_capacity(points.len());
+        let mut shared = None;
         for (index, &at) in points.iter().enumerate() {
             let inside = at.x >= 0.0
                 && at.y >= 0.0
@@ -160,7 +161,7 @@ impl PointTracker {
                     height: first.height(),
                 });
             }
-            let pyramid = Pyramid::around(first, at, tracker.reach(search, levels), levels);
+            let pyramid = tracker.full_range(first, at, points.len(), &mut shared);
             let templates = tracker.templates(&pyramid, at);
             let mut anchors = templates.clone();
             anchors[0].prepare_similarity();
@@ -194,16 +195,42 @@ impl PointTracker {
             });
         }
         let mut out = Vec::with_capacity(self.points.len());
+        let mut shared = None;
         for index in 0..self.points.len() {
-            out.push(self.follow(index, frame));
+            out.push(self.follow(index, frame, &mut shared));
         }
         Ok(out)
     }
 
-    fn follow(&mut self, index: usize, frame: &FloatImage) -> Estimate {
+    /// The pyramid of `frame` a point at `centre` is searched for in over the whole range:
+    /// its own window, or a window of the frame's `shared` pyramid (built on first use) when
+    /// `points` such windows would hold more than that pyramid. Either gives the same values.
+    fn full_range(
+        &self,
+        frame: &FloatImage,
+        centre: DVec2,
+        points: usize,
+        shared: &mut Option<FramePyramid>,
+    ) -> Pyramid {
+        let (reach, levels) = (self.reach(self.search, self.levels), self.levels);
+        let windows = window_area(self.size, centre, reach, levels).saturating_mul(points as u64);
+        if windows <= FramePyramid::area(self.size, levels) {
+            return Pyramid::around(frame, centre, reach, levels);
+        }
+        shared
+            .get_or_insert_with(|| FramePyramid::new(frame, levels))
+            .around(centre, reach)
+    }
+
+    fn follow(
+        &mut self,
+        index: usize,
+        frame: &FloatImage,
+        shared: &mut Option<FramePyramid>,
+    ) -> Estimate {
         let state = &self.points[index];
         let predicted = state.sure_at + state.velocity;
-        let (pyramid, carried) = self.carry(state, frame, predicted);
+        let (pyramid, carried) = self.carry(state, frame, predicted, shared);
         // Re-anchor on the first frame's look, turned and scaled as the feature now is:
         // from the carried estimate when there is one, from the whole search range when
         // the point was lost or the last frame's look is gone.
@@ -265,6 +292,7 @@ impl PointTracker {
         state: &PointState,
         frame: &FloatImage,
         predicted: DVec2,
+        shared: &mut Option<FramePyramid>,
     ) -> (Pyramid, Option<DVec2>) {
         if let Some(levels) = self.near_levels {
             let near = Pyramid::around(frame, predicted, self.reach(NEAR, levels), levels);
@@ -275,8 +303,7 @@ impl PointTracker {
                 return (near, found);
             }
         }
-        let reach = self.reach(self.search, self.levels);
-        let pyramid = Pyramid::around(frame, predicted, reach, self.levels);
+        let pyramid = self.full_range(frame, predicted, self.points.len(), shared);
         let carried = (state.sure.len() == self.levels)
             .then(|| self.pyramidal(&state.sure, &pyramid, predicted, self.search, PRECISE))
             .flatten()
@@ -415,4 +442,43 @@ pub fn pair_motion(a0: DVec2, b0: DVec2, a: DVec2, b: DVec2, previous: f64) -> (
         1.0
     };
     (degrees, scale)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::pixels::PixelFormat;
+
+    /// A smooth texture moved by `shift`.
+    fn frame(shift: DVec2) -> FloatImage {
+        FloatImage::from_fn(160, 120, PixelFormat::RGBA8, |i, j| {
+            let (x, y) = (f64::from(i) - shift.x, f64::from(j) - shift.y);
+            let v = 0.5 + 0.25 * (x * 0.21).sin() * (y * 0.17).cos() + 0.2 * (x * 0.05 + y * 0.09).sin();
+            let v = v as f32;
+            [v, v * 0.8, 1.0 - v, 1.0]
+        })
+        .unwrap()
+    }
+
+    /// Points followed together, whose full-range windows share each frame's pyramid, land
+    /// where each lands followed alone (its own windows), bit for bit, and on the motion.
+    #[test]
+    fn points_followed_together_land_where_each_lands_alone() {
+        let points = [DVec2::new(60.0, 50.0), DVec2::new(100.0, 70.0), DVec2::new(80.0, 40.0)];
+        let options = TrackOptions { size: 63, search: 200 };
+        let step = DVec2::new(1.3, 0.7);
+        let follow = |points: &[DVec2]| {
+            let (mut tracker, _) = PointTracker::start(&frame(DVec2::ZERO), points, options).unwrap();
+            (1..6).map(|k| tracker.next(&frame(step * f64::from(k))).unwrap()).collect::<Vec<_>>()
+        };
+        let together = follow(&points);
+        for (index, &point) in points.iter().enumerate() {
+            let alone = follow(&[point]);
+            for (k, (all, one)) in together.iter().zip(&alone).enumerate() {
+                assert_eq!(all[index], one[0], "point {index}, frame {k}");
+                let expected = point + step * (k + 1) as f64;
+                assert!(one[0].lost.is_none() && one[0].at.distance(expected) < 0.05, "{:?}", one[0]);
+            }
+        }
+    }
 }
