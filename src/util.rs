@@ -289,6 +289,16 @@ pub fn folder_of(path: &Path) -> &Path {
     }
 }
 
+/// Whether two output paths name one file: the same existing file, or the same name in
+/// the same folder (`out.png` and `./out.png`) when it does not exist yet.
+pub fn same_destination(a: &Path, b: &Path) -> bool {
+    if a == b || same_file(a, b) {
+        return true;
+    }
+    let folder = |p: &Path| folder_of(p).canonicalize().ok();
+    a.file_name().is_some() && a.file_name() == b.file_name() && folder(a).is_some() && folder(a) == folder(b)
+}
+
 /// Whether `a` and `b` name one existing file: after following links, and on Unix also
 /// through hard links (same device and inode).
 pub fn same_file(a: &Path, b: &Path) -> bool {

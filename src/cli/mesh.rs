@@ -46,9 +46,8 @@ pub fn run(args: MeshArgs) -> anyhow::Result<()> {
     if !(0.0..=1.0).contains(&threshold) {
         return Err(UsageError(format!("--threshold must be in [0, 1], got {threshold}")).into());
     }
-    for output in args.output.iter().chain(&args.laplacian_out) {
-        lapclone::output::refuse_input(output, &[&args.mask])?;
-    }
+    let outputs = output_files(&args);
+    check_outputs(&outputs, &args.mask)?;
     let mask = BitMask::load(&args.mask, threshold as f32)?;
     let started = Instant::now();
     let mut result = mesh::mesh_mask(&mask, &options)
@@ -67,12 +66,14 @@ pub fn run(args: MeshArgs) -> anyhow::Result<()> {
     for warning in &result.warnings {
         eprint_line!("lapclone: warning: {warning}");
     }
-    if let Some(path) = &args.output {
-        write_picture(&result.mesh, &mask, path)?;
+    let mut contents = Vec::new();
+    if args.output.is_some() {
+        contents.push(picture(&result.mesh, &mask)?);
     }
-    if let Some(path) = &args.laplacian_out {
-        write_laplacian(&result.mesh, path)?;
+    if args.laplacian_out.is_some() {
+        contents.extend(laplacian(&result.mesh));
     }
+    write_all(&outputs, &contents)?;
     let stats = &result.stats;
     if args.stats {
         let json = serde_json::json!({
@@ -106,21 +107,66 @@ fn options_from(args: &MeshArgs) -> anyhow::Result<MeshOptions> {
     Ok(options)
 }
 
-/// The combinatorial Laplacian at `path` and the boundary vertices (0-based, one a line) at
-/// `path.boundary`.
-fn write_laplacian(mesh: &Mesh, path: &Path) -> anyhow::Result<()> {
-    let l = lapclone::solve::laplacian(mesh, lapclone::solve::LaplacianKind::Combinatorial);
-    let comment = "combinatorial Laplacian of a lapclone mesh";
-    lapclone::solve::write_matrix_market(path, &l, comment)?;
-    let mut boundary = path.as_os_str().to_os_string();
-    boundary.push(".boundary");
-    let list: String = mesh.boundary_vertices().map(|v| format!("{v}\n")).collect();
-    lapclone::util::write_atomic(Path::new(&boundary), list.as_bytes())
-        .with_context(|| format!("cannot write {}", Path::new(&boundary).display()))
+/// The files `mesh` writes, in order: the picture, the Laplacian and its `.boundary` list.
+fn output_files(args: &MeshArgs) -> Vec<PathBuf> {
+    let mut files: Vec<PathBuf> = args.output.iter().cloned().collect();
+    if let Some(path) = &args.laplacian_out {
+        let mut boundary = path.as_os_str().to_os_string();
+        boundary.push(".boundary");
+        files.extend([path.clone(), PathBuf::from(boundary)]);
+    }
+    files
 }
 
-/// The mesh over the mask (light grey inside, dark grey outside), upscaled for viewing.
-fn write_picture(mesh: &Mesh, mask: &BitMask, path: &Path) -> anyhow::Result<()> {
+/// Refuses an output that is the mask, and two outputs naming one file (usage errors,
+/// before anything is meshed).
+fn check_outputs(outputs: &[PathBuf], mask: &Path) -> anyhow::Result<()> {
+    for (index, output) in outputs.iter().enumerate() {
+        lapclone::output::refuse_input(output, &[mask])?;
+        if outputs[..index]
+            .iter()
+            .any(|o| lapclone::util::same_destination(o, output))
+        {
+            let named = output.display();
+            return Err(UsageError(format!("two outputs name the same file: {named}")).into());
+        }
+    }
+    Ok(())
+}
+
+/// Writes every output to a temporary file first and renames them only once all are
+/// written, so a failure leaves none of them.
+fn write_all(outputs: &[PathBuf], contents: &[Vec<u8>]) -> anyhow::Result<()> {
+    let mut staged = Vec::with_capacity(outputs.len());
+    for (path, bytes) in outputs.iter().zip(contents) {
+        let cannot = || format!("cannot write {}", path.display());
+        let temp = lapclone::util::TempOutput::new(path).with_context(cannot)?;
+        std::io::Write::write_all(&mut temp.open().with_context(cannot)?, bytes)
+            .with_context(cannot)?;
+        staged.push((temp, path));
+    }
+    for (temp, path) in staged {
+        temp.commit()
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    Ok(())
+}
+
+/// The combinatorial Laplacian (Matrix Market) and the boundary vertices (0-based, one a
+/// line).
+fn laplacian(mesh: &Mesh) -> [Vec<u8>; 2] {
+    let l = lapclone::solve::laplacian(mesh, lapclone::solve::LaplacianKind::Combinatorial);
+    let comment = "combinatorial Laplacian of a lapclone mesh";
+    let list: String = mesh.boundary_vertices().map(|v| format!("{v}\n")).collect();
+    [
+        lapclone::solve::matrix_market_text(&l, comment).into_bytes(),
+        list.into_bytes(),
+    ]
+}
+
+/// The mesh over the mask (light grey inside, dark grey outside), upscaled for viewing: PNG
+/// bytes.
+fn picture(mesh: &Mesh, mask: &BitMask) -> anyhow::Result<Vec<u8>> {
     let background = image::RgbaImage::from_fn(mask.width as u32, mask.height as u32, |x, y| {
         let v = if mask.get(x as i64, y as i64) {
             215
@@ -141,7 +187,5 @@ fn write_picture(mesh: &Mesh, mask: &BitMask, path: &Path) -> anyhow::Result<()>
         &[],
         &style,
     )?;
-    let png = lapclone::golden::encode_rgba_png(&picture);
-    lapclone::util::write_atomic(path, &png)
-        .with_context(|| format!("cannot write {}", path.display()))
+    Ok(lapclone::golden::encode_rgba_png(&picture))
 }

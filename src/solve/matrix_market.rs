@@ -21,7 +21,8 @@ pub fn write_matrix_market(
     )
 }
 
-fn matrix_market_text(m: &SymmetricCsc, comment: &str) -> String {
+/// The Matrix Market text of the symmetric matrix `m` (lower triangle, 1-based).
+pub(crate) fn matrix_market_text(m: &SymmetricCsc, comment: &str) -> String {
     let mut text = String::with_capacity(32 * m.nnz() + 128);
     text.push_str("%%MatrixMarket matrix coordinate real symmetric\n");
     if !comment.is_empty() {

@@ -46,6 +46,7 @@ pub mod update;
 
 pub use csc::SymmetricCsc;
 pub use laplacian::{laplacian, LaplacianKind};
+pub(crate) use matrix_market::matrix_market_text;
 pub use matrix_market::write_matrix_market;
 pub use penalty::{PenaltyFactor, PenaltyOptions, SwitchStats};
 pub use symbolic::FactorMethod;

@@ -263,3 +263,72 @@ fn the_laplacian_text_of_two_triangles_is_exact_and_reads_back() {
     write_matrix_market(&path, &cot, "").unwrap();
     assert_eq!(read_matrix_market(&path).unwrap().values, cot.values);
 }
+
+/// The `.boundary` list beside `--laplacian-out` is an output too: it never replaces the
+/// mask, two outputs never name one file, and when one output cannot be written none is.
+#[test]
+fn every_output_is_checked_and_a_failure_writes_none() {
+    let dir = tempfile::tempdir().unwrap();
+    let original = synth::disc(40, 40, 15.0).to_image();
+    let mask = dir.path().join("m.boundary");
+    original
+        .save_with_format(&mask, image::ImageFormat::Png)
+        .unwrap();
+    let before = std::fs::read(&mask).unwrap();
+    let at = |name: &str| dir.path().join(name).to_string_lossy().into_owned();
+    let mask_arg = mask.to_string_lossy().into_owned();
+    let out = lapclone(&["mesh", &mask_arg, "--laplacian-out", &at("m")]);
+    assert_eq!(
+        out.status.code(),
+        Some(1),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(String::from_utf8_lossy(&out.stderr).contains("would replace an input"));
+    assert_eq!(std::fs::read(&mask).unwrap(), before, "the mask is intact");
+    assert!(!dir.path().join("m").exists());
+
+    for (picture, laplacian) in [(at("out"), at("out")), (at("y.mtx.boundary"), at("y.mtx"))] {
+        let out = lapclone(&[
+            "mesh",
+            &mask_arg,
+            "-o",
+            &picture,
+            "--laplacian-out",
+            &laplacian,
+        ]);
+        assert_eq!(
+            out.status.code(),
+            Some(2),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(String::from_utf8_lossy(&out.stderr).contains("two outputs name the same file"));
+    }
+
+    std::fs::create_dir(dir.path().join("x.mtx.boundary")).unwrap();
+    let out = lapclone(&[
+        "mesh",
+        &mask_arg,
+        "-o",
+        &at("pic.png"),
+        "--laplacian-out",
+        &at("x.mtx"),
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(1),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let mut left: Vec<String> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    left.sort();
+    assert_eq!(
+        left,
+        ["m.boundary", "x.mtx.boundary"],
+        "nothing written, no temporary left"
+    );
+}
