@@ -191,9 +191,17 @@ impl TempOutput {
                     use std::os::unix::fs::PermissionsExt;
                     builder.permissions(std::fs::Permissions::from_mode(0o666));
                 }
-                let file = builder
-                    .tempfile_in(folder_of(&dest))
-                    .map_err(|e| std::io::Error::new(e.kind(), e.to_string()))?;
+                // Made and listed under one lock, so a stop removes every one it lets exist.
+                let file = pending(|list| {
+                    if list.closed {
+                        let stopped = std::io::ErrorKind::Interrupted;
+                        return Err(std::io::Error::new(stopped, "the program is stopping"));
+                    }
+                    let file = builder.tempfile_in(folder_of(&dest));
+                    let file = file.map_err(|e| std::io::Error::new(e.kind(), e.to_string()))?;
+                    list.files.push(file.path().to_path_buf());
+                    Ok(file)
+                })?;
                 Inner::Temporary { file, dest }
             }
         };
@@ -222,15 +230,60 @@ impl TempOutput {
     }
 
     /// Renames the temporary file over the destination (nothing to do for a stream).
-    pub fn commit(self) -> std::io::Result<()> {
-        match self.inner {
-            Inner::Temporary { file, dest } => file
-                .persist(&dest)
-                .map(drop)
-                .map_err(|e| std::io::Error::new(e.error.kind(), e.error.to_string())),
+    pub fn commit(mut self) -> std::io::Result<()> {
+        let inner = std::mem::replace(&mut self.inner, Inner::Through(PathBuf::new()));
+        match inner {
+            Inner::Temporary { file, dest } => {
+                let temp = file.path().to_path_buf();
+                let result = file.persist(&dest);
+                forget_pending(&temp);
+                result
+                    .map(drop)
+                    .map_err(|e| std::io::Error::new(e.error.kind(), e.error.to_string()))
+            }
             Inner::Through(_) => Ok(()),
         }
     }
+}
+
+impl Drop for TempOutput {
+    fn drop(&mut self) {
+        if let Inner::Temporary { file, .. } = &self.inner {
+            forget_pending(file.path());
+        }
+    }
+}
+
+/// The temporary files [`TempOutput`]s are writing, so a program stopped by a signal can
+/// remove them ([`remove_pending_outputs`]) instead of leaving them in the user's folders.
+static PENDING: std::sync::Mutex<Pending> = std::sync::Mutex::new(Pending {
+    files: Vec::new(),
+    closed: false,
+});
+
+struct Pending {
+    files: Vec<PathBuf>,
+    /// Set by [`remove_pending_outputs`]: no temporary file may be made after it.
+    closed: bool,
+}
+
+fn pending<R>(f: impl FnOnce(&mut Pending) -> R) -> R {
+    f(&mut PENDING.lock().unwrap_or_else(std::sync::PoisonError::into_inner))
+}
+
+fn forget_pending(temp: &Path) {
+    pending(|list| list.files.retain(|p| p != temp));
+}
+
+/// Removes every temporary file a [`TempOutput`] is still writing, and refuses new ones
+/// from then on: for a program about to exit on a signal, whose writers will not finish.
+/// Gives how many were removed.
+pub fn remove_pending_outputs() -> usize {
+    let files = pending(|list| {
+        list.closed = true;
+        std::mem::take(&mut list.files)
+    });
+    files.iter().filter(|p| std::fs::remove_file(p).is_ok()).count()
 }
 
 /// A number for a message: as written when short, in exponent form when huge or tiny (a

@@ -13,6 +13,7 @@ pub mod render;
 pub mod render_args;
 pub mod repl;
 mod scene_open;
+mod signals;
 pub mod test;
 pub mod test_args;
 pub mod test_pending;
@@ -153,6 +154,10 @@ pub enum Command {
 }
 
 pub fn run(cli: Cli) -> anyhow::Result<()> {
+    // `render` checks a cancel flag between frames; the REPL takes Ctrl-C for itself.
+    if !matches!(cli.command, Command::Render(_) | Command::Repl(_)) {
+        signals::stop_on_signals();
+    }
     match cli.command {
         Command::Mesh(args) => mesh::run(args),
         Command::Clone(args) => clone::run(args),

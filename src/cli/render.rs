@@ -9,13 +9,13 @@ use lapclone::script::LoadedScene;
 
 pub use super::render_args::{frame_range, OutputFormat, RenderArgs};
 pub(crate) use super::scene_open::{default_jobs, positioned, progress_bar};
-use super::scene_open::{install_cancel_handler, load_renderer, TerminalProgress};
+use super::scene_open::{load_renderer, TerminalProgress};
 pub use lapclone::FrameRange;
 
 pub fn run_render(args: RenderArgs) -> anyhow::Result<()> {
     let jobs = super::jobs(args.jobs, default_jobs())?;
     // Before any output exists, so that Ctrl-C always goes through the clean-up below.
-    let cancel = install_cancel_handler();
+    let cancel = super::signals::cancel_flag();
     let kind = args.output_kind()?;
     // Before the scene: a video's ffmpeg starts up while the scene loads.
     let plan = SinkPlan::new(kind, &args.output, args.sink_settings())?;

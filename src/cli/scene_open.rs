@@ -5,8 +5,6 @@
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
 
 use indicatif::{ProgressBar, ProgressStyle};
 use lapclone::render::{RenderError, Renderer};
@@ -24,15 +22,6 @@ pub(crate) fn load_renderer(scene: &Path) -> anyhow::Result<(LoadedScene, Vec<Pa
 pub(crate) fn positioned(loaded: &LoadedScene, error: RenderError) -> anyhow::Error {
     let scene_error = loaded.error_at_patch(error.patch_name(), error.to_string());
     anyhow::anyhow!("{scene_error}")
-}
-
-pub(crate) fn install_cancel_handler() -> Arc<AtomicBool> {
-    let cancel = Arc::new(AtomicBool::new(false));
-    let flag = cancel.clone();
-    // A second handler cannot be installed (e.g. in tests running several renders in one
-    // process); rendering then simply is not interruptible, which is harmless.
-    let _ = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed));
-    cancel
 }
 
 pub(crate) fn default_jobs() -> usize {

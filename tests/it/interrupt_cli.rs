@@ -1,4 +1,5 @@
-//! Interrupted renders (docs/robustness.md): SIGINT during `lapclone render` leaves no
+//! Interrupted renders (docs/robustness.md): SIGINT (and SIGTERM, SIGHUP) during
+//! `lapclone render` leaves no
 //! frame and no temporary folder (a PNG sequence is all or nothing), and the render exits 1
 //! saying it was interrupted; an interrupted GIF/APNG leaves no file at all, and an
 //! interrupted MP4 neither a file nor an ffmpeg process, whether it comes while frames are
@@ -59,11 +60,79 @@ fn wait_until(child: &mut Child, mut ready: impl FnMut() -> bool) -> bool {
 }
 
 fn interrupt(child: &Child) {
+    signal(child, "-INT");
+}
+
+/// Sends `child` the signal `name` (as `kill` spells it: `-TERM`).
+fn signal(child: &Child, name: &str) {
     let status = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
+        .args([name, &child.id().to_string()])
         .status()
         .unwrap();
     assert!(status.success());
+}
+
+/// SIGTERM (`kill`, `timeout`, a container stopping) and SIGHUP (a closed terminal) stop a
+/// render as Ctrl-C does: exit 1, "interrupted", nothing left beside the scene.
+#[test]
+fn sigterm_and_sighup_stop_a_render_as_ctrl_c_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write_scene(dir.path());
+    for (name, out) in [
+        ("-TERM", "movie.gif"),
+        ("-HUP", "frames"),
+        ("-TERM", "frames"),
+    ] {
+        let mut child = spawn_render(&scene, &dir.path().join(out), &[]);
+        let started = wait_until(&mut child, || {
+            sorted_names(dir.path()).iter().any(|n| n.ends_with(".tmp"))
+        });
+        assert!(started, "{name} {out}: the render ended before writing");
+        signal(&child, name);
+        let output = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(1), "{name} {out}: {stderr}");
+        assert!(stderr.contains("interrupted"), "{name} {out}: {stderr}");
+        assert_eq!(
+            sorted_names(dir.path()),
+            ["long.rhai"],
+            "{name} {out}: files left"
+        );
+    }
+}
+
+/// A stop signal during `lapclone test --update` leaves the goldens it finished and no
+/// temporary file among them, and exits 1 saying so.
+#[test]
+fn a_stopped_golden_update_leaves_no_temporary_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write_scene(dir.path());
+    let goldens = dir.path().join("goldens").join("long");
+    for name in ["-TERM", "-INT"] {
+        let _ = std::fs::remove_dir_all(dir.path().join("goldens"));
+        let mut child = Command::new(env!("CARGO_BIN_EXE_lapclone"))
+            .arg("test")
+            .arg(&scene)
+            .args(["--update", "--jobs", "1", "--frames", "1..2000"])
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let started = wait_until(&mut child, || goldens.join("frame_0002.png").exists());
+        assert!(started, "{name}: the update ended before its second golden");
+        signal(&child, name);
+        let output = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(1), "{name}: {stderr}");
+        assert!(stderr.contains("interrupted"), "{name}: {stderr}");
+        let names = sorted_names(&goldens);
+        assert!(
+            names
+                .iter()
+                .all(|n| n.starts_with("frame_") && n.ends_with(".png")),
+            "{names:?}"
+        );
+    }
 }
 
 #[test]

@@ -1,0 +1,51 @@
+//! Stop signals for the batch commands: takes Ctrl-C, SIGTERM and SIGHUP (`kill`, `timeout`,
+//! a container stopping, a closed terminal) and gives either a cancel flag that a command's
+//! own loop checks (`render`: its outputs removed, "interrupted", exit 1), or, for a command
+//! without such a loop, its temporary outputs removed and exit 1 at once. A second signal
+//! always ends the program at once, its temporary outputs removed.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+
+/// A flag the first stop signal raises; the next one ends the program.
+pub(crate) fn cancel_flag() -> Arc<AtomicBool> {
+    let cancel = Arc::new(AtomicBool::new(false));
+    let flag = cancel.clone();
+    on_signals(move || {
+        if flag.swap(true, Ordering::SeqCst) {
+            stop_now();
+        }
+    });
+    cancel
+}
+
+/// Any stop signal ends the program at once, its temporary outputs removed.
+pub(crate) fn stop_on_signals() {
+    on_signals(stop_now);
+}
+
+fn stop_now() {
+    lapclone::util::remove_pending_outputs();
+    eprint_line!("lapclone: interrupted");
+    std::process::exit(1);
+}
+
+/// Runs `action` on a thread of its own for each stop signal. A handler cannot be
+/// installed twice in one process (tests running commands in-process); the signals then
+/// keep their default action, which is harmless.
+fn on_signals(action: impl Fn() + Send + 'static) {
+    #[cfg(unix)]
+    {
+        use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+        let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) else {
+            return;
+        };
+        let _ = std::thread::Builder::new()
+            .name("signals".into())
+            .spawn(move || signals.forever().for_each(|_| action()));
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = ctrlc::set_handler(action);
+    }
+}
