@@ -27,6 +27,12 @@ pub const MAX_SCENE_BYTES: u64 = 16 << 20;
 /// Widest feather, px: four times the widest canvas, so any feather that can matter fits,
 /// and the raster's integer margins around a patch cannot overflow.
 pub const MAX_FEATHER: f64 = 65_536.0;
+/// Most pixels the raster examines for one patch in one frame: the patch's box, cut to the
+/// canvas grown by the feather (its ramp needs the silhouette that far outside). Every such
+/// pixel holds about 17 bytes of ids, depth, coverage and distance, so this caps a draw near
+/// 2 GiB; a whole largest canvas plus an ordinary feather fits twice over. A feather of
+/// 65,536 px around a patch scaled past the canvas asked for 69 GB.
+pub const MAX_RASTER_PIXELS: u64 = 2 * MAX_IMAGE_PIXELS;
 /// Largest |coordinate| of a place a scene puts something (a patch's `at`, a handle's rest
 /// point and target, a pin, a pivot; from calls or track files), px: a thousand times past
 /// the raster's reach, and far enough from overflow that placed vertices stay finite.

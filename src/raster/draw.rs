@@ -65,6 +65,10 @@ pub fn draw_patch(
     let Some(work) = work_rect(patch, canvas, options.feather) else {
         return Ok(RasterStats::default());
     };
+    if work.area() as u64 > crate::limits::MAX_RASTER_PIXELS {
+        let (width, height) = (work.width(), work.height());
+        return Err(RasterError::WorkTooLarge { width, height });
+    }
     let frame = Frame {
         patch,
         work,

@@ -30,4 +30,11 @@ pub enum RasterError {
     NonFinite { what: &'static str, index: usize },
     #[error("feather must lie in [0, {max}], got {0:?}", max = crate::limits::MAX_FEATHER)]
     Feather(f32),
+    #[error(
+        "with its feather the patch needs {width}×{height} px examined, more than the limit of \
+         {max} px (`limits::MAX_RASTER_PIXELS`): lower the feather, or keep the patch nearer \
+         the canvas",
+        max = crate::limits::MAX_RASTER_PIXELS
+    )]
+    WorkTooLarge { width: usize, height: usize },
 }

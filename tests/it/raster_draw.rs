@@ -656,3 +656,50 @@ fn threads_shade_the_same_pixels() {
         }
     }
 }
+
+/// A wide feather around a patch scaled far past the canvas would need its silhouette over
+/// the canvas grown by the feather: past `limits::MAX_RASTER_PIXELS` the draw is refused
+/// before anything is allocated, the canvas untouched; just under it, it draws.
+#[test]
+fn a_feather_past_the_pixel_budget_is_refused_not_allocated() {
+    let source = white_source(80, 80);
+    let mesh = raster_meshes::grid(DVec2::new(10.0, 10.0), 6.0, 10, 10);
+    let zero = vec![[0.0; 3]; mesh.positions.len()];
+    let huge: Vec<DVec2> = mesh
+        .positions
+        .iter()
+        .map(|&p| (p - DVec2::splat(40.0)) * 1e4)
+        .collect();
+    let patch = Patch {
+        rest: &mesh.positions,
+        placed: &huge,
+        triangles: &mesh.triangles,
+        membrane: &zero,
+        depth: None,
+        loops: &mesh.loops,
+        source: &source,
+    };
+    let mut canvas = opaque_canvas(64, 48, 0.25);
+    let before = canvas.clone();
+    let options = RasterOptions {
+        feather: 65_536.0,
+        ..RasterOptions::default()
+    };
+    let error = draw_patch(&mut canvas, &patch, &options, &mut RasterScratch::new()).unwrap_err();
+    assert!(
+        matches!(error, lapclone::raster::RasterError::WorkTooLarge { .. }),
+        "{error}"
+    );
+    assert!(error.to_string().contains("lower the feather"), "{error}");
+    assert!(canvas == before, "the canvas was touched");
+    let options = RasterOptions {
+        feather: 100.0,
+        ..options
+    };
+    draw_patch(&mut canvas, &patch, &options, &mut RasterScratch::new()).unwrap();
+    assert_eq!(
+        canvas.pixel_f32(30, 20).unwrap()[0],
+        1.0,
+        "covered far from any edge"
+    );
+}
