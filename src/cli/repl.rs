@@ -82,6 +82,12 @@ pub fn run(args: ReplArgs) -> anyhow::Result<()> {
     if args.view.view {
         start_view(&args.view, &session, interactive.then(|| printer.clone()))?;
     }
+    if let Some(script) = &args.script {
+        lock(&session).protect(script);
+        lock(&session)
+            .refuse_input(&preview_path, false)
+            .context("--preview")?;
+    }
     let mut failures = 0;
     if let Some(scene) = &args.scene {
         let loaded = lock(&session).load(scene);

@@ -941,6 +941,36 @@ fn the_repl_refuses_to_render_over_its_own_inputs() {
     assert_eq!(std::fs::read(world.path("lib.rhai")).unwrap(), lib_before);
 }
 
+/// The session's own `--script` is an input too: neither `--preview` nor `:save` nor `:gif`
+/// replaces it (the session would go on reading the picture as entries).
+#[test]
+fn the_repl_never_writes_over_its_own_script() {
+    let world = World::new();
+    world.scene("victim.rhai", "");
+    let text = ":load victim.rhai\n:save session.txt\n:gif session.txt\n:t 0.5\n";
+    world.write("session.txt", text);
+    let repl = |extra: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_lapclone"))
+            .args(["repl", "--script", "session.txt"])
+            .args(extra)
+            .current_dir(world.root.path())
+            .stdin(Stdio::null())
+            .output()
+            .unwrap()
+    };
+    let output = repl(&["--preview", "session.txt"]);
+    expect(&output, 1, "--preview");
+    expect(&output, 1, "would replace an input");
+    let output = repl(&[]);
+    expect(&output, 1, "2 failed entries");
+    let all = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(all.matches("would replace an input").count(), 2, "{all}");
+    assert_eq!(
+        std::fs::read_to_string(world.path("session.txt")).unwrap(),
+        text
+    );
+}
+
 #[cfg(target_os = "linux")]
 #[test]
 fn a_repl_whose_output_fails_ends_with_exit_1_instead_of_a_panic() {

@@ -41,6 +41,8 @@ pub struct Session {
     cancel: Arc<AtomicBool>,
     /// The scene file (absolute), if one was loaded.
     file: Option<PathBuf>,
+    /// Files the session itself reads (its `--script`): never an output.
+    session_inputs: Vec<PathBuf>,
     engine: SceneEngine,
     scope: Scope<'static>,
     /// Function definitions of every successful entry (and of the loaded file).
@@ -104,6 +106,7 @@ impl Session {
             engine: SceneEngine::new(&options),
             cancel,
             file: None,
+            session_inputs: Vec::new(),
             scope: Scope::new(),
             functions: AST::empty(),
             imports: Vec::new(),

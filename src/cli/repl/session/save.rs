@@ -40,9 +40,13 @@ impl Session {
             lapclone::output::refuse_scene_reads(output, loaded, &imports)?;
         }
         let file = self.file.as_deref().filter(|_| !scene_file_ok);
-        Ok(lapclone::output::refuse_input(
-            output,
-            &file.into_iter().collect::<Vec<_>>(),
-        )?)
+        let own = self.session_inputs.iter().map(|p| p.as_path());
+        let inputs: Vec<&Path> = file.into_iter().chain(own).collect();
+        Ok(lapclone::output::refuse_input(output, &inputs)?)
+    }
+
+    /// Adds a file the session reads (its `--script`) to those no output may replace.
+    pub fn protect(&mut self, input: &Path) {
+        self.session_inputs.push(input.to_path_buf());
     }
 }
