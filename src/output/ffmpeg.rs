@@ -407,6 +407,14 @@ impl FfmpegWriter {
         if !status.success() || !fed_ok {
             return Err(self.failure());
         }
+        // ffmpeg exits 0 when finishing the file fails (a full disk): the file is then cut
+        // short, and must not replace a good one.
+        let last = self.encoder.child.last_lines(5);
+        let finishing = ["Error writing trailer", "Error closing file"];
+        if last.iter().any(|l| finishing.iter().any(|f| l.contains(f))) {
+            let (path, stderr) = (self.path.clone(), last.join("\n  "));
+            return Err(OutputError::Ffmpeg { path, stderr });
+        }
         if let Some(temp) = self.encoder.temp.take() {
             temp.commit().map_err(|e| OutputError::io(&self.path, e))?;
         }

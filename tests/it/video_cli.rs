@@ -637,3 +637,26 @@ fn a_video_with_a_quarter_turn_is_read_upright() {
         "largest difference {worst} from the upright plate"
     );
 }
+
+/// ffmpeg exits 0 when it cannot finish the file (its trailer on a full disk): the render
+/// fails with ffmpeg's words instead of reporting a cut-short video as rendered.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_video_ffmpeg_could_not_finish_is_a_failure() {
+    if !has_ffmpeg() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write_scene(
+        dir.path(),
+        "canvas(96, 64, #{ fps: 4, duration: 1 });",
+        PATCH,
+    );
+    let o = render(&scene, Path::new("/dev/full"), &["--format", "webm"]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("No space left on device"),
+        "{}",
+        stderr(&o)
+    );
+}
