@@ -46,8 +46,12 @@ impl Default for Limits {
             max_expr_depth: 64,
             max_function_expr_depth: 32,
             max_string_size: 1 << 20,
-            max_array_size: 100_000,
-            max_map_size: 10_000,
+            // Rhai counts these over a value and everything nested in it: a list of keys
+            // (each a map with an `at` array) holds three map entries and two array
+            // entries per key. A million of each lets 300,000 keys through; the memory
+            // budget bounds the rest.
+            max_array_size: 1_000_000,
+            max_map_size: 1_000_000,
             max_modules: 64,
             max_memory: 256 << 20,
         }

@@ -1200,3 +1200,24 @@ fn an_unreadable_pending_frame_is_passed_over_not_accepted() {
         "{stdout}"
     );
 }
+
+/// Rhai sizes a value with everything nested in it: a list of 5,000 keys (each a map with
+/// an `at` array: 15,000 map entries, 10,000 array entries) is an ordinary long animation
+/// and must load; a runaway array is still refused.
+#[test]
+fn a_long_key_list_loads_and_a_runaway_array_is_still_refused() {
+    let world = World::new();
+    world.scene(
+        "long.rhai",
+        "let k = [];\nfor i in 0..5000 { k.push(#{ t: i / 5000.0, at: [20, 15], ease: \"smooth\" }); }\n\
+         p.keys(k);\n",
+    );
+    let output = world.run(&["check", "long.rhai"]);
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    world.scene("runaway.rhai", "let a = []; a.pad(2000000, 0);\n");
+    expect(&world.run(&["check", "runaway.rhai"]), 1, "Size of array");
+}
