@@ -33,6 +33,24 @@ pub const MAX_FEATHER: f64 = 65_536.0;
 /// 2 GiB; a whole largest canvas plus an ordinary feather fits twice over. A feather of
 /// 65,536 px around a patch scaled past the canvas asked for 69 GB.
 pub const MAX_RASTER_PIXELS: u64 = 2 * MAX_IMAGE_PIXELS;
+/// Slowest frame rate, frames per second: a frame every 100 s. Every output states it
+/// exactly or within a millisecond a frame (a GIF's delays end at 655.35 s).
+pub const MIN_FPS: f64 = 0.01;
+/// Fastest frame rate, frames per second: far past any display, and whole rates up to it
+/// fit every output's fraction.
+pub const MAX_FPS: f64 = 1000.0;
+
+/// Why `fps` cannot be a scene's frame rate (positive, within [`MIN_FPS`] and
+/// [`MAX_FPS`]), if it cannot.
+pub fn fps_error(fps: f64) -> Option<String> {
+    if !(fps.is_finite() && fps > 0.0) {
+        return Some(format!("fps must be > 0, got {}", crate::util::number_text(fps)));
+    }
+    let text = crate::util::number_text(fps);
+    (!(MIN_FPS..=MAX_FPS).contains(&fps))
+        .then(|| format!("fps must be between {MIN_FPS} and {MAX_FPS}, got {text}"))
+}
+
 /// Largest |coordinate| of a place a scene puts something (a patch's `at`, a handle's rest
 /// point and target, a pin, a pivot; from calls or track files), px: a thousand times past
 /// the raster's reach, and far enough from overflow that placed vertices stay finite.

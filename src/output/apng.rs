@@ -173,14 +173,22 @@ fn changed_rect(
     Some((left, top, right - left, bottom - top))
 }
 
-/// Per-frame delays as fractions of a second: `1/fps` exactly for whole fps, otherwise
-/// milliseconds rounded from the exact frame times so the error never accumulates.
+/// Per-frame delays as fractions of a second: `1/fps` exactly when the rate's fraction
+/// ([`fps_fraction`](super::fps_fraction)) fits the 16-bit fields, otherwise the finest
+/// unit (a millisecond, or coarser for slow rates) whose steps fit, rounded from the exact
+/// frame times so the error never accumulates.
 pub fn apng_delays(frames: usize, fps: f64) -> Vec<(u16, u16)> {
-    if fps.fract() == 0.0 && fps <= u16::MAX as f64 {
-        return vec![(1, fps as u16); frames];
+    let (num, den) = super::fps_fraction(fps);
+    if let (Ok(num), Ok(den)) = (u16::try_from(num), u16::try_from(den)) {
+        return vec![(den, num); frames];
     }
-    super::rounded_steps(frames, fps, 1000.0)
-        .into_iter()
-        .map(|ms| (ms.min(u16::MAX as u64) as u16, 1000))
-        .collect()
+    let fits = |steps: &Vec<u64>| steps.iter().all(|&s| s <= u64::from(u16::MAX));
+    for unit in [1000u16, 100, 10, 1] {
+        let steps = super::rounded_steps(frames, fps, f64::from(unit));
+        if fits(&steps) {
+            return steps.into_iter().map(|s| (s as u16, unit)).collect();
+        }
+    }
+    // Only past a frame every 65,535 s, far beyond the scene's slowest rate.
+    vec![(u16::MAX, 1); frames]
 }

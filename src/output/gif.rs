@@ -26,6 +26,19 @@ use super::{FrameRef, OutputError};
 /// Frames sampled for the palette (fewer if the animation is shorter).
 pub const PALETTE_FRAMES: usize = 4;
 
+/// A note when `fps` is past what GIF players keep: delays are whole centiseconds, and
+/// browsers show one under 2 cs for 10 cs, so above 50 fps the GIF plays slower.
+pub(crate) fn slow_in_players(fps: f64) -> Option<String> {
+    (fps > 50.0).then(|| {
+        format!(
+            "{} fps is past what GIF players keep (delays are whole centiseconds, and a \
+             delay under 2 cs plays as 10 cs): this GIF plays slower than the scene; APNG or \
+             a video keeps the rate",
+            crate::util::number_text(fps)
+        )
+    })
+}
+
 /// GIF delays are whole centiseconds; frame i lasts from round(100·i/fps) to round(100·(i+1)/fps).
 pub fn gif_delays_cs(frames: usize, fps: f64) -> Vec<u64> {
     super::rounded_steps(frames, fps, 100.0)

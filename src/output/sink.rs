@@ -78,7 +78,10 @@ impl SinkPlan {
                     open_png_folder(output, renderer, range, jobs, cancel, self.settings)?;
                 Sink::Png(writer, Box::new(staging))
             }
-            OutputKind::Gif => Sink::Gif(Box::new(GifWriter::create(output, canvas.fps)?)),
+            OutputKind::Gif => {
+                note = super::gif::slow_in_players(canvas.fps);
+                Sink::Gif(Box::new(GifWriter::create(output, canvas.fps)?))
+            }
             OutputKind::Y4m => {
                 let path = (output.as_os_str() != "-").then_some(output);
                 let writer = Y4mWriter::create(path, canvas.width, canvas.height, canvas.fps)?;

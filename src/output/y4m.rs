@@ -17,8 +17,9 @@ use crate::util::TempOutput;
 use super::yuv::rgb_to_ycbcr;
 use super::{FrameRef, OutputError};
 
-/// `fps` as the fraction Y4M wants: whole rates exactly, NTSC-style rates over 1001, others
-/// to a thousandth.
+/// `fps` as the fraction Y4M (and ffmpeg) wants: whole rates exactly, NTSC-style rates
+/// over 1001, others as the nearest fraction with a denominator up to 1000 (`1/3` exactly,
+/// `12.5` as `25/2`, a rate typed to the thousandth as typed).
 pub fn fps_fraction(fps: f64) -> (u64, u64) {
     if (fps - fps.round()).abs() < 1e-9 {
         return (fps.round() as u64, 1);
@@ -27,9 +28,33 @@ pub fn fps_fraction(fps: f64) -> (u64, u64) {
     if (ntsc - ntsc.round()).abs() < 1e-6 {
         return (ntsc.round() as u64, 1001);
     }
-    let num = (fps * 1000.0).round() as u64;
-    let g = gcd(num, 1000);
-    (num / g, 1000 / g)
+    nearest_fraction(fps, 1000)
+}
+
+/// The fraction nearest `x` (positive) whose denominator is at most `max_den`: the last
+/// continued-fraction convergent within the bound, or the semiconvergent past it when that
+/// is nearer.
+fn nearest_fraction(x: f64, max_den: u64) -> (u64, u64) {
+    // Convergents h/k, the one before in (h0, k0).
+    let (mut h0, mut k0, mut h1, mut k1) = (0u64, 1u64, 1u64, 0u64);
+    let mut rest = x;
+    loop {
+        let whole = rest.floor();
+        let a = whole as u64;
+        let (h2, k2) = (a.saturating_mul(h1).saturating_add(h0), a.saturating_mul(k1).saturating_add(k0));
+        if k2 > max_den {
+            let t = (max_den - k0) / k1;
+            let (hs, ks) = (t * h1 + h0, t * k1 + k0);
+            let error = |h: u64, k: u64| (h as f64 / k as f64 - x).abs();
+            return if ks > 0 && error(hs, ks) < error(h1, k1) { (hs, ks) } else { (h1, k1) };
+        }
+        (h0, k0, h1, k1) = (h1, k1, h2, k2);
+        let fraction = rest - whole;
+        if fraction < 1e-9 {
+            return (h1, k1);
+        }
+        rest = 1.0 / fraction;
+    }
 }
 
 /// Refuses a stream (`what`) without a positive finite rate or with an empty side.
@@ -47,14 +72,6 @@ pub(super) fn check_stream(what: &str, width: u32, height: u32, fps: f64) -> Res
 pub fn stream_header(width: u32, height: u32, fps: f64, colour: &str) -> String {
     let (num, den) = fps_fraction(fps);
     format!("YUV4MPEG2 W{width} H{height} F{num}:{den} Ip A1:1 {colour} XCOLORRANGE=LIMITED\n")
-}
-
-fn gcd(a: u64, b: u64) -> u64 {
-    if b == 0 {
-        a.max(1)
-    } else {
-        gcd(b, a % b)
-    }
 }
 
 /// Where a Y4M stream goes.

@@ -187,8 +187,8 @@ pub enum ModelError {
     /// The canvas exceeds a resource limit.
     #[error("canvas {0}×{1}: {2}")]
     CanvasLimit(u32, u32, crate::limits::LimitError),
-    /// The frame rate is not a positive finite number.
-    #[error("fps {0} must be a finite number > 0")]
+    /// The frame rate is not within `limits::MIN_FPS` and `limits::MAX_FPS`.
+    #[error("fps {0} must lie between {min} and {max}", min = crate::limits::MIN_FPS, max = crate::limits::MAX_FPS)]
     Fps(f64),
     /// The duration is not a positive finite number.
     #[error("duration {0} must be a finite number > 0")]
@@ -230,7 +230,7 @@ impl Canvas {
         if !side_ok(self.width) || !side_ok(self.height) {
             return Err(ModelError::CanvasSize(self.width, self.height));
         }
-        if !(self.fps.is_finite() && self.fps > 0.0) {
+        if crate::limits::fps_error(self.fps).is_some() {
             return Err(ModelError::Fps(self.fps));
         }
         if !(self.duration.is_finite() && self.duration > 0.0) {

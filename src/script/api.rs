@@ -146,6 +146,9 @@ fn parse_canvas(
         Some(v) => values::positive(v, "fps")?,
         None => 24.0,
     };
+    if let Some(error) = crate::limits::fps_error(fps) {
+        return Err(error);
+    }
     let duration = match options.get("duration") {
         Some(v) => values::positive(v, "duration")?,
         None => 1.0,

@@ -1221,3 +1221,24 @@ fn a_long_key_list_loads_and_a_runaway_array_is_still_refused() {
     world.scene("runaway.rhai", "let a = []; a.pad(2000000, 0);\n");
     expect(&world.run(&["check", "runaway.rhai"]), 1, "Size of array");
 }
+
+/// A GIF above 50 fps cannot keep its rate (whole-centisecond delays, and players show
+/// those under 2 cs for 10 cs): the render says so; at 50 fps it does not.
+#[test]
+fn a_gif_past_fifty_fps_says_it_plays_slower() {
+    let world = World::new();
+    for (fps, slower) in [(60, true), (50, false)] {
+        world.write(
+            "fast.rhai",
+            &format!("canvas(8, 8, #{{ fps: {fps}, duration: 0.1 }});\n"),
+        );
+        let output = world.run(&["render", "fast.rhai", "-o", "fast.gif"]);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(output.status.success(), "{stderr}");
+        assert_eq!(
+            stderr.contains("past what GIF players keep"),
+            slower,
+            "{fps}: {stderr}"
+        );
+    }
+}

@@ -290,7 +290,14 @@ fn gif_has_every_frame_with_exact_delays() {
 
 #[test]
 fn fractional_fps_delays_do_not_drift() {
-    let delays = apng_delays(1000, 23.976);
+    // Rates whose fraction fits the 16-bit fields are exact; the slowest rate's 100 s too.
+    assert_eq!(apng_delays(3, 23.976), vec![(125, 2997); 3]);
+    assert_eq!(apng_delays(2, 1.0 / 3.0), vec![(3, 1); 2]);
+    assert_eq!(apng_delays(2, 0.01), vec![(100, 1); 2]);
+    assert_eq!(apng_delays(2, 30.0), vec![(1, 30); 2]);
+    // Others in rounded milliseconds that never drift from the exact frame times.
+    let fps = 999.999;
+    let delays = apng_delays(1000, fps);
     let total: u64 = delays
         .iter()
         .map(|&(n, d)| {
@@ -298,5 +305,5 @@ fn fractional_fps_delays_do_not_drift() {
             n as u64
         })
         .sum();
-    assert_eq!(total, (1000.0 / 23.976 * 1000.0f64).round() as u64);
+    assert_eq!(total, (1000.0 / fps * 1000.0f64).round() as u64);
 }

@@ -212,6 +212,11 @@ fn bad_inputs_are_positioned() {
     );
     assert_error_at("canvas(64, 48, #{ fps: 0 });", 1, 1, "fps must be > 0");
     assert_error_at("canvas(64, 48, #{ fps: -24 });", 1, 1, "fps must be > 0");
+    // Past what outputs can state: Y4M wrote `F0:1` for 1e-5 and an overflowed 1e300.
+    for fps in ["1e-5", "0.005", "1e300", "1000.5"] {
+        let scene = format!("canvas(64, 48, #{{ fps: {fps} }});");
+        assert_error_at(&scene, 1, 1, "fps must be between 0.01 and 1000");
+    }
     assert_error_at("canvas(0, 48);", 1, 1, "canvas width");
     assert_error_at("canvas(64, -1);", 1, 1, "canvas height");
     assert_error_at("canvas(64, 48, #{ duration: 1.0 / 0.0 });", 1, 1, "finite");
