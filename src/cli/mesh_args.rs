@@ -25,7 +25,7 @@ pub struct MeshQualityArgs {
     pub max_area: Option<f64>,
     /// Sweeps moving interior vertices towards their neighbours' mean (combinatorial
     /// Laplacian accuracy; same vertex count).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub relax: Option<usize>,
 }
 

@@ -60,7 +60,7 @@ pub struct RenderArgs {
     #[arg(long, value_enum, default_value = "fast")]
     pub png_compression: PngCompression,
     /// Constant quality for MP4/WebM/MOV (lower is better; H.264 default 20, VP9 default 32).
-    #[arg(long, visible_alias = "quality", value_parser = clap::value_parser!(u32).range(0..=63))]
+    #[arg(long, visible_alias = "quality", value_parser = clap::value_parser!(u32).range(0..=63), allow_hyphen_values = true)]
     pub crf: Option<u32>,
 }
 

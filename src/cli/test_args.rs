@@ -47,22 +47,22 @@ pub struct TestArgs {
     #[arg(long, value_name = "DIR")]
     pub goldens: Option<PathBuf>,
     /// A pixel fails when a channel differs by more than T (8-bit units) [default: 1].
-    #[arg(long, value_name = "T", value_parser = non_negative)]
+    #[arg(long, value_name = "T", value_parser = non_negative, allow_hyphen_values = true)]
     pub fail: Option<f64>,
     /// Percentage of pixels allowed to fail [default: 0].
-    #[arg(long, value_name = "P", value_parser = percent)]
+    #[arg(long, value_name = "P", value_parser = percent, allow_hyphen_values = true)]
     pub fail_percent: Option<f64>,
     /// Any channel differing by more than T fails the frame, whatever the percentage.
-    #[arg(long, value_name = "T", value_parser = non_negative)]
+    #[arg(long, value_name = "T", value_parser = non_negative, allow_hyphen_values = true)]
     pub hard_fail: Option<f64>,
     /// A pixel warns when a channel differs by more than T [default: 0].
-    #[arg(long, value_name = "T", value_parser = non_negative)]
+    #[arg(long, value_name = "T", value_parser = non_negative, allow_hyphen_values = true)]
     pub warn: Option<f64>,
     /// Percentage of pixels allowed to warn [default: 0].
-    #[arg(long, value_name = "P", value_parser = percent)]
+    #[arg(long, value_name = "P", value_parser = percent, allow_hyphen_values = true)]
     pub warn_percent: Option<f64>,
     /// The frame fails when its SSIM (0–1) is below S.
-    #[arg(long, value_name = "S", value_parser = unit_interval)]
+    #[arg(long, value_name = "S", value_parser = unit_interval, allow_hyphen_values = true)]
     pub min_ssim: Option<f64>,
     /// One JSON object per frame on stdout instead of text lines.
     #[arg(long)]

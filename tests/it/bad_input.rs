@@ -439,6 +439,30 @@ fn every_numeric_flag_refuses_nan_infinity_and_bad_signs() {
             2,
             "--t must be ≥ 0",
         ),
+        // A negative number is the flag's value, refused by its own rule, not an unknown
+        // argument.
+        case(
+            &["mesh", "in/mask.png", "--relax", "-1"],
+            2,
+            "'-1' for '--relax",
+        ),
+        case(&["test", "s.rhai", "--fail", "-1"], 2, "must be ≥ 0"),
+        case(
+            &["test", "s.rhai", "--fail-percent", "-1"],
+            2,
+            "'-1' for '--fail-percent",
+        ),
+        case(&["test", "s.rhai", "--hard-fail", "-1"], 2, "must be ≥ 0"),
+        case(
+            &["test", "s.rhai", "--min-ssim", "-1"],
+            2,
+            "must be in 0..=1",
+        ),
+        case(
+            &["render", "s.rhai", "--crf", "-1"],
+            2,
+            "-1 is not in 0..=63",
+        ),
     ]);
     run_catalogue(&fixture, &cases);
 }
