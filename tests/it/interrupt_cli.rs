@@ -72,6 +72,16 @@ fn signal(child: &Child, name: &str) {
     assert!(status.success());
 }
 
+/// Sends `child` the signal `name` and checks it stopped as an interrupted command does:
+/// exit 1, saying "interrupted" (`what` names the case in failures).
+fn stop(child: Child, name: &str, what: &str) {
+    signal(&child, name);
+    let output = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(1), "{what}: {stderr}");
+    assert!(stderr.contains("interrupted"), "{what}: {stderr}");
+}
+
 /// SIGTERM (`kill`, `timeout`, a container stopping) and SIGHUP (a closed terminal) stop a
 /// render as Ctrl-C does: exit 1, "interrupted", nothing left beside the scene.
 #[test]
@@ -88,11 +98,7 @@ fn sigterm_and_sighup_stop_a_render_as_ctrl_c_does() {
             sorted_names(dir.path()).iter().any(|n| n.ends_with(".tmp"))
         });
         assert!(started, "{name} {out}: the render ended before writing");
-        signal(&child, name);
-        let output = child.wait_with_output().unwrap();
-        let stderr = String::from_utf8_lossy(&output.stderr);
-        assert_eq!(output.status.code(), Some(1), "{name} {out}: {stderr}");
-        assert!(stderr.contains("interrupted"), "{name} {out}: {stderr}");
+        stop(child, name, &format!("{name} {out}"));
         assert_eq!(
             sorted_names(dir.path()),
             ["long.rhai"],
@@ -120,11 +126,7 @@ fn a_stopped_golden_update_leaves_no_temporary_file() {
             .unwrap();
         let started = wait_until(&mut child, || goldens.join("frame_0002.png").exists());
         assert!(started, "{name}: the update ended before its second golden");
-        signal(&child, name);
-        let output = child.wait_with_output().unwrap();
-        let stderr = String::from_utf8_lossy(&output.stderr);
-        assert_eq!(output.status.code(), Some(1), "{name}: {stderr}");
-        assert!(stderr.contains("interrupted"), "{name}: {stderr}");
+        stop(child, name, name);
         let names = sorted_names(&goldens);
         assert!(
             names
@@ -149,11 +151,7 @@ fn sigint_during_a_png_sequence_leaves_nothing() {
             .any(|n| dir.path().join(n).join("frame_0001.png").exists())
     });
     assert!(started, "the render ended before its first frame appeared");
-    interrupt(&child);
-    let output = child.wait_with_output().unwrap();
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    assert_eq!(output.status.code(), Some(1), "{stderr}");
-    assert!(stderr.contains("interrupted"), "{stderr}");
+    stop(child, "-INT", "png sequence");
     assert_eq!(
         sorted_names(dir.path()),
         ["long.rhai"],
@@ -173,11 +171,7 @@ fn sigint_during_an_animation_file_leaves_no_file() {
             sorted_names(dir.path()).iter().any(|n| n.ends_with(".tmp"))
         });
         assert!(started, "{format}: the render ended before writing");
-        interrupt(&child);
-        let output = child.wait_with_output().unwrap();
-        let stderr = String::from_utf8_lossy(&output.stderr);
-        assert_eq!(output.status.code(), Some(1), "{format}: {stderr}");
-        assert!(stderr.contains("interrupted"), "{format}: {stderr}");
+        stop(child, "-INT", format);
         assert_eq!(
             sorted_names(dir.path()),
             ["long.rhai"],

@@ -277,50 +277,43 @@ fn every_output_is_checked_and_a_failure_writes_none() {
     let before = std::fs::read(&mask).unwrap();
     let at = |name: &str| dir.path().join(name).to_string_lossy().into_owned();
     let mask_arg = mask.to_string_lossy().into_owned();
-    let out = lapclone(&["mesh", &mask_arg, "--laplacian-out", &at("m")]);
-    assert_eq!(
-        out.status.code(),
-        Some(1),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    let fails = |args: &[&str], code: i32, message: &str| {
+        let out = lapclone(args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(code), "{stderr}");
+        assert!(stderr.contains(message), "{stderr}");
+    };
+    fails(
+        &["mesh", &mask_arg, "--laplacian-out", &at("m")],
+        1,
+        "would replace an input",
     );
-    assert!(String::from_utf8_lossy(&out.stderr).contains("would replace an input"));
     assert_eq!(std::fs::read(&mask).unwrap(), before, "the mask is intact");
     assert!(!dir.path().join("m").exists());
 
     for (picture, laplacian) in [(at("out"), at("out")), (at("y.mtx.boundary"), at("y.mtx"))] {
-        let out = lapclone(&[
+        let args = [
             "mesh",
             &mask_arg,
             "-o",
             &picture,
             "--laplacian-out",
             &laplacian,
-        ]);
-        assert_eq!(
-            out.status.code(),
-            Some(2),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        assert!(String::from_utf8_lossy(&out.stderr).contains("two outputs name the same file"));
+        ];
+        fails(&args, 2, "two outputs name the same file");
     }
 
     std::fs::create_dir(dir.path().join("x.mtx.boundary")).unwrap();
-    let out = lapclone(&[
+    let (picture, laplacian) = (at("pic.png"), at("x.mtx"));
+    let args = [
         "mesh",
         &mask_arg,
         "-o",
-        &at("pic.png"),
+        &picture,
         "--laplacian-out",
-        &at("x.mtx"),
-    ]);
-    assert_eq!(
-        out.status.code(),
-        Some(1),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+        &laplacian,
+    ];
+    fails(&args, 1, "it is a folder");
     let mut left: Vec<String> = std::fs::read_dir(dir.path())
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
