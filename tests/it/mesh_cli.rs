@@ -291,7 +291,18 @@ fn every_output_is_checked_and_a_failure_writes_none() {
     assert_eq!(std::fs::read(&mask).unwrap(), before, "the mask is intact");
     assert!(!dir.path().join("m").exists());
 
-    for (picture, laplacian) in [(at("out"), at("out")), (at("y.mtx.boundary"), at("y.mtx"))] {
+    std::fs::create_dir(dir.path().join("x.mtx.boundary")).unwrap();
+    for (picture, laplacian, code, message) in [
+        ("out", "out", 2, "two outputs name the same file"),
+        (
+            "y.mtx.boundary",
+            "y.mtx",
+            2,
+            "two outputs name the same file",
+        ),
+        ("pic.png", "x.mtx", 1, "it is a folder"),
+    ] {
+        let (picture, laplacian) = (at(picture), at(laplacian));
         let args = [
             "mesh",
             &mask_arg,
@@ -300,20 +311,8 @@ fn every_output_is_checked_and_a_failure_writes_none() {
             "--laplacian-out",
             &laplacian,
         ];
-        fails(&args, 2, "two outputs name the same file");
+        fails(&args, code, message);
     }
-
-    std::fs::create_dir(dir.path().join("x.mtx.boundary")).unwrap();
-    let (picture, laplacian) = (at("pic.png"), at("x.mtx"));
-    let args = [
-        "mesh",
-        &mask_arg,
-        "-o",
-        &picture,
-        "--laplacian-out",
-        &laplacian,
-    ];
-    fails(&args, 1, "it is a folder");
     let mut left: Vec<String> = std::fs::read_dir(dir.path())
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
