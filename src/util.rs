@@ -57,14 +57,23 @@ pub fn write_atomic_with(
     path: &Path,
     fill: impl FnOnce(&mut std::fs::File) -> std::io::Result<()>,
 ) -> std::io::Result<()> {
+    write_staged(path, fill)?.commit()
+}
+
+/// Calls `fill` with the file [`TempOutput`] gives for `path` and syncs it, leaving the
+/// commit to the caller (a command writing several files renames them only once all are
+/// written). Dropped uncommitted, the temporary file is removed.
+pub fn write_staged(
+    path: &Path,
+    fill: impl FnOnce(&mut std::fs::File) -> std::io::Result<()>,
+) -> std::io::Result<TempOutput> {
     let output = TempOutput::new(path)?;
     let mut file = output.open()?;
     fill(&mut file)?;
     if output.is_temporary() {
         file.sync_all()?;
     }
-    drop(file);
-    output.commit()
+    Ok(output)
 }
 
 /// What an output path names, decided once before anything is written.

@@ -139,10 +139,9 @@ fn check_outputs(outputs: &[PathBuf], mask: &Path) -> anyhow::Result<()> {
 fn write_all(outputs: &[PathBuf], contents: &[Vec<u8>]) -> anyhow::Result<()> {
     let mut staged = Vec::with_capacity(outputs.len());
     for (path, bytes) in outputs.iter().zip(contents) {
-        let cannot = || format!("cannot write {}", path.display());
-        let temp = lapclone::util::TempOutput::new(path).with_context(cannot)?;
-        std::io::Write::write_all(&mut temp.open().with_context(cannot)?, bytes)
-            .with_context(cannot)?;
+        let fill = |file: &mut std::fs::File| std::io::Write::write_all(file, bytes);
+        let temp = lapclone::util::write_staged(path, fill)
+            .with_context(|| format!("cannot write {}", path.display()))?;
         staged.push((temp, path));
     }
     for (temp, path) in staged {

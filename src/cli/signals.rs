@@ -30,9 +30,8 @@ fn stop_now() {
     std::process::exit(1);
 }
 
-/// Runs `action` on a thread of its own for each stop signal. A handler cannot be
-/// installed twice in one process (tests running commands in-process); the signals then
-/// keep their default action, which is harmless.
+/// Runs `action` on a thread of its own for each stop signal. If the handler or its thread
+/// cannot be set up, the signals keep their default action (the program ends).
 fn on_signals(action: impl Fn() + Send + 'static) {
     #[cfg(unix)]
     {
