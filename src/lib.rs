@@ -220,7 +220,10 @@ mod cli;
 #[doc(hidden)]
 pub fn run_cli() -> i32 {
     use clap::Parser as _;
-    let args = cli::Cli::parse();
+    let args = match cli::Cli::try_parse() {
+        Ok(args) => args,
+        Err(error) => return cli::clap_exit(&error),
+    };
     match cli::run(args) {
         Ok(()) => 0,
         Err(err) => {

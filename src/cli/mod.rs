@@ -8,6 +8,7 @@ pub mod check;
 pub mod clone;
 pub mod mesh;
 pub mod mesh_args;
+mod picture_out;
 pub mod preview;
 pub mod render;
 pub mod render_args;
@@ -83,6 +84,21 @@ pub fn say(line: impl std::fmt::Display) -> anyhow::Result<()> {
     writeln!(out, "{line}")
         .and_then(|()| out.flush())
         .map_err(|e| anyhow::anyhow!("writing to standard output: {e}"))
+}
+
+/// Prints what clap gave instead of arguments (the help, the version, or a usage error) and
+/// gives the exit code: help and version that cannot be written (a full disk, a closed
+/// output) are a failure, not a silent 0.
+pub fn clap_exit(error: &clap::Error) -> i32 {
+    use std::io::Write as _;
+    let printed = error.print().and_then(|()| std::io::stdout().flush());
+    if !error.use_stderr() {
+        if let Err(e) = printed {
+            eprint_line!("lapclone: error: writing to standard output: {e}");
+            return 1;
+        }
+    }
+    error.exit_code()
 }
 
 /// The first failed write to standard output (closed, a full disk, a broken pipe).
