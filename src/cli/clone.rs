@@ -16,6 +16,7 @@ use lapclone::pixels::{Canvas, FloatImage, PixelFormat};
 use lapclone::raster::overlay::{draw_mesh_overlay, HandleMarker, OverlayStyle};
 use lapclone::solve::LaplacianKind;
 
+use super::picture_out::PictureOut;
 use super::{finite_f64, point, UsageError};
 
 #[derive(clap::Args, Debug)]
@@ -76,7 +77,8 @@ pub struct CloneArgs {
     /// Print one JSON object with sizes and timings on stdout.
     #[arg(long)]
     pub stats: bool,
-    /// Output PNG (written in the target's bit depth and colour type).
+    /// Output PNG (written in the target's bit depth and colour type); `-` writes it to
+    /// standard output.
     #[arg(short = 'o', long = "output")]
     pub output: PathBuf,
 }
@@ -131,7 +133,7 @@ fn parse_drag(text: &str) -> Result<DragArg, String> {
 }
 
 pub fn run(args: CloneArgs) -> anyhow::Result<()> {
-    check_arguments(&args)?;
+    let out = check_arguments(&args)?;
     let mesh_options = args.mesh.options(args.density)?;
     let load_started = Instant::now();
     // The source and the mask (then the mesh and the factor) load on two threads while the
@@ -165,7 +167,14 @@ pub fn run(args: CloneArgs) -> anyhow::Result<()> {
     let total_ms = mesh_ms + factor_ms + stats.solve_ms + stats.raster_ms;
     report_clone_warnings(&stats);
 
-    write_output(&args, &canvas, target_format, &cloner, &handles, &placement)?;
+    let picture = Picture {
+        canvas: &canvas,
+        format: target_format,
+        cloner: &cloner,
+        handles: &handles,
+        placement: &placement,
+    };
+    write_output(&args, &out, picture)?;
     if let Some(background) = &background {
         let reclone_ms = time_reclone(&mut cloner, background, &placement, deformation.as_mut())?;
         let json = serde_json::json!({
@@ -313,7 +322,7 @@ fn join<T>(handle: std::thread::ScopedJoinHandle<'_, T>) -> T {
         .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
 }
 
-fn check_arguments(args: &CloneArgs) -> anyhow::Result<()> {
+fn check_arguments(args: &CloneArgs) -> anyhow::Result<PictureOut> {
     if args.scale <= 0.0 {
         return Err(UsageError(format!("--scale must be positive, not {}", args.scale)).into());
     }
@@ -344,11 +353,17 @@ fn check_arguments(args: &CloneArgs) -> anyhow::Result<()> {
             .validate()
             .map_err(|e| UsageError(format!("--density: {e}")))?;
     }
-    lapclone::output::check_output_folder(&args.output)?;
-    Ok(lapclone::output::refuse_input(
+    if args.stats && args.output.as_os_str() == "-" {
+        return Err(UsageError(
+            "--stats prints on standard output, which -o - already holds the picture on".into(),
+        )
+        .into());
+    }
+    PictureOut::check(
+        "clone",
         &args.output,
         &[&args.source, &args.mask, &args.target],
-    )?)
+    )
 }
 
 fn laplacian_kind(arg: LaplacianArg) -> LaplacianKind {
@@ -402,23 +417,25 @@ fn report_clone_warnings(stats: &CloneStats) {
     }
 }
 
-fn write_output(
-    args: &CloneArgs,
-    canvas: &Canvas,
-    target_format: PixelFormat,
-    cloner: &PatchCloner,
-    handles: &[Handle],
-    placement: &Placement,
-) -> anyhow::Result<()> {
+/// What `--output` shows: the cloned canvas, or with `--show-mesh` the mesh over it.
+struct Picture<'a> {
+    canvas: &'a Canvas,
+    format: PixelFormat,
+    cloner: &'a PatchCloner,
+    handles: &'a [Handle],
+    placement: &'a Placement,
+}
+
+fn write_output(args: &CloneArgs, out: &PictureOut, picture: Picture) -> anyhow::Result<()> {
+    let Picture {
+        canvas,
+        format,
+        cloner,
+        handles,
+        placement,
+    } = picture;
     if !args.show_mesh {
-        canvas
-            .save_png_threaded(
-                &args.output,
-                target_format,
-                lapclone::util::available_cores(),
-            )
-            .with_context(|| format!("writing {}", args.output.display()))?;
-        return Ok(());
+        return out.write_canvas(canvas, format, lapclone::util::available_cores());
     }
     let map = placement.to_affine();
     let markers: Vec<HandleMarker> = handles
@@ -442,9 +459,7 @@ fn write_output(
         &markers,
         &style,
     )?;
-    let png = lapclone::golden::encode_rgba_png(&picture);
-    lapclone::util::write_atomic(&args.output, &png)
-        .with_context(|| format!("writing {}", args.output.display()))
+    out.write_bytes(&lapclone::golden::encode_rgba_png(&picture))
 }
 
 /// The target as the canvas to clone onto (8-bit images without a float copy; 8-bit PNGs

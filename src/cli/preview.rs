@@ -1,10 +1,9 @@
 //! `lapclone preview`: takes a scene file and a time or frame number and writes that one
-//! frame as a PNG.
+//! frame as a PNG (a file, or standard output for `-o -`).
 
 use std::path::PathBuf;
 
-use anyhow::Context;
-
+use super::picture_out::PictureOut;
 use super::scene_open::{default_jobs, load_renderer, positioned};
 use crate::cli::UsageError;
 
@@ -18,6 +17,7 @@ pub struct PreviewArgs {
     /// Frame number (from 1).
     #[arg(long, allow_hyphen_values = true)]
     pub frame: Option<u64>,
+    /// Output PNG; `-` writes it to standard output.
     #[arg(short = 'o', long = "output")]
     pub output: PathBuf,
 }
@@ -26,9 +26,14 @@ pub fn run_preview(args: PreviewArgs) -> anyhow::Result<()> {
     if args.t.is_some_and(|t| t < 0.0) || args.frame == Some(0) {
         return Err(UsageError("--t must be ≥ 0 and --frame ≥ 1".into()).into());
     }
-    lapclone::output::check_output_folder(&args.output)?;
+    let out = PictureOut::check("preview", &args.output, &[])?;
     let (loaded, imports, mut renderer) = load_renderer(&args.scene)?;
     lapclone::output::refuse_scene_input(&args.output, &loaded, &imports)?;
+    check_inside(
+        &args,
+        renderer.scene().canvas.duration,
+        renderer.frame_count(),
+    )?;
     let format = renderer.output_format();
     let canvas = match (args.t, args.frame) {
         (Some(t), _) => renderer.render_time(t),
@@ -36,8 +41,22 @@ pub fn run_preview(args: PreviewArgs) -> anyhow::Result<()> {
         (None, None) => renderer.render_frame(0),
     }
     .map_err(|e| positioned(&loaded, e))?;
-    canvas
-        .save_png_threaded(&args.output, format, default_jobs())
-        .with_context(|| format!("writing {}", args.output.display()))?;
-    Ok(())
+    out.write_canvas(canvas, format, default_jobs())
+}
+
+/// A time past the scene's end or a frame past its last is a usage error, as `render
+/// --frames` past the end is: the picture would be of no frame the scene renders.
+fn check_inside(args: &PreviewArgs, duration: f64, frames: u64) -> Result<(), UsageError> {
+    let number = lapclone::util::number_text;
+    match (args.t, args.frame) {
+        (Some(t), _) if t > duration => Err(UsageError(format!(
+            "--t {}: the scene lasts {} s",
+            number(t),
+            number(duration)
+        ))),
+        (_, Some(frame)) if frame > frames => Err(UsageError(format!(
+            "--frame {frame}: the scene has {frames} frames"
+        ))),
+        _ => Ok(()),
+    }
 }

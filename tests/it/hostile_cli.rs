@@ -372,7 +372,6 @@ fn an_output_that_is_an_input_is_refused() {
             "--format",
             "gif",
         ],
-        vec!["preview", "follows.rhai", "-o", "face.csv"],
         vec!["render", "reads.rhai", "-o", "keys.csv", "--format", "apng"],
     ];
     #[cfg(unix)]
@@ -391,6 +390,11 @@ fn an_output_that_is_an_input_is_refused() {
     for args in &cases {
         expect(&world.run(args), 1, "would replace an input");
     }
+    expect(
+        &world.run(&["preview", "follows.rhai", "-o", "face.csv"]),
+        2,
+        "preview writes PNG",
+    );
     assert_eq!(snapshot(&world), before);
     assert_eq!(std::fs::read(&scene).unwrap(), original);
     // Plates rendered into their own folder would be replaced (or removed by --force).
@@ -619,6 +623,15 @@ fn a_failed_write_to_standard_output_is_exit_1() {
             1,
             "writing to standard output",
         );
+        // The help and the version are output too: unwritten, they are not a success.
+        for asked in [
+            &["--help"][..],
+            &["--version"],
+            &["render", "--help"],
+            &["help"],
+        ] {
+            expect(&full(asked), 1, "writing to standard output");
+        }
     }
     // Standard output sent to /dev/null on purpose is a legitimate sink.
     let null = Command::new(env!("CARGO_BIN_EXE_lapclone"))
@@ -665,24 +678,21 @@ fn messages_say_what_is_wrong() {
         )
         .unwrap();
     }
+    // A scene longer than its footage: the first frame past the plates is named, on loading.
     let plates = world.write(
         "plates.rhai",
-        "canvas(#{ fps: 3, duration: 1, background: \"plates/plate_%04d.png\" });\n",
+        "canvas(#{ fps: 3, duration: 200, background: \"plates/plate_%04d.png\" });\n",
     );
     let plates = plates.to_str().unwrap();
-    let stderr = expect(
-        &world.run(&["preview", plates, "--t", "1e300", "-o", "p.png"]),
+    expect(
+        &world.run(&["preview", plates, "--t", "1", "-o", "p.png"]),
         1,
-        "needs",
-    );
-    assert!(
-        !stderr.contains("frame 0 ") && !stderr.contains("plate_0000"),
-        "{stderr}"
+        "frame 4 needs",
     );
     expect(
-        &world.run(&["preview", plates, "--t", "100", "-o", "p.png"]),
+        &world.run(&["preview", plates, "--t", "1e300", "-o", "p.png"]),
         1,
-        "frame 301 needs",
+        "frame 4 needs",
     );
     // A mask whose only piece is too small: the mask is named, no setting the command lacks.
     image::GrayImage::from_fn(W, H, |x, y| {
@@ -1240,5 +1250,72 @@ fn a_gif_past_fifty_fps_says_it_plays_slower() {
             slower,
             "{fps}: {stderr}"
         );
+    }
+}
+
+/// `preview` and `clone` write one PNG: `-o -` puts it on standard output (the bytes of the
+/// file they would write), another image extension is refused before any work, and a time
+/// or frame past the scene's end is a usage error, as `render --frames` past it is.
+#[test]
+fn one_picture_outputs_are_png_files_or_standard_output() {
+    let world = World::new();
+    let scene = world.scene("fine.rhai", "").display().to_string();
+    let scene = scene.as_str();
+    for (args, message) in [
+        (&["preview", scene, "-o", "x.jpg"][..], "preview writes PNG"),
+        (
+            &["preview", scene, "--t", "1.5", "-o", "x.png"],
+            "--t 1.5: the scene lasts 1 s",
+        ),
+        (
+            &["preview", scene, "--frame", "4", "-o", "x.png"],
+            "--frame 4: the scene has 3 frames",
+        ),
+        (
+            &[
+                "clone", "--source", "src.png", "--mask", "mask.png", "--target", "bg.png", "--at",
+                "20,15", "-o", "x.webp",
+            ],
+            "clone writes PNG",
+        ),
+        (
+            &[
+                "clone", "--source", "src.png", "--mask", "mask.png", "--target", "bg.png", "--at",
+                "20,15", "--stats", "-o", "-",
+            ],
+            "--stats prints on standard output",
+        ),
+    ] {
+        expect(&world.run(args), 2, message);
+    }
+    assert!(
+        !world.names().iter().any(|n| n.starts_with('x')),
+        "{:?}",
+        world.names()
+    );
+    let clone = [
+        "clone", "--source", "src.png", "--mask", "mask.png", "--target", "bg.png", "--at",
+        "20,15", "-o",
+    ];
+    for (to_stdout, to_file) in [
+        (
+            vec!["preview", scene, "--t", "1", "-o", "-"],
+            vec!["preview", scene, "--t", "1", "-o", "f.PNG"],
+        ),
+        (
+            [&clone[..], &["-"]].concat(),
+            [&clone[..], &["f.PNG"]].concat(),
+        ),
+    ] {
+        let piped = world.run(&to_stdout);
+        expect(&piped, 0, "");
+        expect(&world.run(&to_file), 0, "");
+        assert_eq!(
+            piped.stdout,
+            std::fs::read(world.path("f.PNG")).unwrap(),
+            "{to_stdout:?}"
+        );
+        assert_eq!(&piped.stdout[..4], b"\x89PNG");
+        assert!(!world.path("-").exists());
     }
 }

@@ -1,0 +1,76 @@
+//! Where `preview` and `clone` write their one PNG: takes the `-o` argument and gives a
+//! checked destination (a `.png` file, or standard output for `-`, as `render -o -` is),
+//! then writes a canvas or encoded PNG bytes to it. Another image extension is a usage
+//! error, so `-o x.jpg` never holds PNG bytes under a JPEG name.
+
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+
+use anyhow::Context as _;
+use lapclone::pixels::{Canvas, PixelFormat};
+
+use super::UsageError;
+
+/// A checked `-o` of a one-picture command.
+pub(crate) enum PictureOut {
+    File(PathBuf),
+    Stdout,
+}
+
+impl PictureOut {
+    /// Checks `output` for `command`: standard output open for `-`; otherwise a `.png` name
+    /// (or none) whose folder exists and that names none of `inputs`.
+    pub(crate) fn check(command: &str, output: &Path, inputs: &[&Path]) -> anyhow::Result<Self> {
+        if output.as_os_str() == "-" {
+            if !super::stdout_is_open() {
+                anyhow::bail!("-o -: standard output is closed");
+            }
+            return Ok(PictureOut::Stdout);
+        }
+        if let Some(extension) = output.extension() {
+            if !extension.eq_ignore_ascii_case("png") {
+                return Err(UsageError(format!(
+                    "-o {}: {command} writes PNG; name the output .png (or `-` for standard output)",
+                    output.display()
+                ))
+                .into());
+            }
+        }
+        lapclone::output::check_output_folder(output)?;
+        lapclone::output::refuse_input(output, inputs)?;
+        Ok(PictureOut::File(output.to_path_buf()))
+    }
+
+    /// Writes `canvas` as a PNG in `format`, encoded on `threads` threads.
+    pub(crate) fn write_canvas(
+        &self,
+        canvas: &Canvas,
+        format: PixelFormat,
+        threads: usize,
+    ) -> anyhow::Result<()> {
+        match self {
+            PictureOut::File(path) => canvas
+                .save_png_threaded(path, format, threads)
+                .with_context(|| format!("writing {}", path.display())),
+            PictureOut::Stdout => {
+                let mut png = Vec::new();
+                canvas.write_png(format, threads, &mut png)?;
+                self.write_bytes(&png)
+            }
+        }
+    }
+
+    /// Writes an encoded PNG.
+    pub(crate) fn write_bytes(&self, png: &[u8]) -> anyhow::Result<()> {
+        match self {
+            PictureOut::File(path) => lapclone::util::write_atomic(path, png)
+                .with_context(|| format!("writing {}", path.display())),
+            PictureOut::Stdout => {
+                let mut out = std::io::stdout().lock();
+                out.write_all(png)
+                    .and_then(|()| out.flush())
+                    .context("writing to standard output")
+            }
+        }
+    }
+}
