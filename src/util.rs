@@ -187,13 +187,9 @@ impl TempOutput {
         let inner = match destination(dest)? {
             Destination::Through(path) => Inner::Through(path),
             Destination::Replace(dest) => {
-                let name = dest
-                    .file_name()
-                    .map(|n| n.to_string_lossy().into_owned())
-                    .unwrap_or_default();
-                let prefix = format!(".{name}.");
+                let prefix = temp_prefix(&dest);
                 let mut builder = tempfile::Builder::new();
-                builder.prefix(&prefix).suffix(".tmp");
+                builder.prefix(&prefix).suffix(TEMP_SUFFIX);
                 // An output is an ordinary file: the umask decides, as for any new file.
                 #[cfg(unix)]
                 {
@@ -261,6 +257,22 @@ impl Drop for TempOutput {
             forget_pending(file.path());
         }
     }
+}
+
+/// The end of every temporary output's name.
+pub const TEMP_SUFFIX: &str = ".tmp";
+
+/// The start of a temporary output's name beside `dest`: `.NAME.`, the name cut (on a
+/// character boundary) so that it, the random part and [`TEMP_SUFFIX`] fit the 255 bytes
+/// file systems allow in a name, as `dest`'s own name does.
+pub fn temp_prefix(dest: &Path) -> String {
+    const MOST: usize = 200;
+    let name = dest.file_name().unwrap_or_default().to_string_lossy();
+    let mut end = name.len().min(MOST);
+    while !name.is_char_boundary(end) {
+        end -= 1;
+    }
+    format!(".{}.", &name[..end])
 }
 
 /// The temporary files [`TempOutput`]s are writing, so a program stopped by a signal can
@@ -380,7 +392,19 @@ pub fn same_file(a: &Path, b: &Path) -> bool {
 
 #[cfg(test)]
 mod tests {
-    use super::number_text;
+    use super::{number_text, temp_prefix};
+
+    #[test]
+    fn temporary_names_fit_beside_the_longest_names() {
+        for name in ["a".repeat(255), "é".repeat(127), format!("a{}", "€".repeat(84))] {
+            let prefix = temp_prefix(std::path::Path::new(&format!("out/{name}")));
+            // tempfile adds 6 random characters, then the suffix.
+            assert!(prefix.len() + 6 + super::TEMP_SUFFIX.len() <= 255, "{prefix}");
+            assert!(prefix.starts_with('.') && prefix.ends_with('.'));
+            assert!(name.starts_with(&prefix[1..prefix.len() - 1]));
+        }
+        assert_eq!(temp_prefix(std::path::Path::new("dir/x.png")), ".x.png.");
+    }
 
     #[test]
     fn numbers_in_messages_stay_short() {

@@ -71,10 +71,9 @@ pub(crate) fn open_png_folder(
         check_output_folder(output)?;
         Vec::new()
     };
-    let name = output.file_name().unwrap_or_default().to_string_lossy();
     let temp = tempfile::Builder::new()
-        .prefix(&format!(".{name}."))
-        .suffix(".tmp")
+        .prefix(&crate::util::temp_prefix(output))
+        .suffix(crate::util::TEMP_SUFFIX)
         .tempdir_in(crate::util::folder_of(output))
         .map_err(|source| OutputError::CreatingFolder {
             beside: output.to_path_buf(),

@@ -1319,3 +1319,23 @@ fn one_picture_outputs_are_png_files_or_standard_output() {
         assert!(!world.path("-").exists());
     }
 }
+
+/// An output whose name takes the whole 255 bytes a name may have is written: the temporary
+/// file or folder beside it is named within the limit too.
+#[test]
+fn outputs_with_the_longest_names_are_written() {
+    let world = World::new();
+    let scene = world.scene("fine.rhai", "").display().to_string();
+    let stem = "é".repeat(123);
+    for (args, name) in [
+        (vec!["preview", scene.as_str()], format!("{stem}abcde.png")),
+        (vec!["render", scene.as_str()], format!("{stem}abcde.gif")),
+        (vec!["render", scene.as_str()], format!("{stem}abcdefghi")),
+    ] {
+        assert_eq!(name.len(), 255);
+        let output = world.run(&[&args[..], &["-o", &name]].concat());
+        expect(&output, 0, "");
+        assert!(world.path(&name).exists(), "{name}");
+    }
+    assert!(!world.names().iter().any(|n| n.ends_with(".tmp")));
+}
