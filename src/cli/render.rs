@@ -17,6 +17,9 @@ pub fn run_render(args: RenderArgs) -> anyhow::Result<()> {
     // Before any output exists, so that Ctrl-C always goes through the clean-up below.
     let cancel = super::signals::cancel_flag();
     let kind = args.output_kind()?;
+    for warning in args.unused_flags(kind) {
+        eprint_line!("lapclone: warning: {warning}");
+    }
     // Before the scene: a video's ffmpeg starts up while the scene loads.
     let plan = SinkPlan::new(kind, &args.output, args.sink_settings())?;
     let (loaded, imports, mut renderer) = load_renderer(&args.scene)?;

@@ -56,9 +56,9 @@ pub struct RenderArgs {
     /// such a folder is refused).
     #[arg(long)]
     pub force: bool,
-    /// PNG deflate effort for frame folders.
-    #[arg(long, value_enum, default_value = "fast")]
-    pub png_compression: PngCompression,
+    /// PNG deflate effort for frame folders (default: fast).
+    #[arg(long, value_enum)]
+    pub png_compression: Option<PngCompression>,
     /// Constant quality for MP4/WebM/MOV (lower is better; H.264 default 20, VP9 default 32).
     #[arg(long, visible_alias = "quality", value_parser = clap::value_parser!(u32).range(0..=63), allow_hyphen_values = true)]
     pub crf: Option<u32>,
@@ -94,9 +94,38 @@ impl RenderArgs {
     pub(crate) fn sink_settings(&self) -> SinkSettings {
         SinkSettings {
             force: self.force,
-            png_compression: self.png_compression,
+            png_compression: self.png_compression.unwrap_or(PngCompression::Fast),
             crf: self.crf,
         }
+    }
+
+    /// A warning per flag given that the output `kind` does not use: it changes nothing,
+    /// and a user who gave it expects it to.
+    pub(crate) fn unused_flags(&self, kind: OutputKind) -> Vec<String> {
+        let folder = kind == OutputKind::PngFolder;
+        let unused = [
+            (
+                self.crf.is_some() && !kind.needs_ffmpeg(),
+                "--crf",
+                "MP4, WebM and MOV videos",
+            ),
+            (self.force && !folder, "--force", "PNG frame folders"),
+            (
+                self.png_compression.is_some() && !folder,
+                "--png-compression",
+                "PNG frame folders",
+            ),
+        ];
+        unused
+            .into_iter()
+            .filter(|(given, ..)| *given)
+            .map(|(_, flag, used_by)| {
+                format!(
+                    "{flag} applies to {used_by} only; this {} output ignores it",
+                    kind.label()
+                )
+            })
+            .collect()
     }
 
     /// The frames to render of a scene with `total` frames; beyond its end is a usage error.

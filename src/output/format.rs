@@ -83,4 +83,17 @@ impl OutputKind {
     pub fn needs_ffmpeg(self) -> bool {
         matches!(self, OutputKind::Mp4 | OutputKind::Webm | OutputKind::Mov)
     }
+
+    /// Its name in a message: `PNG frame folder`, `GIF`, `APNG`, `MP4`, `WebM`, `MOV`, `Y4M`.
+    pub fn label(self) -> &'static str {
+        match self {
+            OutputKind::PngFolder => "PNG frame folder",
+            OutputKind::Gif => "GIF",
+            OutputKind::Apng => "APNG",
+            OutputKind::Mp4 => "MP4",
+            OutputKind::Webm => "WebM",
+            OutputKind::Mov => "MOV",
+            OutputKind::Y4m => "Y4M",
+        }
+    }
 }

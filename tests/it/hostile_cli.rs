@@ -1339,3 +1339,56 @@ fn outputs_with_the_longest_names_are_written() {
     }
     assert!(!world.names().iter().any(|n| n.ends_with(".tmp")));
 }
+
+/// A render flag the output's format does not use is named in a warning (the render goes
+/// on): a user who gave `--crf` for a GIF expects a quality change that will not come.
+#[test]
+fn render_flags_the_format_ignores_are_named() {
+    let world = World::new();
+    let scene = world.scene("fine.rhai", "").display().to_string();
+    let scene = scene.as_str();
+    let cases: [(&[&str], &[&str]); 4] = [
+        (
+            &["-o", "a.gif", "--crf", "20"],
+            &["--crf applies to MP4, WebM and MOV videos only; this GIF"],
+        ),
+        (
+            &["-o", "b.apng", "--force", "--png-compression", "best"],
+            &[
+                "--force applies to PNG frame folders only",
+                "--png-compression applies to PNG frame folders only; this APNG",
+            ],
+        ),
+        (
+            &["-o", "frames", "--crf", "3"],
+            &["this PNG frame folder output ignores it"],
+        ),
+        (
+            &[
+                "-o",
+                "c.gif",
+                "--format",
+                "y4m",
+                "--png-compression",
+                "fast",
+            ],
+            &["this Y4M output ignores it"],
+        ),
+    ];
+    for (flags, warnings) in cases {
+        let stderr = expect(&world.run(&[&["render", scene][..], flags].concat()), 0, "");
+        for warning in warnings {
+            assert!(stderr.contains(warning), "{flags:?}: {stderr}");
+        }
+    }
+    let used = world.run(&[
+        "render",
+        scene,
+        "-o",
+        "frames",
+        "--force",
+        "--png-compression",
+        "best",
+    ]);
+    assert!(!expect(&used, 0, "").contains("warning"));
+}
