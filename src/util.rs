@@ -86,6 +86,13 @@ enum Destination {
     Through(PathBuf),
 }
 
+/// Whether `path` may be written as an output (missing, a regular file, a FIFO or a
+/// character device), for a command that writes it only after long work: the error says
+/// what it is otherwise, as [`TempOutput::new`] would at the end.
+pub fn check_destination(path: &Path) -> std::io::Result<()> {
+    destination(path).map(drop)
+}
+
 /// Why an output path is refused before anything is written.
 fn refuse(what: &str) -> std::io::Error {
     std::io::Error::new(

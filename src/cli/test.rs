@@ -59,6 +59,8 @@ pub fn run(args: TestArgs) -> anyhow::Result<()> {
         lapclone::output::check_output_folder(path)?;
     }
     if let Some(junit) = &args.junit {
+        lapclone::util::check_destination(junit)
+            .map_err(|e| UsageError(format!("--junit {}: {e}", junit.display())))?;
         test_report::refuse_replacing_other_than_junit(junit)?;
     }
     let scenes = find_scenes(&paths, &args.out_dir())?;

@@ -365,6 +365,27 @@ fn bad_inputs_give_clear_messages_and_exit_codes() {
             stderr(&out)
         );
     }
+    // A --junit that cannot be written (a folder, a link to nothing) is a usage error before
+    // anything runs: no frame is compared, no line printed.
+    std::fs::create_dir(fixture.root.join("reports")).unwrap();
+    #[cfg(unix)]
+    std::os::unix::fs::symlink("nowhere.xml", fixture.root.join("dangling.xml")).unwrap();
+    for (junit, what) in [
+        ("reports", "it is a folder"),
+        ("dangling.xml", "it is a symbolic link to nothing"),
+    ] {
+        if !cfg!(unix) && junit == "dangling.xml" {
+            continue;
+        }
+        let out = fixture.run(&["--junit", junit]);
+        assert_eq!(code(&out), 2, "{}", stderr(&out));
+        assert!(
+            stderr(&out).contains(&format!("--junit {junit}: {what}")),
+            "{}",
+            stderr(&out)
+        );
+        assert_eq!(stdout(&out), "", "nothing ran");
+    }
     // A golden of another size.
     image::RgbImage::new(5, 3).save(fixture.golden(1)).unwrap();
     let size = fixture.run(&["--frames", "1"]);
