@@ -41,9 +41,28 @@ pub fn find_program_in(name: &str, search: &std::ffi::OsStr) -> Option<PathBuf> 
 }
 
 /// Writes `line` and a newline to standard error, dropping them when it is closed or full:
-/// a message is not worth a crash. Called through `eprint_line!`.
+/// a message is not worth a crash. Called through `eprint_line!`. Control characters a
+/// message quotes (a scene's `throw` text, a file name) are shown escaped, so quoting them
+/// cannot move the cursor, clear the terminal or retitle its window.
 pub fn stderr_line(line: std::fmt::Arguments) {
-    let _ = writeln!(std::io::stderr().lock(), "{line}");
+    let _ = writeln!(std::io::stderr().lock(), "{}", visible_controls(&line.to_string()));
+}
+
+/// `text` with every control character but newline and tab written as `\u{..}`.
+pub fn visible_controls(text: &str) -> std::borrow::Cow<'_, str> {
+    let hidden = |c: char| c.is_control() && c != '\n' && c != '\t';
+    if !text.contains(hidden) {
+        return text.into();
+    }
+    let mut out = String::with_capacity(text.len() + 8);
+    for c in text.chars() {
+        if hidden(c) {
+            out.push_str(&c.escape_unicode().to_string());
+        } else {
+            out.push(c);
+        }
+    }
+    out.into()
 }
 
 /// Writes `bytes` to `path` by the one output rule ([`TempOutput`]).
@@ -400,6 +419,13 @@ pub fn same_file(a: &Path, b: &Path) -> bool {
 #[cfg(test)]
 mod tests {
     use super::{number_text, temp_prefix};
+
+    #[test]
+    fn messages_show_control_characters_escaped() {
+        let shown = super::visible_controls("a\u{1b}[2J\rb\u{7}\u{9b}c\n\td");
+        assert_eq!(shown, "a\\u{1b}[2J\\u{d}b\\u{7}\\u{9b}c\n\td");
+        assert!(matches!(super::visible_controls("plain é"), std::borrow::Cow::Borrowed(_)));
+    }
 
     #[test]
     fn temporary_names_fit_beside_the_longest_names() {

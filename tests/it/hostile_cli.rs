@@ -1392,3 +1392,30 @@ fn render_flags_the_format_ignores_are_named() {
     ]);
     assert!(!expect(&used, 0, "").contains("warning"));
 }
+
+/// Control characters a message quotes (a scene's `throw`, a file name) reach the terminal
+/// escaped: a scene cannot clear the screen or retitle the window of the one reading it.
+#[test]
+fn messages_show_control_characters_escaped() {
+    let world = World::new();
+    world.scene(
+        "throws.rhai",
+        "throw \"bad\\x1b[2J\\x1b]0;title\\x07end\";\n",
+    );
+    let bell = "\u{7}.png";
+    for args in [
+        &["check", "throws.rhai"][..],
+        &[
+            "clone", "--source", bell, "--mask", "mask.png", "--target", "bg.png", "--at", "1,1",
+            "-o", "o.png",
+        ],
+    ] {
+        let output = world.run(args);
+        let stderr = expect(&output, 1, "");
+        assert!(!stderr.contains(['\u{1b}', '\u{7}']), "{stderr:?}");
+        assert!(
+            stderr.contains("\\u{1b}[2J") || stderr.contains("\\u{7}.png"),
+            "{stderr:?}"
+        );
+    }
+}
