@@ -15,6 +15,7 @@ use lapclone::mesh::{BitMask, MeshOptions};
 use lapclone::pixels::{Canvas, FloatImage, PixelFormat};
 use lapclone::raster::overlay::{draw_mesh_overlay, HandleMarker, OverlayStyle};
 use lapclone::solve::LaplacianKind;
+use lapclone::util::number_text;
 
 use super::picture_out::PictureOut;
 use super::{finite_f64, point, UsageError};
@@ -119,7 +120,10 @@ fn parse_drag(text: &str) -> Result<DragArg, String> {
         Some(r) => {
             let r = finite_f64(r)?;
             if r <= 0.0 {
-                return Err(format!("drag radius must be positive, not {r}"));
+                return Err(format!(
+                    "drag radius must be positive, not {}",
+                    number_text(r)
+                ));
             }
             Some(r)
         }
@@ -323,13 +327,13 @@ fn join<T>(handle: std::thread::ScopedJoinHandle<'_, T>) -> T {
 }
 
 fn check_arguments(args: &CloneArgs) -> anyhow::Result<PictureOut> {
-    if args.scale <= 0.0 {
-        return Err(UsageError(format!("--scale must be positive, not {}", args.scale)).into());
+    if let Some(error) = lapclone::limits::scale_error(args.scale) {
+        return Err(UsageError(format!("--scale: {error}")).into());
     }
     if !(0.0..=1.0).contains(&args.threshold) {
         return Err(UsageError(format!(
             "--threshold must lie in [0, 1], not {}",
-            args.threshold
+            number_text(args.threshold)
         ))
         .into());
     }

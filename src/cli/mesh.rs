@@ -6,6 +6,7 @@ use std::time::Instant;
 use anyhow::Context;
 use lapclone::mesh::{self, BitMask, Mesh, MeshOptions};
 use lapclone::raster::overlay::{draw_mesh_overlay, OverlayStyle};
+use lapclone::util::number_text;
 
 use super::mesh_args::MeshQualityArgs;
 use super::UsageError;
@@ -44,7 +45,11 @@ pub fn run(args: MeshArgs) -> anyhow::Result<()> {
         .threshold
         .unwrap_or(f64::from(lapclone::mesh::MASK_THRESHOLD));
     if !(0.0..=1.0).contains(&threshold) {
-        return Err(UsageError(format!("--threshold must be in [0, 1], got {threshold}")).into());
+        return Err(UsageError(format!(
+            "--threshold must be in [0, 1], got {}",
+            number_text(threshold)
+        ))
+        .into());
     }
     let outputs = output_files(&args);
     check_outputs(&outputs, &args.mask)?;

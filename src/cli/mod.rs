@@ -199,12 +199,17 @@ pub fn finite_f64(text: &str) -> Result<f64, String> {
     }
 }
 
-/// Parses `X,Y` into two finite numbers.
+/// Parses `X,Y` into two finite numbers within the positions' bound
+/// ([`lapclone::limits::MAX_POSITION`], as a scene's positions are).
 pub fn point(text: &str) -> Result<[f64; 2], String> {
     let (x, y) = text
         .split_once(',')
         .ok_or_else(|| format!("`{text}` is not a point X,Y"))?;
-    Ok([finite_f64(x)?, finite_f64(y)?])
+    let point = [finite_f64(x)?, finite_f64(y)?];
+    match point.into_iter().find_map(lapclone::limits::position_error) {
+        Some(error) => Err(error),
+        None => Ok(point),
+    }
 }
 
 #[cfg(test)]

@@ -4,6 +4,7 @@
 use glam::DVec2;
 
 use super::{Mesh, MeshError};
+use crate::util::number_text;
 
 /// Meshing parameters. See [`MeshOptions::default`] for the defaults and why.
 #[derive(Clone, Debug, PartialEq)]
@@ -151,19 +152,19 @@ impl MeshOptions {
         if !(self.density.is_finite() && self.density >= 0.05) {
             return bad(format!(
                 "density must be a length ≥ 0.05 px, got {}",
-                self.density
+                number_text(self.density)
             ));
         }
         if !(self.simplify_tolerance.is_finite() && self.simplify_tolerance >= 0.0) {
             return bad(format!(
                 "simplify_tolerance must be ≥ 0, got {}",
-                self.simplify_tolerance
+                number_text(self.simplify_tolerance)
             ));
         }
         if !(self.min_angle_deg.is_finite() && (0.0..=35.0).contains(&self.min_angle_deg)) {
             return bad(format!(
                 "min angle must be in [0, 35] degrees, got {}",
-                self.min_angle_deg
+                number_text(self.min_angle_deg)
             ));
         }
         if self.max_vertices < 3 {
@@ -175,7 +176,7 @@ impl MeshOptions {
         if !(self.min_piece_area.is_finite() && self.min_piece_area >= 0.0) {
             return bad(format!(
                 "min_piece_area must be ≥ 0, got {}",
-                self.min_piece_area
+                number_text(self.min_piece_area)
             ));
         }
         if self.relax_sweeps > MAX_RELAX_SWEEPS {
@@ -187,7 +188,8 @@ impl MeshOptions {
         if let Some(area) = self.max_area {
             if !(area.is_finite() && area >= MIN_MAX_AREA) {
                 return bad(format!(
-                    "max_area must be an area ≥ {MIN_MAX_AREA} px², got {area}"
+                    "max_area must be an area ≥ {MIN_MAX_AREA} px², got {}",
+                    number_text(area)
                 ));
             }
         }

@@ -5,6 +5,7 @@
 use rhai::{Dynamic, Engine, Map, NativeCallContext};
 
 use super::draft::SharedDraft;
+use crate::util::number_text;
 use super::refs::{fail, Fallible};
 use super::values;
 use crate::golden::GoldenSettings;
@@ -35,7 +36,7 @@ fn parse(options: &Dynamic, frame_count: Option<u64>) -> Result<GoldenSettings, 
     let percent = |key: &str| -> Result<Option<f64>, String> {
         let value = level(key)?;
         match value {
-            Some(p) if p > 100.0 => Err(format!("{key} must be a percentage in 0..=100, got {p}")),
+            Some(p) if p > 100.0 => Err(format!("{key} must be a percentage in 0..=100, got {}", number_text(p))),
             _ => Ok(value),
         }
     };

@@ -5,6 +5,7 @@
 use rhai::{Array, Dynamic, Map};
 
 use crate::scene::Easing;
+use crate::util::number_text;
 use glam::DVec2;
 
 /// A finite number from an integer or a float.
@@ -183,7 +184,7 @@ pub fn colour(value: &Dynamic) -> Result<[f32; 4], String> {
     for (slot, c) in rgba.iter_mut().zip(&channels) {
         let v = number(c, "colour channel")?;
         if !(0.0..=1.0).contains(&v) {
-            return Err(format!("colour channels must be in [0, 1], got {v}"));
+            return Err(format!("colour channels must be in [0, 1], got {}", number_text(v)));
         }
         *slot = v as f32;
     }

@@ -356,7 +356,7 @@ fn every_numeric_flag_refuses_nan_infinity_and_bad_signs() {
         cases.push(clone_case(
             &[("--scale", value)],
             2,
-            "--scale must be positive",
+            "must be > 0 and at most 1e6",
         ));
         cases.push(clone_case(
             &[("--density", value)],
@@ -408,6 +408,26 @@ fn every_numeric_flag_refuses_nan_infinity_and_bad_signs() {
         ),
         clone_case(&[("--density", "0.01")], 2, "density"),
         clone_case(&[("--at", "3")], 2, "is not a point"),
+        // Positions and scales have the bounds a scene's have (`lapclone::limits`).
+        clone_case(
+            &[("--scale", "1e300")],
+            2,
+            "--scale: 1e300 must be > 0 and at most 1e6",
+        ),
+        clone_case(&[("--at", "1e300,4")], 2, "1e300 is past ±1e9 px"),
+        clone_case(&[("--pin", "4,-2e9")], 2, "-2e9 is past ±1e9 px"),
+        clone_case(&[("--mask-offset", "1e10,0")], 2, "1e10 is past ±1e9 px"),
+        clone_case(&[("--drag", "4,4:1e300,6")], 2, "1e300 is past ±1e9 px"),
+        clone_case(
+            &[("--threshold", "1e300")],
+            2,
+            "--threshold must lie in [0, 1], not 1e300",
+        ),
+        case(
+            &["mesh", "in/mask.png", "--density", "1e-300"],
+            2,
+            "got 1e-300",
+        ),
         clone_case(&[("--drag", "1,2")], 2, "is not a drag"),
         case(
             &["mesh", "in/mask.png", "--threshold", "-1"],
@@ -1063,7 +1083,15 @@ fn extreme_finite_numbers_work_or_fail_cleanly() {
             }
             Some(1) => !output_file.exists() && stderr.contains("error"),
             // A value past a documented bound is a usage error naming the bound.
-            Some(2) => !output_file.exists() && stderr.contains("must lie in"),
+            Some(2) => {
+                let bounds = [
+                    "must lie in",
+                    "and at most 1e6",
+                    "is past ±1e9 px",
+                    "the scene ",
+                ];
+                !output_file.exists() && bounds.iter().any(|b| stderr.contains(b))
+            }
             _ => false,
         };
         if !fine || stderr.contains("panicked") {
