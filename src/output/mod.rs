@@ -54,6 +54,16 @@ impl OutputError {
             source,
         }
     }
+
+    /// This error met writing `path`: an encoder's I/O failure (a full disk) names the file
+    /// it could not write; other errors stay as they are.
+    pub(crate) fn writing(self, path: &Path) -> Self {
+        match self {
+            OutputError::Png(png::EncodingError::IoError(source))
+            | OutputError::Gif(::gif::EncodingError::Io(source)) => OutputError::io(path, source),
+            other => other,
+        }
+    }
 }
 
 /// Why an output was refused or failed. Messages name the path; the causes (I/O errors)

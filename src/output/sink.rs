@@ -96,7 +96,11 @@ impl SinkPlan {
             }
             OutputKind::Apng => Sink::Apng(Box::new(open_apng(output, renderer, range)?)),
         };
-        Ok(FrameSink { sink, note })
+        Ok(FrameSink {
+            sink,
+            note,
+            path: self.output,
+        })
     }
 }
 
@@ -146,6 +150,8 @@ fn open_apng(
 pub struct FrameSink {
     sink: Sink,
     note: Option<String>,
+    /// The output, named in an encoder's I/O failure.
+    path: PathBuf,
 }
 
 enum Sink {
@@ -164,6 +170,11 @@ impl FrameSink {
 
     /// Writes frame `number` (from 1).
     pub fn push(&mut self, number: u64, canvas: &Canvas) -> Result<(), OutputError> {
+        self.push_frame(number, canvas)
+            .map_err(|e| e.writing(&self.path))
+    }
+
+    fn push_frame(&mut self, number: u64, canvas: &Canvas) -> Result<(), OutputError> {
         match &mut self.sink {
             Sink::Png(writer, _) => {
                 let mut frame = writer.spare_frame().unwrap_or_else(|| empty_frame(canvas));
@@ -180,16 +191,16 @@ impl FrameSink {
 
     /// Finishes the output and gives its path.
     pub fn finish(self) -> Result<PathBuf, OutputError> {
-        match self.sink {
-            Sink::Png(writer, staging) => {
-                let written = writer.finish()?;
-                staging.commit(&written)
-            }
+        let finished = match self.sink {
+            Sink::Png(writer, staging) => writer
+                .finish()
+                .and_then(|written| staging.commit(&written)),
             Sink::Gif(writer) => writer.finish(),
             Sink::Apng(writer) => writer.finish(),
             Sink::Y4m(writer) => writer.finish(),
             Sink::Video(writer) => writer.finish(),
-        }
+        };
+        finished.map_err(|e| e.writing(&self.path))
     }
 
     /// Drops the sink after a failure or an interruption: writers remove their temporary

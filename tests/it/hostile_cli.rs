@@ -1419,3 +1419,21 @@ fn messages_show_control_characters_escaped() {
         );
     }
 }
+
+/// A full disk while writing a GIF, an APNG or one PNG: the message names the file that could
+/// not be written, not just the encoder.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_full_disk_names_the_output() {
+    let world = World::new();
+    let scene = world.scene("fine.rhai", "").display().to_string();
+    let scene = scene.as_str();
+    for args in [
+        &["render", scene, "-o", "/dev/full", "--format", "gif"][..],
+        &["render", scene, "-o", "/dev/full", "--format", "apng"],
+        &["preview", scene, "-o", "/dev/full"],
+    ] {
+        let stderr = expect(&world.run(args), 1, "/dev/full");
+        assert!(stderr.contains("No space left on device"), "{stderr}");
+    }
+}
