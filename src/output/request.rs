@@ -61,16 +61,25 @@ impl FrameRange {
     }
 }
 
-/// Fails before any work when the output's folder does not exist.
+/// Fails before any work when the output's folder does not exist or cannot be reached (a
+/// path too long, a folder that may not be searched): the message says which.
 pub fn check_output_folder(output: &Path) -> Result<(), OutputError> {
-    match output.parent() {
-        Some(dir) if !dir.as_os_str().is_empty() && !dir.is_dir() => {
-            Err(OutputError::MissingFolder {
-                output: output.to_path_buf(),
-                folder: dir.to_path_buf(),
-                exists: dir.exists(),
-            })
-        }
-        _ => Ok(()),
+    let Some(dir) = output.parent().filter(|d| !d.as_os_str().is_empty()) else {
+        return Ok(());
+    };
+    match std::fs::metadata(dir) {
+        Ok(meta) if meta.is_dir() => Ok(()),
+        Ok(_) => Err(missing(output, dir, true)),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Err(missing(output, dir, false)),
+        // Not a missing folder: a path too long, a folder that may not be searched.
+        Err(e) => Err(OutputError::io(output, e)),
+    }
+}
+
+fn missing(output: &Path, folder: &Path, exists: bool) -> OutputError {
+    OutputError::MissingFolder {
+        output: output.to_path_buf(),
+        folder: folder.to_path_buf(),
+        exists,
     }
 }

@@ -1437,3 +1437,29 @@ fn a_full_disk_names_the_output() {
         assert!(stderr.contains("No space left on device"), "{stderr}");
     }
 }
+
+/// An output path longer than the system takes (4,096 bytes) is named as too long, not as a
+/// missing folder the user can see exists.
+#[cfg(target_os = "linux")]
+#[test]
+fn an_output_path_too_long_says_so() {
+    let world = World::new();
+    let scene = world.scene("fine.rhai", "").display().to_string();
+    // The folders exist as far as a path may reach (made one step at a time).
+    let mut folder = world.root.path().to_path_buf();
+    for i in 0..21 {
+        folder.push(format!("{i:02}{}", "d".repeat(198)));
+        if folder.as_os_str().len() < 4000 {
+            std::fs::create_dir(&folder).unwrap();
+        }
+    }
+    let output = format!("{}/x.png", folder.display());
+    assert!(output.len() > 4096);
+    for args in [
+        &["preview", scene.as_str(), "-o", &output][..],
+        &["render", &scene, "-o", &output],
+    ] {
+        let stderr = expect(&world.run(args), 1, "File name too long");
+        assert!(!stderr.contains("does not exist"), "{stderr}");
+    }
+}
