@@ -27,11 +27,7 @@ pub fn run_check(args: CheckArgs) -> anyhow::Result<()> {
         c.frame_count(),
         loaded.scene.patches.len(),
     ))?;
-    for warning in loaded
-        .warnings()
-        .into_iter()
-        .chain(renderer.point_warnings())
-    {
+    for warning in loaded.warnings().into_iter().chain(renderer.warnings()) {
         eprint_line!("warning: {warning}");
     }
     Ok(())

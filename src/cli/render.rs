@@ -23,7 +23,7 @@ pub fn run_render(args: RenderArgs) -> anyhow::Result<()> {
     // Before the scene: a video's ffmpeg starts up while the scene loads.
     let plan = SinkPlan::new(kind, &args.output, args.sink_settings())?;
     let (loaded, imports, mut renderer) = load_renderer(&args.scene)?;
-    for warning in renderer.point_warnings() {
+    for warning in renderer.warnings() {
         eprint_line!("warning: {warning}");
     }
     refuse_render_input(kind, &args.output, &loaded, &imports)?;

@@ -38,6 +38,15 @@ pub enum RenderError {
         #[source]
         source: Box<crate::mesh::MeshError>,
     },
+    /// A polygon patch whose polygons all lie outside its source image: it would clone
+    /// nothing but the source's edge pixels repeated.
+    #[error("patch `{patch}`: its polygons lie entirely outside its {}×{} source (polygon points are source pixels)", size.0, size.1)]
+    OutsideSource {
+        /// The patch's name.
+        patch: String,
+        /// The source's width and height.
+        size: (u32, u32),
+    },
     /// Reading an image or drawing the background failed.
     #[error(transparent)]
     Pixels(#[from] PixelError),
@@ -61,7 +70,8 @@ impl RenderError {
         match self {
             RenderError::Clone { patch, .. }
             | RenderError::Deform { patch, .. }
-            | RenderError::Mask { patch, .. } => Some(patch),
+            | RenderError::Mask { patch, .. }
+            | RenderError::OutsideSource { patch, .. } => Some(patch),
             RenderError::Footage { patch, .. } => patch.as_deref(),
             RenderError::Pixels(_) | RenderError::Scene(_) => None,
         }

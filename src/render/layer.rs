@@ -9,7 +9,7 @@ use crate::clone::{
     mesh_from_mask, mesh_from_polygons, CloneOptions, CloneStats, PatchCloner, PatchMesh, Placement,
 };
 use crate::deform::{DeformRig, DeformStats, Deformed, Handle, Pin};
-use crate::mesh::{BitMask, Mesh, MeshOptions, MASK_THRESHOLD};
+use crate::mesh::{BitMask, Mesh, MeshOptions, Polygon, MASK_THRESHOLD};
 use crate::pixels::{Canvas, FloatImage, Footage, FootageReader};
 use crate::scene::{
     BoundaryData, BoundaryPlacement, CloneMode, LaplacianKind, Patch, PatchState, Shape,
@@ -227,6 +227,12 @@ impl Layer {
         self.deforms = deforms(patch);
     }
 
+    /// The source image's width and height.
+    pub fn source_size(&self) -> (u32, u32) {
+        let source = self.cloner.source();
+        (source.width(), source.height())
+    }
+
     pub fn has_rig(&self) -> bool {
         self.rig.is_some()
     }
@@ -290,6 +296,28 @@ fn mesh_patch(
                 },
             )
         }
-        Shape::Polygons(polygons) => mesh_from_polygons(polygons, options).map_err(clone_error),
+        Shape::Polygons(polygons) => {
+            let size = (source.width(), source.height());
+            if polygons_outside(polygons, size).is_some_and(|far| far.is_infinite()) {
+                let patch = patch.name.clone();
+                return Err(RenderError::OutsideSource { patch, size });
+            }
+            mesh_from_polygons(polygons, options).map_err(clone_error)
+        }
     }
+}
+
+/// How far (px) `polygons` reach past a `size` source's rectangle, when they do: infinite
+/// when they miss it entirely. Only outer rings count: holes lie inside them.
+pub(super) fn polygons_outside(polygons: &[Polygon], (width, height): (u32, u32)) -> Option<f64> {
+    let points = polygons.iter().flat_map(|p| &p.outer);
+    let (min, max) = points.fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), &p| {
+        (lo.min(p), hi.max(p))
+    });
+    let size = DVec2::new(f64::from(width), f64::from(height));
+    if max.x < 0.0 || max.y < 0.0 || min.x > size.x || min.y > size.y {
+        return Some(f64::INFINITY);
+    }
+    let past = (-min).max(max - size).max_element();
+    (past > 0.0).then_some(past)
 }

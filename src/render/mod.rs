@@ -15,6 +15,7 @@ mod layer;
 mod opacity;
 mod point_warnings;
 mod renderer;
+mod source_warnings;
 
 pub use error::RenderError;
 pub use renderer::{DrawnRegion, FrameStats, PlacedMesh, Renderer, SceneUpdate};

@@ -161,6 +161,11 @@ impl Renderer {
         self.layers.iter().map(Layer::pivot).collect()
     }
 
+    /// Each patch's source image size (width, height), in scene order.
+    pub(crate) fn source_sizes(&self) -> Vec<(u32, u32)> {
+        self.layers.iter().map(Layer::source_size).collect()
+    }
+
     /// Whether each patch (scene order) has a deformation rig built.
     pub fn rigs_built(&self) -> Vec<bool> {
         self.layers.iter().map(Layer::has_rig).collect()

@@ -1463,3 +1463,47 @@ fn an_output_path_too_long_says_so() {
         assert!(!stderr.contains("does not exist"), "{stderr}");
     }
 }
+
+/// Sizes that do not fit: polygons entirely outside their source are a positioned error;
+/// polygons reaching past its edge, and a background that does not cover the canvas, are
+/// warnings from `check` and `render` (what they draw is not what the scene seems to say).
+#[test]
+fn sizes_that_do_not_fit_are_named() {
+    let world = World::new();
+    let polygon = |name: &str, ring: &str| {
+        world.write(
+            name,
+            &format!(
+                "canvas({W}, {H}, #{{ fps: 2, duration: 1, background: \"bg.png\" }});\n\
+                 let p = patch(\"p\", #{{ source: \"src.png\", polygons: [{ring}] }});\n"
+            ),
+        )
+    };
+    polygon("away.rhai", "[[-30, -30], [-10, -30], [-10, -10]]");
+    polygon("past.rhai", "[[5, 5], [52.5, 5], [20, 25]]");
+    polygon("inside.rhai", "[[0, 0], [40, 0], [40, 30]]");
+    world.write(
+        "small_bg.rhai",
+        &format!(
+            "canvas({}, {H}, #{{ fps: 2, duration: 1, background: \"bg.png\" }});\n",
+            W + 8
+        ),
+    );
+    let stderr = expect(
+        &world.run(&["check", "away.rhai"]),
+        1,
+        "away.rhai:2:9: patch `p`: its polygons lie entirely outside its 40×30 source",
+    );
+    assert!(stderr.contains('^'), "{stderr}");
+    for command in [&["check"][..], &["render", "-o", "out.gif"]] {
+        let run = |scene: &str| world.run(&[&command[..1], &[scene], &command[1..]].concat());
+        let stderr = expect(
+            &run("past.rhai"),
+            0,
+            "patch `p`: its polygons reach 12.5 px past the edge of its 40×30 source",
+        );
+        assert_eq!(stderr.matches("warning").count(), 1, "{stderr}");
+        expect(&run("small_bg.rhai"), 0, "is 40×30 and the canvas 48×30: it is drawn from the top-left corner, with opaque black");
+        assert!(!expect(&run("inside.rhai"), 0, "").contains("warning"));
+    }
+}
