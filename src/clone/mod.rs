@@ -22,5 +22,7 @@ pub use error::CloneError;
 pub use expand::{expand_boundary, HALF_PIXEL};
 pub use glue::{Glue, GlueFrame, GlueStats, GluedVertex, GLUE_TOLERANCE, MAX_GLUE_ITERATIONS};
 pub use membrane::{MembraneSolver, MembraneStats, MEMBRANE_CHANNELS};
-pub use patch_mesh::{finish_mask_mesh, mesh_from_mask, mesh_from_polygons, PatchMesh};
+pub use patch_mesh::{
+    finish_mask_mesh, mesh_from_mask, mesh_from_polygons, reach_past, PatchMesh, PAST_EDGE_TOLERANCE,
+};
 pub use placement::{Anchor, Placement, PLACED_GRID};

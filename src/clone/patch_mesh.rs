@@ -5,6 +5,7 @@
 use glam::DVec2;
 
 use super::{expand_boundary, CloneError, HALF_PIXEL};
+use crate::util::number_text;
 use crate::mesh::{
     mesh_mask, mesh_polygons, relax_interior, BitMask, BoundaryPlacement, MeshOptions, MeshResult,
     Polygon,
@@ -52,12 +53,32 @@ pub fn mesh_from_mask(
             "mask offset {offset} is not finite"
         )));
     }
+    let (min, max) = inside_bbox(mask);
+    let past = reach_past(min + offset, max + offset, source_size);
+    if past.is_some_and(f64::is_infinite) {
+        return Err(CloneError::BadOption(format!(
+            "the mask at offset ({}, {}) lies entirely outside the {}×{} source",
+            number_text(offset.x),
+            number_text(offset.y),
+            source_size.0,
+            source_size.1
+        )));
+    }
     let mut result = mesh_mask(mask, options)?;
+    if let Some(past) = past.filter(|&p| p > PAST_EDGE_TOLERANCE) {
+        result.warnings.push(format!(
+            "the mask at offset ({}, {}) reaches {} px past the edge of the {}×{} source; the pixels there repeat the edge",
+            number_text(offset.x),
+            number_text(offset.y),
+            number_text((past * 10.0).round() / 10.0),
+            source_size.0,
+            source_size.1
+        ));
+    }
     for p in &mut result.mesh.positions {
         *p += offset;
     }
     finish_mask_mesh(&mut result, options);
-    let (min, max) = inside_bbox(mask);
     Ok(PatchMesh {
         result,
         bbox_min: min + offset,
@@ -104,6 +125,22 @@ pub fn mesh_from_polygons(
 
 /// Corners of the bounding box of the inside pixels; a zero box at the origin when empty
 /// (meshing reports the empty mask before this matters).
+/// How far past a patch may reach beyond its source's edge unremarked, px: a polygon drawn
+/// along the image's border may sit on pixel centres or edges.
+pub const PAST_EDGE_TOLERANCE: f64 = 1.0;
+
+/// How far (px) the box `min`..`max` (source coordinates) reaches past a `size` source's
+/// rectangle, when it does; infinite when it misses the rectangle entirely. The pixels a
+/// patch takes from past the edge repeat the edge (sampling is clamped).
+pub fn reach_past(min: DVec2, max: DVec2, (width, height): (u32, u32)) -> Option<f64> {
+    let size = DVec2::new(f64::from(width), f64::from(height));
+    if max.x <= 0.0 || max.y <= 0.0 || min.x >= size.x || min.y >= size.y {
+        return Some(f64::INFINITY);
+    }
+    let past = (-min).max(max - size).max_element();
+    (past > 0.0).then_some(past)
+}
+
 fn inside_bbox(mask: &BitMask) -> (DVec2, DVec2) {
     let Some(((x0, y0), (x1, y1))) = mask.inside_bounds() else {
         return (DVec2::ZERO, DVec2::ZERO);

@@ -6,7 +6,7 @@ use glam::DVec2;
 
 use super::RenderError;
 use crate::clone::{
-    mesh_from_mask, mesh_from_polygons, CloneOptions, CloneStats, PatchCloner, PatchMesh, Placement,
+    mesh_from_mask, mesh_from_polygons, reach_past, CloneOptions, CloneStats, PatchCloner, PatchMesh, Placement,
 };
 use crate::deform::{DeformRig, DeformStats, Deformed, Handle, Pin};
 use crate::mesh::{BitMask, Mesh, MeshOptions, Polygon, MASK_THRESHOLD};
@@ -307,17 +307,12 @@ fn mesh_patch(
     }
 }
 
-/// How far (px) `polygons` reach past a `size` source's rectangle, when they do: infinite
-/// when they miss it entirely. Only outer rings count: holes lie inside them.
-pub(super) fn polygons_outside(polygons: &[Polygon], (width, height): (u32, u32)) -> Option<f64> {
+/// How far (px) `polygons` reach past a `size` source's rectangle, when they do (see
+/// [`reach_past`]). Only outer rings count: holes lie inside them.
+pub(super) fn polygons_outside(polygons: &[Polygon], size: (u32, u32)) -> Option<f64> {
     let points = polygons.iter().flat_map(|p| &p.outer);
     let (min, max) = points.fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), &p| {
         (lo.min(p), hi.max(p))
     });
-    let size = DVec2::new(f64::from(width), f64::from(height));
-    if max.x < 0.0 || max.y < 0.0 || min.x > size.x || min.y > size.y {
-        return Some(f64::INFINITY);
-    }
-    let past = (-min).max(max - size).max_element();
-    (past > 0.0).then_some(past)
+    reach_past(min, max, size)
 }

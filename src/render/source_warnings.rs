@@ -4,12 +4,9 @@
 //! polygon patch reaches past its source's edge (the pixels there repeat the edge).
 
 use super::layer::polygons_outside;
+use crate::clone::PAST_EDGE_TOLERANCE;
 use super::Renderer;
 use crate::scene::{Background, Shape};
-
-/// How far past its source a polygon may reach unremarked, px: a ring drawn along the
-/// image's border may sit on pixel centres or edges.
-const PAST_EDGE_TOLERANCE: f64 = 1.0;
 
 impl Renderer {
     /// One sentence per background or polygon patch whose size does not fit (see the module

@@ -1506,4 +1506,34 @@ fn sizes_that_do_not_fit_are_named() {
         expect(&run("small_bg.rhai"), 0, "is 40×30 and the canvas 48×30: it is drawn from the top-left corner, with opaque black");
         assert!(!expect(&run("inside.rhai"), 0, "").contains("warning"));
     }
+    // The mask is 40×30 with inside pixels x 10..30, y 8..22; the source 40×30.
+    let clone = |offset: &str| {
+        world.run(&[
+            "clone",
+            "--source",
+            "src.png",
+            "--mask",
+            "mask.png",
+            "--target",
+            "bg.png",
+            "--at",
+            "20,15",
+            "--mask-offset",
+            offset,
+            "-o",
+            "o.png",
+        ])
+    };
+    expect(
+        &clone("-40,0"),
+        1,
+        "the mask at offset (-40, 0) lies entirely outside the 40×30 source",
+    );
+    assert!(!world.path("o.png").exists());
+    expect(
+        &clone("-12.5,0"),
+        0,
+        "the mask at offset (-12.5, 0) reaches 2.5 px past the edge of the 40×30 source",
+    );
+    assert!(!expect(&clone("-10,0"), 0, "").contains("warning"));
 }
