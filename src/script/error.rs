@@ -123,9 +123,15 @@ impl SceneError {
     ) -> Self {
         let mut current_file = file.to_path_buf();
         let mut error = error;
+        // Where the scene file called into what failed: named when the failure is in a
+        // module, whose line alone does not say which of the scene's calls gave the bad value.
+        let mut scene_call = None;
         loop {
             match *error {
-                EvalAltResult::ErrorInFunctionCall(_, source, inner, _) => {
+                EvalAltResult::ErrorInFunctionCall(_, source, inner, call) => {
+                    if current_file == file && !call.is_none() {
+                        scene_call = Some(call);
+                    }
                     if !source.is_empty() {
                         current_file = PathBuf::from(source);
                     }
@@ -142,7 +148,11 @@ impl SceneError {
         }
         let mut error = error;
         let position = error.take_position();
-        let (kind, message) = classify(&error);
+        let (kind, mut message) = classify(&error);
+        let call = scene_call.filter(|_| current_file != file);
+        if let Some((line, column)) = call.and_then(|c| Some((c.line()?, c.position()?))) {
+            message = format!("{message} (called at {}:{line}:{column})", file.display());
+        }
         let text = (current_file == file).then_some(text);
         Self::with_text(kind, &current_file, position, message, text)
     }

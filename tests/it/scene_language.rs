@@ -414,6 +414,35 @@ fn motion_helpers_import_and_produce_keys() {
     assert!(swing.iter().all(|k| k.easing == Easing::EaseInOut));
 }
 
+/// A motion helper given a step or duration it cannot sample (≤ 0, or too fine) fails with
+/// its own words, positioned in the helper and naming the scene's call; before, a negative
+/// step silently gave no keys and 0 failed on an overflow inside the helper.
+#[test]
+fn motion_helpers_refuse_steps_they_cannot_sample() {
+    for (args, fragment) in [
+        ("0, 1, -0.5", "step must be > 0 seconds, got -0.5"),
+        ("0, 1, 0", "step must be > 0 seconds, got 0"),
+        (
+            "0, 1, 1e-300",
+            "step 1e-300 gives more than 10000 keys over 1 s",
+        ),
+        ("0, -2, 0.5", "duration must be > 0 seconds, got -2"),
+        ("0, 0, 0.5", "duration must be > 0 seconds, got 0"),
+    ] {
+        let text =
+            format!("import \"motion\" as m;\n{HEAD}p.keys(m::wiggle([3, 4], 5, 1, {args}));\n");
+        let e = parse_err(&text);
+        assert!(e.file.ends_with("scripts/motion.rhai"), "{e}");
+        assert!(e.message.contains(fragment), "{e}");
+        let called_at = format!(
+            "(called at {}:{}:",
+            scene_file().display(),
+            HEAD.lines().count() + 2
+        );
+        assert!(e.message.ends_with(&format!("{called_at}11)")), "{e}");
+    }
+}
+
 #[test]
 fn failed_call_leaves_the_patch_unchanged() {
     let options = options();
