@@ -121,8 +121,7 @@ pub fn open_scene(path: &std::path::Path) -> Result<(LoadedScene, Renderer), Sce
 /// made the patch).
 pub fn build_renderer(loaded: &LoadedScene) -> Result<Renderer, SceneError> {
     script::validate_scene(loaded)?;
-    Renderer::new(loaded.scene.clone())
-        .map_err(|e| loaded.error_at_patch(e.patch_name(), e.to_string()))
+    Renderer::new(loaded.scene.clone()).map_err(|e| output::render_error_at_call(loaded, &e))
 }
 
 /// Scenes: the animated description a [`Renderer`] draws, built in Rust or loaded from a

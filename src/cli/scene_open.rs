@@ -20,8 +20,7 @@ pub(crate) fn load_renderer(scene: &Path) -> anyhow::Result<(LoadedScene, Vec<Pa
 }
 
 pub(crate) fn positioned(loaded: &LoadedScene, error: RenderError) -> anyhow::Error {
-    let scene_error = loaded.error_at_patch(error.patch_name(), error.to_string());
-    anyhow::anyhow!("{scene_error}")
+    anyhow::anyhow!("{}", lapclone::output::render_error_at_call(loaded, &error))
 }
 
 pub(crate) fn default_jobs() -> usize {

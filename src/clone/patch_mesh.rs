@@ -53,8 +53,10 @@ pub fn mesh_from_mask(
             "mask offset {offset} is not finite"
         )));
     }
-    let (min, max) = inside_bbox(mask);
-    let past = reach_past(min + offset, max + offset, source_size);
+    let bbox = inside_bbox(mask);
+    // An empty mask is the mesher's error to give ("no inside pixels").
+    let past = bbox.and_then(|(min, max)| reach_past(min + offset, max + offset, source_size));
+    let (min, max) = bbox.unwrap_or_default();
     if past.is_some_and(f64::is_infinite) {
         return Err(CloneError::BadOption(format!(
             "the mask at offset ({}, {}) lies entirely outside the {}×{} source",
@@ -141,12 +143,10 @@ pub fn reach_past(min: DVec2, max: DVec2, (width, height): (u32, u32)) -> Option
     (past > 0.0).then_some(past)
 }
 
-fn inside_bbox(mask: &BitMask) -> (DVec2, DVec2) {
-    let Some(((x0, y0), (x1, y1))) = mask.inside_bounds() else {
-        return (DVec2::ZERO, DVec2::ZERO);
-    };
-    (
+fn inside_bbox(mask: &BitMask) -> Option<(DVec2, DVec2)> {
+    let ((x0, y0), (x1, y1)) = mask.inside_bounds()?;
+    Some((
         DVec2::new(x0 as f64, y0 as f64),
         DVec2::new(x1 as f64, y1 as f64),
-    )
+    ))
 }

@@ -38,7 +38,9 @@ pub use png_sequence::{
 pub use inputs::{
     refuse_footage_input, refuse_input, refuse_render_input, refuse_scene_input, refuse_scene_reads,
 };
-pub use scene_render::{render_frames, render_scene, RenderOptions, RenderProgress, Rendered};
+pub use scene_render::{
+    render_error_at_call, render_frames, render_scene, RenderOptions, RenderProgress, Rendered,
+};
 pub use request::{check_output_folder, FrameRange, SinkSettings};
 pub use sink::{FrameSink, SinkPlan};
 pub use y4m::{fps_fraction, Y4mWriter};

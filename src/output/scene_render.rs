@@ -12,8 +12,8 @@ use super::inputs::refuse_render_input;
 use super::request::{FrameRange, SinkSettings};
 use super::sink::{FrameSink, SinkPlan};
 use super::{OutputError, OutputKind};
-use crate::render::Renderer;
-use crate::script::LoadedScene;
+use crate::render::{RenderError, Renderer};
+use crate::script::{LoadedScene, SceneError};
 
 /// What a render reports as it goes. Both methods do nothing by default; `()` is the
 /// silent reporter.
@@ -82,7 +82,7 @@ pub fn render_scene(
     let cancel = options.cancel.clone().unwrap_or_default();
     let sink = plan.open(renderer, range, jobs, cancel.clone())?;
     render_frames(renderer, sink, range, &cancel, progress).map_err(|error| match error {
-        OutputError::Render(e) => loaded.error_at_patch(e.patch_name(), e.to_string()).into(),
+        OutputError::Render(e) => render_error_at_call(loaded, &e).into(),
         other => other,
     })
 }
@@ -137,4 +137,13 @@ pub fn render_frames(
         frames: range.len(),
         compute_ms,
     })
+}
+
+/// A renderer's error as a [`SceneError`] positioned at the scene call it is about: the
+/// call that made its patch, or `canvas(...)` for the background's footage.
+pub fn render_error_at_call(loaded: &LoadedScene, error: &RenderError) -> SceneError {
+    if error.is_about_background() {
+        return loaded.error_at_canvas(error.to_string());
+    }
+    loaded.error_at_patch(error.patch_name(), error.to_string())
 }

@@ -77,6 +77,11 @@ impl RenderError {
         }
     }
 
+    /// Whether it is about the background (its footage), so positioned at `canvas(...)`.
+    pub fn is_about_background(&self) -> bool {
+        matches!(self, RenderError::Footage { patch: None, .. })
+    }
+
     /// A footage error of `patch`'s animated source (`None`: of the background footage).
     pub(crate) fn footage(patch: Option<&str>, error: crate::pixels::FootageError) -> Self {
         RenderError::Footage {

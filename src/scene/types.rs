@@ -326,13 +326,14 @@ impl Patch {
         }
         if let Some(d) = self.density {
             if !(d.is_finite() && d > 0.0) {
+                let d = crate::util::number_text(d);
                 return Err(fail(format!("density {d} must be finite and > 0")));
             }
         }
         if !crate::limits::feather_in_range(self.feather) {
             return Err(fail(format!(
-                "feather {:?} must lie in [0, {}]",
-                self.feather,
+                "feather {} must lie in [0, {}]",
+                crate::util::number_text(self.feather),
                 crate::limits::MAX_FEATHER
             )));
         }

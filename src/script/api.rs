@@ -273,7 +273,7 @@ fn parse_patch(base_dir: &Path, name: &Dynamic, options: &Map) -> Result<Patch, 
             .ok_or_else(|| format!("unknown mode `{text}` (expected normal or monochrome)"))?;
     }
     if let Some(v) = options.get("feather") {
-        patch.feather = values::non_negative(v, "feather")?;
+        patch.feather = values::feather(v)?;
     }
     if let Some(v) = options.get("boundary_sampling") {
         patch.boundary_data = values::string(v, "boundary_sampling")?.parse()?;

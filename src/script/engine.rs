@@ -85,6 +85,11 @@ impl LoadedScene {
         self.error_at(index.and_then(|i| self.origins.patches.get(i)), message)
     }
 
+    /// A validation error at the `canvas(...)` call (about the background, the size).
+    pub fn error_at_canvas(&self, message: impl Into<String>) -> SceneError {
+        self.error_at(self.origins.canvas.as_ref(), message)
+    }
+
     /// A validation error at `origin`: the scene file itself when there is none, or when the
     /// origin names the scene's folder (a call without a source).
     pub(super) fn error_at(&self, origin: Option<&Origin>, message: impl Into<String>) -> SceneError {

@@ -47,6 +47,12 @@ pub fn non_negative(value: &Dynamic, what: &str) -> Result<f64, String> {
     number_where(value, what, |v| v >= 0.0, "≥ 0")
 }
 
+/// A feather width: within [0, `limits::MAX_FEATHER`], checked at the call that gives it.
+pub fn feather(value: &Dynamic) -> Result<f64, String> {
+    let rule = format!("in [0, {}]", crate::limits::MAX_FEATHER);
+    number_where(value, "feather", crate::limits::feather_in_range, &rule)
+}
+
 /// A number in [0, 1] (opacity).
 pub fn unit(value: &Dynamic, what: &str) -> Result<f64, String> {
     number_where(value, what, |v| (0.0..=1.0).contains(&v), "in [0, 1]")

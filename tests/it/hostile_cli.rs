@@ -678,7 +678,8 @@ fn messages_say_what_is_wrong() {
         )
         .unwrap();
     }
-    // A scene longer than its footage: the first frame past the plates is named, on loading.
+    // A scene longer than its footage: the first frame past the plates is named, on loading,
+    // at the `canvas(...)` call that named the footage.
     let plates = world.write(
         "plates.rhai",
         "canvas(#{ fps: 3, duration: 200, background: \"plates/plate_%04d.png\" });\n",
@@ -687,12 +688,12 @@ fn messages_say_what_is_wrong() {
     expect(
         &world.run(&["preview", plates, "--t", "1", "-o", "p.png"]),
         1,
-        "frame 4 needs",
+        "plates.rhai:1:1: background footage: frame 4 needs",
     );
     expect(
         &world.run(&["preview", plates, "--t", "1e300", "-o", "p.png"]),
         1,
-        "frame 4 needs",
+        "plates.rhai:1:1: background footage: frame 4 needs",
     );
     // A mask whose only piece is too small: the mask is named, no setting the command lacks.
     image::GrayImage::from_fn(W, H, |x, y| {
