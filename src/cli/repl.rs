@@ -60,11 +60,18 @@ pub struct EntriesFailed(pub usize);
 pub fn run(args: ReplArgs) -> anyhow::Result<()> {
     let interactive = args.script.is_none() && std::io::stdin().is_terminal();
     // The default preview's folder is this process's own: removed when the session ends.
-    let (preview_path, _cleanup) = match &args.preview {
+    let (preview_path, preview_folder) = match &args.preview {
         Some(path) => (path.clone(), None),
         None => default_preview_path().map(|(path, folder)| (path, Some(folder)))?,
     };
     lapclone::output::check_output_folder(&preview_path)?;
+    // SIGTERM and SIGHUP end the session without the guard's drop: the folder goes here.
+    let folder = preview_folder.as_ref().map(|f| f.path().to_path_buf());
+    super::signals::stop_on_terminate(move || {
+        if let Some(folder) = &folder {
+            let _ = std::fs::remove_dir_all(folder);
+        }
+    });
     let cancel = Arc::new(AtomicBool::new(false));
     let words = Arc::new(Mutex::new(completion::Words::default()));
     let preview = Preview::new(

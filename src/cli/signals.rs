@@ -2,7 +2,8 @@
 //! a container stopping, a closed terminal) and gives either a cancel flag that a command's
 //! own loop checks (`render`: its outputs removed, "interrupted", exit 1), or, for a command
 //! without such a loop, its temporary outputs removed and exit 1 at once. A second signal
-//! always ends the program at once, its temporary outputs removed.
+//! always ends the program at once, its temporary outputs removed. The REPL, which keeps
+//! Ctrl-C for itself, ends on the other two after removing its private preview folder.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -22,6 +23,29 @@ pub(crate) fn cancel_flag() -> Arc<AtomicBool> {
 /// Any stop signal ends the program at once, its temporary outputs removed.
 pub(crate) fn stop_on_signals() {
     on_signals(stop_now);
+}
+
+/// SIGTERM and SIGHUP end the program at once, after `cleanup` and with its temporary
+/// outputs removed; SIGINT is left to the caller (the REPL, whose line editor and cancel
+/// flag own it).
+pub(crate) fn stop_on_terminate(cleanup: impl Fn() + Send + 'static) {
+    #[cfg(unix)]
+    {
+        use signal_hook::consts::{SIGHUP, SIGTERM};
+        let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGTERM, SIGHUP]) else {
+            return;
+        };
+        let _ = std::thread::Builder::new()
+            .name("signals".into())
+            .spawn(move || {
+                if signals.forever().next().is_some() {
+                    cleanup();
+                    stop_now();
+                }
+            });
+    }
+    #[cfg(not(unix))]
+    drop(cleanup);
 }
 
 fn stop_now() {

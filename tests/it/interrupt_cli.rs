@@ -304,3 +304,38 @@ fn sigint_while_ffmpeg_finishes_the_video_stops_it_and_leaves_no_file() {
     let pid = std::fs::read_to_string(&flushing).unwrap();
     interrupt_video(child, dir.path(), pid.trim().parse().unwrap());
 }
+
+/// SIGTERM and SIGHUP end a REPL session (exit 1, "interrupted") and take its private
+/// preview folder with it, as `:quit` does; Ctrl-C stays the session's own.
+#[test]
+fn sigterm_and_sighup_end_a_repl_and_remove_its_preview_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write_scene(dir.path());
+    let temp = dir.path().join("temp");
+    for name in ["-TERM", "-HUP"] {
+        std::fs::create_dir(&temp).unwrap();
+        let mut child = Command::new(env!("CARGO_BIN_EXE_lapclone"))
+            .arg("repl")
+            .arg(&scene)
+            .env("TMPDIR", &temp)
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        // The first preview is drawn once the session (and its signal handler) is up.
+        let drawn = wait_until(&mut child, || {
+            sorted_names(&temp)
+                .iter()
+                .any(|folder| temp.join(folder).join("preview.png").exists())
+        });
+        assert!(drawn, "{name}: the session ended before its first preview");
+        stop(child, name, &format!("repl {name}"));
+        assert_eq!(
+            sorted_names(&temp),
+            Vec::<String>::new(),
+            "{name}: left in the temp folder"
+        );
+        std::fs::remove_dir(&temp).unwrap();
+    }
+}
