@@ -70,6 +70,10 @@ pub fn run(args: TestArgs) -> anyhow::Result<()> {
         );
     }
     check_golden_dirs(&scenes, args.goldens.as_deref())?;
+    let roots = scenes
+        .iter()
+        .map(|scene| super::test_args::goldens_root(scene, args.goldens.as_deref()));
+    super::test_args::check_out_beside_goldens(&args, roots)?;
     check_all(&args, &scenes, jobs.min(scenes.len()))
 }
 

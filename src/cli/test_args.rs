@@ -231,6 +231,56 @@ pub fn check_golden_dirs(scenes: &[PathBuf], root: Option<&Path>) -> anyhow::Res
     Ok(())
 }
 
+/// A usage error when the report folder (`--out`, else [`DEFAULT_OUT`]) is, or lies inside,
+/// one of the `goldens` folders: its pictures would mix with the goldens (and be committed
+/// with them).
+pub fn check_out_beside_goldens(
+    args: &TestArgs,
+    goldens: impl IntoIterator<Item = PathBuf>,
+) -> Result<(), UsageError> {
+    let out = args.out_dir();
+    let inside = absolute(&out);
+    for folder in goldens {
+        if inside.starts_with(absolute(&folder)) {
+            let named = match args.out {
+                Some(_) => format!("--out {}", out.display()),
+                None => format!(
+                    "the report folder {} (name another with --out)",
+                    out.display()
+                ),
+            };
+            return Err(UsageError(format!(
+                "{named}: it lies in the goldens folder {}; the report's pictures would mix with the goldens",
+                folder.display()
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// The folder holding `scene`'s goldens folder (`<scene's folder>/goldens`, or `root`).
+pub fn goldens_root(scene: &Path, root: Option<&Path>) -> PathBuf {
+    let dir = golden_dir(scene, root);
+    dir.parent().unwrap_or(Path::new("")).to_path_buf()
+}
+
+/// `path` with links resolved as far as it exists, the rest joined on (for comparing
+/// folders that may not exist yet).
+fn absolute(path: &Path) -> PathBuf {
+    let path = if path.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        path
+    };
+    if let Ok(real) = path.canonicalize() {
+        return real;
+    }
+    match (path.parent(), path.file_name()) {
+        (Some(parent), Some(name)) => absolute(parent).join(name),
+        _ => path.to_path_buf(),
+    }
+}
+
 /// What happened to one frame.
 #[derive(Debug)]
 pub enum Outcome {

@@ -27,6 +27,11 @@ fn act(args: &TestArgs, paths: &[PathBuf]) -> anyhow::Result<()> {
         return Ok(());
     }
     if args.review {
+        // A pending frame lies in `<goldens>/<scene>/`.
+        let roots = pending
+            .iter()
+            .filter_map(|f| Some(f.parent()?.parent()?.to_path_buf()));
+        super::test_args::check_out_beside_goldens(args, roots)?;
         return review(args, &pending);
     }
     // A file that cannot be taken is reported and the others are still taken.

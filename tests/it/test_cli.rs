@@ -272,6 +272,15 @@ fn review_accepts_rejects_and_skips_from_its_input() {
         stdout(&ci)
     );
     assert_eq!(fixture.files(), before, "nothing written under CI");
+    // Its pictures may not go into the goldens either.
+    let inside = fixture.run(&["--review", "--out", "goldens/tiny/pictures"]);
+    assert_eq!(code(&inside), 2, "{}", stderr(&inside));
+    assert!(
+        stderr(&inside).contains("it lies in the goldens folder goldens"),
+        "{}",
+        stderr(&inside)
+    );
+    assert_eq!(fixture.files(), before, "nothing written into the goldens");
     let output = review(&fixture, b"a\nr\ns\n", &[]);
     assert_eq!(code(&output), 0);
     let text = stdout(&output);
@@ -365,6 +374,18 @@ fn bad_inputs_give_clear_messages_and_exit_codes() {
             stderr(&out)
         );
     }
+    // A report folder in the goldens would mix its pictures with them (and be committed).
+    for out in ["goldens", "goldens/report", "goldens/tiny"] {
+        let run = fixture.run(&["--out", out]);
+        assert_eq!(code(&run), 2, "{}", stderr(&run));
+        assert!(
+            stderr(&run).contains(&format!("--out {out}: it lies in the goldens folder")),
+            "{}",
+            stderr(&run)
+        );
+        assert_eq!(stdout(&run), "", "nothing ran");
+    }
+    assert!(!fixture.root.join("goldens/index.html").exists());
     // A --junit that cannot be written (a folder, a link to nothing) is a usage error before
     // anything runs: no frame is compared, no line printed.
     std::fs::create_dir(fixture.root.join("reports")).unwrap();
