@@ -330,7 +330,10 @@ fn sigterm_and_sighup_end_a_repl_and_remove_its_preview_folder() {
                 .any(|folder| temp.join(folder).join("preview.png").exists())
         });
         assert!(drawn, "{name}: the session ended before its first preview");
+        // Its input stays open: only the signal may end the session.
+        let input = child.stdin.take();
         stop(child, name, &format!("repl {name}"));
+        drop(input);
         assert_eq!(
             sorted_names(&temp),
             Vec::<String>::new(),

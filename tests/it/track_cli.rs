@@ -189,7 +189,7 @@ fn bad_points_and_ranges_are_usage_errors_that_write_nothing() {
         )
         .unwrap();
     }
-    let cases: [(&[&str], &str); 5] = [
+    let cases: [(&[&str], &str); 6] = [
         // A negative coordinate is a value, not a flag: the point is refused for where it is.
         (&["--point", "-5,10"], "outside the first frame"),
         (&["--point", "nan,3"], "not a finite number"),
@@ -198,7 +198,8 @@ fn bad_points_and_ranges_are_usage_errors_that_write_nothing() {
             "must have 1 ≤ A ≤ B",
         ),
         (&["--point", "100,100", "--size", "0"], "between 5 and 255"),
-        (&["--point", "1e12,5"], "outside the first frame"),
+        (&["--point", "1e8,5"], "outside the first frame"),
+        (&["--point", "1e12,5"], "1e12 is past ±1e9 px"),
     ];
     for (args, message) in cases {
         let mut command = Command::new(env!("CARGO_BIN_EXE_lapclone"));
