@@ -816,7 +816,16 @@ fn a_connection_past_the_limit_is_told_why_and_a_closed_page_frees_its_place() {
         Some(get_page(&repl)).filter(|a| a.starts_with("HTTP/1.1 200"))
     });
     assert!(served.is_some(), "no place freed");
-    let mut last = repl.page();
+    // The GET's own connection holds the place until its thread sees it closed.
+    let origin = format!("http://{}", repl.host());
+    let last = (0..100).find_map(|_| {
+        let page = repl.connect(&repl.socket_url(), Some(&origin)).ok();
+        page.or_else(|| {
+            std::thread::sleep(Duration::from_millis(50));
+            None
+        })
+    });
+    let mut last = last.expect("the freed place serves a page");
     last.send(&json!({"type": "seek", "t": 0.5}));
     last.until(|v| v["type"] == "scene" && v["t"] == 0.5);
     drop((pages, last));
