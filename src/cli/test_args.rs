@@ -231,7 +231,7 @@ pub fn check_golden_dirs(scenes: &[PathBuf], root: Option<&Path>) -> anyhow::Res
     Ok(())
 }
 
-/// A usage error when the report folder (`--out`, else [`DEFAULT_OUT`]) is, or lies inside,
+/// A usage error when the report folder (`--out`, else `lapclone-test-out`) is, or lies inside,
 /// one of the `goldens` folders: its pictures would mix with the goldens (and be committed
 /// with them).
 pub fn check_out_beside_goldens(
