@@ -125,8 +125,6 @@ pub fn mesh_from_polygons(
     })
 }
 
-/// Corners of the bounding box of the inside pixels; a zero box at the origin when empty
-/// (meshing reports the empty mask before this matters).
 /// How far past a patch may reach beyond its source's edge unremarked, px: a polygon drawn
 /// along the image's border may sit on pixel centres or edges.
 pub const PAST_EDGE_TOLERANCE: f64 = 1.0;
@@ -143,6 +141,8 @@ pub fn reach_past(min: DVec2, max: DVec2, (width, height): (u32, u32)) -> Option
     (past > 0.0).then_some(past)
 }
 
+/// Corners of the bounding box of the inside pixels; `None` for an empty mask (meshing
+/// reports it).
 fn inside_bbox(mask: &BitMask) -> Option<(DVec2, DVec2)> {
     let ((x0, y0), (x1, y1)) = mask.inside_bounds()?;
     Some((

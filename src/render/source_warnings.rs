@@ -4,8 +4,8 @@
 //! polygon patch reaches past its source's edge (the pixels there repeat the edge).
 
 use super::layer::polygons_outside;
-use crate::clone::PAST_EDGE_TOLERANCE;
 use super::Renderer;
+use crate::clone::PAST_EDGE_TOLERANCE;
 use crate::scene::{Background, Shape};
 
 impl Renderer {
