@@ -67,7 +67,13 @@ pub fn run(args: ReplArgs) -> anyhow::Result<()> {
     lapclone::output::check_output_folder(&preview_path)?;
     // SIGTERM and SIGHUP end the session without the guard's drop: the folder goes here.
     let folder = preview_folder.as_ref().map(|f| f.path().to_path_buf());
+    let terminal = interactive
+        .then(super::signals::SavedTerminal::capture)
+        .flatten();
     super::signals::stop_on_terminate(move || {
+        if let Some(terminal) = &terminal {
+            terminal.restore();
+        }
         if let Some(folder) = &folder {
             let _ = std::fs::remove_dir_all(folder);
         }

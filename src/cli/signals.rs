@@ -3,7 +3,8 @@
 //! own loop checks (`render`: its outputs removed, "interrupted", exit 1), or, for a command
 //! without such a loop, its temporary outputs removed and exit 1 at once. A second signal
 //! always ends the program at once, its temporary outputs removed. The REPL, which keeps
-//! Ctrl-C for itself, ends on the other two after removing its private preview folder.
+//! Ctrl-C for itself, ends on the other two after removing its private preview folder and
+//! giving the terminal back its settings.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -46,6 +47,43 @@ pub(crate) fn stop_on_terminate(cleanup: impl Fn() + Send + 'static) {
     }
     #[cfg(not(unix))]
     drop(cleanup);
+}
+
+/// The terminal's settings as the REPL found them. A signal that ends the session while the
+/// line editor holds the terminal raw puts them back, so the shell it returns to echoes and
+/// takes lines again.
+pub(crate) struct SavedTerminal {
+    #[cfg(unix)]
+    settings: rustix::termios::Termios,
+}
+
+impl SavedTerminal {
+    /// Standard input's settings, when it is a terminal.
+    pub fn capture() -> Option<Self> {
+        #[cfg(unix)]
+        {
+            let settings = rustix::termios::tcgetattr(std::io::stdin()).ok()?;
+            Some(Self { settings })
+        }
+        #[cfg(not(unix))]
+        None
+    }
+
+    /// Puts the settings back, turns off the bracketed paste the line editor turned on, and
+    /// ends the prompt's line.
+    pub fn restore(&self) {
+        #[cfg(unix)]
+        {
+            use rustix::termios::{tcsetattr, OptionalActions};
+            use std::io::{IsTerminal, Write};
+            let _ = tcsetattr(std::io::stdin(), OptionalActions::Now, &self.settings);
+            let mut out = std::io::stdout();
+            if out.is_terminal() {
+                let _ = out.write_all(b"\x1b[?2004l\r\n");
+                let _ = out.flush();
+            }
+        }
+    }
 }
 
 fn stop_now() {

@@ -17,6 +17,8 @@ mod golden;
 mod matrix_market;
 #[path = "../common/mesh_fixtures.rs"]
 mod mesh_fixtures;
+#[path = "../common/processes.rs"]
+mod processes;
 #[path = "../common/raster_meshes.rs"]
 mod raster_meshes;
 #[path = "../common/synth_masks.rs"]

@@ -109,3 +109,41 @@ fn ctrl_c_cancels_a_running_render_and_keeps_the_session() {
     p.send_control('d').unwrap();
     p.exp_eof().unwrap();
 }
+
+/// SIGTERM at the prompt ends the session (exit 1, "interrupted") and gives the terminal
+/// back as the session found it: the line editor's raw mode and bracketed paste are undone,
+/// so the shell's `stty -g` reads the same before and after.
+#[test]
+fn sigterm_at_the_prompt_gives_the_terminal_back() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut command = Command::new("sh");
+    command
+        .arg("-c")
+        .arg("echo \"shell $$\"; stty -g; echo =; \"$0\" repl --preview \"$1\" --history \"$2\"; echo \"exit $?\"; stty -g; echo =")
+        .arg(env!("CARGO_BIN_EXE_lapclone"))
+        .arg(dir.path().join("preview.png"))
+        .arg(dir.path().join("history.txt"))
+        .env("TERM", "xterm")
+        .env("LAPCLONE_INLINE", "off");
+    let mut p = spawn_command(command, Some(20_000)).unwrap();
+    p.exp_string("shell ").unwrap();
+    let shell: u32 = p.read_line().unwrap().trim().parse().unwrap();
+    let before = p.exp_string("=").unwrap();
+    p.exp_string("lapclone> ").unwrap();
+    let repl = crate::processes::children_named(shell, "lapclone");
+    assert_eq!(repl.len(), 1, "the session under the shell: {repl:?}");
+    let status = Command::new("kill")
+        .args(["-TERM", &repl[0].to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let ended = p.exp_string("exit 1").unwrap();
+    assert!(ended.contains("interrupted"), "{ended:?}");
+    assert!(
+        ended.contains("\x1b[?2004l"),
+        "bracketed paste left on: {ended:?}"
+    );
+    let after = p.exp_string("=").unwrap();
+    assert_eq!(after.trim(), before.trim(), "the terminal's settings");
+    p.exp_eof().unwrap();
+}
