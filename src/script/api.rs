@@ -28,12 +28,9 @@ fn renamed(ctx: &NativeCallContext, draft: &SharedDraft, options: &Map) -> Falli
     for old in old {
         // invariant: rename_keys gives only names from RENAMED_KEYS.
         let new = values::RENAMED_KEYS.iter().find(|(o, _)| *o == old).expect("renamed").1;
-        let (line, column) = (at.position.line(), at.position.position());
         d.origins.warnings.push(format!(
-            "{}:{}:{}: `{old}` is now `{new}` (the old name still works)",
-            at.file.display(),
-            line.unwrap_or(0),
-            column.unwrap_or(0)
+            "{}: `{old}` is now `{new}` (the old name still works)",
+            super::error::location(&at.file, at.position)
         ));
     }
     Ok(options)

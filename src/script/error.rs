@@ -77,19 +77,19 @@ impl SceneError {
         error
     }
 
-    /// The 1-based line, if known.
+    /// The 1-based line, if known (not past line 65,534, as far as Rhai counts).
     pub fn line(&self) -> Option<usize> {
-        self.position.line()
+        line_and_column(self.position).0
     }
 
-    /// The 1-based column, if known.
+    /// The 1-based column, if known (not past column 65,534, as far as Rhai counts).
     pub fn column(&self) -> Option<usize> {
-        self.position.position()
+        line_and_column(self.position).1
     }
 
     /// Fills `source_line` from `text` (the file's contents) or, failing that, from disk.
     pub fn load_source_line(&mut self, text: Option<&str>) {
-        let Some(line) = self.position.line() else {
+        let Some(line) = self.line() else {
             return;
         };
         let from_disk;
@@ -149,9 +149,8 @@ impl SceneError {
         let mut error = error;
         let position = error.take_position();
         let (kind, mut message) = classify(&error);
-        let call = scene_call.filter(|_| current_file != file);
-        if let Some((line, column)) = call.and_then(|c| Some((c.line()?, c.position()?))) {
-            message = format!("{message} (called at {}:{line}:{column})", file.display());
+        if let Some(call) = scene_call.filter(|_| current_file != file) {
+            message = format!("{message} (called at {})", location(file, call));
         }
         let text = (current_file == file).then_some(text);
         Self::with_text(kind, &current_file, position, message, text)
@@ -192,16 +191,40 @@ fn classify(error: &EvalAltResult) -> (ErrorKind, String) {
     }
 }
 
+/// Rhai counts lines and columns in 16 bits and stops at 65,535, so a position there may lie
+/// anywhere past it: it is never shown as if it were exact.
+const POSITION_CEILING: usize = u16::MAX as usize;
+
+/// `position`'s 1-based line and column, each `None` when unknown or past what Rhai counts.
+fn line_and_column(position: Position) -> (Option<usize>, Option<usize>) {
+    let line = position.line().filter(|&l| l < POSITION_CEILING);
+    let column = line
+        .and(position.position())
+        .filter(|&c| c < POSITION_CEILING);
+    (line, column)
+}
+
+/// Where `position` is in `file`, as messages print it: `file:line:col`, `file:line` or
+/// `file`, with a word when the line or column lies past what Rhai counts.
+pub(crate) fn location(file: &Path, position: Position) -> String {
+    let file = file.display();
+    let past = |what| format!("{what} {POSITION_CEILING} or later");
+    match (line_and_column(position), position.line(), position.position()) {
+        ((Some(line), Some(col)), ..) => format!("{file}:{line}:{col}"),
+        ((Some(line), None), _, Some(_)) => format!("{file}:{line}: {}", past("column")),
+        ((Some(line), None), ..) => format!("{file}:{line}"),
+        ((None, _), Some(_), _) => format!("{file}: {}", past("line")),
+        _ => format!("{file}"),
+    }
+}
+
 impl fmt::Display for SceneError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let file = self.file.display();
-        match (self.position.line(), self.position.position()) {
-            (Some(line), Some(col)) => write!(f, "{file}:{line}:{col}: {}", self.message)?,
-            (Some(line), None) => write!(f, "{file}:{line}: {}", self.message)?,
-            _ => return write!(f, "{file}: {}", self.message),
-        }
-        if let Some(source) = &self.source_line {
-            let (shown, col) = excerpt(source, self.position.position());
+        write!(f, "{}: {}", location(&self.file, self.position), self.message)?;
+        // A column past what Rhai counts says nothing of where in a long line to look.
+        let column_lost = self.column().is_none() && self.position.position().is_some();
+        if let Some(source) = self.source_line.as_ref().filter(|_| !column_lost) {
+            let (shown, col) = excerpt(source, self.column());
             write!(f, "\n{shown}")?;
             if let Some(col) = col {
                 write!(f, "\n{}^", caret_indent(&shown, col))?;
@@ -258,6 +281,26 @@ mod tests {
         );
         e.load_source_line(Some("first\n\tab(cd);\n"));
         assert_eq!(e.to_string(), "s.rhai:2:5: bad\n\tab(cd);\n\t   ^");
+    }
+
+    /// Rhai stops counting lines and columns at 65,535: a position there is said to be at or
+    /// past it, never given as exact, and no caret points into a line it cannot place.
+    #[test]
+    fn positions_past_what_rhai_counts_are_not_shown_as_exact() {
+        let text = "canvas(1, 1);\nbad();\n";
+        let cases = [
+            (Position::new(2, 1), "s.rhai:2:1: bad\nbad();\n^", Some(2), Some(1)),
+            (Position::new(65_534, 7), "s.rhai:65534:7: bad", Some(65_534), Some(7)),
+            (Position::new(65_535, 7), "s.rhai: line 65535 or later: bad", None, None),
+            (Position::new(2, 65_535), "s.rhai:2: column 65535 or later: bad", Some(2), None),
+            (Position::NONE, "s.rhai: bad", None, None),
+        ];
+        for (position, shown, line, column) in cases {
+            let mut e = SceneError::new(ErrorKind::Runtime, Path::new("s.rhai"), position, "bad");
+            e.load_source_line(Some(text));
+            assert_eq!(e.to_string(), shown, "{position:?}");
+            assert_eq!((e.line(), e.column()), (line, column), "{position:?}");
+        }
     }
 
     /// A line of megabytes is shown as the characters around the column, and the caret
