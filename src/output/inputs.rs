@@ -20,16 +20,17 @@ enum Input {
 }
 
 impl Input {
-    /// Whether `path` (an existing file) is this input or one of its files.
+    /// Whether writing `path` would replace this input or one of its files: for a sequence,
+    /// also a plate it names that does not exist yet, and the plate a link leads to (an
+    /// output is written through a link to its target).
     fn covers(&self, path: &Path) -> bool {
         match self {
             Input::File(file) => same_file(file, path),
             Input::Sequence(pattern) => {
-                let Some(name) = path.file_name() else {
-                    return false;
-                };
-                pattern.number_of(&name.to_string_lossy()).is_some()
-                    && same_file(folder_of(&pattern.path(0)), folder_of(path))
+                let target = path.canonicalize().ok();
+                std::iter::once(path)
+                    .chain(target.as_deref())
+                    .any(|p| names_plate(pattern, p))
             }
         }
     }
@@ -40,6 +41,15 @@ impl Input {
             Input::Sequence(pattern) => pattern.text().to_string(),
         }
     }
+}
+
+/// Whether `path` is a plate of `pattern`: a name it numbers, in its folder.
+fn names_plate(pattern: &Pattern, path: &Path) -> bool {
+    let Some(name) = path.file_name() else {
+        return false;
+    };
+    pattern.number_of(&name.to_string_lossy()).is_some()
+        && same_file(folder_of(&pattern.path(0)), folder_of(path))
 }
 
 /// What `footage` reads: its video, or every plate its pattern names.
@@ -112,7 +122,7 @@ pub fn refuse_scene_input(
     loaded: &LoadedScene,
     imports: &[PathBuf],
 ) -> Result<(), OutputError> {
-    if output.as_os_str() == "-" || !output.exists() {
+    if output.as_os_str() == "-" {
         return Ok(());
     }
     refuse_replacing(&[output.to_path_buf()], loaded, imports)
@@ -140,9 +150,6 @@ pub fn refuse_scene_reads(
     loaded: &LoadedScene,
     imports: &[PathBuf],
 ) -> Result<(), OutputError> {
-    if !output.exists() {
-        return Ok(());
-    }
     match script_reads(loaded, imports).iter().find(|i| i.covers(output)) {
         Some(input) => Err(overwrite(output, &input.describe())),
         None => Ok(()),
@@ -152,7 +159,7 @@ pub fn refuse_scene_reads(
 /// Refuses an output that is `footage`'s video or any plate its pattern names.
 pub fn refuse_footage_input(output: &Path, footage: &Footage) -> Result<(), OutputError> {
     let input = footage_input(footage);
-    match output.exists() && input.covers(output) {
+    match input.covers(output) {
         true => Err(overwrite(output, &input.describe())),
         false => Ok(()),
     }

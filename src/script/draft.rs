@@ -24,8 +24,8 @@ pub struct Origins {
     pub patches: Vec<Origin>,
     /// `file:line:col: …` for each old spelling the script used.
     pub warnings: Vec<String>,
-    /// Track files read into plain values (`track_keys`): inputs of a render like the
-    /// files a patch follows, which the scene itself records.
+    /// Track files the script read (`follow`, `track_keys`): inputs of every render, also
+    /// when a later call replaced the keys one of them gave.
     pub read: Vec<PathBuf>,
 }
 

@@ -76,16 +76,22 @@ fn whole(value: &Dynamic, what: &str) -> Result<u64, String> {
     Ok(v as u64)
 }
 
-/// Reads `file` (against the scene's folder) into keys at the canvas's frame rate.
+/// Reads `file` (against the scene's folder) into keys at the canvas's frame rate, and notes
+/// it among the files the script read: an input of every render of the scene, even when a
+/// later `follow` replaces what it keyed.
 fn load_keys(
-    base_dir: &Path,
-    fps: Option<f64>,
+    draft: &SharedDraft,
     file: &str,
     options: &Map,
 ) -> Result<(std::path::PathBuf, FollowSettings, Vec<FollowKey>), String> {
+    let (base_dir, fps) = context(draft);
     let settings = settings(options)?;
     let fps = fps.ok_or("call canvas(...) before reading a track: its frames become times at the canvas's fps")?;
     let path = base_dir.join(file);
+    let read = &mut draft.lock().origins.read;
+    if !read.contains(&path) {
+        read.push(path.clone());
+    }
     let track = TrackFile::load(&path).map_err(|e| e.to_string())?;
     let keys = track.follow_keys(&settings, fps)?;
     Ok((path, settings, keys))
@@ -138,8 +144,7 @@ fn context(draft: &SharedDraft) -> (std::path::PathBuf, Option<f64>) {
 }
 
 fn follow_patch(ctx: &NativeCallContext, p: &mut PatchRef, file: &str, options: &Map) -> Fallible<PatchRef> {
-    let (base, fps) = context(&p.draft);
-    let (path, settings, keys) = load_keys(&base, fps, file, options).map_err(|m| fail(ctx, m))?;
+    let (path, settings, keys) = load_keys(&p.draft, file, options).map_err(|m| fail(ctx, m))?;
     let k = keyed(&keys).map_err(|m| fail(ctx, m))?;
     p.edit(ctx, |patch| {
         patch.placement.position = k.at.clone();
@@ -157,8 +162,7 @@ fn follow_patch(ctx: &NativeCallContext, p: &mut PatchRef, file: &str, options: 
 }
 
 fn follow_handle(ctx: &NativeCallContext, h: &mut HandleRef, file: &str, options: &Map) -> Fallible<HandleRef> {
-    let (base, fps) = context(&h.draft);
-    let (path, settings, keys) = load_keys(&base, fps, file, options).map_err(|m| fail(ctx, m))?;
+    let (path, settings, keys) = load_keys(&h.draft, file, options).map_err(|m| fail(ctx, m))?;
     if settings.scale == Some(true) {
         return Err(fail(ctx, "a handle has no scale to follow: leave out `scale: true`"));
     }
@@ -181,12 +185,7 @@ fn follow_handle(ctx: &NativeCallContext, h: &mut HandleRef, file: &str, options
 
 /// `[#{ t, at, rotate?, scale? }, …]` for `keys(...)`.
 fn track_keys(ctx: &NativeCallContext, draft: &SharedDraft, file: &str, options: &Map) -> Fallible<Array> {
-    let (base, fps) = context(draft);
-    let (path, _, keys) = load_keys(&base, fps, file, options).map_err(|m| fail(ctx, m))?;
-    let read = &mut draft.lock().origins.read;
-    if !read.contains(&path) {
-        read.push(path);
-    }
+    let (_, _, keys) = load_keys(draft, file, options).map_err(|m| fail(ctx, m))?;
     Ok(keys
         .iter()
         .map(|k| {

@@ -332,6 +332,12 @@ fn an_output_that_is_an_input_is_refused() {
     world.scene("follows.rhai", "p.follow(\"face.csv\");\n");
     world.write("keys.csv", "frame,x,y\n1,20,15\n2,21,15\n");
     world.scene("reads.rhai", "let keys = track_keys(\"keys.csv\");\n");
+    // A track file stays an input after a later `follow` replaces the keys it gave.
+    world.write("old.csv", "frame,x,y\n1,20,15\n2,21,15\n");
+    world.scene(
+        "refollows.rhai",
+        "p.follow(\"old.csv\");\np.follow(\"face.csv\");\n",
+    );
     #[cfg(unix)]
     {
         std::os::unix::fs::symlink(world.path("lib.rhai"), world.path("lib_link.gif")).unwrap();
@@ -373,6 +379,14 @@ fn an_output_that_is_an_input_is_refused() {
             "gif",
         ],
         vec!["render", "reads.rhai", "-o", "keys.csv", "--format", "apng"],
+        vec![
+            "render",
+            "refollows.rhai",
+            "-o",
+            "old.csv",
+            "--format",
+            "gif",
+        ],
     ];
     #[cfg(unix)]
     cases.extend([
@@ -426,10 +440,39 @@ fn an_output_that_is_an_input_is_refused() {
         "1..2",
         "-o",
     ];
-    for output in ["out/frame_0009.png", "out/frame_0002.png"] {
+    // Also a plate the pattern names that does not exist yet, and a plate reached through a
+    // link (an output is written through a link to its target).
+    let mut outputs = vec![
+        "out/frame_0009.png",
+        "out/frame_0002.png",
+        "out/frame_0031.png",
+    ];
+    #[cfg(unix)]
+    {
+        std::os::unix::fs::symlink("out/frame_0002.png", world.path("plate_link.csv")).unwrap();
+        outputs.push("plate_link.csv");
+        let args = [
+            plates.to_str().unwrap(),
+            "-o",
+            "plate_link.csv",
+            "--format",
+            "gif",
+        ];
+        expect(
+            &world.run(&[&["render"][..], &args].concat()),
+            1,
+            "would replace an input",
+        );
+    }
+    for output in outputs {
         let args: Vec<&str> = track.iter().copied().chain([output]).collect();
         expect(&world.run(&args), 1, "would replace an input");
     }
+    assert!(!world.path("out/frame_0031.png").exists());
+    assert_eq!(
+        std::fs::read(world.path("out/frame_0002.png")).unwrap(),
+        std::fs::read(world.path("bg.png")).unwrap()
+    );
     let args = [
         "preview",
         plates.to_str().unwrap(),
