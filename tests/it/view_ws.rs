@@ -369,6 +369,41 @@ fn no_preview_outlives_an_entry_that_shows_nothing() {
     assert!(repl.finish().success());
 }
 
+/// A page's line names a patch by a variable only while that variable, as entries see it,
+/// holds the patch: after `let cat = dog;` (the scope keeps the old `cat` behind the new one)
+/// or `let cat = 5;`, the line says `get_patch("cat")` and moves the cat, not the dog.
+#[test]
+fn a_page_line_never_names_a_patch_through_a_shadowed_variable() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = cat_scene(dir.path());
+    let mut text = std::fs::read_to_string(&scene).unwrap();
+    text.push_str(&format!(
+        "let dog = patch(\"dog\", #{{ source: \"{}\", mask: \"{}\" }});\ndog.at(0, [100, 100]);\n",
+        asset("chelsea.png"),
+        asset("masks/chelsea_face.png")
+    ));
+    std::fs::write(&scene, text).unwrap();
+    let mut repl = ViewRepl::start(dir.path(), &scene);
+    let mut page = repl.page();
+    let at = |page: &Page, i: usize| page.scene["patches"][i]["at"].clone();
+    for (shadow, x) in [("let cat = dog;", 40), ("let cat = 5;", 60)] {
+        repl.type_line(shadow);
+        // `:t` publishes the frame: the shadowing line has run before it.
+        repl.type_line(":t 0");
+        page.until_scene();
+        let dog = at(&page, 1);
+        let edit = json!({"op": "at", "patch": "cat", "value": [x, 50]});
+        page.send(&json!({"type": "edit", "rev": page.rev(), "commit": true, "edit": edit}));
+        let line = page.until(|v| v["type"] == "line");
+        let want = format!("get_patch(\"cat\").at(0, [{x}, 50]);");
+        assert_eq!(line["text"], want.as_str(), "after {shadow}");
+        // The entry's scene message came before its line.
+        assert_eq!(at(&page, 0), json!([x as f64, 50.0]), "after {shadow}");
+        assert_eq!(at(&page, 1), dog, "the dog moved after {shadow}");
+    }
+    assert!(repl.finish().success());
+}
+
 /// A gesture's keys go at the playhead it began at, even when another page seeks while it
 /// runs: its values were measured in that frame.
 #[test]

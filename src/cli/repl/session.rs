@@ -247,6 +247,19 @@ impl Session {
         Ok(scene)
     }
 
+    /// The variables entries see: the last binding of each name (a `let` shadows an earlier
+    /// one of the same name, which the scope still holds), in the order they were bound.
+    fn visible_variables(&self) -> Vec<(&str, &rhai::Dynamic)> {
+        // `iter_raw` walks the scope from the newest binding back.
+        let mut seen = std::collections::HashSet::new();
+        let mut visible: Vec<(&str, &rhai::Dynamic)> = (self.scope.iter_raw())
+            .filter(|(name, _, _)| seen.insert(*name))
+            .map(|(name, _, value)| (name, value))
+            .collect();
+        visible.reverse();
+        visible
+    }
+
     fn refresh_words(&self) {
         let mut functions = function_names(self.engine.engine());
         functions.extend(self.functions.iter_functions().map(|f| f.name.to_string()));
@@ -261,9 +274,9 @@ impl Session {
                 .map(|p| p.name.clone())
                 .collect(),
             variables: self
-                .scope
-                .iter_raw()
-                .map(|(name, _, _)| name.to_string())
+                .visible_variables()
+                .into_iter()
+                .map(|(name, _)| name.to_string())
                 .collect(),
             functions,
         };

@@ -61,7 +61,8 @@ impl Session {
             out.push_str(&patch_lines(patch));
         }
         out.push_str(&layer_order(&draft, self.time));
-        let names: Vec<&str> = self.scope.iter_raw().map(|(name, _, _)| name).collect();
+        let variables = self.visible_variables();
+        let names: Vec<&str> = variables.iter().map(|(name, _)| *name).collect();
         if !names.is_empty() {
             out.push_str(&format!("variables: {}\n", names.join(", ")));
         }

@@ -102,11 +102,11 @@ impl Session {
         result.map_err(|e| crate::cli::describe(&e))
     }
 
-    /// How a line names patch `name`: a variable holding it (one spelled like the patch
-    /// first), else `get_patch("name")`.
+    /// How a line names patch `name`: a variable entries see holding it (one spelled like
+    /// the patch first), else `get_patch("name")`.
     fn receiver(&self, name: &str) -> String {
         let mut holders: Vec<String> = Vec::new();
-        for (var, _, value) in self.scope.iter_raw() {
+        for (var, value) in self.visible_variables() {
             if value.type_name().ends_with("PatchRef") || value.type_name() == "Patch" {
                 let mut scope = Scope::new();
                 scope.push(var, value.clone());
