@@ -369,6 +369,27 @@ fn no_preview_outlives_an_entry_that_shows_nothing() {
     assert!(repl.finish().success());
 }
 
+/// A page closed mid-gesture takes its preview with it, as Escape would: the other pages
+/// go back to the committed scene.
+#[test]
+fn a_page_closed_mid_gesture_leaves_no_preview_behind() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = cat_scene(dir.path());
+    let repl = ViewRepl::start(dir.path(), &scene);
+    let mut gone = repl.page();
+    let mut other = repl.page();
+    let (before, [x, y]) = (other.frame.clone(), other.cat_at());
+    let edit = json!({"op": "at", "patch": "cat", "value": [x + 40.0, y]});
+    gone.send(&json!({"type": "edit", "rev": gone.rev(), "commit": false, "edit": edit}));
+    other.until_scene();
+    assert!(other.frame != before, "the preview changed nothing");
+    drop(gone);
+    other.until_scene();
+    assert!(other.frame == before, "the closed page's preview stayed");
+    assert_eq!(other.cat_at(), [x, y]);
+    assert!(repl.finish().success());
+}
+
 /// A page's line names a patch by a variable only while that variable, as entries see it,
 /// holds the patch: after `let cat = dog;` (the scope keeps the old `cat` behind the new one)
 /// or `let cat = 5;`, the line says `get_patch("cat")` and moves the cat, not the dog.

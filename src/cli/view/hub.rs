@@ -71,6 +71,8 @@ struct State {
     /// The last published frame.
     frame: Option<Published>,
     scene: Option<(Utf8Bytes, Option<Utf8Bytes>)>,
+    /// The page whose preview edit came last: its gesture is the one on every page.
+    previewer: Option<u64>,
 }
 
 /// The last published frame: its size, RGBA8 bytes and where it may differ from its
@@ -106,8 +108,21 @@ impl Hub {
         id
     }
 
-    pub fn disconnect(&self, id: u64) {
-        lock(&self.state).clients.retain(|c| c.id != id);
+    /// Forgets page `id`; true when its gesture was the last previewed, which then ends
+    /// with it (a closed page leaves no preview behind on the others).
+    pub fn disconnect(&self, id: u64) -> bool {
+        let mut state = lock(&self.state);
+        state.clients.retain(|c| c.id != id);
+        let previewed = state.previewer == Some(id);
+        if previewed {
+            state.previewer = None;
+        }
+        previewed
+    }
+
+    /// Page `id` has just previewed a gesture.
+    pub fn set_previewer(&self, id: u64) {
+        lock(&self.state).previewer = Some(id);
     }
 
     /// For page `id` once it has read its queue: if updates were dropped for it, queues the

@@ -183,7 +183,11 @@ fn page_loop(mut socket: WebSocket<TcpStream>, session: &Mutex<dyn LiveSession>,
         }
         hub.catch_up(id);
     }
-    hub.disconnect(id);
+    // A gesture never finished (the page closed mid-drag) is cancelled as Escape would be;
+    // without a preview in progress the cancel changes nothing.
+    if hub.disconnect(id) {
+        let _ = lock(session).view_cancel();
+    }
 }
 
 /// Sends what is queued for this page; false once the page is gone.
@@ -214,6 +218,7 @@ fn handle(
         Ok(request) => request,
         Err(message) => return reply(error_message(&message)),
     };
+    let previews = matches!(request, Request::Edit { commit: false, .. });
     let mut session = lock(session);
     let result = match request {
         Request::Seek { t } => session.view_seek(t),
@@ -235,7 +240,9 @@ fn handle(
             session.view_publish()
         }
     };
-    if let Err(message) = result {
-        reply(error_message(&message));
+    match result {
+        Ok(()) if previews => hub.set_previewer(id),
+        Ok(()) => {}
+        Err(message) => reply(error_message(&message)),
     }
 }
