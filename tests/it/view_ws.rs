@@ -887,3 +887,41 @@ fn a_connection_past_the_limit_is_told_why_and_a_closed_page_frees_its_place() {
     drop((pages, last));
     assert!(repl.finish().success());
 }
+
+/// A client that sends its request head a byte at a time is answered `408` once the head's
+/// whole time is up: trickling cannot hold one of the server's few connections for good.
+#[test]
+fn a_request_head_sent_a_byte_at_a_time_times_out_as_a_whole() {
+    use std::io::Read as _;
+    let dir = tempfile::tempdir().unwrap();
+    let scene = cat_scene(dir.path());
+    let repl = ViewRepl::start(dir.path(), &scene);
+    let mut stream = TcpStream::connect(repl.host()).unwrap();
+    stream
+        .set_read_timeout(Some(Duration::from_millis(400)))
+        .unwrap();
+    let trickle = b"GET / HTTP/1.1\r\nX-Slow: "
+        .iter()
+        .chain([b'a'; 200].iter());
+    let mut answer = Vec::new();
+    for &byte in trickle {
+        if stream.write_all(&[byte]).is_err() {
+            break;
+        }
+        let mut buffer = [0u8; 512];
+        match stream.read(&mut buffer) {
+            Ok(0) => break,
+            Ok(n) => answer.extend_from_slice(&buffer[..n]),
+            Err(_) => continue,
+        }
+        if !answer.is_empty() {
+            break;
+        }
+    }
+    stream.set_read_timeout(Some(WAIT)).unwrap();
+    let _ = stream.read_to_end(&mut answer);
+    let answer = String::from_utf8_lossy(&answer);
+    assert!(answer.starts_with("HTTP/1.1 408"), "{answer:?}");
+    assert!(answer.contains("did not arrive within 5 s"), "{answer:?}");
+    assert!(repl.finish().success());
+}

@@ -6,7 +6,7 @@
 
 use std::io::{Read, Write};
 use std::net::TcpStream;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use tungstenite::handshake::derive_accept_key;
 use tungstenite::protocol::{Role, WebSocketConfig};
@@ -16,7 +16,7 @@ use super::edit::MAX_MESSAGE_BYTES;
 
 /// Largest request head read, bytes.
 const MAX_HEAD: usize = 8 * 1024;
-/// How long a client may take to send its request head.
+/// How long a client may take to send its whole request head.
 const HEAD_TIMEOUT: Duration = Duration::from_secs(5);
 
 /// What the server answers with: its token, the page, and the `host:port` names it goes by.
@@ -130,13 +130,31 @@ impl Head {
     }
 }
 
+/// Reads a request head within [`HEAD_TIMEOUT`] in all: a client sending a byte now and
+/// then cannot keep its connection (one of the server's few) any longer.
 fn read_head(stream: &mut TcpStream) -> Result<(Head, Vec<u8>), Refusal> {
+    let deadline = Instant::now() + HEAD_TIMEOUT;
+    let late = || {
+        let seconds = HEAD_TIMEOUT.as_secs();
+        Refusal(
+            "408 Request Timeout",
+            format!("the request head did not arrive within {seconds} s"),
+        )
+    };
     let mut buffer = Vec::with_capacity(1024);
     let mut chunk = [0u8; 1024];
     loop {
-        let n = stream
-            .read(&mut chunk)
-            .map_err(|e| Refusal("408 Request Timeout", e.to_string()))?;
+        let left = deadline.saturating_duration_since(Instant::now());
+        if left.is_zero() || stream.set_read_timeout(Some(left)).is_err() {
+            return Err(late());
+        }
+        let n = stream.read(&mut chunk).map_err(|e| match e.kind() {
+            std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut => late(),
+            _ => Refusal(
+                "400 Bad Request",
+                format!("reading the request failed: {e}"),
+            ),
+        })?;
         if n == 0 {
             return Err(Refusal("400 Bad Request", "connection closed".into()));
         }
