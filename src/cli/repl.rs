@@ -307,7 +307,10 @@ fn line_editor(
             Ok(mut external) => {
                 printer.set_print(Box::new(move |text: String| {
                     use rustyline::ExternalPrinter as _;
-                    let _ = external.print(format!("{text}\n"));
+                    // A page's text may carry a scene's own strings: no control reaches
+                    // the terminal raw, as on standard error.
+                    let shown = lapclone::util::visible_controls(&text);
+                    let _ = external.print(format!("{shown}\n"));
                 }));
             }
             Err(error) => eprint_line!("warning: page edits print through the prompt: {error}"),

@@ -147,3 +147,63 @@ fn sigterm_at_the_prompt_gives_the_terminal_back() {
     assert_eq!(after.trim(), before.trim(), "the terminal's settings");
     p.exp_eof().unwrap();
 }
+
+/// What a page's line prints (its value, a warning) goes above the prompt with the line
+/// itself, so the prompt and the half-typed entry under it stay whole; typing ahead with a
+/// view attached reaches the prompt whole.
+#[test]
+fn a_page_lines_output_goes_above_a_prompt_in_use() {
+    use tungstenite::client::IntoClientRequest;
+    let dir = tempfile::tempdir().unwrap();
+    let scene = crate::view_ws::cat_scene(dir.path());
+    let mut command = Command::new(env!("CARGO_BIN_EXE_lapclone"));
+    command
+        .arg("repl")
+        .arg(&scene)
+        .args(["--view", "--port", "0", "--preview"])
+        .arg(dir.path().join("preview.png"))
+        .arg("--history")
+        .arg(dir.path().join("history.txt"))
+        .env("TERM", "xterm")
+        .env("LAPCLONE_INLINE", "off");
+    let mut p = spawn_command(command, Some(20_000)).unwrap();
+    p.exp_string("view: http://").unwrap();
+    let rest = p.read_line().unwrap();
+    let (host, token) = rest.trim().split_once("/?token=").unwrap();
+    p.exp_string("lapclone> ").unwrap();
+    // Typed ahead at once, as a paste without bracketed paste comes: every character is
+    // read (the line editor once kept all but the first until the next key).
+    p.send("cat.na").unwrap();
+    p.flush().unwrap();
+    p.exp_string("cat.na").unwrap();
+    let mut request = format!("ws://{host}/ws?token={token}")
+        .into_client_request()
+        .unwrap();
+    let origin = format!("http://{host}").parse().unwrap();
+    request.headers_mut().insert("Origin", origin);
+    let (mut socket, _) = tungstenite::connect(request).unwrap();
+    let rev = loop {
+        if let tungstenite::Message::Text(text) = socket.read().unwrap() {
+            let value: serde_json::Value = serde_json::from_str(text.as_str()).unwrap();
+            if value["type"] == "scene" {
+                break value["rev"].as_u64().unwrap();
+            }
+        }
+    };
+    // A key past the scene's end: the line's value and a warning are both printed.
+    let edit = serde_json::json!({"type": "edit", "rev": rev, "commit": true, "t": 5,
+        "edit": {"op": "at", "patch": "cat", "value": [300, 160]}});
+    let text = edit.to_string();
+    socket
+        .send(tungstenite::Message::Text(text.into()))
+        .unwrap();
+    p.exp_string("(view) cat.at(5, [300, 160]);").unwrap();
+    p.exp_string("warning: ").unwrap();
+    p.exp_string("=> patch(\"cat\")").unwrap();
+    // The prompt comes back, with the half-typed entry, after everything the line printed.
+    p.exp_string("lapclone> cat.na").unwrap();
+    p.send_control('c').unwrap();
+    p.exp_string("lapclone> ").unwrap();
+    p.send_control('d').unwrap();
+    p.exp_eof().unwrap();
+}

@@ -5,6 +5,7 @@
 
 use glam::DVec2;
 use lapclone::scene::{rhai_string_literal, Easing, Handle, Patch, Scene};
+use lapclone::util::number_text;
 use serde::Deserialize;
 
 /// Largest text message a page may send, bytes.
@@ -34,10 +35,11 @@ pub enum Request {
         #[serde(default)]
         t: Option<f64>,
     },
-    /// Escape: drop the gesture's preview.
-    Cancel,
+    /// Escape: drop the gesture's preview. (Braces, so that serde refuses unknown fields
+    /// here too: it does not for a unit variant of a tagged enum.)
+    Cancel {},
     /// Ctrl+Z: `:undo`.
-    Undo,
+    Undo {},
     /// Ctrl+S (after the page's confirmation): `:save` to the loaded file.
     Save { rev: u64 },
     /// This page wants the placed meshes with every scene message (overlay on).
@@ -157,7 +159,8 @@ fn bounded(v: f64) -> Result<(), String> {
         Ok(())
     } else {
         Err(format!(
-            "{v} is not a finite number within ±{MAX_MAGNITUDE}"
+            "{} is not a finite number within ±{MAX_MAGNITUDE}",
+            number_text(v)
         ))
     }
 }
@@ -165,7 +168,7 @@ fn bounded(v: f64) -> Result<(), String> {
 fn time(t: f64) -> Result<(), String> {
     bounded(t)?;
     if t < 0.0 {
-        return Err(format!("time {t} is negative"));
+        return Err(format!("time {} is negative", number_text(t)));
     }
     Ok(())
 }
@@ -173,7 +176,16 @@ fn time(t: f64) -> Result<(), String> {
 fn positive(v: f64) -> Result<(), String> {
     bounded(v)?;
     if v <= 0.0 {
-        return Err(format!("{v} must be greater than 0"));
+        return Err(format!("{} must be greater than 0", number_text(v)));
+    }
+    Ok(())
+}
+
+/// A handle's or pin's index: no patch has anywhere near [`MAX_MAGNITUDE`] of them, and a
+/// larger one would not be read back as an integer.
+fn index(i: usize, what: &str) -> Result<(), String> {
+    if i as f64 > MAX_MAGNITUDE {
+        return Err(format!("{what} index {i} is past ±{MAX_MAGNITUDE}"));
     }
     Ok(())
 }
@@ -183,6 +195,9 @@ fn check_edit(edit: &Edit) -> Result<(), String> {
     if patch.is_empty() || patch.len() > MAX_NAME {
         return Err("patch name empty or too long".into());
     }
+    edit.indices()
+        .into_iter()
+        .try_for_each(|(i, what)| index(i, what))?;
     match edit {
         Edit::At { value, .. } | Edit::HandleKey { value, .. } => {
             value.iter().try_for_each(|v| bounded(*v))
@@ -240,6 +255,25 @@ impl Edit {
             | Edit::RemovePin { patch, .. }
             | Edit::MoveKey { patch, .. }
             | Edit::RemoveKey { patch, .. } => patch,
+        }
+    }
+
+    /// The handle and pin indices this edit names, with what each indexes.
+    fn indices(&self) -> Vec<(usize, &'static str)> {
+        match self {
+            Edit::HandleKey { handle, .. }
+            | Edit::HandleRadius { handle, .. }
+            | Edit::RemoveHandle { handle, .. }
+            | Edit::MoveKey {
+                handle: Some(handle),
+                ..
+            }
+            | Edit::RemoveKey {
+                handle: Some(handle),
+                ..
+            } => vec![(*handle, "handle")],
+            Edit::RemovePin { pin, .. } => vec![(*pin, "pin")],
+            _ => Vec::new(),
         }
     }
 
@@ -383,9 +417,14 @@ fn round(v: f64, per: f64) -> f64 {
     }
 }
 
-/// A number as Rhai reads it back exactly (integers without a fraction).
+/// A number as Rhai reads it back exactly: whole ones without a fraction (`240`), others in
+/// their shortest form, with an exponent when tiny or huge (`5e-324`, not 324 digits).
 fn num(v: f64) -> String {
-    format!("{v}")
+    if v.fract() == 0.0 && v.abs() < 1e15 {
+        format!("{v}")
+    } else {
+        format!("{v:?}")
+    }
 }
 
 fn point(v: [f64; 2]) -> String {
@@ -483,11 +522,38 @@ mod tests {
             r#"{"type":"edit","rev":1,"commit":true,"t":-0.5,"edit":{"op":"at","patch":"c","value":[1,2]}}"#,
             r#"{"type":"edit","rev":1,"commit":true,"t":1e7,"edit":{"op":"at","patch":"c","value":[1,2]}}"#,
             r#"{"type":"edit","rev":1,"commit":true,"t":"1","edit":{"op":"at","patch":"c","value":[1,2]}}"#,
+            r#"{"type":"edit","rev":1,"commit":true,"edit":{"op":"remove_handle","patch":"c","handle":18446744073709551615}}"#,
+            r#"{"type":"edit","rev":1,"commit":true,"edit":{"op":"remove_pin","patch":"c","pin":1000001}}"#,
+            r#"{"type":"edit","rev":1,"commit":true,"edit":{"op":"move_key","patch":"c","handle":1000001,"track":"at","from":1,"to":2}}"#,
+            r#"{"type":"undo","rev":12345}"#,
+            r#"{"type":"cancel","code":"anything"}"#,
             "not json",
         ] {
             assert!(parse_request(text).is_err(), "{text}");
         }
         assert!(parse_request(&" ".repeat(MAX_MESSAGE_BYTES + 1)).is_err());
+        for text in [r#"{"type":"undo"}"#, r#"{"type":"cancel"}"#] {
+            assert!(parse_request(text).is_ok(), "{text}");
+        }
+        // Extreme numbers are named short in the refusal.
+        let message = parse_request(r#"{"type":"seek","t":1e308}"#).unwrap_err();
+        assert!(message.starts_with("1e308 is not"), "{message}");
+    }
+
+    /// Times are written exactly, and readably when tiny: Rhai reads the line back to the
+    /// same key time.
+    #[test]
+    fn key_times_are_written_exactly_and_short() {
+        let at = edit(r#"{"op":"at","patch":"cat","value":[1,2]}"#);
+        for (t, shown) in [
+            (5e-324, "5e-324"),
+            (0.1 + 0.2, "0.30000000000000004"),
+            (2.0, "2"),
+        ] {
+            let line = at.line(t, "cat", "h");
+            assert_eq!(line, format!("cat.at({shown}, [1, 2]);"));
+            assert_eq!(shown.parse::<f64>().unwrap(), t);
+        }
     }
 
     #[test]

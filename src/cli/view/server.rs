@@ -232,8 +232,8 @@ fn handle(
             edit,
             t,
         } => session.view_edit(rev, commit, &edit, t),
-        Request::Cancel => session.view_cancel(),
-        Request::Undo => session.view_undo(),
+        Request::Cancel {} => session.view_cancel(),
+        Request::Undo {} => session.view_undo(),
         Request::Save { rev } => session.view_save(rev),
         Request::Mesh { on } => {
             hub.set_mesh(id, on);

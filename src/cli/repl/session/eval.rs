@@ -42,11 +42,11 @@ impl Session {
         self.refresh_words();
         if !value.is_unit() {
             let shown = self.display(value);
-            if self.interactive {
-                crate::cli::print_line(format_args!("=> {shown}"));
+            self.say(if self.interactive {
+                format!("=> {shown}")
             } else {
-                crate::cli::print_line(&shown);
-            }
+                shown
+            });
         }
         Ok(())
     }
@@ -152,7 +152,7 @@ impl Session {
         };
         let warnings = scene.warnings();
         for warning in warnings.iter().filter(|w| !self.warned.contains(w)) {
-            eprint_line!("warning: {warning}");
+            self.say_warning(format!("warning: {warning}"));
         }
         self.warned = warnings;
     }

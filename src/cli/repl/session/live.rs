@@ -27,12 +27,24 @@ impl Session {
     /// Prints a line of the session's own: through the prompt's printer while a page's
     /// request runs, so the prompt stays intact.
     pub(super) fn say(&self, text: String) {
-        let unprinted = match (&self.printer, self.from_view) {
+        if let Some(text) = self.above_prompt(text) {
+            crate::cli::print_line(&text);
+        }
+    }
+
+    /// Prints a warning as [`say`](Self::say) prints a line: above the prompt while a page's
+    /// request runs, else to standard error.
+    pub(super) fn say_warning(&self, text: String) {
+        if let Some(text) = self.above_prompt(text) {
+            eprint_line!("{text}");
+        }
+    }
+
+    /// Prints `text` above the prompt while a page's request runs; else gives it back.
+    fn above_prompt(&self, text: String) -> Option<String> {
+        match (&self.printer, self.from_view) {
             (Some(printer), true) => printer.print(text),
             _ => Some(text),
-        };
-        if let Some(text) = unprinted {
-            crate::cli::print_line(&text);
         }
     }
 
