@@ -660,3 +660,50 @@ fn a_video_ffmpeg_could_not_finish_is_a_failure() {
         stderr(&o)
     );
 }
+
+/// A video shorter than a second is a patch source like any other: its first frame is read
+/// at the scene's rate, as every later one is (at one frame a second, a clip of 11 frames
+/// at 24 fps gave none). A one-frame clip held (`source_hold`) works too.
+#[test]
+fn a_short_video_is_an_animated_source() {
+    if !has_ffmpeg() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let ffmpeg = |args: &str| {
+        let status = Command::new("sh")
+            .arg("-c")
+            .arg(format!("ffmpeg -v error -y {args}"))
+            .current_dir(dir.path())
+            .status()
+            .unwrap();
+        assert!(status.success(), "ffmpeg {args}");
+    };
+    ffmpeg("-f lavfi -i testsrc2=s=96x64:r=24 -frames:v 11 -c:v ffv1 short.mkv");
+    ffmpeg("-f lavfi -i testsrc2=s=96x64:r=24 -frames:v 1 -c:v ffv1 one.mkv");
+    for (video, extra, duration) in [
+        ("short.mkv", "", 0.4),
+        ("one.mkv", ", source_hold: true", 0.5),
+    ] {
+        let scene = dir.path().join("clip.rhai");
+        std::fs::write(
+            &scene,
+            format!(
+                "canvas(120, 80, #{{ fps: 24, duration: {duration} }});\n\
+                 let p = patch(\"p\", #{{ source: \"{video}\"{extra}, polygons: [[[10, 10], [60, 10], [60, 50], [10, 50]]] }});\n\
+                 p.at(0, [60, 40]);\n"
+            ),
+        )
+        .unwrap();
+        let out = Command::new(env!("CARGO_BIN_EXE_lapclone"))
+            .arg("render")
+            .arg(&scene)
+            .arg("-o")
+            .arg(dir.path().join("out.gif"))
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{video}: {stderr}");
+        assert!(dir.path().join("out.gif").is_file(), "{video}");
+    }
+}

@@ -104,8 +104,8 @@ impl Renderer {
                     Planned::Keep { index, rig }
                 }
                 None => {
-                    let source = source_image(&mut sources, patch)?;
                     let fps = self.scene.canvas.fps;
+                    let source = source_image(&mut sources, patch, fps)?;
                     Planned::Build(Box::new(Layer::new(patch, source, fps)?))
                 }
             });

@@ -14,19 +14,22 @@ pub(super) fn build_layers(scene: &Scene) -> Result<Vec<Layer>, RenderError> {
     let mut sources: HashMap<PathBuf, FloatImage> = HashMap::new();
     let mut layers = Vec::with_capacity(scene.patches.len());
     for patch in &scene.patches {
-        let source = source_image(&mut sources, patch)?;
+        let source = source_image(&mut sources, patch, scene.canvas.fps)?;
         layers.push(Layer::new(patch, source, scene.canvas.fps)?);
     }
     Ok(layers)
 }
 
-/// The patch's source image, loaded once per path (an animated source's first frame).
+/// The patch's source image, loaded once per path (an animated source's first frame, read
+/// at the scene's `fps` as every later one is: at a slower rate a clip shorter than one of
+/// its frames would give none).
 pub(super) fn source_image(
     sources: &mut HashMap<PathBuf, FloatImage>,
     patch: &Patch,
+    fps: f64,
 ) -> Result<FloatImage, RenderError> {
     if let Some(footage) = &patch.footage {
-        let mut reader = FootageReader::new(footage.clone(), 1.0);
+        let mut reader = FootageReader::new(footage.clone(), fps);
         return reader.take_frame(0).map_err(|e| RenderError::footage(Some(&patch.name), e));
     }
     if let Some(image) = sources.get(&patch.source) {
