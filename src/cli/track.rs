@@ -46,7 +46,7 @@ pub struct TrackArgs {
     #[arg(long, default_value_t = 24.0, value_parser = super::finite_f64,
           allow_hyphen_values = true)]
     pub fps: f64,
-    /// The track CSV to write.
+    /// The track CSV to write (`-`: standard output).
     #[arg(short, long)]
     pub output: PathBuf,
 }
@@ -56,7 +56,10 @@ pub fn run(args: TrackArgs) -> anyhow::Result<()> {
     // `track` has no setting that holds a last frame: its messages suggest none.
     let footage = Footage::open(&args.footage, args.start, false, "")
         .with_context(|| format!("opening {}", args.footage.display()))?;
-    lapclone::output::refuse_footage_input(&args.output, &footage)?;
+    let to_stdout = args.output.as_os_str() == "-";
+    if !to_stdout {
+        lapclone::output::refuse_footage_input(&args.output, &footage)?;
+    }
     let reader = FootageReader::new(footage, args.fps);
     let available = available_frames(&reader, args.fps, args.frames)?;
     let range = match (args.frames, available) {
@@ -81,19 +84,27 @@ pub fn run(args: TrackArgs) -> anyhow::Result<()> {
         ..range
     };
     warn_lost(&frames);
-    lapclone::util::write_atomic_with(&args.output, |file| {
-        let mut out = std::io::BufWriter::new(file);
-        lapclone::track::write_csv(&mut out, &frames)?;
-        out.flush()
-    })
-    .with_context(|| format!("writing {}", args.output.display()))?;
+    let into = if to_stdout {
+        let mut out = std::io::BufWriter::new(std::io::stdout().lock());
+        lapclone::track::write_csv(&mut out, &frames)
+            .and_then(|()| out.flush())
+            .context("writing the track to standard output")?;
+        "standard output".to_string()
+    } else {
+        lapclone::util::write_atomic_with(&args.output, |file| {
+            let mut out = std::io::BufWriter::new(file);
+            lapclone::track::write_csv(&mut out, &frames)?;
+            out.flush()
+        })
+        .with_context(|| format!("writing {}", args.output.display()))?;
+        args.output.display().to_string()
+    };
     eprint_line!(
-        "tracked {} point{} through frames {}..{} into {}",
+        "tracked {} point{} through frames {}..{} into {into}",
         points.len(),
         if points.len() == 1 { "" } else { "s" },
         range.first,
         range.last,
-        args.output.display()
     );
     Ok(())
 }
@@ -182,11 +193,17 @@ fn check_arguments(args: &TrackArgs) -> anyhow::Result<()> {
     if args.fps <= 0.0 || args.fps > 1000.0 {
         return Err(UsageError(format!("--fps {} must be in (0, 1000]", args.fps)).into());
     }
-    if args.output.is_dir() {
-        return Err(UsageError(format!("-o {} is a folder", args.output.display())).into());
-    }
     if let Err(error) = options(args).check() {
         return Err(UsageError(format!("--{error}")).into());
+    }
+    if args.output.as_os_str() == "-" {
+        if !super::stdout_is_open() {
+            anyhow::bail!("-o -: standard output is closed");
+        }
+        return Ok(());
+    }
+    if args.output.is_dir() {
+        return Err(UsageError(format!("-o {} is a folder", args.output.display())).into());
     }
     Ok(lapclone::output::check_output_folder(&args.output)?)
 }

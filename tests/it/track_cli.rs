@@ -72,6 +72,18 @@ fn a_translating_point_is_followed_to_a_third_of_a_pixel() {
         text.starts_with("frame,x,y,confidence\n1,150.0000,112.0000,1.000\n"),
         "{text}"
     );
+    // `-o -` puts the same CSV on standard output, as `render -o -` puts its frames, and
+    // writes no file named `-`.
+    let piped = Command::new(env!("CARGO_BIN_EXE_lapclone"))
+        .arg("track")
+        .arg(dir.path().join("f_%04d.jpg"))
+        .args(["--point", "150,112", "-o", "-"])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    assert!(piped.status.success());
+    assert_eq!(String::from_utf8_lossy(&piped.stdout), text);
+    assert!(!dir.path().join("-").exists());
     let file = TrackFile::load(&dir.path().join("track.csv")).unwrap();
     let (rms, last) = errors(&file.points[0], &motion, start);
     println!("translation: RMS {rms:.3} px, last frame {last:.3} px");
