@@ -82,7 +82,10 @@ pub use clone::{
     CloneStats, GlueStats, MembraneStats, PatchCloner, PatchMesh, Placement,
 };
 pub use deform::{DeformError, DeformOptions, DeformRig, DeformStats, Deformed, Handle, Pin};
-pub use limits::{check_image_size, LimitError, MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE};
+pub use limits::{
+    check_image_size, feather_in_range, position_error, scale_error, LimitError, MAX_FEATHER,
+    MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE, MAX_POSITION, MAX_SCALE,
+};
 pub use mesh::{
     BitMask, BoundaryLoop, BoundaryPlacement, LoopKind, Mesh, MeshError, MeshOptions, MeshResult,
     MeshStats, Polygon, SanityError, MASK_THRESHOLD,
@@ -105,7 +108,7 @@ pub use script::{
 };
 pub use simd::{levels_to_rgb8, rgb8_to_levels};
 pub use solve::{FactorMethod, LaplacianKind, PenaltyOptions, SolveError, SwitchStats};
-pub use util::available_cores;
+pub use util::{available_cores, not_a_file, number_text};
 
 /// Opens a scene file as `lapclone render` does: loads and runs it ([`load_scene`]), then
 /// [`build_renderer`].
@@ -122,6 +125,13 @@ pub fn open_scene(path: &std::path::Path) -> Result<(LoadedScene, Renderer), Sce
 pub fn build_renderer(loaded: &LoadedScene) -> Result<Renderer, SceneError> {
     script::validate_scene(loaded)?;
     Renderer::new(loaded.scene.clone()).map_err(|e| output::render_error_at_call(loaded, &e))
+}
+
+/// A renderer's error for a loaded scene, positioned as [`build_renderer`] and
+/// [`render_scene`] position theirs: at the call that made the patch it is about, or at
+/// `canvas(...)` for the background's footage.
+pub fn scene_render_error(loaded: &LoadedScene, error: &RenderError) -> SceneError {
+    output::render_error_at_call(loaded, error)
 }
 
 /// Scenes: the animated description a [`Renderer`] draws, built in Rust or loaded from a

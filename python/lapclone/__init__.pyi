@@ -10,7 +10,7 @@ that is not an array), never crashes the interpreter.
 """
 
 from os import PathLike
-from typing import Iterator, Optional, Sequence, Tuple, Union
+from typing import Any, Iterator, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -26,8 +26,9 @@ MONOCHROME_TRANSFER: int
 
 Image = npt.NDArray[Union[np.uint8, np.uint16]]
 Mask = npt.NDArray[Union[np.uint8, np.uint16, np.bool_]]
-Point = Tuple[float, float]
-Drag = Union[Tuple[Point, Point], Tuple[Point, Point, float]]
+Point = Union[Tuple[float, float], Sequence[float], npt.NDArray[np.floating]]
+"""Two numbers (x, y): a tuple, a list or a numpy array, each within ±1e9 px."""
+Drag = Union[Tuple[Point, Point], Tuple[Point, Point, float], Sequence[Any]]
 
 class SceneError(Exception):
     """A scene file's error: ``str(error)`` is ``file:line:col: message``."""
@@ -45,7 +46,7 @@ def seamless_clone(
     src: Image,
     dst: Image,
     mask: Mask,
-    p: Tuple[int, int],
+    p: Union[Tuple[int, int], Sequence[int]],
     flags: int = NORMAL_CLONE,
 ) -> Image:
     """``cv2.seamlessClone`` with lapclone: the same arguments, array layout (BGR) and

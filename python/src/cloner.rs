@@ -3,6 +3,7 @@
 //! [`Patch`]; `seamless_clone` reads its arguments as `cv2.seamlessClone` does.
 
 use lapclone::glam::DVec2;
+use lapclone::number_text;
 use lapclone::{
     mesh_from_mask, Anchor, BitMask, BoundaryData, CloneMode, CloneOptions, Handle, LaplacianKind,
     MeshOptions, Pin, Placement,
@@ -38,21 +39,29 @@ pub struct Cloner {
 #[pymethods]
 impl Cloner {
     #[new]
-    #[pyo3(signature = (source, mask, *, density=3.0, laplacian="combinatorial", mode="normal", feather=0.0, boundary_data="hat-average", bgr=false, threads=None))]
+    #[pyo3(signature = (source, mask, *, density=InRange(3.0), laplacian="combinatorial", mode="normal", feather=InRange(0.0), boundary_data="hat-average", bgr=false, threads=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
         source: &Bound<'_, PyAny>,
         mask: &Bound<'_, PyAny>,
-        density: f64,
+        density: InRange<f64>,
         laplacian: &str,
         mode: &str,
-        feather: f64,
+        feather: InRange<f64>,
         boundary_data: &str,
         bgr: bool,
         threads: Option<InRange<usize>>,
     ) -> PyResult<Self> {
-        let threads = threads.map(|t| t.0);
+        let (threads, density, feather) = (threads.map(|t| t.0), density.0, feather.0);
+        // Asked before the cast to the option's f32, so the message names the value given.
+        if !lapclone::feather_in_range(feather) {
+            return Err(PyValueError::new_err(format!(
+                "feather must lie in [0, {}], not {}",
+                lapclone::MAX_FEATHER,
+                number_text(feather)
+            )));
+        }
         if threads == Some(0) {
             return Err(PyValueError::new_err("threads must be at least 1"));
         }
@@ -107,14 +116,14 @@ impl Cloner {
         };
         let at = point(at, "at")?;
         let (scale, rotate) = (scale.0, rotate.0);
-        if !(scale.is_finite() && scale > 0.0) {
-            return Err(PyValueError::new_err(format!(
-                "scale must be a finite number > 0, not {scale}"
-            )));
+        if let Some(why) = lapclone::scale_error(scale) {
+            return Err(PyValueError::new_err(format!("scale {why}")));
         }
-        if !rotate.is_finite() {
+        if !(rotate.is_finite() && rotate.abs() <= lapclone::MAX_POSITION) {
             return Err(PyValueError::new_err(format!(
-                "rotate must be a finite number of degrees, not {rotate}"
+                "rotate must be a finite number of degrees within ±{:e}, not {}",
+                lapclone::MAX_POSITION,
+                number_text(rotate)
             )));
         }
         let handles = drags
@@ -201,7 +210,8 @@ fn build(
 fn mesh_options(density: f64) -> PyResult<MeshOptions> {
     if !(density.is_finite() && density > 0.0) {
         return Err(PyValueError::new_err(format!(
-            "density must be a finite length > 0 px, not {density}"
+            "density must be a finite length > 0 px, not {}",
+            number_text(density)
         )));
     }
     let options = MeshOptions {
@@ -225,15 +235,25 @@ fn target_layout(
     Ok(layout)
 }
 
-/// A finite point from a 2-sequence of numbers.
+/// A point from two numbers (a tuple, a list, a numpy array), each finite and within the
+/// positions lapclone takes (`lapclone clone`'s bound).
 fn point(value: &Bound<'_, PyAny>, what: &str) -> PyResult<DVec2> {
-    let (x, y): (f64, f64) = value
-        .extract()
-        .map_err(|_| PyValueError::new_err(format!("{what} must be a pair of numbers (x, y)")))?;
-    if !(x.is_finite() && y.is_finite()) {
-        return Err(PyValueError::new_err(format!(
-            "{what} must be finite, not ({x}, {y})"
-        )));
+    let bad = || PyValueError::new_err(format!("{what} must be two numbers (x, y)"));
+    let (x, y) = match value.extract::<(f64, f64)>() {
+        Ok(pair) => pair,
+        Err(_) => match value.extract::<Vec<f64>>().map_err(|_| bad())?[..] {
+            [x, y] => (x, y),
+            _ => return Err(bad()),
+        },
+    };
+    for v in [x, y] {
+        let why = match v.is_finite() {
+            true => lapclone::position_error(v),
+            false => Some(format!("{} is not finite", number_text(v))),
+        };
+        if let Some(why) = why {
+            return Err(PyValueError::new_err(format!("{what}: {why}")));
+        }
     }
     Ok(DVec2::new(x, y))
 }
@@ -252,7 +272,8 @@ fn drag(value: &Bound<'_, PyAny>, default_radius: f64) -> PyResult<Handle> {
             let r: f64 = parts[2].extract().map_err(|_| bad())?;
             if !(r.is_finite() && r > 0.0) {
                 return Err(PyValueError::new_err(format!(
-                    "a drag's radius must be a finite number > 0, not {r}"
+                    "a drag's radius must be a finite number > 0, not {}",
+                    number_text(r)
                 )));
             }
             r
@@ -266,14 +287,13 @@ fn drag(value: &Bound<'_, PyAny>, default_radius: f64) -> PyResult<Handle> {
 
 /// A whole pixel `p` as `cv2.seamlessClone` takes it (integers; integral floats too).
 fn pixel(value: &Bound<'_, PyAny>) -> PyResult<[i64; 2]> {
-    if let Ok((x, y)) = value.extract::<(i64, i64)>() {
-        return Ok([x, y]);
-    }
+    // Through `point`, so whole numbers past the position bound are refused as floats are.
     let p = point(value, "p")?;
-    if p.x.fract() != 0.0 || p.y.fract() != 0.0 || p.abs().max_element() > 1e15 {
+    if p.x.fract() != 0.0 || p.y.fract() != 0.0 {
         return Err(PyValueError::new_err(format!(
             "p must be a whole pixel (x, y), not ({}, {})",
-            p.x, p.y
+            number_text(p.x),
+            number_text(p.y)
         )));
     }
     Ok([p.x as i64, p.y as i64])
@@ -348,13 +368,13 @@ pub fn seamless_clone<'py>(
 /// The patch mesh of `mask` (inside where its luma, or alpha, is at least half scale), as
 /// `Cloner` meshes it: `(vertices, triangles)`.
 #[pyfunction]
-#[pyo3(signature = (mask, *, density=3.0))]
+#[pyo3(signature = (mask, *, density=InRange(3.0)))]
 pub fn mesh<'py>(
     py: Python<'py>,
     mask: &Bound<'py, PyAny>,
-    density: f64,
+    density: InRange<f64>,
 ) -> PyResult<arrays::MeshArrays<'py>> {
-    let options = mesh_options(density)?;
+    let options = mesh_options(density.0)?;
     let mask = arrays::read_mask(mask, "mask")?;
     let size = (mask.image.width(), mask.image.height());
     let patch = py.allow_threads(|| {

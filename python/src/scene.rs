@@ -8,11 +8,13 @@ use std::path::PathBuf;
 use std::sync::Mutex;
 
 use lapclone::{Depth, LoadedScene, OutputKind, RenderOptions, Renderer};
-use pyo3::exceptions::{PyFileNotFoundError, PyIndexError, PyRuntimeError};
+use pyo3::exceptions::{
+    PyFileNotFoundError, PyIndexError, PyIsADirectoryError, PyRuntimeError, PyValueError,
+};
 use pyo3::prelude::*;
 
 use crate::arrays::{self, Dtype, Layout};
-use crate::errors::{output_error, scene_error, to_py, FrameIndex};
+use crate::errors::{output_error, scene_error, FrameIndex};
 
 /// Scene(path, *, bgr=False)
 ///
@@ -40,12 +42,22 @@ impl Scene {
     #[new]
     #[pyo3(signature = (path, *, bgr=false))]
     fn new(py: Python<'_>, path: PathBuf, bgr: bool) -> PyResult<Self> {
-        if !path.is_file() {
+        if path.is_dir() {
+            return Err(PyIsADirectoryError::new_err((
+                21,
+                format!("{} is a folder, not a scene file", path.display()),
+                path.display().to_string(),
+            )));
+        }
+        if !path.exists() {
             return Err(PyFileNotFoundError::new_err((
                 2,
                 format!("no scene file {}", path.display()),
                 path.display().to_string(),
             )));
+        }
+        if let Some(kind) = lapclone::not_a_file(&path) {
+            return Err(PyValueError::new_err(format!("{} {kind}", path.display())));
         }
         let opened = py.allow_threads(|| {
             let (loaded, imports) = lapclone::load_scene_and_imports(&path)?;
@@ -103,12 +115,16 @@ impl Scene {
                 "frame {index} is out of range: the scene has {frames} frames"
             )));
         }
-        let (samples, depth) = py.allow_threads(|| {
+        // A renderer's error is a SceneError at its call, as `render` raises it.
+        let rendered = py.allow_threads(|| {
             let mut renderer = self.renderer()?;
             let format = renderer.output_format();
-            let canvas = renderer.render_frame(i as u64).map_err(to_py)?;
-            Ok::<_, PyErr>((canvas.samples(format), canvas.depth()))
+            Ok::<_, PyErr>(match renderer.render_frame(i as u64) {
+                Ok(canvas) => Ok((canvas.samples(format), canvas.depth())),
+                Err(e) => Err(lapclone::scene_render_error(&self.loaded, &e)),
+            })
         })?;
+        let (samples, depth) = rendered.map_err(|e| scene_error(py, &e).unwrap_or_else(|e| e))?;
         let layout = Layout {
             height: self.height as usize,
             width: self.width as usize,
@@ -128,6 +144,9 @@ impl Scene {
     /// folder). The GIL is released while it renders.
     #[pyo3(signature = (path, format=None))]
     fn render(&self, py: Python<'_>, path: PathBuf, format: Option<&str>) -> PyResult<String> {
+        if path.as_os_str().is_empty() {
+            return Err(PyValueError::new_err("the output path is empty"));
+        }
         let format = format
             .map(OutputKind::from_name)
             .transpose()

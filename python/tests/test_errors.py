@@ -3,6 +3,8 @@ shapes, empty and mismatched arrays, non-finite placements, MIXED_CLONE, bad opt
 files that are missing or wrong (lapclone.SceneError with file, line and column), and 1,000
 random fixed-seed cases run in a child interpreter so a crash would show."""
 
+import os
+import shutil
 import subprocess
 import sys
 import textwrap
@@ -11,7 +13,7 @@ import numpy as np
 import pytest
 
 import lapclone
-from conftest import ROOT
+from conftest import ASSETS, ROOT
 
 SRC = np.full((40, 50, 3), 120, np.uint8)
 DST = np.full((60, 70, 3), 30, np.uint8)
@@ -255,3 +257,88 @@ def test_a_scene_error_shows_its_line_around_the_column(tmp_path):
     big.write_text("canvas(16, 16);\n//" + "x" * (17 << 20) + "\n")
     with pytest.raises(lapclone.SceneError, match="larger than 16 MiB"):
         lapclone.Scene(big)
+
+
+@pytest.mark.parametrize(
+    "call, shown",
+    [
+        (lambda: lapclone.Cloner(SRC, MASK, density=-1e300), "-1e300"),
+        (lambda: lapclone.mesh(MASK, density=-1e300), "-1e300"),
+        (lambda: lapclone.Cloner(SRC, MASK, feather=1e300), "not 1e300"),
+        (lambda: lapclone.Cloner(SRC, MASK, feather=1e39), "not 1e39"),
+        (lambda: lapclone.seamless_clone(SRC, DST, MASK, (1e300, 0)), "1e300 is past"),
+        (lambda: lapclone.seamless_clone(SRC, DST, MASK, (2**63, 0)), "is past"),
+        (lambda: lapclone.Cloner(SRC, MASK).clone(DST, (1, 1), scale=-1e300), "-1e300"),
+        (lambda: lapclone.Cloner(SRC, MASK).clone(DST, (1e-300, 1e300)), "1e300 is past"),
+        (lambda: lapclone.Cloner(SRC, MASK).clone(DST, (1, 1), drags=[((20, 20), (1e300, 20))]),
+         "1e300 is past"),
+        (lambda: lapclone.Cloner(SRC, MASK).clone(DST, (1, 1), drags=[((1, 1), (2, 2), -1e300)]),
+         "-1e300"),
+    ],
+)
+def test_extreme_numbers_are_named_short(call, shown):
+    with pytest.raises(ValueError) as caught:
+        call()
+    message = str(caught.value)
+    assert shown in message, message
+    assert "0" * 20 not in message, message
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda: lapclone.Cloner(SRC, MASK, density=10**400),
+        lambda: lapclone.Cloner(SRC, MASK, feather=10**400),
+        lambda: lapclone.mesh(MASK, density=10**400),
+    ],
+)
+def test_integers_too_large_for_a_float_raise_value_error(call):
+    with pytest.raises(ValueError, match="out of range"):
+        call()
+
+
+def test_a_pair_may_be_a_tuple_a_list_or_an_array():
+    cloner = lapclone.Cloner(SRC, MASK)
+    want = cloner.clone(DST, (35, 30))
+    for at in ([35, 30], np.array([35.0, 30.0])):
+        assert np.array_equal(cloner.clone(DST, at), want)
+    want = lapclone.seamless_clone(SRC, DST, MASK, (35, 30))
+    assert np.array_equal(lapclone.seamless_clone(SRC, DST, MASK, [35, 30]), want)
+    dragged = cloner.clone(DST, (35, 30), drags=[((20, 20), (24, 22))], pins=[(5, 5)])
+    listed = cloner.clone(DST, (35, 30), drags=[[[20, 20], [24, 22]]], pins=[[5, 5]])
+    assert np.array_equal(dragged, listed)
+    with pytest.raises(ValueError, match="two numbers"):
+        cloner.clone(DST, [1, 2, 3])
+
+
+def test_a_scene_path_that_is_not_a_file_says_what_it_is(tmp_path):
+    with pytest.raises(IsADirectoryError, match="is a folder"):
+        lapclone.Scene(tmp_path)
+    fifo = tmp_path / "scene.rhai"
+    os.mkfifo(fifo)
+    with pytest.raises(ValueError, match="not a regular file"):
+        lapclone.Scene(fifo)
+
+
+def test_an_empty_output_path_is_refused_before_rendering():
+    scene = lapclone.Scene(ROOT / "scenes" / "cat_in_coffee.rhai")
+    for fmt in (None, "gif"):
+        with pytest.raises(ValueError, match="empty"):
+            scene.render("", format=fmt)
+
+
+def test_a_frame_that_fails_raises_the_scene_error_render_raises(tmp_path):
+    plates = tmp_path / "plates"
+    plates.mkdir()
+    for k in (1, 2, 3):
+        shutil.copy(ASSETS / "coffee.png", plates / f"frame_{k:04d}.png")
+    path = tmp_path / "plates.rhai"
+    path.write_text('canvas(#{ fps: 24, duration: 0.125, background: "plates/frame_%04d.png" });\n')
+    scene = lapclone.Scene(path)
+    (plates / "frame_0002.png").unlink()
+    with pytest.raises(lapclone.SceneError) as caught:
+        scene[1]
+    assert caught.value.line == 1 and "frame_0002.png" in str(caught.value)
+    with pytest.raises(lapclone.SceneError) as rendered:
+        scene.render(str(tmp_path / "out.gif"))
+    assert rendered.value.line == caught.value.line
