@@ -201,3 +201,52 @@ fn a_whole_video_is_tracked_to_its_last_decoded_frame() {
         stderr(&out)
     );
 }
+
+/// A video's frame size takes the image limits a plate's does, from ffprobe's answer before
+/// anything is decoded (a 68 kB video of 12000×12000 frames took 2.5 GB), for `track` and
+/// for a scene's footage alike.
+#[test]
+fn a_video_past_the_image_limits_is_refused_before_decoding() {
+    if !has_ffmpeg() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let status = Command::new("ffmpeg")
+        .args([
+            "-v",
+            "error",
+            "-y",
+            "-f",
+            "lavfi",
+            "-i",
+            "color=c=gray:s=16400x16:r=24",
+        ])
+        .args(["-frames:v", "2", "-c:v", "ffv1", "wide.mkv"])
+        .current_dir(dir.path())
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let wide = dir.path().join("wide.mkv");
+    let csv = dir.path().join("track.csv");
+    let out = track(&wide, &csv);
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("exceeds the size limit"),
+        "{}",
+        stderr(&out)
+    );
+    assert!(!csv.exists());
+    let scene = dir.path().join("wide.rhai");
+    std::fs::write(
+        &scene,
+        "canvas(#{ fps: 24, duration: 0.1, background: \"wide.mkv\" });\n",
+    )
+    .unwrap();
+    let out = lapclone(&["check".as_ref(), scene.as_os_str()]);
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("exceeds the size limit"),
+        "{}",
+        stderr(&out)
+    );
+}

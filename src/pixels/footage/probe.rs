@@ -6,6 +6,7 @@ use std::path::Path;
 use std::process::{Command, Stdio};
 
 use super::FootageError;
+use crate::pixels::PixelError;
 use crate::process::Child;
 
 /// Starts the program `name` (ffmpeg or ffprobe) with `command`'s arguments applied.
@@ -71,6 +72,11 @@ pub(super) fn probe_video(path: &Path) -> Result<(u32, u32), FootageError> {
     };
     if w == 0 || h == 0 {
         return Err(video_error(path, format!("no frame size in `{text}`")));
+    }
+    // The frames are decoded whole: their size takes the image limits, as a plate's does.
+    if let Err(source) = crate::limits::check_image_size(u64::from(w), u64::from(h)) {
+        let path = path.to_path_buf();
+        return Err(Box::new(PixelError::TooLarge { path, source }).into());
     }
     let rotation = value::<f64>(&text, "rotation").unwrap_or(0.0);
     let quarter = (rotation / 90.0).round().rem_euclid(2.0) == 1.0;
