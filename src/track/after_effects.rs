@@ -12,8 +12,8 @@ type Failure = (usize, String);
 
 /// Whether `text` is keyframe data (its first non-blank line says so).
 pub(super) fn is_keyframe_data(text: &str) -> bool {
-    text.lines()
-        .map(str::trim)
+    super::numbered_lines(text)
+        .map(|(_, line)| line.trim())
         .find(|l| !l.is_empty())
         .is_some_and(|l| l.starts_with("Adobe After Effects") && l.ends_with("Keyframe Data"))
 }
@@ -40,8 +40,8 @@ pub(super) fn parse(text: &str) -> Result<Vec<Vec<TrackRow>>, Failure> {
     let mut keys = Keys::default();
     let mut section = Section::Header;
     let mut last_line = 1;
-    for (index, line) in text.lines().enumerate().skip_while(|(_, l)| l.trim().is_empty()).skip(1) {
-        let number = index + 1;
+    let lines = super::numbered_lines(text).skip_while(|(_, l)| l.trim().is_empty());
+    for (number, line) in lines.skip(1) {
         last_line = number;
         let cells: Vec<&str> = line.split('\t').map(str::trim).filter(|c| !c.is_empty()).collect();
         match cells.as_slice() {
@@ -199,6 +199,21 @@ mod tests {
         assert_eq!(rows[1].at, DVec2::new(101.5, 81.25));
         assert_eq!(rows[1].rotate, Some(2.0));
         assert_eq!(rows[1].scale, Some(1.0));
+    }
+
+    /// Keyframe text saved with a byte-order mark, Windows or old-Mac line ends reads as
+    /// the plain text does (it was taken for CSV), and errors keep their line numbers.
+    #[test]
+    fn a_byte_order_mark_and_any_line_ends_read_the_same() {
+        let want = parse(SAMPLE).unwrap();
+        let bad = SAMPLE.replace("\t101.5\t", "\tabc\t");
+        for (bom, ending) in [("\u{feff}", "\n"), ("", "\r\n"), ("\u{feff}", "\r")] {
+            let text = format!("{bom}{}", SAMPLE.replace('\n', ending));
+            assert!(is_keyframe_data(&text), "{ending:?}");
+            assert_eq!(parse(&text).unwrap(), want, "{ending:?}");
+            let bad = format!("{bom}{}", bad.replace('\n', ending));
+            assert_eq!(parse(&bad).unwrap_err().0, 12, "{ending:?}");
+        }
     }
 
     #[test]

@@ -85,15 +85,11 @@ fn shown(text: &str) -> String {
     out
 }
 
-/// Each point's rows from CSV `text`: a byte-order mark (as spreadsheets write "CSV
-/// UTF-8") is skipped, and lines may end in `\n`, `\r\n` or a lone `\r`.
+/// Each point's rows from CSV `text`, its lines as [`numbered_lines`](super::numbered_lines)
+/// gives them.
 pub(super) fn parse(text: &str) -> Result<Vec<Vec<TrackRow>>, Failure> {
-    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-    let ending = if text.contains('\n') { '\n' } else { '\r' };
-    let mut lines = text
-        .split(ending)
-        .enumerate()
-        .map(|(i, l)| (i + 1, l.trim()))
+    let mut lines = super::numbered_lines(text)
+        .map(|(number, l)| (number, l.trim()))
         .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
     let Some((header_line, header)) = lines.next() else {
         return Err((1, "the file is empty: expected a header such as frame,x,y".into()));
@@ -241,7 +237,9 @@ mod tests {
     #[test]
     fn spreadsheet_csv_reads_and_errors_quote_little() {
         let plain = parse("frame,x,y\n1,2,3\n2,4,5\n").unwrap();
-        for text in ["\u{feff}frame,x,y\r\n1,2,3\r\n2,4,5\r\n", "frame,x,y\r1,2,3\r2,4,5\r"] {
+        // Line ends mixed in one file too: lone-CR lines ending in a CRLF.
+        let mixed = "frame,x,y\r1,2,3\r2,4,5\r\n";
+        for text in ["\u{feff}frame,x,y\r\n1,2,3\r\n2,4,5\r\n", "frame,x,y\r1,2,3\r2,4,5\r", mixed] {
             assert_eq!(parse(text).unwrap(), plain, "{text:?}");
         }
         let (line, message) = parse("frame,x,y\r\n1,2,3\r\n2,4,5\u{1b}z\r\n").unwrap_err();

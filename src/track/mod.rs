@@ -225,3 +225,14 @@ fn wanted(asked: Option<bool>, present: bool, name: &str, path: &Path) -> Result
         None => Ok(present),
     }
 }
+
+/// A track file's lines, numbered from 1, as every reader takes them: a byte-order mark (as
+/// spreadsheets and editors write "UTF-8 with BOM") is skipped, and a line may end in `\n`,
+/// `\r\n` or a lone `\r` (old Mac text), even mixed in one file.
+fn numbered_lines(text: &str) -> impl Iterator<Item = (usize, &str)> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    text.split('\n')
+        .flat_map(|line| line.strip_suffix('\r').unwrap_or(line).split('\r'))
+        .enumerate()
+        .map(|(i, line)| (i + 1, line))
+}
