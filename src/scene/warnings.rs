@@ -1,6 +1,7 @@
 //! Things a scene allows but a user probably did not mean: takes a [`Scene`] and gives
 //! warnings as sentences (today: keys after the scene's end, which no frame shows).
 
+use crate::util::number_text;
 use super::types::{Follow, FollowTarget};
 use super::track::{Interpolate, Track};
 use super::types::Scene;
@@ -47,14 +48,16 @@ fn short_track(out: &mut Vec<String>, owner: &str, follow: &Follow, last: f64) {
         FollowTarget::Handle(i) => format!("handle {i}"),
     };
     let name = follow.file_name();
+    let (first_text, end_text) = (number_text(first), number_text(end));
     if first > 0.0 {
         out.push(format!(
-            "{owner}: {what} follows {name} from t = {first} s only; earlier frames hold its first position"
+            "{owner}: {what} follows {name} from t = {first_text} s only; earlier frames hold its first position"
         ));
     }
     if end < last - 1e-9 {
         out.push(format!(
-            "{owner}: {what} follows {name} until t = {end} s; the frames after it (to t = {last} s) hold its last position"
+            "{owner}: {what} follows {name} until t = {end_text} s; the frames after it (to t = {} s) hold its last position",
+            number_text(last)
         ));
     }
 }
@@ -76,20 +79,21 @@ fn late<T: Interpolate>(
     let shown: Vec<String> = late
         .iter()
         .take(SHOWN_TIMES)
-        .map(|k| k.time.to_string())
+        .map(|k| number_text(k.time))
         .collect();
     let times = if late.len() > SHOWN_TIMES {
         format!(
             "{} keys at t = {}, … {}",
             late.len(),
             shown.join(", "),
-            last.time
+            number_text(last.time)
         )
     } else {
         format!("key(s) at t = {}", shown.join(", "))
     };
     out.push(format!(
-        "{owner}: {name:?} {times} after the scene's end ({end} s); no frame shows them"
+        "{owner}: {name:?} {times} after the scene's end ({} s); no frame shows them",
+        number_text(end)
     ));
 }
 
@@ -115,6 +119,20 @@ mod tests {
         assert_eq!(
             out,
             ["patch \"p\": \"scale\" key(s) at t = 997, 998, 999 after the scene's end (996 s); no frame shows them"]
+        );
+    }
+
+    /// Times far from a second are written short, not as hundreds of digits.
+    #[test]
+    fn extreme_key_times_are_written_short() {
+        let mut track = Track::<f64>::new();
+        track.push(1e-320, 0.0, Easing::Linear).unwrap();
+        track.push(1e308, 0.0, Easing::Linear).unwrap();
+        let mut out = Vec::new();
+        late(&mut out, "patch \"p\"", "scale", &track, 0.0);
+        assert_eq!(
+            out,
+            ["patch \"p\": \"scale\" key(s) at t = 1e-320, 1e308 after the scene's end (0 s); no frame shows them"]
         );
     }
 }

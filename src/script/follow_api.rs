@@ -71,7 +71,10 @@ fn settings(options: &Map) -> Result<FollowSettings, String> {
 fn whole(value: &Dynamic, what: &str) -> Result<u64, String> {
     let v = number(value, what)?;
     if v.fract() != 0.0 || !(1.0..=1e9).contains(&v) {
-        return Err(format!("`{what}` must be a whole number ≥ 1, got {v}"));
+        return Err(format!(
+            "`{what}` must be a whole number ≥ 1, got {}",
+            crate::util::number_text(v)
+        ));
     }
     Ok(v as u64)
 }
