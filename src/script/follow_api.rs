@@ -4,7 +4,6 @@
 //! the patch's `at` (and `rotate` / `scale` from a two-point track) or the handle's target
 //! with them and records the call, `track_keys` returns them as a key list for `keys(...)`.
 
-use std::path::Path;
 
 use glam::DVec2;
 use rhai::{Array, Dynamic, Engine, Map, NativeCallContext};
