@@ -16,7 +16,7 @@ use lapclone::FloatImage;
 
 use crate::files::asset;
 use crate::track_footage::{frame, jpeg, Motion, Noise};
-use crate::video_cli::has_ffmpeg;
+use crate::video_cli::{has_ffmpeg, run_ffmpeg};
 
 const SIZE: (u32, u32) = (320, 240);
 const FRAMES: u32 = 100;
@@ -159,15 +159,7 @@ fn a_whole_video_is_tracked_to_its_last_decoded_frame() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
-    let ffmpeg = |args: &str| {
-        let out = Command::new("sh")
-            .arg("-c")
-            .arg(format!("ffmpeg -v error -y {args}"))
-            .current_dir(dir.path())
-            .output()
-            .unwrap();
-        assert!(out.status.success(), "ffmpeg {args}: {}", stderr(&out));
-    };
+    let ffmpeg = |args: &str| run_ffmpeg(dir.path(), args);
     ffmpeg("-f lavfi -i testsrc2=s=96x64:d=3.3:r=60 -c:v ffv1 r60.mkv");
     ffmpeg("-f lavfi -i testsrc2=s=96x64:d=1:r=24 -c:v ffv1 -f matroska - > piped.mkv");
     let run = |video: &str, extra: &[&str]| {
@@ -211,21 +203,8 @@ fn a_video_past_the_image_limits_is_refused_before_decoding() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
-    let status = Command::new("ffmpeg")
-        .args([
-            "-v",
-            "error",
-            "-y",
-            "-f",
-            "lavfi",
-            "-i",
-            "color=c=gray:s=16400x16:r=24",
-        ])
-        .args(["-frames:v", "2", "-c:v", "ffv1", "wide.mkv"])
-        .current_dir(dir.path())
-        .status()
-        .unwrap();
-    assert!(status.success());
+    let args = "-f lavfi -i color=c=gray:s=16400x16:r=24 -frames:v 2 -c:v ffv1 wide.mkv";
+    run_ffmpeg(dir.path(), args);
     let wide = dir.path().join("wide.mkv");
     let csv = dir.path().join("track.csv");
     let out = track(&wide, &csv);

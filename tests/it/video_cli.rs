@@ -37,6 +37,19 @@ pub(crate) fn has_ffmpeg() -> bool {
     found
 }
 
+/// Runs `ffmpeg -v error -y ARGS` through the shell in `dir` (so ARGS may redirect),
+/// failing the test with what ffmpeg said.
+pub(crate) fn run_ffmpeg(dir: &Path, args: &str) {
+    let out = Command::new("sh")
+        .arg("-c")
+        .arg(format!("ffmpeg -v error -y {args}"))
+        .current_dir(dir)
+        .output()
+        .unwrap();
+    let said = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "ffmpeg {args}: {said}");
+}
+
 /// A plate whose every pixel differs from the other plates' (seeded by `k`).
 pub(crate) fn plate(k: u32, width: u32, height: u32) -> image::RgbImage {
     image::RgbImage::from_fn(width, height, |x, y| {
@@ -670,15 +683,7 @@ fn a_short_video_is_an_animated_source() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
-    let ffmpeg = |args: &str| {
-        let status = Command::new("sh")
-            .arg("-c")
-            .arg(format!("ffmpeg -v error -y {args}"))
-            .current_dir(dir.path())
-            .status()
-            .unwrap();
-        assert!(status.success(), "ffmpeg {args}");
-    };
+    let ffmpeg = |args: &str| run_ffmpeg(dir.path(), args);
     ffmpeg("-f lavfi -i testsrc2=s=96x64:r=24 -frames:v 11 -c:v ffv1 short.mkv");
     ffmpeg("-f lavfi -i testsrc2=s=96x64:r=24 -frames:v 1 -c:v ffv1 one.mkv");
     for (video, extra, duration) in [
