@@ -21,6 +21,10 @@ pub const MAX_IMAGE_PIXELS: u64 = 64 * 1024 * 1024;
 pub const MAX_MESH_VERTICES: usize = 2_000_000;
 /// Most frames a scene may have (`check` evaluates every one of them).
 pub const MAX_FRAMES: u64 = 1_000_000;
+/// Largest file number a numbered sequence may start at (a scene's `…_start_number`,
+/// `track --start`): plates past it, counted up to [`MAX_FRAMES`] on, stay far from
+/// overflowing a frame number.
+pub const MAX_START_NUMBER: u64 = 1_000_000_000_000_000;
 /// Largest scene or module file, bytes: far beyond any hand-written or generated scene, and
 /// small enough that its text, its errors and the REPL's copy of it stay cheap.
 pub const MAX_SCENE_BYTES: u64 = 16 << 20;

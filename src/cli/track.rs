@@ -40,7 +40,8 @@ pub struct TrackArgs {
     #[arg(long, value_name = "A..B", value_parser = frame_range)]
     pub frames: Option<FrameRange>,
     /// The file number of frame 1 of a pattern (default: the lowest number with a file).
-    #[arg(long, value_name = "N", allow_hyphen_values = true)]
+    #[arg(long, value_name = "N", allow_hyphen_values = true,
+          value_parser = clap::value_parser!(u64).range(..=lapclone::limits::MAX_START_NUMBER))]
     pub start: Option<u64>,
     /// The rate a video is decoded at, frames per second (as the scene's `fps`).
     #[arg(long, default_value_t = 24.0, value_parser = super::finite_f64,

@@ -63,8 +63,10 @@ pub fn footage_option(
 
 fn frame_number(value: &rhai::Dynamic, what: &str) -> Result<u64, String> {
     let n = values::number(value, what)?;
-    if n.fract() != 0.0 || !(0.0..=1e15).contains(&n) {
-        return Err(format!("`{what}` must be a whole number ≥ 0, not {n}"));
+    let max = crate::limits::MAX_START_NUMBER;
+    if n.fract() != 0.0 || !(0.0..=max as f64).contains(&n) {
+        let n = crate::util::number_text(n);
+        return Err(format!("`{what}` must be a whole number in [0, {max}], not {n}"));
     }
     Ok(n as u64)
 }

@@ -201,7 +201,7 @@ fn bad_points_and_ranges_are_usage_errors_that_write_nothing() {
         )
         .unwrap();
     }
-    let cases: [(&[&str], &str); 6] = [
+    let cases: [(&[&str], &str); 7] = [
         // A negative coordinate is a value, not a flag: the point is refused for where it is.
         (&["--point", "-5,10"], "outside the first frame"),
         (&["--point", "nan,3"], "not a finite number"),
@@ -212,6 +212,11 @@ fn bad_points_and_ranges_are_usage_errors_that_write_nothing() {
         (&["--point", "100,100", "--size", "0"], "between 5 and 255"),
         (&["--point", "1e8,5"], "outside the first frame"),
         (&["--point", "1e12,5"], "1e12 is past ±1e9 px"),
+        // Plate numbers counted on from it would wrap around (all frames read one file).
+        (
+            &["--point", "100,100", "--start", "18446744073709551615"],
+            "is not in 0..=1000000000000000",
+        ),
     ];
     for (args, message) in cases {
         let mut command = Command::new(env!("CARGO_BIN_EXE_lapclone"));
