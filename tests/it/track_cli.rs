@@ -290,3 +290,35 @@ fn a_gap_in_the_plates_is_named_and_flags_are_checked_first() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--size 0 must be between 5"));
 }
+
+/// A plate or video path that holds something other than a file says what it holds: the
+/// first plate a folder, a video a FIFO (a FIFO could also never be read to its end).
+#[cfg(unix)]
+#[test]
+fn a_plate_or_video_that_is_no_file_says_what_it_is() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir(dir.path().join("f_0001.jpg")).unwrap();
+    std::fs::copy(asset("chelsea.png"), dir.path().join("f_0002.jpg")).unwrap();
+    let fifo = dir.path().join("clip.mp4");
+    let made = Command::new("mkfifo").arg(&fifo).status().unwrap();
+    assert!(made.success());
+    for (footage, message) in [
+        (
+            dir.path().join("f_%04d.jpg"),
+            "f_0001.jpg is a folder, not a file",
+        ),
+        (fifo, "clip.mp4 is not a regular file (a FIFO)"),
+    ] {
+        let out = Command::new(env!("CARGO_BIN_EXE_lapclone"))
+            .arg("track")
+            .arg(&footage)
+            .args(["--point", "10,10", "-o"])
+            .arg(dir.path().join("track.csv"))
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{stderr}");
+        assert!(stderr.contains(message), "{stderr}");
+        assert!(!dir.path().join("track.csv").exists());
+    }
+}

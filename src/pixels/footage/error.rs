@@ -28,6 +28,15 @@ pub enum FootageError {
     /// The path (or a frame's file) is a folder.
     #[error("{} is a folder, not an image or video", .0.display())]
     IsFolder(PathBuf),
+    /// A plate or video path holds something other than a regular file (a FIFO, a device,
+    /// a dangling link; a plate that is a folder).
+    #[error("{} {kind}", file.display())]
+    NotAFile {
+        /// The path.
+        file: PathBuf,
+        /// What it is instead, as a phrase ("is not a regular file (a FIFO)").
+        kind: &'static str,
+    },
     /// The video file does not exist.
     #[error("{} not found", .0.display())]
     NotFound(PathBuf),

@@ -64,6 +64,18 @@ pub struct Footage {
     pub hold_key: String,
 }
 
+/// Why `file` (a plate or a video) cannot be read, when it is there but is no regular file
+/// (a FIFO, a device, a dangling link, a folder); `None` when it is a file or is missing.
+pub(super) fn not_a_file_error(file: &Path) -> Option<FootageError> {
+    match crate::util::not_a_file(file) {
+        None | Some("does not exist") => None,
+        Some(kind) => Some(FootageError::NotAFile {
+            file: file.to_path_buf(),
+            kind,
+        }),
+    }
+}
+
 impl Footage {
     /// Opens footage at `path`: a printf-style pattern of numbered images
     /// (`plates/frame_%04d.png`) or a video file (`.mp4`, `.mov`, `.webm`, `.mkv`, read
@@ -81,7 +93,8 @@ impl Footage {
         }
         let (source, (width, height)) = if is_video_path(path) {
             if !path.is_file() {
-                return Err(FootageError::NotFound(path.to_path_buf()));
+                let missing = || FootageError::NotFound(path.to_path_buf());
+                return Err(not_a_file_error(path).unwrap_or_else(missing));
             }
             (FootageSource::Video(path.to_path_buf()), probe::probe_video(path)?)
         } else {
@@ -92,6 +105,9 @@ impl Footage {
                 None => pattern.lowest_number()?,
             };
             let first = pattern.path(start);
+            if let Some(error) = not_a_file_error(&first) {
+                return Err(error);
+            }
             if !first.is_file() {
                 return Err(FootageError::MissingFrame {
                     frame: 1,

@@ -74,7 +74,8 @@ impl FootageReader {
             return Err(FootageError::IsFolder(file));
         }
         if !file.is_file() {
-            return Err(self.footage.missing(index, file));
+            let missing = || self.footage.missing(index, file.clone());
+            return Err(super::not_a_file_error(&file).unwrap_or_else(missing));
         }
         let image = FloatImage::load(&file).map_err(|e| FootageError::Image(Box::new(e)))?;
         let size = (image.width(), image.height());
