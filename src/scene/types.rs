@@ -193,6 +193,16 @@ pub enum ModelError {
     /// The duration is not a positive finite number.
     #[error("duration {0} must be a finite number > 0")]
     Duration(f64),
+    /// The duration at the frame rate gives more frames than `limits::MAX_FRAMES`.
+    #[error(
+        "duration {duration} s at {fps} fps is {frames} frames, over the limit of {max} \
+         frames per scene",
+        duration = crate::util::number_text(*.0),
+        fps = crate::util::number_text(*.1),
+        frames = crate::util::number_text((.0 * .1).ceil()),
+        max = crate::limits::MAX_FRAMES
+    )]
+    TooLong(f64, f64),
     /// The background colour has a channel outside [0, 1].
     #[error("background colour channels must be finite and in [0, 1]")]
     Colour,
@@ -239,7 +249,10 @@ impl Canvas {
         let limit = |e| ModelError::CanvasLimit(self.width, self.height, e);
         crate::limits::check_image_size(u64::from(self.width), u64::from(self.height))
             .map_err(limit)?;
-        crate::limits::check_frame_count(self.frame_count()).map_err(limit)?;
+        // Decided on the product, not the saturated count, so the message names it.
+        if crate::limits::check_frame_count(self.frame_count()).is_err() {
+            return Err(ModelError::TooLong(self.duration, self.fps));
+        }
         if let Background::Colour(c) = &self.background {
             if !c.iter().all(|v| v.is_finite() && (0.0..=1.0).contains(v)) {
                 return Err(ModelError::Colour);
