@@ -35,6 +35,10 @@ struct Keys {
     scale: Vec<(f64, f64)>,
 }
 
+/// Most values one line holds: a key has a frame and up to three, other sections' lines a
+/// few more; the bound keeps one huge line from becoming a huge list.
+const MAX_CELLS: usize = 64;
+
 /// The rows of the one point keyframe data holds.
 pub(super) fn parse(text: &str) -> Result<Vec<Vec<TrackRow>>, Failure> {
     let mut keys = Keys::default();
@@ -43,7 +47,15 @@ pub(super) fn parse(text: &str) -> Result<Vec<Vec<TrackRow>>, Failure> {
     let lines = super::numbered_lines(text).skip_while(|(_, l)| l.trim().is_empty());
     for (number, line) in lines.skip(1) {
         last_line = number;
-        let cells: Vec<&str> = line.split('\t').map(str::trim).filter(|c| !c.is_empty()).collect();
+        let cells: Vec<&str> = line
+            .split('\t')
+            .map(str::trim)
+            .filter(|c| !c.is_empty())
+            .take(MAX_CELLS + 1)
+            .collect();
+        if cells.len() > MAX_CELLS {
+            return Err((number, format!("more than {MAX_CELLS} values on one line")));
+        }
         match cells.as_slice() {
             [] => continue,
             ["End of Keyframe Data"] => break,
@@ -58,7 +70,7 @@ pub(super) fn parse(text: &str) -> Result<Vec<Vec<TrackRow>>, Failure> {
                 if section == Section::Header {
                     header_line(&mut keys, number, &cells)?;
                 } else if *first != "Frame" && section != Section::Other {
-                    return Err((number, format!("`{first}` is not a frame number")));
+                    return Err((number, format!("`{}` is not a frame number", super::shown(first))));
                 }
             }
             _ => key_line(&mut keys, section, number, &cells)?,
@@ -99,7 +111,7 @@ fn key_line(keys: &mut Keys, section: Section, number: usize, cells: &[&str]) ->
             c.parse::<f64>()
                 .ok()
                 .filter(|v| v.is_finite())
-                .ok_or_else(|| (number, format!("`{c}` is not a number")))
+                .ok_or_else(|| (number, format!("`{}` is not a number", super::shown(c))))
         })
         .collect::<Result<Vec<f64>, Failure>>()?;
     let need = match section {

@@ -72,19 +72,6 @@ const COLUMNS: [(&str, Column); 8] = [
 
 type Failure = (usize, String);
 
-/// Most characters of a file's text an error quotes.
-const SHOWN: usize = 60;
-
-/// `text` as an error quotes it: at most [`SHOWN`] characters, control characters escaped.
-fn shown(text: &str) -> String {
-    let mut out: String = text.chars().take(SHOWN).flat_map(char::escape_debug).collect();
-    let length = text.chars().count();
-    if length > SHOWN {
-        out.push_str(&format!("… ({length} characters)"));
-    }
-    out
-}
-
 /// Each point's rows from CSV `text`, its lines as [`numbered_lines`](super::numbered_lines)
 /// gives them.
 pub(super) fn parse(text: &str) -> Result<Vec<Vec<TrackRow>>, Failure> {
@@ -124,7 +111,9 @@ pub(super) fn parse(text: &str) -> Result<Vec<Vec<TrackRow>>, Failure> {
 }
 
 fn parse_header(line: usize, header: &str) -> Result<Vec<Column>, Failure> {
-    let names: Vec<&str> = header.split(',').map(str::trim).collect();
+    // Past as many names as there are columns one must be unknown or repeated, which the
+    // loop says; the rest of the line stays one slice instead of a list.
+    let names: Vec<&str> = header.splitn(COLUMNS.len() + 1, ',').map(str::trim).collect();
     if names.iter().any(|n| n.parse::<f64>().is_ok()) {
         return Err((
             line,
@@ -139,7 +128,7 @@ fn parse_header(line: usize, header: &str) -> Result<Vec<Column>, Failure> {
             .map(|(_, c)| *c)
             .ok_or_else(|| {
                 let known: Vec<&str> = COLUMNS.iter().map(|(n, _)| *n).collect();
-                let name = shown(name);
+                let name = super::shown(name);
                 (line, format!("unknown column `{name}` (known: {})", known.join(", ")))
             })?;
         if columns.contains(&column) {
@@ -158,13 +147,12 @@ fn parse_header(line: usize, header: &str) -> Result<Vec<Column>, Failure> {
 }
 
 fn parse_row(line: usize, text: &str, columns: &[Column]) -> Result<(usize, TrackRow), Failure> {
-    let cells: Vec<&str> = text.split(',').map(str::trim).collect();
-    if cells.len() != columns.len() {
-        return Err((
-            line,
-            format!("expected {} values, found {}", columns.len(), cells.len()),
-        ));
+    // Counted before any list is made, so a huge line costs no memory.
+    let found = text.bytes().filter(|&b| b == b',').count() + 1;
+    if found != columns.len() {
+        return Err((line, format!("expected {} values, found {found}", columns.len())));
     }
+    let cells: Vec<&str> = text.split(',').map(str::trim).collect();
     let mut row = TrackRow {
         time: TrackTime::Seconds(0.0),
         at: DVec2::ZERO,
@@ -179,7 +167,7 @@ fn parse_row(line: usize, text: &str, columns: &[Column]) -> Result<(usize, Trac
             .parse()
             .ok()
             .filter(|v: &f64| v.is_finite())
-            .ok_or_else(|| (line, format!("column `{name}`: `{}` is not a number", shown(cell))))?;
+            .ok_or_else(|| (line, format!("column `{name}`: `{}` is not a number", super::shown(cell))))?;
         match column {
             Column::Frame => row.time = TrackTime::Frame(whole(line, name, value, u64::MAX)?),
             Column::Seconds if value < 0.0 => {

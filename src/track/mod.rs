@@ -226,6 +226,19 @@ fn wanted(asked: Option<bool>, present: bool, name: &str, path: &Path) -> Result
     }
 }
 
+/// Most characters of a file's text an error quotes.
+const SHOWN: usize = 60;
+
+/// `text` as an error quotes it: at most [`SHOWN`] characters, control characters escaped.
+pub(super) fn shown(text: &str) -> String {
+    let mut out: String = text.chars().take(SHOWN).flat_map(char::escape_debug).collect();
+    let length = text.chars().count();
+    if length > SHOWN {
+        out.push_str(&format!("… ({length} characters)"));
+    }
+    out
+}
+
 /// A track file's lines, numbered from 1, as every reader takes them: a byte-order mark (as
 /// spreadsheets and editors write "UTF-8 with BOM") is skipped, and a line may end in `\n`,
 /// `\r\n` or a lone `\r` (old Mac text), even mixed in one file.

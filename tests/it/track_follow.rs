@@ -285,3 +285,54 @@ fn same_files(mut scene: lapclone::animation::Scene) -> lapclone::animation::Sce
     }
     scene
 }
+
+/// One huge line (16 MB of separators) is refused in about the file's own size: before,
+/// each separator became a list entry and 200 MB of address space was not enough.
+#[cfg(unix)]
+#[test]
+fn one_huge_track_line_is_refused_in_little_memory() {
+    let huge = 8_000_000;
+    let ae_head = "Adobe After Effects 8.0 Keyframe Data\n\n\tUnits Per Second\t6\n\n\
+                   Transform\tPosition\n\tFrame\tX pixels\tY pixels\tZ pixels\n\t";
+    let found = format!("expected 3 values, found {}", huge + 1);
+    let cases: [(&str, String, usize, &str); 3] = [
+        (
+            "a header of commas",
+            format!("{}\n1,2,3\n", ",".repeat(2 * huge)),
+            1,
+            "unknown column ``",
+        ),
+        (
+            "a row of values",
+            format!("frame,x,y\n{}\n", "1,".repeat(huge)),
+            2,
+            &found,
+        ),
+        (
+            "a keyframe line",
+            format!("{ae_head}{}", "1\t".repeat(huge)),
+            7,
+            "more than 64 values",
+        ),
+    ];
+    for (what, text, line, message) in cases {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("track.csv"), text).unwrap();
+        let scene = dir.path().join("scene.rhai");
+        std::fs::write(&scene, scene_text("p.follow(\"track.csv\");\n")).unwrap();
+        // 200 MB of address space: the binary and a 16 MB file fit, a list per separator not.
+        let out = Command::new("sh")
+            .arg("-c")
+            .arg("ulimit -v 200000 && exec \"$0\" check \"$1\"")
+            .arg(env!("CARGO_BIN_EXE_lapclone"))
+            .arg(&scene)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{what}: {stderr}");
+        assert!(
+            stderr.contains(&format!("track.csv:{line}: {message}")),
+            "{what}: {stderr}"
+        );
+    }
+}
