@@ -148,6 +148,40 @@ fn start_number_and_hold_pick_the_plates() {
     assert_eq!(corner(3)[..3], plate_corner(1));
 }
 
+/// With the last plate held, a plate in the middle that is there but no file (a FIFO, a
+/// folder) is an error naming it: it does not end the footage early, silently.
+#[cfg(unix)]
+#[test]
+fn a_plate_that_is_no_file_is_an_error_even_when_the_last_one_holds() {
+    for (kind, message) in [
+        ("fifo", "is not a regular file (a FIFO)"),
+        ("folder", "is a folder, not a file"),
+    ] {
+        let dir = tempfile::tempdir().unwrap();
+        write_plates(dir.path(), 2, 1);
+        let odd = dir.path().join("plates/frame_0003.png");
+        if kind == "fifo" {
+            assert!(Command::new("mkfifo").arg(&odd).status().unwrap().success());
+        } else {
+            std::fs::create_dir(&odd).unwrap();
+        }
+        plate(3, W, H)
+            .save(dir.path().join("plates/frame_0004.png"))
+            .unwrap();
+        let canvas = "canvas(#{ fps: 3, duration: 2, background: \"plates/frame_%04d.png\", background_hold: true });";
+        let scene = write_scene(dir.path(), canvas, PATCH);
+        let out = dir.path().join("out");
+        let o = render(&scene, &out, &[]);
+        assert_eq!(o.status.code(), Some(1), "{kind}: {}", stderr(&o));
+        assert!(
+            stderr(&o).contains(&format!("frame_0003.png {message}")),
+            "{kind}: {}",
+            stderr(&o)
+        );
+        assert!(!out.exists(), "{kind}");
+    }
+}
+
 #[test]
 fn an_alternating_source_alternates_the_patch_with_one_factorisation() {
     let dir = tempfile::tempdir().unwrap();

@@ -153,6 +153,11 @@ impl Footage {
                 for i in 0..frames {
                     let file = pattern.path(start + i);
                     if !file.is_file() {
+                        // Only a missing plate ends the run a hold keeps: a FIFO or a folder
+                        // in the middle is an error, not the footage's end.
+                        if let Some(error) = not_a_file_error(&file) {
+                            return Err(error);
+                        }
                         if self.hold && i > 0 {
                             return Ok(());
                         }

@@ -62,10 +62,18 @@ impl FootageReader {
     ) -> Result<FloatImage, FootageError> {
         // Saturating: a time far beyond any footage names a far frame, never frame 0.
         let mut file = pattern.path(start.saturating_add(index));
-        if !file.is_file() && self.footage.hold {
-            // The last file of the unbroken run from the start holds.
+        if self.footage.hold && !file.is_file() && super::not_a_file_error(&file).is_none() {
+            // The last file of the unbroken run from the start holds; the run ends at a
+            // missing plate, and one that is there but no file is an error.
             let mut last = 0;
-            while last < index && pattern.path(start + last + 1).is_file() {
+            while last < index {
+                let next = pattern.path(start + last + 1);
+                if let Some(error) = super::not_a_file_error(&next) {
+                    return Err(error);
+                }
+                if !next.is_file() {
+                    break;
+                }
                 last += 1;
             }
             file = pattern.path(start + last);
