@@ -925,3 +925,37 @@ fn a_request_head_sent_a_byte_at_a_time_times_out_as_a_whole() {
     assert!(answer.contains("did not arrive within 5 s"), "{answer:?}");
     assert!(repl.finish().success());
 }
+
+/// A request head past the size limit sent whole is answered `431` and the answer arrives:
+/// closing with the rest of the head unread would reset the connection and could drop it.
+#[test]
+fn an_oversized_request_head_gets_its_answer_not_a_reset() {
+    use std::io::Read as _;
+    let dir = tempfile::tempdir().unwrap();
+    let scene = cat_scene(dir.path());
+    let repl = ViewRepl::start(dir.path(), &scene);
+    for round in 0..5 {
+        let mut stream = TcpStream::connect(repl.host()).unwrap();
+        stream.set_read_timeout(Some(WAIT)).unwrap();
+        let filler = "a".repeat(200_000);
+        let request = format!(
+            "GET / HTTP/1.1\r\nHost: {}\r\nX-Big: {filler}\r\n\r\n",
+            repl.host()
+        );
+        // The server may stop reading (and answer) before all of it is sent.
+        let _ = stream.write_all(request.as_bytes());
+        let mut answer = Vec::new();
+        let read = stream.read_to_end(&mut answer);
+        let answer = String::from_utf8_lossy(&answer);
+        assert!(read.is_ok(), "round {round}: {read:?} after {answer:?}");
+        assert!(
+            answer.starts_with("HTTP/1.1 431"),
+            "round {round}: {answer:?}"
+        );
+        assert!(
+            answer.contains("request head too large"),
+            "round {round}: {answer:?}"
+        );
+    }
+    assert!(repl.finish().success());
+}

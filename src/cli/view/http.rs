@@ -18,6 +18,10 @@ use super::edit::MAX_MESSAGE_BYTES;
 const MAX_HEAD: usize = 8 * 1024;
 /// How long a client may take to send its whole request head.
 const HEAD_TIMEOUT: Duration = Duration::from_secs(5);
+/// After a refusal, how long and how much of what the client still sends is read and
+/// dropped before the connection closes (see [`close_gently`]).
+const LINGER: Duration = Duration::from_secs(1);
+const LINGER_BYTES: usize = 1 << 20;
 
 /// What the server answers with: its token, the page, and the `host:port` names it goes by.
 pub struct Routes {
@@ -45,6 +49,7 @@ pub fn accept(mut stream: TcpStream, routes: &Routes) -> std::io::Result<Accepte
         Err(Refusal(status, body)) => {
             let kind = "text/plain; charset=utf-8";
             respond(&mut stream, status, kind, body.as_bytes(), &[])?;
+            close_gently(stream);
             Ok(Accepted::Answered)
         }
         Ok((Route::Page, _)) => {
@@ -77,7 +82,29 @@ pub fn refuse_busy(mut stream: TcpStream, limit: usize) {
         body.as_bytes(),
         &[],
     );
+    close_gently(stream);
+}
+
+/// Closes a connection after its answer without resetting the answer away: closing with
+/// unread input (a head past the limit, a request still arriving) sends a reset, and the
+/// client's system may then drop the answer unread. So the answer is ended, and what the
+/// client still sends is read and dropped until it closes, for at most [`LINGER`] and
+/// [`LINGER_BYTES`].
+fn close_gently(mut stream: TcpStream) {
     let _ = stream.shutdown(std::net::Shutdown::Write);
+    let deadline = Instant::now() + LINGER;
+    let mut sink = [0u8; 8192];
+    let mut read = 0;
+    while read < LINGER_BYTES {
+        let left = deadline.saturating_duration_since(Instant::now());
+        if left.is_zero() || stream.set_read_timeout(Some(left)).is_err() {
+            return;
+        }
+        match stream.read(&mut sink) {
+            Ok(0) | Err(_) => return,
+            Ok(n) => read += n,
+        }
+    }
 }
 
 /// The page, with headers that keep it out of frames and caches and its scripts its own.
