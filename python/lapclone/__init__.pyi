@@ -167,7 +167,7 @@ class Scene:
     def __getitem__(self, index: int) -> Image:
         """``frame(index)``."""
     def __iter__(self) -> Iterator[Image]:
-        """Every frame in order."""
+        """Every frame in order (Ctrl-C stops between frames, in ``list(scene)`` too)."""
     def render(
         self, path: Union[str, PathLike[str]], format: Optional[str] = None
     ) -> str:
@@ -183,6 +183,8 @@ class Scene:
 
         The output appears whole or not at all (a temporary file or folder beside it,
         renamed at the end). A PNG folder holding frame files of another render is refused.
+        Ctrl-C stops the render after the frame in progress and raises
+        ``KeyboardInterrupt``; nothing is written.
 
         Raises ``ValueError`` for an unknown format or extension and for an output that is
         one of the scene's inputs (the scene, its imports, images, plates, videos);

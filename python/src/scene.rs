@@ -3,13 +3,18 @@
 //! gives its frames as arrays: H×W×4 RGBA (or BGRA), `uint8`, or `uint16` for a 16-bit
 //! canvas, the samples `lapclone render` writes to its PNG frames; `.render(path, format)`
 //! writes them to files through the library's output stage, as `lapclone render` does.
+//! Ctrl-C (any exception a signal handler raises) stops a render after the frame in
+//! progress, its output removed, and stops iterating between frames.
 
 use std::path::PathBuf;
-use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::{self, RecvTimeoutError};
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
 
 use lapclone::{Depth, LoadedScene, OutputKind, RenderOptions, Renderer};
 use pyo3::exceptions::{
-    PyFileNotFoundError, PyIndexError, PyIsADirectoryError, PyRuntimeError, PyValueError,
+    PyFileNotFoundError, PyIndexError, PyIsADirectoryError, PyOSError, PyRuntimeError, PyValueError,
 };
 use pyo3::prelude::*;
 
@@ -141,7 +146,8 @@ impl Scene {
     /// byte for byte, and returns the path written. `format` is "png" (a folder of
     /// frame_NNNN.png), "gif", "apng", "y4m", "mp4", "webm" or "mov" (the last three through
     /// ffmpeg); without it, the path's extension names the format (no extension, or .png: a
-    /// folder). The GIL is released while it renders.
+    /// folder). The GIL is released while it renders. Ctrl-C stops it after the frame in
+    /// progress: KeyboardInterrupt is raised and nothing is written.
     #[pyo3(signature = (path, format=None))]
     fn render(&self, py: Python<'_>, path: PathBuf, format: Option<&str>) -> PyResult<String> {
         if path.as_os_str().is_empty() {
@@ -151,11 +157,13 @@ impl Scene {
             .map(OutputKind::from_name)
             .transpose()
             .map_err(|e| output_error(py, e))?;
+        let cancel = Arc::new(AtomicBool::new(false));
         let options = RenderOptions {
             format,
+            cancel: Some(cancel.clone()),
             ..RenderOptions::default()
         };
-        let rendered = py.allow_threads(|| {
+        let rendered = until_signal(py, &cancel, || {
             let mut renderer = self.renderer()?;
             Ok::<_, PyErr>(lapclone::render_scene(
                 &self.loaded,
@@ -165,7 +173,7 @@ impl Scene {
                 &options,
                 &mut (),
             ))
-        })?;
+        })??;
         match rendered {
             Ok(rendered) => Ok(rendered.path.display().to_string()),
             Err(error) => Err(output_error(py, error)),
@@ -222,6 +230,8 @@ impl SceneFrames {
 
     fn __next__<'py>(&mut self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
         let scene = self.scene.get();
+        // `list(scene)` runs no Python between frames, so nothing else would look for Ctrl-C.
+        py.check_signals()?;
         if self.next >= scene.frames {
             return Ok(None);
         }
@@ -229,4 +239,57 @@ impl SceneFrames {
         self.next += 1;
         Ok(Some(frame))
     }
+}
+
+/// How often a render's caller looks for a signal while the render runs.
+const SIGNAL_POLL: Duration = Duration::from_millis(50);
+
+/// Runs `work` on a thread of its own, with the GIL released, while this thread runs
+/// Python's signal handlers every [`SIGNAL_POLL`] (they only run on the main thread, and
+/// only while it holds the GIL). When a handler raises (KeyboardInterrupt for Ctrl-C),
+/// `cancel` is raised, `work` is waited for (a render stops after the frame in progress and
+/// removes its output) and the handler's exception is returned instead of `work`'s result.
+fn until_signal<T: Send>(
+    py: Python<'_>,
+    cancel: &AtomicBool,
+    work: impl FnOnce() -> T + Send,
+) -> PyResult<T> {
+    std::thread::scope(|scope| {
+        // The sender is dropped when `work` returns or unwinds: the wait below then ends.
+        let (running, finished) = mpsc::channel::<()>();
+        let worker = std::thread::Builder::new()
+            .name("lapclone render".into())
+            .spawn_scoped(scope, move || {
+                let _running = running;
+                work()
+            })
+            .map_err(|e| PyOSError::new_err(format!("cannot start the render thread: {e}")))?;
+        let mut interrupt = None;
+        let mut finished = finished;
+        loop {
+            // The receiver goes to the GIL-free wait and back (it cannot be shared).
+            let waited = py.allow_threads(move || {
+                let waited = finished.recv_timeout(SIGNAL_POLL);
+                (finished, waited)
+            });
+            finished = waited.0;
+            if waited.1 != Err(RecvTimeoutError::Timeout) {
+                break;
+            }
+            if interrupt.is_none() {
+                if let Err(error) = py.check_signals() {
+                    cancel.store(true, Ordering::Relaxed);
+                    interrupt = Some(error);
+                }
+            }
+        }
+        // `work` has returned or unwound: the join waits only for its thread to end.
+        let result = worker
+            .join()
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+        match interrupt {
+            Some(error) => Err(error),
+            None => Ok(result),
+        }
+    })
 }
