@@ -21,6 +21,27 @@ pub enum Dtype {
     U16,
 }
 
+impl Dtype {
+    /// numpy's name of the dtype, as messages give it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Dtype::U8 => "uint8",
+            Dtype::U16 => "uint16",
+        }
+    }
+}
+
+/// A shape (or strides) as numpy writes it: `(64, 96, 3)`, `(5,)`, `()`.
+fn tuple_text<T: std::fmt::Display>(items: &[T]) -> String {
+    match items {
+        [one] => format!("({one},)"),
+        _ => {
+            let items: Vec<String> = items.iter().map(T::to_string).collect();
+            format!("({})", items.join(", "))
+        }
+    }
+}
+
 /// An input array's layout, given back to outputs: rows, columns, channels (`None` for a
 /// 2-D grey array) and sample type.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -54,10 +75,11 @@ impl Layout {
         }
     }
 
+    /// The array's shape as numpy writes it: `(height, width)` or `(height, width, channels)`.
     fn shape_text(&self) -> String {
         match self.channels {
-            None => format!("{}×{}", self.height, self.width),
-            Some(c) => format!("{}×{}×{c}", self.height, self.width),
+            None => tuple_text(&[self.height, self.width]),
+            Some(c) => tuple_text(&[self.height, self.width, c]),
         }
     }
 }
@@ -108,26 +130,35 @@ pub fn layout_of(object: &Bound<'_, PyAny>, what: &str, allow_bool: bool) -> PyR
         [h, w, c] if matches!(c, 1 | 3 | 4) => (h, w, Some(c)),
         _ => {
             return Err(PyValueError::new_err(format!(
-                "{what} must be H×W (grey) or H×W×C with C = 1, 3 or 4, not of shape {shape:?}"
+                "{what} must have shape (H, W) (grey) or (H, W, C) with C = 1, 3 or 4, not {}",
+                tuple_text(shape)
             )))
         }
     };
     if height == 0 || width == 0 {
         return Err(PyValueError::new_err(format!(
-            "{what} is empty ({height}×{width} pixels)"
+            "{what} is empty: shape {}",
+            tuple_text(shape)
         )));
     }
     // The limits of every image lapclone reads, before anything of that size is allocated.
-    let (w, h) = (width as u64, height as u64);
-    lapclone::check_image_size(w, h).map_err(|e| PyValueError::new_err(format!("{what}: {e}")))?;
+    if lapclone::check_image_size(width as u64, height as u64).is_err() {
+        return Err(PyValueError::new_err(format!(
+            "{what} of shape {} exceeds the image size limit (at most {} px per side and {} \
+             pixels)",
+            tuple_text(shape),
+            lapclone::MAX_IMAGE_SIDE,
+            lapclone::MAX_IMAGE_PIXELS
+        )));
+    }
     // A view into packed records (a uint16 field after a byte) steps by part of a sample;
     // numpy's strides in bytes would be read as whole samples.
     let itemsize = array.dtype().itemsize() as isize;
     if array.strides().iter().any(|s| s % itemsize != 0) {
         return Err(PyValueError::new_err(format!(
-            "{what} steps by fractions of a sample (strides {:?} bytes for {itemsize}-byte \
+            "{what} steps by fractions of a sample (strides {} bytes for {itemsize}-byte \
              samples); pass numpy.ascontiguousarray({what})",
-            array.strides()
+            tuple_text(array.strides())
         )));
     }
     Ok(Layout {
@@ -607,11 +638,11 @@ pub fn check_out(out: &Bound<'_, PyAny>, layout: &Layout) -> PyResult<()> {
     let out_layout = layout_of(out, "out", false)?;
     if out_layout != *layout {
         return Err(PyValueError::new_err(format!(
-            "out must be a {} {:?} array like the target, not {} {:?}",
+            "out must be a {} array of shape {}, as the target is, not a {} array of shape {}",
+            layout.dtype.name(),
             layout.shape_text(),
-            layout.dtype,
-            out_layout.shape_text(),
-            out_layout.dtype
+            out_layout.dtype.name(),
+            out_layout.shape_text()
         )));
     }
     Ok(())

@@ -339,8 +339,8 @@ pub fn seamless_clone<'py>(
     let mask_layout = arrays::layout_of(mask, "mask", true)?;
     if (mask_layout.height, mask_layout.width) != (src_layout.height, src_layout.width) {
         return Err(PyValueError::new_err(format!(
-            "mask is {}×{} pixels but src is {}×{}: they must be the same size",
-            mask_layout.width, mask_layout.height, src_layout.width, src_layout.height
+            "mask has height and width ({}, {}) but src ({}, {}): they must be the same",
+            mask_layout.height, mask_layout.width, src_layout.height, src_layout.width
         )));
     }
     let options = CloneOptions {

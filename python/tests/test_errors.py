@@ -342,3 +342,47 @@ def test_a_frame_that_fails_raises_the_scene_error_render_raises(tmp_path):
     with pytest.raises(lapclone.SceneError) as rendered:
         scene.render(str(tmp_path / "out.gif"))
     assert rendered.value.line == caught.value.line
+
+
+@pytest.mark.parametrize(
+    "out, message",
+    [
+        (np.zeros((60, 70, 3), np.uint16),
+         "out must be a uint8 array of shape (60, 70, 3), as the target is, "
+         "not a uint16 array of shape (60, 70, 3)"),
+        (np.zeros((70, 60, 3), np.uint8),
+         "out must be a uint8 array of shape (60, 70, 3), as the target is, "
+         "not a uint8 array of shape (70, 60, 3)"),
+        (np.zeros((60, 70), np.uint8),
+         "out must be a uint8 array of shape (60, 70, 3), as the target is, "
+         "not a uint8 array of shape (60, 70)"),
+        (np.zeros((60, 70, 3), np.float32), "out must have dtype uint8 or uint16, not float32"),
+        (np.zeros((60, 70, 2), np.uint8),
+         "out must have shape (H, W) (grey) or (H, W, C) with C = 1, 3 or 4, not (60, 70, 2)"),
+        (np.zeros(60, np.uint8),
+         "out must have shape (H, W) (grey) or (H, W, C) with C = 1, 3 or 4, not (60,)"),
+    ],
+)
+def test_a_wrong_out_array_is_named_as_numpy_names_it(out, message):
+    with pytest.raises(ValueError) as caught:
+        lapclone.Cloner(SRC, MASK).clone(DST, (35, 30), out=out)
+    assert str(caught.value) == message
+
+
+@pytest.mark.parametrize(
+    "call, message",
+    [
+        (lambda: lapclone.Cloner(SRC, MASK).clone(DST[:, :0], (35, 30)),
+         "target is empty: shape (60, 0, 3)"),
+        (lambda: lapclone.seamless_clone(SRC, DST, MASK[:39], (35, 30)),
+         "mask has height and width (39, 50) but src (40, 50): they must be the same"),
+        (lambda: lapclone.mesh(np.broadcast_to(np.uint8(255), (20000, 10))),
+         "mask of shape (20000, 10) exceeds the image size limit"),
+    ],
+)
+def test_array_sizes_are_numpy_shapes(call, message):
+    with pytest.raises(ValueError) as caught:
+        call()
+    assert str(caught.value).startswith(message), str(caught.value)
+    assert "×" not in str(caught.value)
+
