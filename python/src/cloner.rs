@@ -12,7 +12,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use crate::arrays::{self, Layout};
-use crate::errors::{to_py, InRange};
+use crate::errors::{clone_error, to_py, InRange};
 use crate::patch::{Patch, Pose, MASK_THRESHOLD};
 
 /// `cv2.NORMAL_CLONE`.
@@ -379,7 +379,7 @@ pub fn mesh<'py>(
     let size = (mask.image.width(), mask.image.height());
     let patch = py.allow_threads(|| {
         let bits = BitMask::from_image(&mask.image, MASK_THRESHOLD);
-        mesh_from_mask(&bits, None, size, &options).map_err(to_py)
+        mesh_from_mask(&bits, None, size, &options).map_err(clone_error)
     })?;
     let mesh = &patch.result.mesh;
     let vertices: Vec<[f64; 2]> = mesh.positions.iter().map(|p| [p.x, p.y]).collect();

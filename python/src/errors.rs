@@ -2,9 +2,11 @@
 //! `ValueError` with lapclone's message, `FileNotFoundError` for a missing file, and
 //! `lapclone.SceneError` (with `file`, `line` and `column`) for a scene file's errors; an
 //! output's errors as `ValueError` (bad format, an output that is an input),
-//! `FileNotFoundError` (missing folder) or `OSError` (the write failed).
+//! `FileNotFoundError` (missing folder) or `OSError` (the write failed). A clone's errors
+//! that would name what only the CLI has (a mask offset, a vertex budget) say what Python's
+//! API can do instead.
 
-use lapclone::OutputError;
+use lapclone::{CloneError, MeshError, OutputError};
 use pyo3::exceptions::{
     PyFileNotFoundError, PyIndexError, PyIsADirectoryError, PyNotADirectoryError, PyOSError,
     PyOverflowError, PyValueError,
@@ -23,6 +25,33 @@ pyo3::create_exception!(
 /// arrays): a `ValueError`.
 pub fn to_py(error: impl std::fmt::Display) -> PyErr {
     PyValueError::new_err(error.to_string())
+}
+
+/// A meshing or cloning error as a `ValueError`, in terms of what `Cloner` and `mesh` take:
+/// no mask offset (a mask has the source's height and width) and no `max_vertices` (density,
+/// or a simpler mask, gives fewer vertices); sizes in numpy's order, (height, width).
+pub fn clone_error(error: CloneError) -> PyErr {
+    let message = match error {
+        CloneError::MaskSize { mask, source_size } => format!(
+            "mask has height and width ({}, {}) but source ({}, {}): they must be the same; \
+             crop or pad the mask to the source's size",
+            mask.1, mask.0, source_size.1, source_size.0
+        ),
+        CloneError::Mesh(MeshError::VertexBudget {
+            max_vertices,
+            needed,
+        }) => format!(
+            "the mask's boundary needs {needed} vertices at this density, more than the \
+             {max_vertices} a patch mesh may have: raise density (the longest boundary edge, \
+             in pixels) or use a mask of fewer, larger pieces and holes"
+        ),
+        CloneError::Mesh(MeshError::BoundaryTooLong { edges, max_edges }) => format!(
+            "the mask's boundary has {edges} pixel edges, more than the {max_edges} a patch \
+             mesh allows: use a smoother mask (fewer, larger pieces and holes)"
+        ),
+        other => other.to_string(),
+    };
+    PyValueError::new_err(message)
 }
 
 /// A number argument of type `T` whose value outside `T`'s range (a negative thread count,

@@ -14,7 +14,7 @@ use lapclone::{
 use pyo3::prelude::*;
 
 use crate::arrays::{self, Layout, Picture, Rect};
-use crate::errors::to_py;
+use crate::errors::{clone_error, to_py};
 
 /// The mask threshold of `lapclone clone` (`--threshold` default): inside where the mask's
 /// luma (or alpha, if it has one) is at least half scale.
@@ -66,11 +66,12 @@ impl Patch {
             let bits = BitMask::from_image(&mask.image, MASK_THRESHOLD);
             let size = (source.image.width(), source.image.height());
             let patch: PatchMesh =
-                mesh_from_mask(&bits, None, size, mesh_options).map_err(to_py)?;
+                mesh_from_mask(&bits, None, size, mesh_options).map_err(clone_error)?;
             let source = lapclone::FloatImage::from_dynamic(&source.image).map_err(to_py)?;
             let bbox = (patch.bbox_min, patch.bbox_max, patch.default_drag_radius());
             let triangles = patch.result.mesh.triangles.len();
-            let mut cloner = PatchCloner::new(source, patch.result.mesh, options).map_err(to_py)?;
+            let mut cloner =
+                PatchCloner::new(source, patch.result.mesh, options).map_err(clone_error)?;
             // Unless told otherwise every core, as `lapclone clone` uses (the pixels are the same
             // for any count); looked up once per process, since the look-up reads cgroup files.
             cloner.set_raster_threads(threads.unwrap_or_else(lapclone::available_cores));

@@ -386,3 +386,24 @@ def test_array_sizes_are_numpy_shapes(call, message):
     assert str(caught.value).startswith(message), str(caught.value)
     assert "×" not in str(caught.value)
 
+
+def test_a_mask_of_another_size_names_no_mask_offset():
+    # `lapclone clone` takes --mask-offset for a smaller mask; Cloner takes none.
+    with pytest.raises(ValueError) as caught:
+        lapclone.Cloner(SRC, MASK[:39])
+    message = str(caught.value)
+    assert message.startswith("mask has height and width (39, 50) but source (40, 50)"), message
+    assert "crop or pad the mask" in message and "offset" not in message
+
+
+def test_a_boundary_past_the_vertex_budget_names_density_not_max_vertices():
+    # 562,500 pieces of 2×2 pixels: 2,250,000 boundary vertices, past the 2,000,000 a mesh
+    # may have; Python has no max_vertices to raise.
+    mask = np.zeros((3000, 3000), np.uint8)
+    mask.reshape(750, 4, 750, 4)[:, :2, :, :2] = 255
+    for call in (lambda: lapclone.mesh(mask), lambda: lapclone.Cloner(mask, mask)):
+        with pytest.raises(ValueError) as caught:
+            call()
+        message = str(caught.value)
+        assert "2250000 vertices" in message and "raise density" in message, message
+        assert "max_vertices" not in message, message
