@@ -62,7 +62,8 @@ pub enum MeshError {
     /// `max_vertices` is below what the boundary alone needs.
     #[error(
         "vertex budget of {max_vertices} is below the {needed} boundary vertices this mask needs; \
-         raise max_vertices or the density (max boundary edge length)"
+         raise the density (the longest boundary edge, px), use a mask with a shorter outline, \
+         or raise the budget where it is set (max_vertices; `lapclone mesh --max-vertices`)"
     )]
     VertexBudget {
         /// The budget.
@@ -73,7 +74,8 @@ pub enum MeshError {
     /// The mask's boundary is too long for the vertex budget.
     #[error(
         "the mask's boundary has {edges} pixel edges, more than the {max_edges} the vertex \
-         budget allows (16 per vertex, at least 2^20); use a smoother mask or raise max_vertices"
+         budget allows (16 per vertex, at least 2^20); use a smoother mask, or raise the budget \
+         where it is set (max_vertices; `lapclone mesh --max-vertices`)"
     )]
     BoundaryTooLong {
         /// Pixel edges on the mask's boundary.

@@ -683,7 +683,7 @@ fn hostile_scenes_fail_at_a_position_without_output() {
         ("bowtie_polygon", "canvas(8, 8);\npatch(\"p\", #{ source: \"../in/src.png\", polygons: [[[1, 1], [9, 9], [9, 1], [1, 9]]] });\n".into(), "enclose no area"),
         ("nan_polygon", "canvas(8, 8);\npatch(\"p\", #{ source: \"../in/src.png\", polygons: [[[1, 1], [0.0 / 0.0, 1], [1, 6]]] });\n".into(), "finite"),
         ("far_polygon", "canvas(8, 8);\npatch(\"p\", #{ source: \"../in/src.png\", polygons: [[[1, 1], [1e308, 1], [1, 6]]] });\n".into(), "beyond"),
-        ("long_polygon", "canvas(8, 8);\npatch(\"p\", #{ source: \"../in/src.png\", density: 0.05, polygons: [[[1, 1], [1.6e7, 1], [1, 6]]] });\n".into(), "vertex budget"),
+        ("long_polygon", "canvas(8, 8);\npatch(\"p\", #{ source: \"../in/src.png\", density: 0.05, polygons: [[[1, 1], [1.6e7, 1], [1, 6]]] });\n".into(), "this mask needs; raise the density"),
         ("huge_feather", "canvas(8, 8);\npatch(\"p\", #{ source: \"../in/src.png\", feather: 1e10, polygons: [[[1, 1], [6, 1], [1, 6]]] });\n".into(), "huge_feather.rhai:2:1: feather must be in [0, 65536], got 1e10"),
         ("duplicate_patch", with_head("patch(\"p\", #{ source: \"../in/src.png\", mask: \"../in/mask.png\" });\n"), "already exists"),
         ("wrong_types", with_head("p.at(\"soon\", [1, 2]);\n"), "must be a number"),
