@@ -959,3 +959,48 @@ fn an_oversized_request_head_gets_its_answer_not_a_reset() {
     }
     assert!(repl.finish().success());
 }
+
+/// Wake-ups of the server's page threads so far (voluntary context switches, Linux).
+#[cfg(target_os = "linux")]
+fn page_thread_wakeups(pid: u32) -> u64 {
+    let tasks = std::fs::read_dir(format!("/proc/{pid}/task")).unwrap();
+    let mut total = 0;
+    for task in tasks.flatten() {
+        let comm = std::fs::read_to_string(task.path().join("comm")).unwrap_or_default();
+        if comm.trim() != "view-page" {
+            continue;
+        }
+        let status = std::fs::read_to_string(task.path().join("status")).unwrap_or_default();
+        let switches = status
+            .lines()
+            .find_map(|l| l.strip_prefix("voluntary_ctxt_switches:"))
+            .and_then(|n| n.trim().parse::<u64>().ok());
+        total += switches.unwrap_or(0);
+    }
+    total
+}
+
+/// An idle page's thread sleeps until the page sends something or a frame is published
+/// for it (a loop looking every 5 ms woke 200 times a second per page), and a line typed
+/// at the terminal still reaches every page.
+#[cfg(target_os = "linux")]
+#[test]
+fn idle_pages_sleep_and_still_follow_the_terminal() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = cat_scene(dir.path());
+    let mut repl = ViewRepl::start(dir.path(), &scene);
+    let mut pages: Vec<Page> = (0..4).map(|_| repl.page()).collect();
+    std::thread::sleep(Duration::from_millis(300));
+    let pid = repl.child.id();
+    let before = page_thread_wakeups(pid);
+    std::thread::sleep(Duration::from_secs(2));
+    let woken = page_thread_wakeups(pid) - before;
+    // Four pages over two seconds: about eight with a one-second safety wake each.
+    assert!(woken < 40, "{woken} wake-ups of 4 idle page threads in 2 s");
+    repl.type_line(":t 1.5");
+    for page in &mut pages {
+        page.until(|v| v["type"] == "scene" && v["t"] == 1.5);
+    }
+    drop(pages);
+    assert!(repl.finish().success());
+}

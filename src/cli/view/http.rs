@@ -19,8 +19,10 @@ const MAX_HEAD: usize = 8 * 1024;
 /// How long a client may take to send its whole request head.
 const HEAD_TIMEOUT: Duration = Duration::from_secs(5);
 /// After a refusal, how long and how much of what the client still sends is read and
-/// dropped before the connection closes (see [`close_gently`]).
+/// dropped before the connection closes (see [`close_gently`]); shorter for a `503`, which
+/// the thread accepting connections answers itself.
 const LINGER: Duration = Duration::from_secs(1);
+const BUSY_LINGER: Duration = Duration::from_millis(200);
 const LINGER_BYTES: usize = 1 << 20;
 
 /// What the server answers with: its token, the page, and the `host:port` names it goes by.
@@ -49,7 +51,7 @@ pub fn accept(mut stream: TcpStream, routes: &Routes) -> std::io::Result<Accepte
         Err(Refusal(status, body)) => {
             let kind = "text/plain; charset=utf-8";
             respond(&mut stream, status, kind, body.as_bytes(), &[])?;
-            close_gently(stream);
+            close_gently(stream, LINGER);
             Ok(Accepted::Answered)
         }
         Ok((Route::Page, _)) => {
@@ -82,17 +84,17 @@ pub fn refuse_busy(mut stream: TcpStream, limit: usize) {
         body.as_bytes(),
         &[],
     );
-    close_gently(stream);
+    close_gently(stream, BUSY_LINGER);
 }
 
 /// Closes a connection after its answer without resetting the answer away: closing with
 /// unread input (a head past the limit, a request still arriving) sends a reset, and the
 /// client's system may then drop the answer unread. So the answer is ended, and what the
-/// client still sends is read and dropped until it closes, for at most [`LINGER`] and
+/// client still sends is read and dropped until it closes, for at most `linger` and
 /// [`LINGER_BYTES`].
-fn close_gently(mut stream: TcpStream) {
+fn close_gently(mut stream: TcpStream, linger: Duration) {
     let _ = stream.shutdown(std::net::Shutdown::Write);
-    let deadline = Instant::now() + LINGER;
+    let deadline = Instant::now() + linger;
     let mut sink = [0u8; 8192];
     let mut read = 0;
     while read < LINGER_BYTES {

@@ -6,7 +6,7 @@
 //! Between two frames over the same background only the union of their drawn regions can
 //! differ, so only that part is converted and compared.
 
-use std::sync::mpsc::{Receiver, SyncSender, TrySendError};
+use std::sync::mpsc::TrySendError;
 use std::sync::Mutex;
 
 use lapclone::pixels::{Canvas, CanvasPixels, PixelFormat, PixelRect};
@@ -14,6 +14,7 @@ use lapclone::render::DrawnRegion;
 use tungstenite::{Bytes, Utf8Bytes};
 
 use super::lock;
+use super::wake::PageSender;
 
 /// Bytes before the pixels of a frame message: seven little-endian u32 — kind ([`RECT`] or
 /// [`RUNS`]), canvas width, canvas height, then the rectangle's x, y, width and height.
@@ -50,7 +51,7 @@ pub const PAGE_QUEUE: usize = 64;
 
 struct Client {
     id: u64,
-    tx: SyncSender<Outgoing>,
+    tx: PageSender,
     /// Whether this page's queue filled: it missed updates, so the next thing it is sent is
     /// the whole frame ([`Hub::catch_up`]).
     behind: bool,
@@ -92,7 +93,7 @@ pub struct Hub {
 
 impl Hub {
     /// Registers a page; it is sent the whole last frame and scene message first.
-    pub fn connect(&self, tx: SyncSender<Outgoing>) -> u64 {
+    pub fn connect(&self, tx: PageSender) -> u64 {
         let mut state = lock(&self.state);
         state.next_id += 1;
         let id = state.next_id;
@@ -334,11 +335,6 @@ fn compared_region(
     }
 }
 
-/// A channel for one page's messages.
-pub fn channel() -> (SyncSender<Outgoing>, Receiver<Outgoing>) {
-    std::sync::mpsc::sync_channel(PAGE_QUEUE)
-}
-
 /// The binary frame message ([`RECT`]) for `rect` of the `width`×`height` frame `rgba`.
 pub fn frame_message(width: u32, height: u32, rgba: &[u8], rect: [u32; 4]) -> Vec<u8> {
     let [x, y, w, h] = rect;
@@ -380,6 +376,10 @@ fn runs_message(last: &Published, changes: &Changes) -> Vec<u8> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn channel() -> (PageSender, crate::cli::view::wake::PageQueue) {
+        crate::cli::view::wake::page_channel().unwrap()
+    }
 
     fn canvas(pixels: &[(usize, [u8; 4])]) -> Canvas {
         let mut rgba = vec![[10, 20, 30, 255]; 6 * 5];

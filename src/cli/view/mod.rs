@@ -9,6 +9,7 @@ mod hub;
 mod open;
 mod scene;
 mod server;
+mod wake;
 mod watch;
 
 use std::collections::VecDeque;

@@ -14,13 +14,17 @@ use tungstenite::{Message, WebSocket};
 
 use super::edit::{parse_request, Edit, Request};
 use super::http::{accept, Accepted, Routes};
-use super::hub::{channel, Hub, Outgoing};
+use super::hub::{Hub, Outgoing};
+use super::wake::{page_channel, PageQueue};
 use super::{error_message, lock};
 
 /// Connections served at once; more are closed unanswered.
 const MAX_CONNECTIONS: usize = 32;
-/// How often a page's thread looks for frames to send while it waits for messages.
+/// How long a page's socket read waits once input was seen (a message's rest may still be
+/// on its way); where the wait cannot watch the queue, how often frames are looked for.
 const POLL: Duration = Duration::from_millis(5);
+/// The longest an idle page's thread sleeps before it looks again, woken or not.
+const IDLE_WAIT: Duration = Duration::from_secs(1);
 /// How long a write to a page may block before the page counts as gone.
 const WRITE_TIMEOUT: Duration = Duration::from_secs(10);
 
@@ -141,7 +145,8 @@ fn serve(
     }
 }
 
-/// Serves one page until it closes: its messages in, frames and replies out.
+/// Serves one page until it closes: its messages in, frames and replies out. Its thread
+/// sleeps until the page sends something or something is queued for it.
 fn page_loop(mut socket: WebSocket<TcpStream>, session: &Mutex<dyn LiveSession>, hub: &Hub) {
     // A page that stops reading fails the write after a while, instead of blocking its
     // connection (one of MAX_CONNECTIONS) for good.
@@ -152,33 +157,20 @@ fn page_loop(mut socket: WebSocket<TcpStream>, session: &Mutex<dyn LiveSession>,
         return;
     }
     let _ = socket.get_mut().set_nodelay(true);
-    let (tx, rx) = channel();
+    let Ok((tx, queue)) = page_channel() else {
+        return;
+    };
     let id = hub.connect(tx.clone());
+    let reply = |m: String| {
+        let _ = tx.try_send(Outgoing::Text(m.into()));
+    };
     loop {
-        match socket.read() {
-            Ok(Message::Text(text)) => handle(text.as_str(), id, session, hub, &|m| {
-                let _ = tx.try_send(Outgoing::Text(m.into()));
-            }),
-            Ok(Message::Binary(_)) => {
-                let _ = tx.try_send(Outgoing::Text(
-                    error_message("binary messages are not accepted").into(),
-                ));
-            }
-            Ok(Message::Close(_)) => break,
-            Ok(_) => {}
-            Err(tungstenite::Error::Io(e))
-                if matches!(
-                    e.kind(),
-                    std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
-                ) => {}
-            Err(tungstenite::Error::Capacity(e)) => {
-                let _ = tx.try_send(Outgoing::Text(
-                    error_message(&format!("refused: {e}")).into(),
-                ));
-            }
-            Err(_) => break,
+        if queue.wait(socket.get_ref(), IDLE_WAIT)
+            && !read_messages(&mut socket, &queue, id, session, hub, &reply)
+        {
+            break;
         }
-        if !flush(&mut socket, &rx) {
+        if !flush(&mut socket, &queue) {
             break;
         }
         hub.catch_up(id);
@@ -190,10 +182,43 @@ fn page_loop(mut socket: WebSocket<TcpStream>, session: &Mutex<dyn LiveSession>,
     }
 }
 
+/// Reads and applies the page's messages until none is waiting, sending each one's
+/// answers before the next is read; false once the page is gone.
+fn read_messages(
+    socket: &mut WebSocket<TcpStream>,
+    queue: &PageQueue,
+    id: u64,
+    session: &Mutex<dyn LiveSession>,
+    hub: &Hub,
+    reply: &dyn Fn(String),
+) -> bool {
+    loop {
+        match socket.read() {
+            Ok(Message::Text(text)) => handle(text.as_str(), id, session, hub, reply),
+            Ok(Message::Binary(_)) => reply(error_message("binary messages are not accepted")),
+            Ok(Message::Close(_)) => return false,
+            Ok(_) => {}
+            Err(tungstenite::Error::Io(e))
+                if matches!(
+                    e.kind(),
+                    std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
+                ) =>
+            {
+                return true
+            }
+            Err(tungstenite::Error::Capacity(e)) => reply(error_message(&format!("refused: {e}"))),
+            Err(_) => return false,
+        }
+        if !flush(socket, queue) {
+            return false;
+        }
+    }
+}
+
 /// Sends what is queued for this page; false once the page is gone.
-fn flush(socket: &mut WebSocket<TcpStream>, rx: &std::sync::mpsc::Receiver<Outgoing>) -> bool {
+fn flush(socket: &mut WebSocket<TcpStream>, queue: &PageQueue) -> bool {
     let mut sent = false;
-    while let Ok(message) = rx.try_recv() {
+    while let Ok(message) = queue.try_recv() {
         let message = match message {
             Outgoing::Binary(bytes) => Message::Binary(bytes),
             Outgoing::Text(text) => Message::Text(text),
