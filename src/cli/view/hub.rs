@@ -51,7 +51,7 @@ pub const PAGE_QUEUE: usize = 64;
 
 struct Client {
     id: u64,
-    tx: PageSender,
+    tx: PageSender<Outgoing>,
     /// Whether this page's queue filled: it missed updates, so the next thing it is sent is
     /// the whole frame ([`Hub::catch_up`]).
     behind: bool,
@@ -93,7 +93,7 @@ pub struct Hub {
 
 impl Hub {
     /// Registers a page; it is sent the whole last frame and scene message first.
-    pub fn connect(&self, tx: PageSender) -> u64 {
+    pub fn connect(&self, tx: PageSender<Outgoing>) -> u64 {
         let mut state = lock(&self.state);
         state.next_id += 1;
         let id = state.next_id;
@@ -377,8 +377,11 @@ fn runs_message(last: &Published, changes: &Changes) -> Vec<u8> {
 mod tests {
     use super::*;
 
-    fn channel() -> (PageSender, crate::cli::view::wake::PageQueue) {
-        crate::cli::view::wake::page_channel().unwrap()
+    fn channel() -> (
+        PageSender<Outgoing>,
+        crate::cli::view::wake::PageQueue<Outgoing>,
+    ) {
+        crate::cli::view::wake::page_channel(PAGE_QUEUE).unwrap()
     }
 
     fn canvas(pixels: &[(usize, [u8; 4])]) -> Canvas {

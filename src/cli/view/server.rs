@@ -14,7 +14,7 @@ use tungstenite::{Message, WebSocket};
 
 use super::edit::{parse_request, Edit, Request};
 use super::http::{accept, Accepted, Routes};
-use super::hub::{Hub, Outgoing};
+use super::hub::{Hub, Outgoing, PAGE_QUEUE};
 use super::wake::{page_channel, PageQueue};
 use super::{error_message, lock};
 
@@ -157,7 +157,7 @@ fn page_loop(mut socket: WebSocket<TcpStream>, session: &Mutex<dyn LiveSession>,
         return;
     }
     let _ = socket.get_mut().set_nodelay(true);
-    let Ok((tx, queue)) = page_channel() else {
+    let Ok((tx, queue)) = page_channel(PAGE_QUEUE) else {
         return;
     };
     let id = hub.connect(tx.clone());
@@ -186,7 +186,7 @@ fn page_loop(mut socket: WebSocket<TcpStream>, session: &Mutex<dyn LiveSession>,
 /// answers before the next is read; false once the page is gone.
 fn read_messages(
     socket: &mut WebSocket<TcpStream>,
-    queue: &PageQueue,
+    queue: &PageQueue<Outgoing>,
     id: u64,
     session: &Mutex<dyn LiveSession>,
     hub: &Hub,
@@ -216,7 +216,7 @@ fn read_messages(
 }
 
 /// Sends what is queued for this page; false once the page is gone.
-fn flush(socket: &mut WebSocket<TcpStream>, queue: &PageQueue) -> bool {
+fn flush(socket: &mut WebSocket<TcpStream>, queue: &PageQueue<Outgoing>) -> bool {
     let mut sent = false;
     while let Ok(message) = queue.try_recv() {
         let message = match message {

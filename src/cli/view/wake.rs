@@ -1,4 +1,4 @@
-//! One page's queue of outgoing messages, with a wake-up: takes nothing and gives a sender
+//! One page's queue of outgoing messages, with a wake-up: takes a bound and gives a sender
 //! (kept by the [`Hub`](super::hub::Hub)) whose every message also wakes the page's thread,
 //! and the queue that thread drains, which waits until the page's socket has input or a
 //! message is queued. An idle page's thread so sleeps until there is something to do,
@@ -13,18 +13,25 @@ use std::ops::Deref;
 use std::sync::mpsc::{Receiver, SyncSender, TrySendError};
 use std::time::Duration;
 
-use super::hub::{Outgoing, PAGE_QUEUE};
-
 /// The sending half: queues a message for the page and wakes its thread.
-#[derive(Clone)]
-pub struct PageSender {
-    tx: SyncSender<Outgoing>,
+pub struct PageSender<T> {
+    tx: SyncSender<T>,
     wake: platform::Waker,
 }
 
-impl PageSender {
-    /// Queues `message` unless the queue is full (see [`PAGE_QUEUE`]), then wakes the page.
-    pub fn try_send(&self, message: Outgoing) -> Result<(), TrySendError<Outgoing>> {
+// Derived, it would ask `T: Clone`, which a sender does not need.
+impl<T> Clone for PageSender<T> {
+    fn clone(&self) -> Self {
+        PageSender {
+            tx: self.tx.clone(),
+            wake: self.wake.clone(),
+        }
+    }
+}
+
+impl<T> PageSender<T> {
+    /// Queues `message` unless the queue is full, then wakes the page.
+    pub fn try_send(&self, message: T) -> Result<(), TrySendError<T>> {
         self.tx.try_send(message)?;
         self.wake.wake();
         Ok(())
@@ -32,20 +39,20 @@ impl PageSender {
 }
 
 /// The receiving half: the page's queue, and a wait for the page's socket or the queue.
-pub struct PageQueue {
-    rx: Receiver<Outgoing>,
+pub struct PageQueue<T> {
+    rx: Receiver<T>,
     wait: platform::Waiter,
 }
 
-impl Deref for PageQueue {
-    type Target = Receiver<Outgoing>;
+impl<T> Deref for PageQueue<T> {
+    type Target = Receiver<T>;
 
-    fn deref(&self) -> &Receiver<Outgoing> {
+    fn deref(&self) -> &Receiver<T> {
         &self.rx
     }
 }
 
-impl PageQueue {
+impl<T> PageQueue<T> {
     /// Sleeps until `socket` has input (or closed), a message was queued, or `limit` passed;
     /// whether the socket may have input (always true where the wait cannot tell).
     pub fn wait(&self, socket: &TcpStream, limit: Duration) -> bool {
@@ -53,9 +60,9 @@ impl PageQueue {
     }
 }
 
-/// A page's queue, bounded by [`PAGE_QUEUE`] messages.
-pub fn page_channel() -> std::io::Result<(PageSender, PageQueue)> {
-    let (tx, rx) = std::sync::mpsc::sync_channel(PAGE_QUEUE);
+/// A page's queue of at most `bound` messages.
+pub fn page_channel<T>(bound: usize) -> std::io::Result<(PageSender<T>, PageQueue<T>)> {
+    let (tx, rx) = std::sync::mpsc::sync_channel(bound);
     let (wake, wait) = platform::pair()?;
     Ok((PageSender { tx, wake }, PageQueue { rx, wait }))
 }
