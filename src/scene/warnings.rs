@@ -25,7 +25,8 @@ impl Scene {
                 late(&mut out, &owner, "rotate", &h.rotation, end);
             }
             for follow in patch.follows.iter().filter(|f| f.is_intact(patch)) {
-                short_track(&mut out, &owner, follow, self.last_frame_time());
+                let last = self.last_frame_time();
+                short_track(&mut out, &owner, follow, (last, self.canvas.fps));
             }
         }
         out
@@ -37,8 +38,9 @@ impl Scene {
     }
 }
 
-/// A followed track that starts after the first frame or ends before the last.
-fn short_track(out: &mut Vec<String>, owner: &str, follow: &Follow, last: f64) {
+/// A followed track that starts after the first frame or ends before the last (`last`, the
+/// last frame's time, at `fps`).
+fn short_track(out: &mut Vec<String>, owner: &str, follow: &Follow, (last, fps): (f64, f64)) {
     let times: Vec<f64> = follow.at.times().collect();
     let (Some(&first), Some(&end)) = (times.first(), times.last()) else {
         return;
@@ -48,18 +50,33 @@ fn short_track(out: &mut Vec<String>, owner: &str, follow: &Follow, last: f64) {
         FollowTarget::Handle(i) => format!("handle {i}"),
     };
     let name = follow.file_name();
-    let (first_text, end_text) = (number_text(first), number_text(end));
     if first > 0.0 {
         out.push(format!(
-            "{owner}: {what} follows {name} from t = {first_text} s only; earlier frames hold its first position"
+            "{owner}: {what} follows {name} from {} only; earlier frames hold its first position",
+            moment(first, fps)
         ));
     }
     if end < last - 1e-9 {
         out.push(format!(
-            "{owner}: {what} follows {name} until t = {end_text} s; the frames after it (to t = {} s) hold its last position",
-            number_text(last)
+            "{owner}: {what} follows {name} until {}; the frames after it (to {}) hold its last position",
+            moment(end, fps),
+            moment(last, fps)
         ));
     }
+}
+
+/// A time as a warning names it: the frame shown then when it is a frame's time (numbered
+/// from 1, as the frame files are), with the time rounded for reading; otherwise the time.
+/// A track read from frame numbers has frame times, which written in full are 17 digits.
+fn moment(t: f64, fps: f64) -> String {
+    let frames = t * fps;
+    let index = frames.round();
+    if (frames - index).abs() > 1e-6 || !(0.0..1e15).contains(&index) {
+        return format!("t = {} s", number_text(t));
+    }
+    let rounded = (t * 1e4).round() / 1e4;
+    let sign = if rounded == t { "=" } else { "≈" };
+    format!("frame {} (t {sign} {} s)", index as u64 + 1, number_text(rounded))
 }
 
 /// How many key times a warning lists before it only counts them.
@@ -123,6 +140,17 @@ mod tests {
     }
 
     /// Times far from a second are written short, not as hundreds of digits.
+    #[test]
+    fn frame_times_are_named_by_their_frame() {
+        assert_eq!(moment(1.0 / 24.0, 24.0), "frame 2 (t ≈ 0.0417 s)");
+        assert_eq!(moment(23.0 / 24.0, 24.0), "frame 24 (t ≈ 0.9583 s)");
+        assert_eq!(moment(1.5, 24.0), "frame 37 (t = 1.5 s)");
+        assert_eq!(moment(0.0, 30.0), "frame 1 (t = 0 s)");
+        // Between frames, or past any frame number: the time itself.
+        assert_eq!(moment(0.01, 24.0), "t = 0.01 s");
+        assert_eq!(moment(1e300, 24.0), "t = 1e300 s");
+    }
+
     #[test]
     fn extreme_key_times_are_written_short() {
         let mut track = Track::<f64>::new();

@@ -223,7 +223,7 @@ fn a_followed_track_is_written_back_as_one_call() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{stderr}");
     assert!(
-        stderr.contains("follows track.csv from t = 0.16666666666666666 s only"),
+        stderr.contains("follows track.csv from frame 2 (t ≈ 0.1667 s) only"),
         "{stderr}"
     );
 }
