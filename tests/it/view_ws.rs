@@ -934,10 +934,14 @@ fn an_oversized_request_head_gets_its_answer_not_a_reset() {
     let dir = tempfile::tempdir().unwrap();
     let scene = cat_scene(dir.path());
     let repl = ViewRepl::start(dir.path(), &scene);
-    for round in 0..5 {
+    // 9,000 bytes (past the 8 KiB limit, though read in one go), then far past it.
+    for (round, size) in [9_000, 200_000, 200_000, 200_000, 200_000]
+        .into_iter()
+        .enumerate()
+    {
         let mut stream = TcpStream::connect(repl.host()).unwrap();
         stream.set_read_timeout(Some(WAIT)).unwrap();
-        let filler = "a".repeat(200_000);
+        let filler = "a".repeat(size);
         let request = format!(
             "GET / HTTP/1.1\r\nHost: {}\r\nX-Big: {filler}\r\n\r\n",
             repl.host()
@@ -1002,5 +1006,119 @@ fn idle_pages_sleep_and_still_follow_the_terminal() {
         page.until(|v| v["type"] == "scene" && v["t"] == 1.5);
     }
     drop(pages);
+    assert!(repl.finish().success());
+}
+
+/// A page message sent in the same write as the WebSocket handshake is applied at once
+/// (its bytes are read with the request head, not left waiting for more input).
+#[test]
+fn a_message_sent_with_the_handshake_is_applied() {
+    use std::io::Read as _;
+    let dir = tempfile::tempdir().unwrap();
+    let scene = cat_scene(dir.path());
+    let repl = ViewRepl::start(dir.path(), &scene);
+    let mut stream = TcpStream::connect(repl.host()).unwrap();
+    stream.set_read_timeout(Some(WAIT)).unwrap();
+    let path = repl
+        .socket_url()
+        .split_once(&repl.host())
+        .unwrap()
+        .1
+        .to_string();
+    let head = format!(
+        "GET {path} HTTP/1.1\r\nHost: {h}\r\nOrigin: http://{h}\r\nUpgrade: websocket\r\n\
+         Connection: Upgrade\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n\
+         Sec-WebSocket-Version: 13\r\n\r\n",
+        h = repl.host()
+    );
+    // One masked text frame (a zero mask leaves the payload as it is).
+    let seek = br#"{"type":"seek","t":0.75}"#;
+    let mut bytes = head.into_bytes();
+    bytes.extend_from_slice(&[0x81, 0x80 | seek.len() as u8, 0, 0, 0, 0]);
+    bytes.extend_from_slice(seek);
+    stream.write_all(&bytes).unwrap();
+    let mut answer = Vec::new();
+    let mut byte = [0u8; 1];
+    while !answer.ends_with(b"\r\n\r\n") {
+        stream.read_exact(&mut byte).unwrap();
+        answer.push(byte[0]);
+    }
+    assert!(
+        answer.starts_with(b"HTTP/1.1 101"),
+        "{}",
+        String::from_utf8_lossy(&answer)
+    );
+    let mut socket = WebSocket::from_raw_socket(stream, tungstenite::protocol::Role::Client, None);
+    loop {
+        if let Message::Text(text) = socket.read().unwrap() {
+            let value: Value = serde_json::from_str(text.as_str()).unwrap();
+            if value["type"] == "scene" && value["t"] == 0.75 {
+                break;
+            }
+        }
+    }
+    drop(socket);
+    assert!(repl.finish().success());
+}
+
+/// A page's close is answered with a close, and a message over the size limit is refused
+/// with an error, then a close with code 1009 (message too big), changing nothing: the
+/// rest of a fragmented message past the limit is not applied.
+#[test]
+fn a_close_is_answered_and_an_oversized_message_closes_the_page() {
+    use tungstenite::protocol::frame::coding::CloseCode;
+    let dir = tempfile::tempdir().unwrap();
+    let scene = cat_scene(dir.path());
+    let mut repl = ViewRepl::start(dir.path(), &scene);
+    let mut page = repl.page();
+    page.socket.close(None).unwrap();
+    let closed = loop {
+        match page.socket.read() {
+            Ok(_) => continue,
+            Err(e) => break e,
+        }
+    };
+    assert!(
+        matches!(closed, tungstenite::Error::ConnectionClosed),
+        "{closed:?}"
+    );
+    // Fragments: the start of a seek, a part past the limit, then the seek's end.
+    let mut page = repl.page();
+    let t = page.scene["t"].clone();
+    let big = format!("{:<1$}", "", 17_000);
+    let MaybeTlsStream::Plain(stream) = page.socket.get_mut() else {
+        panic!("not a plain stream")
+    };
+    let parts = [
+        (0x01, r#"{"type":"seek","t":0.9"#),
+        (0x00, big.as_str()),
+        (0x80, "}"),
+    ];
+    for (first_byte, text) in parts {
+        // A masked client frame with a zero mask, which leaves the payload as it is.
+        let mut frame = vec![first_byte, 0x80 | 126];
+        frame.extend_from_slice(&(text.len() as u16).to_be_bytes());
+        frame.extend_from_slice(&[0; 4]);
+        frame.extend_from_slice(text.as_bytes());
+        // The server may already have closed before the last fragment.
+        let _ = stream.write_all(&frame);
+    }
+    let error = page.until(|v| v["type"] == "error");
+    assert!(
+        error["message"].as_str().unwrap().contains("refused"),
+        "{error}"
+    );
+    let close = loop {
+        match page.socket.read() {
+            Ok(Message::Close(frame)) => break frame,
+            Ok(other) => panic!("after the refusal: {other:?}"),
+            Err(e) => panic!("no close frame: {e:?}"),
+        }
+    };
+    assert_eq!(close.map(|f| f.code), Some(CloseCode::Size));
+    // Nothing of the refused message was applied.
+    let other = repl.page();
+    assert_eq!(other.scene["t"], t);
+    drop(other);
     assert!(repl.finish().success());
 }

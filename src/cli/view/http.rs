@@ -21,7 +21,7 @@ const HEAD_TIMEOUT: Duration = Duration::from_secs(5);
 /// After a refusal, how long and how much of what the client still sends is read and
 /// dropped before the connection closes (see [`close_gently`]); shorter for a `503`, which
 /// the thread accepting connections answers itself.
-const LINGER: Duration = Duration::from_secs(1);
+pub(super) const LINGER: Duration = Duration::from_secs(1);
 const BUSY_LINGER: Duration = Duration::from_millis(200);
 const LINGER_BYTES: usize = 1 << 20;
 
@@ -51,7 +51,7 @@ pub fn accept(mut stream: TcpStream, routes: &Routes) -> std::io::Result<Accepte
         Err(Refusal(status, body)) => {
             let kind = "text/plain; charset=utf-8";
             respond(&mut stream, status, kind, body.as_bytes(), &[])?;
-            close_gently(stream, LINGER);
+            close_gently(&mut stream, LINGER);
             Ok(Accepted::Answered)
         }
         Ok((Route::Page, _)) => {
@@ -84,7 +84,7 @@ pub fn refuse_busy(mut stream: TcpStream, limit: usize) {
         body.as_bytes(),
         &[],
     );
-    close_gently(stream, BUSY_LINGER);
+    close_gently(&mut stream, BUSY_LINGER);
 }
 
 /// Closes a connection after its answer without resetting the answer away: closing with
@@ -92,7 +92,7 @@ pub fn refuse_busy(mut stream: TcpStream, limit: usize) {
 /// client's system may then drop the answer unread. So the answer is ended, and what the
 /// client still sends is read and dropped until it closes, for at most `linger` and
 /// [`LINGER_BYTES`].
-fn close_gently(mut stream: TcpStream, linger: Duration) {
+pub(super) fn close_gently(stream: &mut TcpStream, linger: Duration) {
     let _ = stream.shutdown(std::net::Shutdown::Write);
     let deadline = Instant::now() + linger;
     let mut sink = [0u8; 8192];
@@ -189,16 +189,23 @@ fn read_head(stream: &mut TcpStream) -> Result<(Head, Vec<u8>), Refusal> {
         }
         buffer.extend_from_slice(&chunk[..n]);
         if let Some(end) = buffer.windows(4).position(|w| w == b"\r\n\r\n") {
+            if end + 4 > MAX_HEAD {
+                return Err(too_large());
+            }
             let head = parse_head(&buffer[..end + 4])?;
             return Ok((head, buffer[end + 4..].to_vec()));
         }
         if buffer.len() > MAX_HEAD {
-            return Err(Refusal(
-                "431 Request Header Fields Too Large",
-                "request head too large".into(),
-            ));
+            return Err(too_large());
         }
     }
+}
+
+fn too_large() -> Refusal {
+    Refusal(
+        "431 Request Header Fields Too Large",
+        "request head too large".into(),
+    )
 }
 
 /// Parses a complete request head.

@@ -10,6 +10,8 @@ use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 use anyhow::Context as _;
+use tungstenite::protocol::frame::coding::CloseCode;
+use tungstenite::protocol::CloseFrame;
 use tungstenite::{Message, WebSocket};
 
 use super::edit::{parse_request, Edit, Request};
@@ -164,16 +166,18 @@ fn page_loop(mut socket: WebSocket<TcpStream>, session: &Mutex<dyn LiveSession>,
     let reply = |m: String| {
         let _ = tx.try_send(Outgoing::Text(m.into()));
     };
+    // Bytes that came with the handshake are already read from the socket, so the first
+    // look for messages does not wait for the socket.
+    let mut input = true;
     loop {
-        if queue.wait(socket.get_ref(), IDLE_WAIT)
-            && !read_messages(&mut socket, &queue, id, session, hub, &reply)
-        {
+        if input && !read_messages(&mut socket, &queue, id, session, hub, &reply) {
             break;
         }
         if !flush(&mut socket, &queue) {
             break;
         }
         hub.catch_up(id);
+        input = queue.wait(socket.get_ref(), IDLE_WAIT);
     }
     // A gesture never finished (the page closed mid-drag) is cancelled as Escape would be;
     // without a preview in progress the cancel changes nothing.
@@ -196,7 +200,11 @@ fn read_messages(
         match socket.read() {
             Ok(Message::Text(text)) => handle(text.as_str(), id, session, hub, reply),
             Ok(Message::Binary(_)) => reply(error_message("binary messages are not accepted")),
-            Ok(Message::Close(_)) => return false,
+            Ok(Message::Close(_)) => {
+                // Sends the close reply the protocol queued.
+                let _ = socket.flush();
+                return false;
+            }
             Ok(_) => {}
             Err(tungstenite::Error::Io(e))
                 if matches!(
@@ -206,13 +214,40 @@ fn read_messages(
             {
                 return true
             }
-            Err(tungstenite::Error::Capacity(e)) => reply(error_message(&format!("refused: {e}"))),
+            Err(tungstenite::Error::Capacity(e)) => {
+                refuse_oversized(socket, queue, &e.to_string(), reply);
+                return false;
+            }
             Err(_) => return false,
         }
         if !flush(socket, queue) {
             return false;
         }
     }
+}
+
+/// Answers a message over the size limit and closes the page's connection (1009): the
+/// rest of an oversized frame, or of a fragmented message, cannot be told from what the
+/// page sends next, so going on could apply part of a refused message.
+fn refuse_oversized(
+    socket: &mut WebSocket<TcpStream>,
+    queue: &PageQueue<Outgoing>,
+    problem: &str,
+    reply: &dyn Fn(String),
+) {
+    reply(error_message(&format!(
+        "refused: {problem}; the page disconnects (reload it)"
+    )));
+    if flush(socket, queue) {
+        let frame = CloseFrame {
+            code: CloseCode::Size,
+            reason: "message too big".into(),
+        };
+        let _ = socket.close(Some(frame));
+        let _ = socket.flush();
+    }
+    // The rest of the message is still arriving: closing on it would reset the answer away.
+    super::http::close_gently(socket.get_mut(), super::http::LINGER);
 }
 
 /// Sends what is queued for this page; false once the page is gone.
