@@ -1069,7 +1069,7 @@ fn a_close_is_answered_and_an_oversized_message_closes_the_page() {
     use tungstenite::protocol::frame::coding::CloseCode;
     let dir = tempfile::tempdir().unwrap();
     let scene = cat_scene(dir.path());
-    let mut repl = ViewRepl::start(dir.path(), &scene);
+    let repl = ViewRepl::start(dir.path(), &scene);
     let mut page = repl.page();
     page.socket.close(None).unwrap();
     let closed = loop {
@@ -1108,12 +1108,10 @@ fn a_close_is_answered_and_an_oversized_message_closes_the_page() {
         error["message"].as_str().unwrap().contains("refused"),
         "{error}"
     );
-    let close = loop {
-        match page.socket.read() {
-            Ok(Message::Close(frame)) => break frame,
-            Ok(other) => panic!("after the refusal: {other:?}"),
-            Err(e) => panic!("no close frame: {e:?}"),
-        }
+    let close = match page.socket.read() {
+        Ok(Message::Close(frame)) => frame,
+        Ok(other) => panic!("after the refusal: {other:?}"),
+        Err(e) => panic!("no close frame: {e:?}"),
     };
     assert_eq!(close.map(|f| f.code), Some(CloseCode::Size));
     // Nothing of the refused message was applied.
