@@ -76,6 +76,16 @@ pub(super) fn not_a_file_error(file: &Path) -> Option<FootageError> {
     }
 }
 
+/// Whether plate `file` is there: `Ok(true)` for a file, `Ok(false)` when nothing is
+/// there (which ends the run a hold keeps), an error when something other than a file is
+/// (a FIFO or a folder mid-sequence is no end of the footage).
+pub(super) fn plate_present(file: &Path) -> Result<bool, FootageError> {
+    if file.is_file() {
+        return Ok(true);
+    }
+    not_a_file_error(file).map_or(Ok(false), Err)
+}
+
 impl Footage {
     /// Opens footage at `path`: a printf-style pattern of numbered images
     /// (`plates/frame_%04d.png`) or a video file (`.mp4`, `.mov`, `.webm`, `.mkv`, read
@@ -152,12 +162,7 @@ impl Footage {
             FootageSource::Sequence { pattern, start } => {
                 for i in 0..frames {
                     let file = pattern.path(start + i);
-                    if !file.is_file() {
-                        // Only a missing plate ends the run a hold keeps: a FIFO or a folder
-                        // in the middle is an error, not the footage's end.
-                        if let Some(error) = not_a_file_error(&file) {
-                            return Err(error);
-                        }
+                    if !plate_present(&file)? {
                         if self.hold && i > 0 {
                             return Ok(());
                         }

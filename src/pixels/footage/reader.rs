@@ -62,18 +62,10 @@ impl FootageReader {
     ) -> Result<FloatImage, FootageError> {
         // Saturating: a time far beyond any footage names a far frame, never frame 0.
         let mut file = pattern.path(start.saturating_add(index));
-        if self.footage.hold && !file.is_file() && super::not_a_file_error(&file).is_none() {
-            // The last file of the unbroken run from the start holds; the run ends at a
-            // missing plate, and one that is there but no file is an error.
+        if self.footage.hold && !super::plate_present(&file)? {
+            // The last file of the unbroken run from the start holds.
             let mut last = 0;
-            while last < index {
-                let next = pattern.path(start + last + 1);
-                if let Some(error) = super::not_a_file_error(&next) {
-                    return Err(error);
-                }
-                if !next.is_file() {
-                    break;
-                }
+            while last < index && super::plate_present(&pattern.path(start + last + 1))? {
                 last += 1;
             }
             file = pattern.path(start + last);
