@@ -94,5 +94,6 @@ mod track_video;
 mod video_cli;
 mod video_encode;
 mod view_browser;
+mod view_faults;
 mod view_open;
 mod view_ws;

@@ -12,17 +12,16 @@ use tungstenite::handshake::derive_accept_key;
 use tungstenite::protocol::{Role, WebSocketConfig};
 use tungstenite::WebSocket;
 
+use super::admit::{PagePlace, Pending, MAX_PAGES};
 use super::edit::MAX_MESSAGE_BYTES;
 
 /// Largest request head read, bytes.
 const MAX_HEAD: usize = 8 * 1024;
 /// How long a client may take to send its whole request head.
 const HEAD_TIMEOUT: Duration = Duration::from_secs(5);
-/// After a refusal, how long and how much of what the client still sends is read and
-/// dropped before the connection closes (see [`close_gently`]); shorter for a `503`, which
-/// the thread accepting connections answers itself.
+/// After an answer, how long and how much of what the client still sends is read and
+/// dropped before the connection closes (see [`close_gently`]).
 pub(super) const LINGER: Duration = Duration::from_secs(1);
-const BUSY_LINGER: Duration = Duration::from_millis(200);
 const LINGER_BYTES: usize = 1 << 20;
 
 /// What the server answers with: its token, the page, and the `host:port` names it goes by.
@@ -36,55 +35,51 @@ pub struct Routes {
 pub enum Accepted {
     /// A response was written (the page, or an error); the connection is done.
     Answered,
-    Socket(Box<WebSocket<TcpStream>>),
+    /// A page's WebSocket, and the place it holds until dropped.
+    Socket(Box<WebSocket<TcpStream>>, PagePlace),
 }
 
 /// A request refused: its status line and the reason shown in the body.
 #[derive(Debug)]
 struct Refusal(&'static str, String);
 
-/// Reads one request from `stream` and answers it.
-pub fn accept(mut stream: TcpStream, routes: &Routes) -> std::io::Result<Accepted> {
+/// Reads one request from `stream` and answers it; a WebSocket takes a page's place, or
+/// is refused when all are taken.
+pub fn accept(mut stream: TcpStream, routes: &Routes, place: Pending) -> std::io::Result<Accepted> {
     stream.set_read_timeout(Some(HEAD_TIMEOUT))?;
     let routed = read_head(&mut stream).and_then(|(head, rest)| Ok((route(&head, routes)?, rest)));
-    match routed {
-        Err(Refusal(status, body)) => {
-            let kind = "text/plain; charset=utf-8";
-            respond(&mut stream, status, kind, body.as_bytes(), &[])?;
-            close_gently(&mut stream, LINGER);
-            Ok(Accepted::Answered)
-        }
+    let refused = match routed {
+        Err(refusal) => refusal,
+        Ok((Route::Page, _)) if place.pages_full() => busy(),
         Ok((Route::Page, _)) => {
             serve_page(&mut stream, routes)?;
-            Ok(Accepted::Answered)
+            // A request carrying a body would otherwise reset the page away.
+            close_gently(&mut stream, LINGER);
+            return Ok(Accepted::Answered);
         }
-        Ok((Route::Socket { key }, rest)) => upgrade(stream, &key, rest),
-    }
+        Ok((Route::Socket { key }, rest)) => match place.into_page() {
+            Ok(place) => return upgrade(stream, &key, rest, place),
+            Err(true) => busy(),
+            Err(false) => return Ok(Accepted::Answered),
+        },
+    };
+    let Refusal(status, body) = refused;
+    let kind = "text/plain; charset=utf-8";
+    respond(&mut stream, status, kind, body.as_bytes(), &[])?;
+    close_gently(&mut stream, LINGER);
+    Ok(Accepted::Answered)
 }
 
-/// Answers a connection past the server's page limit with 503 and why, instead of closing
-/// it unanswered (the browser would say only that the connection was reset). The request is
-/// read first, briefly, so that closing does not reset the answer away.
-pub fn refuse_busy(mut stream: TcpStream, limit: usize) {
-    let brief = Some(Duration::from_millis(200));
-    if stream.set_read_timeout(brief).is_err() || stream.set_write_timeout(brief).is_err() {
-        return;
-    }
-    let mut head = [0u8; 8192];
-    let _ = stream.read(&mut head);
-    let body = format!(
-        "the live view serves at most {limit} connections at once: close a page of this \
-         session, then reload this one"
-    );
-    let kind = "text/plain; charset=utf-8";
-    let _ = respond(
-        &mut stream,
+/// The answer when every page's place is taken: why, instead of a connection closed
+/// unanswered (the browser would say only that it was reset).
+fn busy() -> Refusal {
+    Refusal(
         "503 Service Unavailable",
-        kind,
-        body.as_bytes(),
-        &[],
-    );
-    close_gently(&mut stream, BUSY_LINGER);
+        format!(
+            "the live view serves at most {MAX_PAGES} pages at once: close a page of this \
+             session, then reload this one"
+        ),
+    )
 }
 
 /// Closes a connection after its answer without resetting the answer away: closing with
@@ -127,7 +122,12 @@ fn serve_page(stream: &mut TcpStream, routes: &Routes) -> std::io::Result<()> {
 }
 
 /// Answers the WebSocket handshake and gives the socket, its messages bounded.
-fn upgrade(mut stream: TcpStream, key: &str, rest: Vec<u8>) -> std::io::Result<Accepted> {
+fn upgrade(
+    mut stream: TcpStream,
+    key: &str,
+    rest: Vec<u8>,
+    place: PagePlace,
+) -> std::io::Result<Accepted> {
     let reply = format!(
         "HTTP/1.1 101 Switching Protocols\r\nConnection: Upgrade\r\nUpgrade: websocket\r\n\
          Sec-WebSocket-Accept: {}\r\n\r\n",
@@ -138,7 +138,7 @@ fn upgrade(mut stream: TcpStream, key: &str, rest: Vec<u8>) -> std::io::Result<A
         .max_message_size(Some(MAX_MESSAGE_BYTES))
         .max_frame_size(Some(MAX_MESSAGE_BYTES));
     let socket = WebSocket::from_partially_read(stream, rest, Role::Server, Some(config));
-    Ok(Accepted::Socket(Box::new(socket)))
+    Ok(Accepted::Socket(Box::new(socket), place))
 }
 
 /// The parts of a request head the routes look at.

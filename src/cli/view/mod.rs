@@ -3,6 +3,7 @@
 //! structured edits, which the session writes as REPL lines (see docs/view.md). The server
 //! knows the session and the renderer; nothing in the library knows the view.
 
+mod admit;
 mod edit;
 mod http;
 mod hub;

@@ -5,30 +5,30 @@
 //! the [`Hub`]. Threads only: one accepting, one per connection.
 
 use std::net::{IpAddr, Ipv4Addr, SocketAddr, TcpListener, TcpStream};
-use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use anyhow::Context as _;
 use tungstenite::protocol::frame::coding::CloseCode;
 use tungstenite::protocol::CloseFrame;
 use tungstenite::{Message, WebSocket};
 
+use super::admit::Admission;
 use super::edit::{parse_request, Edit, Request};
 use super::http::{accept, Accepted, Routes};
 use super::hub::{Hub, Outgoing, PAGE_QUEUE};
 use super::wake::{page_channel, PageQueue};
 use super::{error_message, lock};
 
-/// Connections served at once; more are closed unanswered.
-const MAX_CONNECTIONS: usize = 32;
 /// How long a page's socket read waits once input was seen (a message's rest may still be
 /// on its way); where the wait cannot watch the queue, how often frames are looked for.
 const POLL: Duration = Duration::from_millis(5);
 /// The longest an idle page's thread sleeps before it looks again, woken or not.
 const IDLE_WAIT: Duration = Duration::from_secs(1);
-/// How long a write to a page may block before the page counts as gone.
+/// How long sending what is queued for a page may take before the page counts as gone.
 const WRITE_TIMEOUT: Duration = Duration::from_secs(10);
+/// The longest one write to a page's socket blocks before the deadline is looked at.
+const WRITE_SLICE: Duration = Duration::from_millis(250);
 
 const PAGE: &str = include_str!("page/index.html");
 const SCRIPT: &str = include_str!("page/view.js");
@@ -121,27 +121,21 @@ fn serve(
     session: Arc<Mutex<dyn LiveSession>>,
     hub: Arc<Hub>,
 ) {
-    let open = Arc::new(AtomicUsize::new(0));
+    let admission = Arc::new(Admission::default());
     for stream in listener.incoming() {
         let Ok(stream) = stream else { continue };
-        if open.load(Ordering::SeqCst) >= MAX_CONNECTIONS {
-            super::http::refuse_busy(stream, MAX_CONNECTIONS);
+        let Some(place) = admission.arrive(&stream) else {
             continue;
-        }
-        open.fetch_add(1, Ordering::SeqCst);
-        let (routes, session, hub, slot) =
-            (routes.clone(), session.clone(), hub.clone(), open.clone());
+        };
+        let (routes, session, hub) = (routes.clone(), session.clone(), hub.clone());
         let spawned = std::thread::Builder::new()
             .name("view-page".into())
             .spawn(move || {
-                if let Ok(Accepted::Socket(socket)) = accept(stream, &routes) {
+                if let Ok(Accepted::Socket(socket, _place)) = accept(stream, &routes, place) {
                     page_loop(*socket, &session, &hub);
                 }
-                slot.fetch_sub(1, Ordering::SeqCst);
             });
         if spawned.is_err() {
-            // The thread never ran to give its slot back.
-            open.fetch_sub(1, Ordering::SeqCst);
             eprint_line!("warning: the view cannot serve another page");
         }
     }
@@ -151,10 +145,10 @@ fn serve(
 /// sleeps until the page sends something or something is queued for it.
 fn page_loop(mut socket: WebSocket<TcpStream>, session: &Mutex<dyn LiveSession>, hub: &Hub) {
     // A page that stops reading fails the write after a while, instead of blocking its
-    // connection (one of MAX_CONNECTIONS) for good.
+    // connection (one of the server's few) for good.
     let stream = socket.get_mut();
     if stream.set_read_timeout(Some(POLL)).is_err()
-        || stream.set_write_timeout(Some(WRITE_TIMEOUT)).is_err()
+        || stream.set_write_timeout(Some(WRITE_SLICE)).is_err()
     {
         return;
     }
@@ -206,19 +200,14 @@ fn read_messages(
                 return false;
             }
             Ok(_) => {}
-            Err(tungstenite::Error::Io(e))
-                if matches!(
-                    e.kind(),
-                    std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
-                ) =>
-            {
-                return true
-            }
-            Err(tungstenite::Error::Capacity(e)) => {
-                refuse_oversized(socket, queue, &e.to_string(), reply);
+            Err(tungstenite::Error::Io(e)) if blocked(&e) => return true,
+            Err(fault) => {
+                if let Some((code, reason)) = close_code(&fault) {
+                    let problem = format!("refused: {fault}; the page disconnects (reload it)");
+                    close_for(socket, queue, (code, reason), &problem, reply);
+                }
                 return false;
             }
-            Err(_) => return false,
         }
         if !flush(socket, queue) {
             return false;
@@ -226,44 +215,92 @@ fn read_messages(
     }
 }
 
-/// Answers a message over the size limit and closes the page's connection (1009): the
+/// The close code and reason a page's fault is answered with; `None` when the page is
+/// gone and there is no one to answer.
+fn close_code(fault: &tungstenite::Error) -> Option<(CloseCode, &'static str)> {
+    use tungstenite::error::ProtocolError;
+    match fault {
+        tungstenite::Error::Capacity(_) => Some((CloseCode::Size, "message too big")),
+        tungstenite::Error::Utf8(_) => Some((CloseCode::Invalid, "text not UTF-8")),
+        tungstenite::Error::Protocol(ProtocolError::ResetWithoutClosingHandshake) => None,
+        tungstenite::Error::Protocol(_) => Some((CloseCode::Protocol, "protocol error")),
+        _ => None,
+    }
+}
+
+/// Answers a fault in what the page sent and closes its connection with `close`: the
 /// rest of an oversized frame, or of a fragmented message, cannot be told from what the
-/// page sends next, so going on could apply part of a refused message.
-fn refuse_oversized(
+/// page sends next, and a frame that breaks the protocol leaves nothing after it to trust,
+/// so going on could apply part of a refused message.
+fn close_for(
     socket: &mut WebSocket<TcpStream>,
     queue: &PageQueue<Outgoing>,
+    (code, reason): (CloseCode, &'static str),
     problem: &str,
     reply: &dyn Fn(String),
 ) {
-    reply(error_message(&format!(
-        "refused: {problem}; the page disconnects (reload it)"
-    )));
+    reply(error_message(problem));
     if flush(socket, queue) {
         let frame = CloseFrame {
-            code: CloseCode::Size,
-            reason: "message too big".into(),
+            code,
+            reason: reason.into(),
         };
         let _ = socket.close(Some(frame));
         let _ = socket.flush();
     }
-    // The rest of the message is still arriving: closing on it would reset the answer away.
+    // The rest of the message may still be arriving: closing on it would reset the answer
+    // away.
     super::http::close_gently(socket.get_mut(), super::http::LINGER);
 }
 
-/// Sends what is queued for this page; false once the page is gone.
+/// Sends what is queued for this page; false once the page is gone, or has not taken it
+/// within [`WRITE_TIMEOUT`].
 fn flush(socket: &mut WebSocket<TcpStream>, queue: &PageQueue<Outgoing>) -> bool {
+    flush_within(socket, queue, WRITE_TIMEOUT)
+}
+
+/// [`flush`] with its deadline. Each write to the socket blocks at most [`WRITE_SLICE`]
+/// (its write timeout), so a page reading a little now and then is still dropped once
+/// `limit` has passed in all.
+fn flush_within(
+    socket: &mut WebSocket<TcpStream>,
+    queue: &PageQueue<Outgoing>,
+    limit: Duration,
+) -> bool {
+    let deadline = Instant::now() + limit;
+    let late = || Instant::now() >= deadline;
     let mut sent = false;
     while let Ok(message) = queue.try_recv() {
         let message = match message {
             Outgoing::Binary(bytes) => Message::Binary(bytes),
             Outgoing::Text(text) => Message::Text(text),
         };
-        if socket.write(message).is_err() {
-            return false;
+        // A write that timed out keeps its message buffered for the next write or flush.
+        match socket.write(message) {
+            Ok(()) => {}
+            Err(tungstenite::Error::Io(e)) if blocked(&e) && !late() => {}
+            Err(_) => return false,
         }
         sent = true;
     }
-    !sent || socket.flush().is_ok()
+    if !sent {
+        return true;
+    }
+    loop {
+        match socket.flush() {
+            Ok(()) => return true,
+            Err(tungstenite::Error::Io(e)) if blocked(&e) && !late() => {}
+            Err(_) => return false,
+        }
+    }
+}
+
+/// Whether a socket call failed only for its timeout.
+fn blocked(e: &std::io::Error) -> bool {
+    matches!(
+        e.kind(),
+        std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
+    )
 }
 
 /// Applies one page message to the session; `reply` answers this page only.
@@ -304,5 +341,38 @@ fn handle(
         Ok(()) if previews => hub.set_previewer(id),
         Ok(()) => {}
         Err(message) => reply(error_message(&message)),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::net::TcpListener;
+    use tungstenite::protocol::Role;
+
+    /// A page that stops reading is given up on once the whole deadline has passed, not
+    /// after a timeout per write (each of which may move a little and start again).
+    #[test]
+    fn sending_to_a_page_that_stops_reading_ends_at_the_deadline() {
+        let listener = TcpListener::bind("127.0.0.1:0").unwrap();
+        let client = TcpStream::connect(listener.local_addr().unwrap()).unwrap();
+        let (server, _) = listener.accept().unwrap();
+        server
+            .set_write_timeout(Some(Duration::from_millis(50)))
+            .unwrap();
+        let mut socket = WebSocket::from_raw_socket(server, Role::Server, None);
+        let (tx, queue) = page_channel(PAGE_QUEUE).unwrap();
+        let frame = tungstenite::Bytes::from(vec![7u8; 1 << 20]);
+        for _ in 0..PAGE_QUEUE {
+            tx.try_send(Outgoing::Binary(frame.clone())).unwrap();
+        }
+        let limit = Duration::from_millis(400);
+        let started = Instant::now();
+        assert!(!flush_within(&mut socket, &queue, limit));
+        let took = started.elapsed();
+        assert!(took >= limit, "gave up after {took:?}");
+        // One write's timeout past the deadline at most, with room for a loaded machine.
+        assert!(took < limit + Duration::from_secs(3), "took {took:?}");
+        drop(client);
     }
 }

@@ -1,0 +1,152 @@
+//! Which connections the live view serves: takes each accepted connection and gives it a
+//! place while its request is read and answered (at most [`MAX_PENDING`]; a connection
+//! past that ends the oldest one still waiting, so connections that send nothing cannot
+//! lock a page out) and, once its token is checked, a page's place (at most [`MAX_PAGES`];
+//! past that it is refused with why). The thread accepting connections never waits on one.
+
+use std::collections::VecDeque;
+use std::net::{Shutdown, TcpStream};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex};
+
+use super::lock;
+
+/// Pages served at once.
+pub const MAX_PAGES: usize = 32;
+/// Connections whose request is being read or answered at once.
+pub const MAX_PENDING: usize = 32;
+
+/// The places the server gives out.
+#[derive(Default)]
+pub struct Admission {
+    /// Connections not yet a page, oldest first: an id and a handle to end it by.
+    pending: Mutex<VecDeque<(u64, TcpStream)>>,
+    next: AtomicUsize,
+    pages: AtomicUsize,
+}
+
+/// A connection's place while its request is read and answered; given back when dropped.
+pub struct Pending {
+    admission: Arc<Admission>,
+    id: u64,
+}
+
+/// A page's place; given back when dropped.
+pub struct PagePlace(Arc<Admission>);
+
+impl Admission {
+    /// Gives `stream` a place, ending the oldest waiting connection when all are taken (a
+    /// browser sends its request as soon as it connects; one that has sent nothing by the
+    /// time [`MAX_PENDING`] more arrived is the one to go). `None`: `stream` cannot be
+    /// watched and is not served.
+    pub fn arrive(self: &Arc<Self>, stream: &TcpStream) -> Option<Pending> {
+        let handle = stream.try_clone().ok()?;
+        let id = self.next.fetch_add(1, Ordering::Relaxed) as u64;
+        let mut pending = lock(&self.pending);
+        while pending.len() >= MAX_PENDING {
+            if let Some((_, oldest)) = pending.pop_front() {
+                // Its thread's read or write then fails at once, and the thread ends.
+                let _ = oldest.shutdown(Shutdown::Both);
+            }
+        }
+        pending.push_back((id, handle));
+        Some(Pending {
+            admission: self.clone(),
+            id,
+        })
+    }
+
+    /// Whether every page's place is taken.
+    pub fn pages_full(&self) -> bool {
+        self.pages.load(Ordering::SeqCst) >= MAX_PAGES
+    }
+}
+
+impl Pending {
+    /// Whether every page's place is taken (a page loaded now could not connect).
+    pub fn pages_full(&self) -> bool {
+        self.admission.pages_full()
+    }
+
+    /// Turns this connection's place into a page's. `Err(true)`: every page's place is
+    /// taken; `Err(false)`: the connection was ended meanwhile (to make room).
+    pub fn into_page(self) -> Result<PagePlace, bool> {
+        if !self.forget() {
+            return Err(false);
+        }
+        let pages = &self.admission.pages;
+        let taken = pages.fetch_update(Ordering::SeqCst, Ordering::SeqCst, |n| {
+            (n < MAX_PAGES).then_some(n + 1)
+        });
+        match taken {
+            Ok(_) => Ok(PagePlace(self.admission.clone())),
+            Err(_) => Err(true),
+        }
+    }
+
+    /// Takes this connection off the waiting list; false when it was already taken off.
+    fn forget(&self) -> bool {
+        let mut pending = lock(&self.admission.pending);
+        let at = pending.iter().position(|(id, _)| *id == self.id);
+        at.and_then(|at| pending.remove(at)).is_some()
+    }
+}
+
+impl Drop for Pending {
+    fn drop(&mut self) {
+        self.forget();
+    }
+}
+
+impl Drop for PagePlace {
+    fn drop(&mut self) {
+        self.0.pages.fetch_sub(1, Ordering::SeqCst);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::io::Read;
+    use std::net::TcpListener;
+
+    fn connection(listener: &TcpListener) -> (TcpStream, TcpStream) {
+        let client = TcpStream::connect(listener.local_addr().unwrap()).unwrap();
+        let (server, _) = listener.accept().unwrap();
+        (client, server)
+    }
+
+    #[test]
+    fn a_new_connection_past_the_limit_ends_the_oldest_waiting_one() {
+        let listener = TcpListener::bind("127.0.0.1:0").unwrap();
+        let admission = Arc::new(Admission::default());
+        let mut held = Vec::new();
+        for _ in 0..MAX_PENDING + 3 {
+            let (client, server) = connection(&listener);
+            let place = admission.arrive(&server).unwrap();
+            held.push((client, server, place));
+        }
+        assert_eq!(lock(&admission.pending).len(), MAX_PENDING);
+        // The three oldest were ended: their reads see the end at once; the others wait.
+        for (i, (_, server, _)) in held.iter_mut().enumerate() {
+            server.set_nonblocking(true).unwrap();
+            let read = server.read(&mut [0u8; 1]);
+            assert_eq!(matches!(read, Ok(0)), i < 3, "connection {i}: {read:?}");
+        }
+        for (_, _, place) in held.drain(..3) {
+            assert!(matches!(place.into_page(), Err(false)));
+        }
+        let pages: Vec<PagePlace> = held
+            .drain(..)
+            .map(|(_, _, place)| place.into_page().ok().unwrap())
+            .collect();
+        assert!(admission.pages_full());
+        assert!(lock(&admission.pending).is_empty());
+        let (_client, server) = connection(&listener);
+        let late = admission.arrive(&server).unwrap();
+        assert!(matches!(late.into_page(), Err(true)));
+        assert!(lock(&admission.pending).is_empty());
+        drop(pages);
+        assert!(!admission.pages_full());
+    }
+}

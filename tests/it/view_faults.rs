@@ -1,0 +1,135 @@
+//! The live view against clients that misbehave: connections that never send a request
+//! cannot lock a page out, a request carrying a body still gets its whole answer, and a
+//! WebSocket frame that breaks the protocol is answered with an error and a close with the
+//! fitting code (1002, 1007), changing nothing.
+
+use std::io::{Read, Write};
+use std::net::TcpStream;
+use std::time::Duration;
+
+use serde_json::json;
+use tungstenite::protocol::frame::coding::CloseCode;
+use tungstenite::stream::MaybeTlsStream;
+use tungstenite::Message;
+
+use super::view_ws::{cat_scene, Page, ViewRepl};
+
+#[test]
+fn connections_that_send_nothing_cannot_lock_a_page_out() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = cat_scene(dir.path());
+    let repl = ViewRepl::start(dir.path(), &scene);
+    // More silent connections than the server has places for, all kept open.
+    let silent: Vec<TcpStream> = (0..40)
+        .map(|_| TcpStream::connect(repl.host()).unwrap())
+        .collect();
+    let mut page = repl.page();
+    page.send(&json!({"type": "seek", "t": 0.5}));
+    page.until(|v| v["type"] == "scene" && v["t"] == 0.5);
+    // The oldest silent ones were ended to make room; the newest still wait their turn.
+    let ended = silent
+        .iter()
+        .filter(|s| {
+            s.set_read_timeout(Some(Duration::from_millis(200)))
+                .unwrap();
+            matches!((&**s).read(&mut [0u8; 1]), Ok(0))
+        })
+        .count();
+    assert!(ended >= 9, "{ended} of 40 silent connections ended");
+    drop((silent, page));
+    assert!(repl.finish().success());
+}
+
+#[test]
+fn a_request_carrying_a_body_gets_the_whole_page() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = cat_scene(dir.path());
+    let repl = ViewRepl::start(dir.path(), &scene);
+    let mut stream = TcpStream::connect(repl.host()).unwrap();
+    stream
+        .set_read_timeout(Some(Duration::from_secs(60)))
+        .unwrap();
+    let path = repl.url.split_once(&repl.host()).unwrap().1.to_string();
+    let body = vec![b'x'; 900_000];
+    let head = format!(
+        "GET {path} HTTP/1.1\r\nHost: {}\r\nContent-Length: {}\r\n\r\n",
+        repl.host(),
+        body.len()
+    );
+    let mut writer = stream.try_clone().unwrap();
+    let sending = std::thread::spawn(move || {
+        let _ = writer.write_all(head.as_bytes());
+        let _ = writer.write_all(&body);
+    });
+    let mut answer = Vec::new();
+    let read = stream.read_to_end(&mut answer);
+    sending.join().unwrap();
+    read.expect("the answer is read to its end, not reset away");
+    let answer = String::from_utf8(answer).unwrap();
+    assert!(answer.starts_with("HTTP/1.1 200"), "{answer:.200}");
+    let (head, page) = answer.split_once("\r\n\r\n").unwrap();
+    let length = head
+        .lines()
+        .find_map(|l| l.strip_prefix("Content-Length: "))
+        .unwrap();
+    assert_eq!(page.len(), length.parse::<usize>().unwrap());
+    assert!(page.trim_end().ends_with("</html>"));
+    assert!(repl.finish().success());
+}
+
+/// Sends one raw client frame: `first` is its first byte (FIN, reserved bits, opcode);
+/// masked with a zero mask (which leaves the payload as it is) unless `unmasked`.
+fn send_frame(page: &mut Page, first: u8, payload: &[u8], unmasked: bool) {
+    let MaybeTlsStream::Plain(stream) = page.socket.get_mut() else {
+        panic!("not a plain stream")
+    };
+    assert!(payload.len() < 126);
+    let mut frame = vec![first];
+    if unmasked {
+        frame.push(payload.len() as u8);
+    } else {
+        frame.push(0x80 | payload.len() as u8);
+        frame.extend_from_slice(&[0; 4]);
+    }
+    frame.extend_from_slice(payload);
+    stream.write_all(&frame).unwrap();
+}
+
+#[test]
+fn frames_that_break_the_protocol_are_closed_with_their_code_and_change_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = cat_scene(dir.path());
+    let repl = ViewRepl::start(dir.path(), &scene);
+    let seek = br#"{"type":"seek","t":0.9}"#;
+    let mut not_utf8 = seek.to_vec();
+    not_utf8[9] = 0xff;
+    let cases: [(&str, u8, &[u8], bool, CloseCode); 4] = [
+        ("unmasked", 0x81, seek, true, CloseCode::Protocol),
+        (
+            "reserved bits",
+            0x81 | 0x40,
+            seek,
+            false,
+            CloseCode::Protocol,
+        ),
+        ("unknown opcode", 0x83, seek, false, CloseCode::Protocol),
+        ("not UTF-8", 0x81, &not_utf8, false, CloseCode::Invalid),
+    ];
+    for (what, first, payload, unmasked, code) in cases {
+        let mut page = repl.page();
+        let t = page.scene["t"].clone();
+        send_frame(&mut page, first, payload, unmasked);
+        let error = page.until(|v| v["type"] == "error");
+        let message = error["message"].as_str().unwrap();
+        assert!(message.contains("refused"), "{what}: {error}");
+        let close = match page.socket.read() {
+            Ok(Message::Close(frame)) => frame,
+            Ok(other) => panic!("{what}: after the refusal: {other:?}"),
+            Err(e) => panic!("{what}: no close frame: {e:?}"),
+        };
+        assert_eq!(close.map(|f| f.code), Some(code), "{what}");
+        let other = repl.page();
+        assert_eq!(other.scene["t"], t, "{what}: applied");
+    }
+    assert!(repl.finish().success());
+}
