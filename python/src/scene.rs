@@ -147,7 +147,8 @@ impl Scene {
     /// frame_NNNN.png), "gif", "apng", "y4m", "mp4", "webm" or "mov" (the last three through
     /// ffmpeg); without it, the path's extension names the format (no extension, or .png: a
     /// folder). The GIL is released while it renders. Ctrl-C stops it after the frame in
-    /// progress: KeyboardInterrupt is raised and nothing is written.
+    /// progress: KeyboardInterrupt is raised and nothing is written (one that comes once the
+    /// output is finished carries a note naming it).
     #[pyo3(signature = (path, format=None))]
     fn render(&self, py: Python<'_>, path: PathBuf, format: Option<&str>) -> PyResult<String> {
         if path.as_os_str().is_empty() {
@@ -163,7 +164,7 @@ impl Scene {
             cancel: Some(cancel.clone()),
             ..RenderOptions::default()
         };
-        let rendered = until_signal(py, &cancel, || {
+        let (rendered, interrupt) = until_signal(py, &cancel, || {
             let mut renderer = self.renderer()?;
             Ok::<_, PyErr>(lapclone::render_scene(
                 &self.loaded,
@@ -173,10 +174,21 @@ impl Scene {
                 &options,
                 &mut (),
             ))
-        })??;
-        match rendered {
-            Ok(rendered) => Ok(rendered.path.display().to_string()),
-            Err(error) => Err(output_error(py, error)),
+        })?;
+        match (rendered?, interrupt) {
+            (Ok(rendered), None) => Ok(rendered.path.display().to_string()),
+            (Err(error), None) => Err(output_error(py, error)),
+            // The render had finished when Ctrl-C came: the output is whole and kept, and
+            // the interrupt says so rather than leave the user to think it went.
+            (Ok(rendered), Some(interrupt)) => {
+                let note = format!(
+                    "the render had already finished: {} was written",
+                    rendered.path.display()
+                );
+                let _ = interrupt.value(py).call_method1("add_note", (note,));
+                Err(interrupt)
+            }
+            (Err(_), Some(interrupt)) => Err(interrupt),
         }
     }
 
@@ -246,14 +258,16 @@ const SIGNAL_POLL: Duration = Duration::from_millis(50);
 
 /// Runs `work` on a thread of its own, with the GIL released, while this thread runs
 /// Python's signal handlers every [`SIGNAL_POLL`] (they only run on the main thread, and
-/// only while it holds the GIL). When a handler raises (KeyboardInterrupt for Ctrl-C),
-/// `cancel` is raised, `work` is waited for (a render stops after the frame in progress and
-/// removes its output) and the handler's exception is returned instead of `work`'s result.
+/// only while it holds the GIL), and once more when `work` is done. When a handler raises
+/// (KeyboardInterrupt for Ctrl-C), `cancel` is raised and `work` is waited for (a render
+/// stops after the frame in progress and removes its output). Gives `work`'s result and the
+/// handler's exception, if one raised: the caller tells a render stopped from one that had
+/// finished when the signal came.
 fn until_signal<T: Send>(
     py: Python<'_>,
     cancel: &AtomicBool,
     work: impl FnOnce() -> T + Send,
-) -> PyResult<T> {
+) -> PyResult<(T, Option<PyErr>)> {
     std::thread::scope(|scope| {
         // The sender is dropped when `work` returns or unwinds: the wait below then ends.
         let (running, finished) = mpsc::channel::<()>();
@@ -273,23 +287,21 @@ fn until_signal<T: Send>(
                 (finished, waited)
             });
             finished = waited.0;
-            if waited.1 != Err(RecvTimeoutError::Timeout) {
-                break;
-            }
+            let done = waited.1 != Err(RecvTimeoutError::Timeout);
             if interrupt.is_none() {
                 if let Err(error) = py.check_signals() {
                     cancel.store(true, Ordering::Relaxed);
                     interrupt = Some(error);
                 }
             }
+            if done {
+                break;
+            }
         }
         // `work` has returned or unwound: the join waits only for its thread to end.
         let result = worker
             .join()
             .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
-        match interrupt {
-            Some(error) => Err(error),
-            None => Ok(result),
-        }
+        Ok((result, interrupt))
     })
 }

@@ -128,6 +128,12 @@ pub fn render_frames(
         compute_ms += renderer.last_stats().total_ms;
         progress.frame_done(number);
     }
+    // A cancel that came while the last frame rendered stops the render as one during
+    // any other frame does, before the output is finished and named.
+    if cancelled() {
+        sink.abandon();
+        return Err(OutputError::Interrupted { after: range.last });
+    }
     let path = match sink.finish() {
         Err(_) if cancelled() => return Err(OutputError::InterruptedFinishing),
         result => result?,

@@ -161,3 +161,55 @@ fn refusals_are_typed_and_write_nothing() {
     assert!(!out.exists() && !bmp.exists());
     assert_eq!(sorted_names(dir.path()), ["tiny.rhai"]);
 }
+
+/// Raises the cancel flag as frame `at` is done, as a Ctrl-C arriving while it rendered
+/// would.
+struct CancelAt {
+    at: u64,
+    cancel: std::sync::Arc<std::sync::atomic::AtomicBool>,
+}
+
+impl RenderProgress for CancelAt {
+    fn frame_done(&mut self, number: u64) {
+        if number == self.at {
+            self.cancel
+                .store(true, std::sync::atomic::Ordering::Relaxed);
+        }
+    }
+}
+
+/// A cancel that comes while the last frame renders stops the render as one during any
+/// other frame does: an error and nothing written, not the whole output.
+#[test]
+fn a_cancel_during_the_last_frame_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write_scene(dir.path());
+    let (loaded, imports) = load_scene_and_imports(&scene).unwrap();
+    for name in ["frames", "clip.gif", "clip.apng", "clip.y4m"] {
+        for at in [2, 4] {
+            let output = dir.path().join(format!("{at}_{name}"));
+            let cancel = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+            let options = RenderOptions {
+                cancel: Some(cancel.clone()),
+                ..RenderOptions::default()
+            };
+            let mut renderer = lapclone::build_renderer(&loaded).unwrap();
+            let mut progress = CancelAt { at, cancel };
+            let rendered = render_scene(
+                &loaded,
+                &imports,
+                &mut renderer,
+                &output,
+                &options,
+                &mut progress,
+            );
+            assert!(
+                matches!(rendered, Err(OutputError::Interrupted { after }) if after == at),
+                "{name} at {at}: {rendered:?}"
+            );
+            assert!(!output.exists(), "{name} at {at}: written");
+        }
+        let left: Vec<_> = sorted_names(dir.path());
+        assert_eq!(left, ["tiny.rhai"], "{name}: left behind");
+    }
+}
