@@ -133,3 +133,47 @@ fn frames_that_break_the_protocol_are_closed_with_their_code_and_change_nothing(
     }
     assert!(repl.finish().success());
 }
+
+/// The CPU time `pid` has used, in clock ticks (user and system).
+fn cpu_ticks(pid: u32) -> u64 {
+    let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).unwrap();
+    let fields: Vec<&str> = stat
+        .rsplit_once(')')
+        .unwrap()
+        .1
+        .split_whitespace()
+        .collect();
+    fields[11].parse::<u64>().unwrap() + fields[12].parse::<u64>().unwrap()
+}
+
+/// Out of file descriptors, accepting fails until one closes: the server neither spins on
+/// the failure nor lets the connections holding them lock a page out.
+#[test]
+fn out_of_file_descriptors_the_server_neither_spins_nor_locks_pages_out() {
+    let Some(prlimit) = lapclone::util::find_program("prlimit") else {
+        eprintln!("skipped: prlimit (util-linux) is not installed");
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let scene = cat_scene(dir.path());
+    let mut command = std::process::Command::new(prlimit);
+    command
+        .arg("--nofile=24")
+        .arg(env!("CARGO_BIN_EXE_lapclone"));
+    let repl = ViewRepl::start_in(command, dir.path(), &scene, &[]);
+    let silent: Vec<TcpStream> = (0..40)
+        .filter_map(|_| TcpStream::connect(repl.host()).ok())
+        .collect();
+    std::thread::sleep(Duration::from_millis(300));
+    let pid = repl.pid();
+    let before = cpu_ticks(pid);
+    std::thread::sleep(Duration::from_secs(1));
+    let used = cpu_ticks(pid) - before;
+    // A spinning accept loop uses the whole second (100 ticks); waiting, next to none.
+    assert!(used < 30, "{used} ticks of CPU in 1 s with nothing to do");
+    let mut page = repl.page();
+    page.send(&json!({"type": "seek", "t": 0.5}));
+    page.until(|v| v["type"] == "scene" && v["t"] == 0.5);
+    drop((silent, page));
+    assert!(repl.finish().success());
+}

@@ -50,7 +50,23 @@ impl ViewRepl {
     }
 
     fn start_with(dir: &Path, scene: &Path, extra: &[&str]) -> ViewRepl {
-        let mut child = Command::new(env!("CARGO_BIN_EXE_lapclone"))
+        Self::start_in(
+            Command::new(env!("CARGO_BIN_EXE_lapclone")),
+            dir,
+            scene,
+            extra,
+        )
+    }
+
+    /// Started by `command`, which runs `lapclone` with the arguments it is given (the
+    /// binary itself, or a program that runs it such as `prlimit`).
+    pub(super) fn start_in(
+        mut command: Command,
+        dir: &Path,
+        scene: &Path,
+        extra: &[&str],
+    ) -> ViewRepl {
+        let mut child = command
             .args(["repl", scene.to_str().unwrap(), "--view", "--port", "0"])
             .args(extra)
             .arg("--preview")
@@ -145,6 +161,10 @@ impl ViewRepl {
     pub(super) fn page(&self) -> Page {
         let origin = format!("http://{}", self.host());
         self.connect(&self.socket_url(), Some(&origin)).unwrap()
+    }
+
+    pub(super) fn pid(&self) -> u32 {
+        self.child.id()
     }
 
     /// Closes stdin (the server ends with the input) and waits for the exit.

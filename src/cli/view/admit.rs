@@ -8,6 +8,7 @@ use std::collections::VecDeque;
 use std::net::{Shutdown, TcpStream};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
+use std::time::Duration;
 
 use super::lock;
 
@@ -15,6 +16,10 @@ use super::lock;
 pub const MAX_PAGES: usize = 32;
 /// Connections whose request is being read or answered at once.
 pub const MAX_PENDING: usize = 32;
+/// How long making room waits for the ended connection's thread to close it.
+const ROOM_WAIT: Duration = Duration::from_millis(10);
+/// How many times room is made for one thing that needs file descriptors.
+const ROOM_TRIES: usize = 8;
 
 /// The places the server gives out.
 #[derive(Default)]
@@ -44,10 +49,7 @@ impl Admission {
         let id = self.next.fetch_add(1, Ordering::Relaxed) as u64;
         let mut pending = lock(&self.pending);
         while pending.len() >= MAX_PENDING {
-            if let Some((_, oldest)) = pending.pop_front() {
-                // Its thread's read or write then fails at once, and the thread ends.
-                let _ = oldest.shutdown(Shutdown::Both);
-            }
+            end(pending.pop_front());
         }
         pending.push_back((id, handle));
         Some(Pending {
@@ -56,9 +58,37 @@ impl Admission {
         })
     }
 
+    /// Ends the oldest waiting connection, if one is, then waits [`ROOM_WAIT`] for its
+    /// thread to close it: room when the process is out of file descriptors (accepting then
+    /// fails until one closes, and would spin).
+    pub fn make_room(&self) {
+        end(lock(&self.pending).pop_front());
+        std::thread::sleep(ROOM_WAIT);
+    }
+
+    /// Runs `open`, which needs file descriptors, until it gives something, making room
+    /// after each failure, at most [`ROOM_TRIES`] times.
+    pub fn with_room<T>(&self, mut open: impl FnMut() -> Option<T>) -> Option<T> {
+        for _ in 0..ROOM_TRIES {
+            if let Some(opened) = open() {
+                return Some(opened);
+            }
+            self.make_room();
+        }
+        open()
+    }
+
     /// Whether every page's place is taken.
     pub fn pages_full(&self) -> bool {
         self.pages.load(Ordering::SeqCst) >= MAX_PAGES
+    }
+}
+
+/// Ends a waiting connection: its thread's read or write then fails at once, and the thread
+/// ends.
+fn end(waiting: Option<(u64, TcpStream)>) {
+    if let Some((_, stream)) = waiting {
+        let _ = stream.shutdown(Shutdown::Both);
     }
 }
 

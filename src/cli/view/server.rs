@@ -123,16 +123,25 @@ fn serve(
 ) {
     let admission = Arc::new(Admission::default());
     for stream in listener.incoming() {
-        let Ok(stream) = stream else { continue };
-        let Some(place) = admission.arrive(&stream) else {
+        let stream = match stream {
+            Ok(stream) => stream,
+            Err(e) if e.kind() == std::io::ErrorKind::ConnectionAborted => continue,
+            Err(_) => {
+                // Out of file descriptors, most likely: the error stays until one closes.
+                admission.make_room();
+                continue;
+            }
+        };
+        let Some(place) = admission.with_room(|| admission.arrive(&stream)) else {
             continue;
         };
         let (routes, session, hub) = (routes.clone(), session.clone(), hub.clone());
+        let admission = admission.clone();
         let spawned = std::thread::Builder::new()
             .name("view-page".into())
             .spawn(move || {
                 if let Ok(Accepted::Socket(socket, _place)) = accept(stream, &routes, place) {
-                    page_loop(*socket, &session, &hub);
+                    page_loop(*socket, &session, &hub, &admission);
                 }
             });
         if spawned.is_err() {
@@ -143,7 +152,12 @@ fn serve(
 
 /// Serves one page until it closes: its messages in, frames and replies out. Its thread
 /// sleeps until the page sends something or something is queued for it.
-fn page_loop(mut socket: WebSocket<TcpStream>, session: &Mutex<dyn LiveSession>, hub: &Hub) {
+fn page_loop(
+    mut socket: WebSocket<TcpStream>,
+    session: &Mutex<dyn LiveSession>,
+    hub: &Hub,
+    admission: &Admission,
+) {
     // A page that stops reading fails the write after a while, instead of blocking its
     // connection (one of the server's few) for good.
     let stream = socket.get_mut();
@@ -153,7 +167,7 @@ fn page_loop(mut socket: WebSocket<TcpStream>, session: &Mutex<dyn LiveSession>,
         return;
     }
     let _ = socket.get_mut().set_nodelay(true);
-    let Ok((tx, queue)) = page_channel(PAGE_QUEUE) else {
+    let Some((tx, queue)) = admission.with_room(|| page_channel(PAGE_QUEUE).ok()) else {
         return;
     };
     let id = hub.connect(tx.clone());
