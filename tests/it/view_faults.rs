@@ -177,3 +177,63 @@ fn out_of_file_descriptors_the_server_neither_spins_nor_locks_pages_out() {
     drop((silent, page));
     assert!(repl.finish().success());
 }
+
+/// How many threads process `pid` runs.
+fn threads(pid: u32) -> usize {
+    let status = std::fs::read_to_string(format!("/proc/{pid}/status")).unwrap();
+    let line = status.lines().find(|l| l.starts_with("Threads:")).unwrap();
+    line["Threads:".len()..].trim().parse().unwrap()
+}
+
+/// With every page's place taken, a flood of WebSocket requests (with the token) that are
+/// refused and never closed stays within the server's bound on connection threads: each is
+/// counted among the waiting connections while it is answered, and the accepting thread
+/// waits for ended ones to finish before it starts another.
+#[test]
+fn a_flood_of_refused_pages_keeps_the_threads_bounded() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = cat_scene(dir.path());
+    let repl = ViewRepl::start(dir.path(), &scene);
+    let pages: Vec<Page> = (0..32).map(|_| repl.page()).collect();
+    let pid = repl.pid();
+    let before = threads(pid);
+    let watching = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(true));
+    let watcher = {
+        let watching = watching.clone();
+        std::thread::spawn(move || {
+            let mut most = 0;
+            while watching.load(std::sync::atomic::Ordering::Relaxed) {
+                most = most.max(threads(pid));
+                std::thread::sleep(Duration::from_millis(2));
+            }
+            most
+        })
+    };
+    let path = repl
+        .socket_url()
+        .replacen(&format!("ws://{}", repl.host()), "", 1);
+    let request = format!(
+        "GET {path} HTTP/1.1\r\nHost: {0}\r\nOrigin: http://{0}\r\nUpgrade: websocket\r\n\
+         Connection: Upgrade\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n\
+         Sec-WebSocket-Version: 13\r\n\r\n",
+        repl.host()
+    );
+    let held: Vec<TcpStream> = (0..400)
+        .filter_map(|_| {
+            let mut stream = TcpStream::connect(repl.host()).ok()?;
+            stream.write_all(request.as_bytes()).ok()?;
+            Some(stream)
+        })
+        .collect();
+    std::thread::sleep(Duration::from_millis(300));
+    watching.store(false, std::sync::atomic::Ordering::Relaxed);
+    let most = watcher.join().unwrap();
+    // 32 waiting connections and 8 finishing, over the threads the 32 pages already run;
+    // and a few more, counted as given back while their system thread is still ending.
+    assert!(
+        most <= before + 44,
+        "{most} threads at most, {before} with the 32 pages"
+    );
+    drop((held, pages));
+    assert!(repl.finish().success());
+}

@@ -2,7 +2,9 @@
 //! place while its request is read and answered (at most [`MAX_PENDING`]; a connection
 //! past that ends the oldest one still waiting, so connections that send nothing cannot
 //! lock a page out) and, once its token is checked, a page's place (at most [`MAX_PAGES`];
-//! past that it is refused with why). The thread accepting connections never waits on one.
+//! past that it is refused with why). The thread accepting connections never waits on a
+//! client; it waits only for the threads of ended connections to finish, so that at most
+//! [`MAX_THREADS`] connection threads run.
 
 use std::collections::VecDeque;
 use std::net::{Shutdown, TcpStream};
@@ -16,6 +18,12 @@ use super::lock;
 pub const MAX_PAGES: usize = 32;
 /// Connections whose request is being read or answered at once.
 pub const MAX_PENDING: usize = 32;
+/// Connection threads at once: each waiting connection's and each page's, and a few whose
+/// connection was ended and which are finishing.
+const MAX_THREADS: usize = MAX_PENDING + MAX_PAGES + 8;
+/// How long the accepting thread waits for a finishing connection thread before it looks
+/// again.
+const THREAD_WAIT: Duration = Duration::from_millis(1);
 /// How long making room waits for the ended connection's thread to close it.
 const ROOM_WAIT: Duration = Duration::from_millis(10);
 /// How many times room is made for one thing that needs file descriptors.
@@ -28,6 +36,7 @@ pub struct Admission {
     pending: Mutex<VecDeque<(u64, TcpStream)>>,
     next: AtomicUsize,
     pages: AtomicUsize,
+    threads: AtomicUsize,
 }
 
 /// A connection's place while its request is read and answered; given back when dropped.
@@ -38,6 +47,9 @@ pub struct Pending {
 
 /// A page's place; given back when dropped.
 pub struct PagePlace(Arc<Admission>);
+
+/// A connection thread's place among [`MAX_THREADS`]; given back when dropped.
+pub struct ThreadPlace(Arc<Admission>);
 
 impl Admission {
     /// Gives `stream` a place, ending the oldest waiting connection when all are taken (a
@@ -56,6 +68,21 @@ impl Admission {
             admission: self.clone(),
             id,
         })
+    }
+
+    /// A place for one more connection thread, once fewer than [`MAX_THREADS`] run: the
+    /// threads of connections ended to make room take a moment to finish, and a flood of
+    /// connections would otherwise outrun them.
+    pub fn thread_place(self: &Arc<Self>) -> ThreadPlace {
+        let more = |n: usize| (n < MAX_THREADS).then_some(n + 1);
+        while self
+            .threads
+            .fetch_update(Ordering::SeqCst, Ordering::SeqCst, more)
+            .is_err()
+        {
+            std::thread::sleep(THREAD_WAIT);
+        }
+        ThreadPlace(self.clone())
     }
 
     /// Ends the oldest waiting connection, if one is, then waits [`ROOM_WAIT`] for its
@@ -98,19 +125,22 @@ impl Pending {
         self.admission.pages_full()
     }
 
-    /// Turns this connection's place into a page's. `Err(true)`: every page's place is
-    /// taken; `Err(false)`: the connection was ended meanwhile (to make room).
-    pub fn into_page(self) -> Result<PagePlace, bool> {
-        if !self.forget() {
-            return Err(false);
-        }
+    /// Turns this connection's place into a page's. `Err(Some(self))`: every page's place
+    /// is taken, and the connection keeps its waiting place while it is refused (so a flood
+    /// of refused pages stays within [`MAX_PENDING`]); `Err(None)`: the connection was
+    /// ended meanwhile (to make room).
+    pub fn into_page(self) -> Result<PagePlace, Option<Pending>> {
         let pages = &self.admission.pages;
         let taken = pages.fetch_update(Ordering::SeqCst, Ordering::SeqCst, |n| {
             (n < MAX_PAGES).then_some(n + 1)
         });
-        match taken {
-            Ok(_) => Ok(PagePlace(self.admission.clone())),
-            Err(_) => Err(true),
+        if taken.is_err() {
+            return Err(Some(self));
+        }
+        let place = PagePlace(self.admission.clone());
+        match self.forget() {
+            true => Ok(place),
+            false => Err(None),
         }
     }
 
@@ -125,6 +155,12 @@ impl Pending {
 impl Drop for Pending {
     fn drop(&mut self) {
         self.forget();
+    }
+}
+
+impl Drop for ThreadPlace {
+    fn drop(&mut self) {
+        self.0.threads.fetch_sub(1, Ordering::SeqCst);
     }
 }
 
@@ -164,7 +200,7 @@ mod tests {
             assert_eq!(matches!(read, Ok(0)), i < 3, "connection {i}: {read:?}");
         }
         for (_, _, place) in held.drain(..3) {
-            assert!(matches!(place.into_page(), Err(false)));
+            assert!(matches!(place.into_page(), Err(None)));
         }
         let pages: Vec<PagePlace> = held
             .drain(..)
@@ -174,7 +210,12 @@ mod tests {
         assert!(lock(&admission.pending).is_empty());
         let (_client, server) = connection(&listener);
         let late = admission.arrive(&server).unwrap();
-        assert!(matches!(late.into_page(), Err(true)));
+        // Refused, it keeps its waiting place until it is dropped.
+        let Err(Some(late)) = late.into_page() else {
+            panic!("a 33rd page was given a place");
+        };
+        assert_eq!(lock(&admission.pending).len(), 1);
+        drop(late);
         assert!(lock(&admission.pending).is_empty());
         drop(pages);
         assert!(!admission.pages_full());

@@ -59,14 +59,19 @@ pub fn accept(mut stream: TcpStream, routes: &Routes, place: Pending) -> std::io
         }
         Ok((Route::Socket { key }, rest)) => match place.into_page() {
             Ok(place) => return upgrade(stream, &key, rest, place),
-            Err(true) => busy(),
-            Err(false) => return Ok(Accepted::Answered),
+            // Refused while still counted among the waiting connections.
+            Err(Some(_waiting)) => return refuse(&mut stream, busy()),
+            Err(None) => return Ok(Accepted::Answered),
         },
     };
-    let Refusal(status, body) = refused;
+    refuse(&mut stream, refused)
+}
+
+/// Answers `refusal` and closes the connection gently.
+fn refuse(stream: &mut TcpStream, Refusal(status, body): Refusal) -> std::io::Result<Accepted> {
     let kind = "text/plain; charset=utf-8";
-    respond(&mut stream, status, kind, body.as_bytes(), &[])?;
-    close_gently(&mut stream, LINGER);
+    respond(stream, status, kind, body.as_bytes(), &[])?;
+    close_gently(stream, LINGER);
     Ok(Accepted::Answered)
 }
 

@@ -136,10 +136,11 @@ fn serve(
             continue;
         };
         let (routes, session, hub) = (routes.clone(), session.clone(), hub.clone());
-        let admission = admission.clone();
+        let (admission, thread) = (admission.clone(), admission.thread_place());
         let spawned = std::thread::Builder::new()
             .name("view-page".into())
             .spawn(move || {
+                let _thread = thread;
                 if let Ok(Accepted::Socket(socket, _place)) = accept(stream, &routes, place) {
                     page_loop(*socket, &session, &hub, &admission);
                 }
