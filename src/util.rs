@@ -1,12 +1,16 @@
 //! Small helpers shared by every stage: the one rule for output files ([`TempOutput`]: a
 //! temporary file in the destination folder, then a rename, so a failure never leaves a
-//! partial file; streams written through, nothing else replaced), whether two paths name one
+//! partial file; streams written through, nothing else replaced, a FIFO's reader waited for
+//! only until the program is interrupted), whether two paths name one
 //! file, a lock that survives poisoning, finding an external program (ffmpeg) on `PATH`, and
 //! the number of cores this process may use.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::sync::{Mutex, MutexGuard};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex, MutexGuard, Weak};
+#[cfg(unix)]
+use std::time::Duration;
 
 /// Locks `mutex`, also when a panicking thread poisoned it: every user here keeps its data
 /// whole under the lock (a queue position, a finished entry, a hand-off state).
@@ -256,7 +260,7 @@ impl TempOutput {
     pub fn open(&self) -> std::io::Result<std::fs::File> {
         match &self.inner {
             Inner::Temporary { file, .. } => file.reopen(),
-            Inner::Through(path) => std::fs::OpenOptions::new().write(true).open(path),
+            Inner::Through(path) => open_through(path),
         }
     }
 
@@ -283,6 +287,62 @@ impl Drop for TempOutput {
             forget_pending(file.path());
         }
     }
+}
+
+/// Opens a FIFO or device to write through. A FIFO's open waits for a program to read it,
+/// as a shell's `>` does, but looks every [`FIFO_WAIT`] whether the program was interrupted
+/// ([`interrupted`]): a blocking open cannot be interrupted, and a FIFO nobody reads would
+/// hang the program (a REPL's `:save`) for good.
+fn open_through(path: &Path) -> std::io::Result<std::fs::File> {
+    #[cfg(unix)]
+    {
+        use rustix::fs::{fcntl_getfl, fcntl_setfl, Mode, OFlags};
+        let flags = OFlags::WRONLY | OFlags::NONBLOCK | OFlags::CLOEXEC;
+        loop {
+            match rustix::fs::open(path, flags, Mode::empty()) {
+                Ok(fd) => {
+                    // Written as any file is: a full pipe waits for its reader.
+                    fcntl_setfl(&fd, fcntl_getfl(&fd)? - OFlags::NONBLOCK)?;
+                    return Ok(std::fs::File::from(fd));
+                }
+                // No reader yet (only a FIFO opened this way says so).
+                Err(rustix::io::Errno::NXIO) if !interrupted() => std::thread::sleep(FIFO_WAIT),
+                Err(rustix::io::Errno::NXIO) => {
+                    let kind = std::io::ErrorKind::Interrupted;
+                    let message = "interrupted while waiting for a program to read the FIFO";
+                    return Err(std::io::Error::new(kind, message));
+                }
+                Err(e) => return Err(e.into()),
+            }
+        }
+    }
+    #[cfg(not(unix))]
+    std::fs::OpenOptions::new().write(true).open(path)
+}
+
+/// How often a wait for a FIFO's reader looks whether the program was interrupted.
+#[cfg(unix)]
+const FIFO_WAIT: Duration = Duration::from_millis(20);
+
+/// The flags that, raised, interrupt the program's waits for a FIFO's reader (a render's
+/// cancel, a REPL's Ctrl-C); held weakly, so a flag dropped is forgotten.
+static INTERRUPTS: Mutex<Vec<Weak<AtomicBool>>> = Mutex::new(Vec::new());
+
+/// Lets `flag`, raised, interrupt a wait for a FIFO's reader (as long as the flag lives).
+pub fn interrupt_waits_with(flag: &Arc<AtomicBool>) {
+    let mut flags = lock(&INTERRUPTS);
+    flags.retain(|f| f.strong_count() > 0);
+    flags.push(Arc::downgrade(flag));
+}
+
+/// Whether a flag given to [`interrupt_waits_with`] is raised, or the program is stopping
+/// ([`remove_pending_outputs`]).
+#[cfg_attr(not(unix), allow(dead_code))]
+fn interrupted() -> bool {
+    let raised = lock(&INTERRUPTS)
+        .iter()
+        .any(|f| f.upgrade().is_some_and(|f| f.load(Ordering::Relaxed)));
+    raised || pending(|list| list.closed)
 }
 
 /// The end of every temporary output's name.

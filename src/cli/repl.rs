@@ -79,6 +79,8 @@ pub fn run(args: ReplArgs) -> anyhow::Result<()> {
         }
     });
     let cancel = Arc::new(AtomicBool::new(false));
+    // Ctrl-C also ends a wait for a FIFO's reader (`:save fifo` with nobody reading).
+    lapclone::util::interrupt_waits_with(&cancel);
     let words = Arc::new(Mutex::new(completion::Words::default()));
     let preview = Preview::new(
         preview_path.clone(),

@@ -63,6 +63,8 @@ impl SinkPlan {
         jobs: usize,
         cancel: Arc<AtomicBool>,
     ) -> Result<FrameSink, OutputError> {
+        // A FIFO output waits for its reader until the render is cancelled.
+        crate::util::interrupt_waits_with(&cancel);
         let canvas = &renderer.scene().canvas;
         let output = self.output.as_path();
         // A file's folder must exist (a PNG folder's is checked as it is staged, a video's

@@ -23,3 +23,10 @@ pub fn sorted_names(dir: &Path) -> Vec<String> {
     names.sort();
     names
 }
+
+/// Makes a FIFO at `path` (with `mkfifo`, as a user would).
+#[cfg(unix)]
+pub fn make_fifo(path: &Path) {
+    let made = std::process::Command::new("mkfifo").arg(path).status();
+    assert!(made.unwrap().success(), "mkfifo {}", path.display());
+}

@@ -6,6 +6,8 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 
+#[cfg(unix)]
+use crate::files::make_fifo;
 use crate::files::sorted_names;
 
 const W: u32 = 40;
@@ -608,12 +610,6 @@ fn special_files_as_inputs_fail_at_once_instead_of_waiting() {
         1,
         "the output folder bg.png is not a folder",
     );
-}
-
-/// Makes a FIFO at `path`.
-#[cfg(unix)]
-fn make_fifo(path: &Path) {
-    assert!(Command::new("mkfifo").arg(path).status().unwrap().success());
 }
 
 fn clone_into(world: &World, output: &str) -> Output {

@@ -320,3 +320,36 @@ fn sigterm_and_sighup_end_a_repl_and_remove_its_preview_folder() {
         std::fs::remove_dir(&temp).unwrap();
     }
 }
+
+/// Whether process `pid`'s main thread is asleep (in `nanosleep`): a render waiting for its
+/// FIFO's reader sleeps between looks; one stuck in a blocking open never does.
+fn sleeping(pid: u32) -> bool {
+    let wchan = std::fs::read_to_string(format!("/proc/{pid}/wchan"));
+    wchan.is_ok_and(|w| w.contains("nanosleep"))
+}
+
+/// A render into a FIFO nobody reads waits for a reader, and one Ctrl-C ends the wait: exit
+/// 1, "interrupted", the FIFO left as it was (a blocking open could not be interrupted).
+#[test]
+fn ctrl_c_ends_a_wait_for_a_fifo_reader() {
+    use std::os::unix::fs::FileTypeExt;
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write_scene(dir.path());
+    let fifo = dir.path().join("out.y4m");
+    files::make_fifo(&fifo);
+    let child = spawn_render(&scene, &fifo, &[]);
+    // Looked at for at most a minute: a blocking open never sleeps.
+    let waiting = (0..6000).any(|_| {
+        std::thread::sleep(std::time::Duration::from_millis(10));
+        sleeping(child.id())
+    });
+    if !waiting {
+        let mut child = child;
+        let _ = child.kill();
+        panic!("the render never waited interruptibly for its reader");
+    }
+    stop(child, "-INT", "a FIFO with no reader");
+    let kind = std::fs::symlink_metadata(&fifo).unwrap().file_type();
+    assert!(kind.is_fifo());
+    assert_eq!(sorted_names(dir.path()), ["long.rhai", "out.y4m"]);
+}

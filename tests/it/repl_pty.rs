@@ -207,3 +207,63 @@ fn a_page_lines_output_goes_above_a_prompt_in_use() {
     p.send_control('d').unwrap();
     p.exp_eof().unwrap();
 }
+
+/// `:save` into a FIFO nobody reads waits for a reader, as a shell's `>` does, and Ctrl-C
+/// ends the wait with an error; the session goes on (a blocking open hung it for good).
+#[cfg(unix)]
+#[test]
+fn ctrl_c_ends_a_save_waiting_for_a_fifo_reader() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = crate::view_ws::cat_scene(dir.path());
+    let fifo = dir.path().join("saved.rhai");
+    crate::files::make_fifo(&fifo);
+    let mut command = Command::new(env!("CARGO_BIN_EXE_lapclone"));
+    command
+        .arg("repl")
+        .arg(&scene)
+        .arg("--preview")
+        .arg(dir.path().join("preview.png"))
+        .arg("--history")
+        .arg(dir.path().join("history.txt"))
+        .env("TERM", "xterm")
+        .env("LAPCLONE_INLINE", "off");
+    let mut p = spawn_command(command, Some(60_000)).unwrap();
+    p.exp_string("lapclone> ").unwrap();
+    p.send_line(&format!(":save {}", fifo.display())).unwrap();
+    // The Ctrl-C comes once the entry waits for the reader (asleep between its looks):
+    // earlier, the prompt would clear the line, or the entry's start lower the flag.
+    let pid = process_with_argument(&fifo.with_file_name("preview.png"));
+    let waiting = (0..6000).any(|_| {
+        std::thread::sleep(std::time::Duration::from_millis(10));
+        std::fs::read_to_string(format!("/proc/{pid}/wchan")).is_ok_and(|w| w.contains("nanosleep"))
+    });
+    assert!(
+        waiting,
+        "the save never waited interruptibly for its reader"
+    );
+    p.send_control('c').unwrap();
+    p.exp_string("interrupted while waiting for a program to read the FIFO")
+        .unwrap();
+    p.exp_string("lapclone> ").unwrap();
+    p.send_line("1 + 1").unwrap();
+    p.exp_string("=> 2").unwrap();
+    p.send_control('d').unwrap();
+    p.exp_eof().unwrap();
+}
+
+/// The process whose command line holds `argument` (a path unique to one test).
+#[cfg(unix)]
+fn process_with_argument(argument: &Path) -> u32 {
+    let wanted = argument.as_os_str().as_encoded_bytes();
+    let found = std::fs::read_dir("/proc")
+        .unwrap()
+        .flatten()
+        .find_map(|entry| {
+            let pid: u32 = entry.file_name().to_str()?.parse().ok()?;
+            let line = std::fs::read(entry.path().join("cmdline")).ok()?;
+            line.split(|&b| b == 0)
+                .any(|part| part == wanted)
+                .then_some(pid)
+        });
+    found.expect("the REPL's process")
+}
