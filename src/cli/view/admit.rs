@@ -4,12 +4,13 @@
 //! lock a page out) and, once its token is checked, a page's place (at most [`MAX_PAGES`];
 //! past that it is refused with why). The thread accepting connections never waits on a
 //! client; it waits only for the threads of ended connections to finish, so that at most
-//! [`MAX_THREADS`] connection threads run.
+//! [`MAX_THREADS`] connection threads run ([`ConnectionThreads`]).
 
 use std::collections::VecDeque;
 use std::net::{Shutdown, TcpStream};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
+use std::thread::JoinHandle;
 use std::time::Duration;
 
 use super::lock;
@@ -36,7 +37,6 @@ pub struct Admission {
     pending: Mutex<VecDeque<(u64, TcpStream)>>,
     next: AtomicUsize,
     pages: AtomicUsize,
-    threads: AtomicUsize,
 }
 
 /// A connection's place while its request is read and answered; given back when dropped.
@@ -47,9 +47,6 @@ pub struct Pending {
 
 /// A page's place; given back when dropped.
 pub struct PagePlace(Arc<Admission>);
-
-/// A connection thread's place among [`MAX_THREADS`]; given back when dropped.
-pub struct ThreadPlace(Arc<Admission>);
 
 impl Admission {
     /// Gives `stream` a place, ending the oldest waiting connection when all are taken (a
@@ -68,21 +65,6 @@ impl Admission {
             admission: self.clone(),
             id,
         })
-    }
-
-    /// A place for one more connection thread, once fewer than [`MAX_THREADS`] run: the
-    /// threads of connections ended to make room take a moment to finish, and a flood of
-    /// connections would otherwise outrun them.
-    pub fn thread_place(self: &Arc<Self>) -> ThreadPlace {
-        let more = |n: usize| (n < MAX_THREADS).then_some(n + 1);
-        while self
-            .threads
-            .fetch_update(Ordering::SeqCst, Ordering::SeqCst, more)
-            .is_err()
-        {
-            std::thread::sleep(THREAD_WAIT);
-        }
-        ThreadPlace(self.clone())
     }
 
     /// Ends the oldest waiting connection, if one is, then waits [`ROOM_WAIT`] for its
@@ -108,6 +90,36 @@ impl Admission {
     /// Whether every page's place is taken.
     pub fn pages_full(&self) -> bool {
         self.pages.load(Ordering::SeqCst) >= MAX_PAGES
+    }
+}
+
+/// The connection threads: each is joined once finished, so that at most [`MAX_THREADS`]
+/// system threads run (a thread that has given back its places is still ending for a
+/// moment, and a flood of connections would otherwise outrun them).
+#[derive(Default)]
+pub struct ConnectionThreads {
+    running: Vec<JoinHandle<()>>,
+}
+
+impl ConnectionThreads {
+    /// Starts `serve` on a thread of its own, once fewer than [`MAX_THREADS`] run (waiting
+    /// for the threads of ended connections to finish).
+    pub fn spawn(&mut self, serve: impl FnOnce() + Send + 'static) -> std::io::Result<()> {
+        loop {
+            let (done, running) = self.running.drain(..).partition(|t| t.is_finished());
+            self.running = running;
+            // Each join returns once its system thread is gone.
+            (done as Vec<JoinHandle<()>>)
+                .into_iter()
+                .for_each(|t| drop(t.join()));
+            if self.running.len() < MAX_THREADS {
+                break;
+            }
+            std::thread::sleep(THREAD_WAIT);
+        }
+        let thread = std::thread::Builder::new().name("view-page".into());
+        self.running.push(thread.spawn(serve)?);
+        Ok(())
     }
 }
 
@@ -155,12 +167,6 @@ impl Pending {
 impl Drop for Pending {
     fn drop(&mut self) {
         self.forget();
-    }
-}
-
-impl Drop for ThreadPlace {
-    fn drop(&mut self) {
-        self.0.threads.fetch_sub(1, Ordering::SeqCst);
     }
 }
 

@@ -13,7 +13,7 @@ use tungstenite::protocol::frame::coding::CloseCode;
 use tungstenite::protocol::CloseFrame;
 use tungstenite::{Message, WebSocket};
 
-use super::admit::Admission;
+use super::admit::{Admission, ConnectionThreads};
 use super::edit::{parse_request, Edit, Request};
 use super::http::{accept, Accepted, Routes};
 use super::hub::{Hub, Outgoing, PAGE_QUEUE};
@@ -122,6 +122,7 @@ fn serve(
     hub: Arc<Hub>,
 ) {
     let admission = Arc::new(Admission::default());
+    let mut threads = ConnectionThreads::default();
     for stream in listener.incoming() {
         let stream = match stream {
             Ok(stream) => stream,
@@ -136,15 +137,12 @@ fn serve(
             continue;
         };
         let (routes, session, hub) = (routes.clone(), session.clone(), hub.clone());
-        let (admission, thread) = (admission.clone(), admission.thread_place());
-        let spawned = std::thread::Builder::new()
-            .name("view-page".into())
-            .spawn(move || {
-                let _thread = thread;
-                if let Ok(Accepted::Socket(socket, _place)) = accept(stream, &routes, place) {
-                    page_loop(*socket, &session, &hub, &admission);
-                }
-            });
+        let admission = admission.clone();
+        let spawned = threads.spawn(move || {
+            if let Ok(Accepted::Socket(socket, _place)) = accept(stream, &routes, place) {
+                page_loop(*socket, &session, &hub, &admission);
+            }
+        });
         if spawned.is_err() {
             eprint_line!("warning: the view cannot serve another page");
         }
