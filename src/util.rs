@@ -365,11 +365,14 @@ pub fn temp_prefix(dest: &Path) -> String {
 /// remove them ([`remove_pending_outputs`]) instead of leaving them in the user's folders.
 static PENDING: std::sync::Mutex<Pending> = std::sync::Mutex::new(Pending {
     files: Vec::new(),
+    folders: Vec::new(),
     closed: false,
 });
 
 struct Pending {
     files: Vec<PathBuf>,
+    /// Temporary folders ([`TempFolder`]), removed with what they hold.
+    folders: Vec<PathBuf>,
     /// Set by [`remove_pending_outputs`]: no temporary file may be made after it.
     closed: bool,
 }
@@ -382,15 +385,82 @@ fn forget_pending(temp: &Path) {
     pending(|list| list.files.retain(|p| p != temp));
 }
 
-/// Removes every temporary file a [`TempOutput`] is still writing, and refuses new ones
-/// from then on: for a program about to exit on a signal, whose writers will not finish.
-/// Gives how many were removed.
+/// Removes every temporary file a [`TempOutput`] is still writing and every [`TempFolder`]
+/// with what it holds, and refuses new ones from then on: for a program about to exit on a
+/// signal, whose writers will not finish. Gives how many were removed.
 pub fn remove_pending_outputs() -> usize {
-    let files = pending(|list| {
+    let (files, folders) = pending(|list| {
         list.closed = true;
-        std::mem::take(&mut list.files)
+        (std::mem::take(&mut list.files), std::mem::take(&mut list.folders))
     });
-    files.iter().filter(|p| std::fs::remove_file(p).is_ok()).count()
+    let files = files.iter().filter(|p| std::fs::remove_file(p).is_ok());
+    // A writer finishing its frame may add a file while the folder goes: a few tries.
+    let folder_gone = |p: &&PathBuf| {
+        (0..FOLDER_TRIES).any(|_| {
+            let gone = std::fs::remove_dir_all(p).is_ok() || !p.exists();
+            if !gone {
+                std::thread::sleep(std::time::Duration::from_millis(2));
+            }
+            gone
+        })
+    };
+    files.count() + folders.iter().filter(folder_gone).count()
+}
+
+/// How many times a stop tries to remove a temporary folder.
+const FOLDER_TRIES: usize = 20;
+
+/// A temporary folder beside an output (a PNG sequence staged whole), listed so that a
+/// program stopped by a signal removes it ([`remove_pending_outputs`]); dropped, it is
+/// removed with what it holds, as `tempfile`'s `TempDir` is.
+#[derive(Debug)]
+pub struct TempFolder {
+    dir: Option<tempfile::TempDir>,
+}
+
+impl TempFolder {
+    /// Makes the folder beside `output`, named as [`TempOutput`]'s files are.
+    pub fn beside(output: &Path) -> std::io::Result<Self> {
+        let prefix = temp_prefix(output);
+        let mut builder = tempfile::Builder::new();
+        builder.prefix(&prefix).suffix(TEMP_SUFFIX);
+        // Made and listed under one lock, so a stop removes every one it lets exist.
+        let dir = pending(|list| {
+            if list.closed {
+                let stopped = std::io::ErrorKind::Interrupted;
+                return Err(std::io::Error::new(stopped, "the program is stopping"));
+            }
+            let dir = builder.tempdir_in(folder_of(output))?;
+            list.folders.push(dir.path().to_path_buf());
+            Ok(dir)
+        })?;
+        Ok(TempFolder { dir: Some(dir) })
+    }
+
+    pub fn path(&self) -> &Path {
+        // invariant: `dir` is taken only by `keep`, which consumes the folder.
+        self.dir.as_ref().expect("a temporary folder").path()
+    }
+
+    /// Keeps the folder (no longer removed when dropped or on a stop) and gives its path.
+    pub fn keep(mut self) -> PathBuf {
+        // invariant: as in `path`.
+        let path = self.dir.take().expect("a temporary folder").keep();
+        pending(|list| list.folders.retain(|p| *p != path));
+        path
+    }
+}
+
+impl Drop for TempFolder {
+    fn drop(&mut self) {
+        if let Some(dir) = self.dir.take() {
+            // Removed before it is unlisted: a stop meanwhile removes it too, instead of
+            // exiting with it half gone.
+            let path = dir.path().to_path_buf();
+            drop(dir);
+            pending(|list| list.folders.retain(|p| *p != path));
+        }
+    }
 }
 
 /// A number for a message: as written when short, in exponent form when huge or tiny (a

@@ -65,19 +65,22 @@ pub fn run(args: ReplArgs) -> anyhow::Result<()> {
         None => default_preview_path().map(|(path, folder)| (path, Some(folder)))?,
     };
     lapclone::output::check_output_folder(&preview_path)?;
-    // SIGTERM and SIGHUP end the session without the guard's drop: the folder goes here.
+    // SIGTERM and SIGHUP (and, piped, SIGINT) end the session without the guard's drop: the
+    // folder goes here.
     let folder = preview_folder.as_ref().map(|f| f.path().to_path_buf());
     let terminal = interactive
         .then(super::signals::SavedTerminal::capture)
         .flatten();
-    super::signals::stop_on_terminate(move || {
+    let cleanup = move || {
         if let Some(terminal) = &terminal {
             terminal.restore();
         }
         if let Some(folder) = &folder {
             let _ = std::fs::remove_dir_all(folder);
         }
-    });
+    };
+    // Piped or scripted, Ctrl-C stops the session as SIGTERM does.
+    super::signals::stop_on_terminate(cleanup, !interactive);
     let cancel = Arc::new(AtomicBool::new(false));
     // Ctrl-C also ends a wait for a FIFO's reader (`:save fifo` with nobody reading).
     lapclone::util::interrupt_waits_with(&cancel);

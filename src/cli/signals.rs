@@ -27,13 +27,19 @@ pub(crate) fn stop_on_signals() {
 }
 
 /// SIGTERM and SIGHUP end the program at once, after `cleanup` and with its temporary
-/// outputs removed; SIGINT is left to the caller (the REPL, whose line editor and cancel
-/// flag own it).
-pub(crate) fn stop_on_terminate(cleanup: impl Fn() + Send + 'static) {
+/// outputs removed; so does SIGINT with `ctrl_c` (a REPL fed by a pipe or a script, which
+/// has no prompt to give Ctrl-C to). Without it SIGINT is left to the caller (the
+/// interactive REPL, whose line editor and cancel flag own it).
+pub(crate) fn stop_on_terminate(cleanup: impl Fn() + Send + 'static, ctrl_c: bool) {
     #[cfg(unix)]
     {
-        use signal_hook::consts::{SIGHUP, SIGTERM};
-        let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGTERM, SIGHUP]) else {
+        use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+        let stops: &[i32] = if ctrl_c {
+            &[SIGTERM, SIGHUP, SIGINT]
+        } else {
+            &[SIGTERM, SIGHUP]
+        };
+        let Ok(mut signals) = signal_hook::iterator::Signals::new(stops) else {
             return;
         };
         let _ = std::thread::Builder::new()
@@ -46,7 +52,7 @@ pub(crate) fn stop_on_terminate(cleanup: impl Fn() + Send + 'static) {
             });
     }
     #[cfg(not(unix))]
-    drop(cleanup);
+    drop((cleanup, ctrl_c));
 }
 
 /// The terminal's settings as the REPL found them. A signal that ends the session while the

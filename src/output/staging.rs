@@ -17,7 +17,7 @@ use crate::render::Renderer;
 /// leaves no new folder, and an existing folder exactly as it was.
 pub(crate) struct PngStaging {
     dest: PathBuf,
-    temp: tempfile::TempDir,
+    temp: crate::util::TempFolder,
     /// Frame files of an earlier render to remove at the end (`force`).
     foreign: Vec<PathBuf>,
 }
@@ -71,14 +71,12 @@ pub(crate) fn open_png_folder(
         check_output_folder(output)?;
         Vec::new()
     };
-    let temp = tempfile::Builder::new()
-        .prefix(&crate::util::temp_prefix(output))
-        .suffix(crate::util::TEMP_SUFFIX)
-        .tempdir_in(crate::util::folder_of(output))
-        .map_err(|source| OutputError::CreatingFolder {
+    let temp = crate::util::TempFolder::beside(output).map_err(|source| {
+        OutputError::CreatingFolder {
             beside: output.to_path_buf(),
             source,
-        })?;
+        }
+    })?;
     let writer = PngSequenceWriter::new(
         temp.path(),
         renderer.frame_count(),

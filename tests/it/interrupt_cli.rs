@@ -284,13 +284,15 @@ fn sigint_while_ffmpeg_finishes_the_video_stops_it_and_leaves_no_file() {
 }
 
 /// SIGTERM and SIGHUP end a REPL session (exit 1, "interrupted") and take its private
-/// preview folder with it, as `:quit` does; Ctrl-C stays the session's own.
+/// preview folder with it, as `:quit` does, and a `:render` in progress with its temporary
+/// folder; so does Ctrl-C in a piped session, which has no prompt to give it to.
 #[test]
 fn sigterm_and_sighup_end_a_repl_and_remove_its_preview_folder() {
+    use std::io::Write as _;
     let dir = tempfile::tempdir().unwrap();
     let scene = write_scene(dir.path());
     let temp = dir.path().join("temp");
-    for name in ["-TERM", "-HUP"] {
+    for name in ["-TERM", "-HUP", "-INT"] {
         std::fs::create_dir(&temp).unwrap();
         let mut child = Command::new(env!("CARGO_BIN_EXE_lapclone"))
             .arg("repl")
@@ -309,7 +311,13 @@ fn sigterm_and_sighup_end_a_repl_and_remove_its_preview_folder() {
         });
         assert!(drawn, "{name}: the session ended before its first preview");
         // Its input stays open: only the signal may end the session.
-        let input = child.stdin.take();
+        let mut input = child.stdin.take().unwrap();
+        let frames = dir.path().join("frames");
+        writeln!(input, ":render -o {}", frames.display()).unwrap();
+        let rendering = wait_until(&mut child, || {
+            sorted_names(dir.path()).iter().any(|n| n.ends_with(".tmp"))
+        });
+        assert!(rendering, "{name}: the session ended before its render");
         stop(child, name, &format!("repl {name}"));
         drop(input);
         assert_eq!(
@@ -318,6 +326,7 @@ fn sigterm_and_sighup_end_a_repl_and_remove_its_preview_folder() {
             "{name}: left in the temp folder"
         );
         std::fs::remove_dir(&temp).unwrap();
+        assert_eq!(sorted_names(dir.path()), ["long.rhai"], "{name}: left");
     }
 }
 
@@ -352,4 +361,27 @@ fn ctrl_c_ends_a_wait_for_a_fifo_reader() {
     let kind = std::fs::symlink_metadata(&fifo).unwrap().file_type();
     assert!(kind.is_fifo());
     assert_eq!(sorted_names(dir.path()), ["long.rhai", "out.y4m"]);
+}
+
+/// A second signal ends a render at once (the first asks it to stop after the frame in
+/// progress): a PNG sequence's temporary folder goes too, however the two fall against the
+/// render's own cleanup.
+#[test]
+fn a_second_signal_during_a_png_render_leaves_no_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write_scene(dir.path());
+    for name in ["-INT", "-TERM", "-INT", "-TERM"] {
+        let mut child = spawn_render(&scene, &dir.path().join("frames"), &[]);
+        let started = wait_until(&mut child, || {
+            sorted_names(dir.path()).iter().any(|n| n.ends_with(".tmp"))
+        });
+        assert!(started, "{name}: the render ended before writing");
+        signal(&child, name);
+        stop(child, name, &format!("{name} twice"));
+        assert_eq!(
+            sorted_names(dir.path()),
+            ["long.rhai"],
+            "{name} twice: files left"
+        );
+    }
 }
