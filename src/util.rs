@@ -140,14 +140,13 @@ fn destination(path: &Path) -> std::io::Result<Destination> {
         (Ok(_), Ok(meta)) => meta,
     };
     let is_link = link.is_ok_and(|m| m.file_type().is_symlink());
-    let target = if is_link {
-        path.canonicalize()?
-    } else {
-        path.to_path_buf()
-    };
     match kind_of(&meta) {
-        Kind::File => Ok(Destination::Replace(target)),
-        Kind::Fifo | Kind::CharDevice => Ok(Destination::Through(target)),
+        // The file the link names is replaced, not the link.
+        Kind::File if is_link => Ok(Destination::Replace(path.canonicalize()?)),
+        Kind::File => Ok(Destination::Replace(path.to_path_buf())),
+        // Opened by the path given, which the system follows: `/dev/stdout` on a pipe
+        // links to `pipe:[N]`, which names nothing a path could.
+        Kind::Fifo | Kind::CharDevice => Ok(Destination::Through(path.to_path_buf())),
         Kind::Folder => Err(refuse("a folder")),
         Kind::BlockDevice => Err(refuse("a block device")),
         Kind::Socket => Err(refuse("a socket")),

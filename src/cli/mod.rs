@@ -51,9 +51,12 @@ pub fn jobs(asked: Option<usize>, useful: usize) -> Result<usize, UsageError> {
     }
 }
 
-/// Whether standard output is open. Rust's runtime reopens a closed one (`>&-`) on
-/// `/dev/null`, read-write, so writes would vanish without an error; a shell's
-/// `>/dev/null` opens it write-only, which stays a legitimate sink.
+/// Whether standard output is open, for data written to it (`-o -`). Rust's runtime reopens
+/// a closed one (`>&-`) on `/dev/null`, read-write, so the data would vanish without an
+/// error; a shell's `>/dev/null` opens it write-only, which stays a legitimate sink.
+/// Python's `subprocess.DEVNULL` is read-write too and cannot be told from a closed one,
+/// so summary lines ([`say`]) never ask: losing them is harmless, and a command that did
+/// its work must not then fail.
 pub fn stdout_is_open() -> bool {
     #[cfg(target_os = "linux")]
     {
@@ -73,13 +76,21 @@ pub fn stdout_is_open() -> bool {
     }
 }
 
+/// For data written to standard output (`-o -`): an error when it is closed
+/// ([`stdout_is_open`]), since the data would be lost without one.
+pub fn check_stdout_for_data() -> anyhow::Result<()> {
+    if !stdout_is_open() {
+        anyhow::bail!(
+            "-o -: standard output is closed (or /dev/null opened read-write): the data would be lost"
+        );
+    }
+    Ok(())
+}
+
 /// Writes `line` and a newline to standard output; a failed write (closed, a full disk, a
 /// broken pipe) is an error (exit 1), never a panic and never silently lost.
 pub fn say(line: impl std::fmt::Display) -> anyhow::Result<()> {
     use std::io::Write as _;
-    if !stdout_is_open() {
-        anyhow::bail!("standard output is closed");
-    }
     let mut out = std::io::stdout().lock();
     writeln!(out, "{line}")
         .and_then(|()| out.flush())

@@ -22,9 +22,7 @@ impl PictureOut {
     /// (or none) whose folder exists and that names none of `inputs`.
     pub(crate) fn check(command: &str, output: &Path, inputs: &[&Path]) -> anyhow::Result<Self> {
         if output.as_os_str() == "-" {
-            if !super::stdout_is_open() {
-                anyhow::bail!("-o -: standard output is closed");
-            }
+            super::check_stdout_for_data()?;
             return Ok(PictureOut::Stdout);
         }
         if let Some(extension) = output.extension() {

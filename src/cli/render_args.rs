@@ -81,8 +81,8 @@ impl RenderArgs {
             }
             Err(other) => return Err(other.into()),
         };
-        if self.output.as_os_str() == "-" && !super::stdout_is_open() {
-            anyhow::bail!("-o -: standard output is closed");
+        if self.output.as_os_str() == "-" {
+            super::check_stdout_for_data()?;
         }
         if kind.needs_ffmpeg() && lapclone::util::find_program("ffmpeg").is_none() {
             anyhow::bail!("{}", lapclone::util::FFMPEG_MISSING);

@@ -198,10 +198,7 @@ fn check_arguments(args: &TrackArgs) -> anyhow::Result<()> {
         return Err(UsageError(format!("--{error}")).into());
     }
     if args.output.as_os_str() == "-" {
-        if !super::stdout_is_open() {
-            anyhow::bail!("-o -: standard output is closed");
-        }
-        return Ok(());
+        return super::check_stdout_for_data();
     }
     if args.output.is_dir() {
         return Err(UsageError(format!("-o {} is a folder", args.output.display())).into());
