@@ -12,16 +12,7 @@ fn prompt_line_completion_and_ctrl_d() {
     let dir = tempfile::tempdir().unwrap();
     let history = dir.path().join("history.txt");
     let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cat_in_coffee.rhai");
-    let mut command = Command::new(env!("CARGO_BIN_EXE_lapclone"));
-    command
-        .arg("repl")
-        .arg(&scene)
-        .arg("--preview")
-        .arg(dir.path().join("preview.png"))
-        .arg("--history")
-        .arg(&history)
-        .env("TERM", "xterm")
-        .env("LAPCLONE_INLINE", "off");
+    let command = repl_command(&scene, dir.path(), &history, &[]);
     let mut p = spawn_command(command, Some(20_000)).unwrap();
     p.exp_string("lapclone> ").unwrap();
 
@@ -72,16 +63,7 @@ fn ctrl_c_cancels_a_running_render_and_keeps_the_session() {
     )
     .unwrap();
     let frames = dir.path().join("frames");
-    let mut command = Command::new(env!("CARGO_BIN_EXE_lapclone"));
-    command
-        .arg("repl")
-        .arg(&scene)
-        .arg("--preview")
-        .arg(dir.path().join("preview.png"))
-        .arg("--history")
-        .arg(dir.path().join("history.txt"))
-        .env("TERM", "xterm")
-        .env("LAPCLONE_INLINE", "off");
+    let command = repl_command(&scene, dir.path(), &dir.path().join("history.txt"), &[]);
     let mut p = spawn_command(command, Some(60_000)).unwrap();
     p.exp_string("lapclone> ").unwrap();
     // Interrupt the render once its first frame file exists (in the temporary folder the
@@ -156,16 +138,8 @@ fn a_page_lines_output_goes_above_a_prompt_in_use() {
     use tungstenite::client::IntoClientRequest;
     let dir = tempfile::tempdir().unwrap();
     let scene = crate::view_ws::cat_scene(dir.path());
-    let mut command = Command::new(env!("CARGO_BIN_EXE_lapclone"));
-    command
-        .arg("repl")
-        .arg(&scene)
-        .args(["--view", "--port", "0", "--preview"])
-        .arg(dir.path().join("preview.png"))
-        .arg("--history")
-        .arg(dir.path().join("history.txt"))
-        .env("TERM", "xterm")
-        .env("LAPCLONE_INLINE", "off");
+    let history = dir.path().join("history.txt");
+    let command = repl_command(&scene, dir.path(), &history, &["--view", "--port", "0"]);
     let mut p = spawn_command(command, Some(20_000)).unwrap();
     p.exp_string("view: http://").unwrap();
     let rest = p.read_line().unwrap();
@@ -217,16 +191,7 @@ fn ctrl_c_ends_a_save_waiting_for_a_fifo_reader() {
     let scene = crate::view_ws::cat_scene(dir.path());
     let fifo = dir.path().join("saved.rhai");
     crate::files::make_fifo(&fifo);
-    let mut command = Command::new(env!("CARGO_BIN_EXE_lapclone"));
-    command
-        .arg("repl")
-        .arg(&scene)
-        .arg("--preview")
-        .arg(dir.path().join("preview.png"))
-        .arg("--history")
-        .arg(dir.path().join("history.txt"))
-        .env("TERM", "xterm")
-        .env("LAPCLONE_INLINE", "off");
+    let command = repl_command(&scene, dir.path(), &dir.path().join("history.txt"), &[]);
     let mut p = spawn_command(command, Some(60_000)).unwrap();
     p.exp_string("lapclone> ").unwrap();
     p.send_line(&format!(":save {}", fifo.display())).unwrap();
@@ -266,4 +231,21 @@ fn process_with_argument(argument: &Path) -> u32 {
                 .then_some(pid)
         });
     found.expect("the REPL's process")
+}
+
+/// `lapclone repl SCENE` with `extra` arguments, its preview in `dir` and its history at
+/// `history`, for a terminal that shows no inline pictures.
+fn repl_command(scene: &Path, dir: &Path, history: &Path, extra: &[&str]) -> Command {
+    let mut command = Command::new(env!("CARGO_BIN_EXE_lapclone"));
+    command
+        .arg("repl")
+        .arg(scene)
+        .args(extra)
+        .arg("--preview")
+        .arg(dir.join("preview.png"))
+        .arg("--history")
+        .arg(history)
+        .env("TERM", "xterm")
+        .env("LAPCLONE_INLINE", "off");
+    command
 }
