@@ -166,9 +166,14 @@ impl SandboxResolver {
         } else {
             relative.with_extension("rhai")
         };
-        let mut escaped = None;
+        let (mut escaped, mut broken) = (None, None);
         for root in &self.roots {
-            let Ok(found) = root.join(&file_name).canonicalize() else {
+            let candidate = root.join(&file_name);
+            let Ok(found) = candidate.canonicalize() else {
+                // A link that resolves to no file (dangling, or a loop) is there all the same.
+                if candidate.symlink_metadata().is_ok() {
+                    broken = broken.or(Some(candidate));
+                }
                 continue;
             };
             if found.starts_with(root) {
@@ -179,13 +184,17 @@ impl SandboxResolver {
             }
             escaped = escaped.or(Some(found));
         }
-        Err(match escaped {
-            Some(target) => format!(
+        Err(match (escaped, broken) {
+            (Some(target), _) => format!(
                 "module `{name}` is a link to {}, outside the scene's folder and the project's \
                  scripts/ folder",
                 target.display()
             ),
-            None => format!(
+            (None, Some(link)) => format!(
+                "module `{name}` is a symbolic link to nothing (or a loop of links): {}",
+                link.display()
+            ),
+            (None, None) => format!(
                 "module `{name}` not found in the scene's folder or the project's scripts/ folder"
             ),
         })

@@ -633,6 +633,13 @@ fn hostile_scenes_fail_at_a_position_without_output() {
     #[cfg(unix)]
     std::os::unix::fs::symlink(fixture.path("evil.rhai"), fixture.path("scenes/link.rhai"))
         .unwrap();
+    #[cfg(unix)]
+    for (link, to) in [
+        ("scenes/loop.rhai", "loop_b.rhai"),
+        ("scenes/loop_b.rhai", "loop.rhai"),
+    ] {
+        std::os::unix::fs::symlink(to, fixture.path(link)).unwrap();
+    }
     let head = "canvas(32, 28, #{ fps: 4, duration: 1, background: \"../in/tgt.png\" });\n\
                 let p = patch(\"p\", #{ source: \"../in/src.png\", mask: \"../in/mask.png\" });\n";
     let with_head = |body: &str| format!("{head}{body}");
@@ -696,6 +703,11 @@ fn hostile_scenes_fail_at_a_position_without_output() {
             "import_link_outside",
             with_head("import \"link\" as e;\n"),
             "is a link to",
+        ));
+        table.push((
+            "import_link_loop",
+            with_head("import \"loop\" as e;\n"),
+            "module `loop` is a symbolic link to nothing (or a loop of links)",
         ));
         table
     };
