@@ -8,7 +8,7 @@
 
 use std::collections::VecDeque;
 use std::net::{Shutdown, TcpStream};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 use std::time::Duration;
@@ -35,7 +35,7 @@ const ROOM_TRIES: usize = 8;
 pub struct Admission {
     /// Connections not yet a page, oldest first: an id and a handle to end it by.
     pending: Mutex<VecDeque<(u64, TcpStream)>>,
-    next: AtomicUsize,
+    next: AtomicU64,
     pages: AtomicUsize,
 }
 
@@ -55,7 +55,7 @@ impl Admission {
     /// watched and is not served.
     pub fn arrive(self: &Arc<Self>, stream: &TcpStream) -> Option<Pending> {
         let handle = stream.try_clone().ok()?;
-        let id = self.next.fetch_add(1, Ordering::Relaxed) as u64;
+        let id = self.next.fetch_add(1, Ordering::Relaxed);
         let mut pending = lock(&self.pending);
         while pending.len() >= MAX_PENDING {
             end(pending.pop_front());
@@ -106,12 +106,11 @@ impl ConnectionThreads {
     /// for the threads of ended connections to finish).
     pub fn spawn(&mut self, serve: impl FnOnce() + Send + 'static) -> std::io::Result<()> {
         loop {
-            let (done, running) = self.running.drain(..).partition(|t| t.is_finished());
+            let (done, running): (Vec<_>, Vec<_>) =
+                self.running.drain(..).partition(|t| t.is_finished());
             self.running = running;
             // Each join returns once its system thread is gone.
-            (done as Vec<JoinHandle<()>>)
-                .into_iter()
-                .for_each(|t| drop(t.join()));
+            done.into_iter().for_each(|t| drop(t.join()));
             if self.running.len() < MAX_THREADS {
                 break;
             }
