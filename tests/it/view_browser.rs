@@ -227,3 +227,59 @@ fn in_chromium_a_circle_drag_sets_the_radius_and_handle_keys_and_deletes_are_lin
     drop(browser);
     assert!(repl.finish().success());
 }
+
+#[test]
+fn in_a_small_window_the_frame_fits_and_the_pointer_reads_the_pixel_under_it() {
+    let Some(program) = find_chromium() else {
+        println!("skipped: chromium is not installed (apt-get install chromium)");
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let scene = cat_scene(dir.path());
+    let repl = ViewRepl::start(dir.path(), &scene);
+    let profile = tempfile::tempdir().unwrap();
+    // Narrow enough that the help text wraps over several lines, leaving the frame less
+    // height than its width alone would give it.
+    let mut browser = Browser::launch(&program, profile.path(), (640, 560), &repl.url).unwrap();
+    wait_for(
+        &mut browser,
+        "!!window.lapcloneScene && !!window.lapcloneScene() && document.getElementById('frame').width === 600",
+    );
+    // Frame, pointer canvas and stage: left, top, width, height; then the room it has.
+    let boxes = numbers(
+        &mut browser,
+        "(() => { const out = [];
+          for (const id of ['frame', 'overlay', 'stage']) { const r = document.getElementById(id).getBoundingClientRect(); out.push(r.left, r.top, r.width, r.height); }
+          const m = document.querySelector('main').getBoundingClientRect();
+          out.push(m.left, m.top, m.right, m.bottom); return out; })()",
+    );
+    let (frame, room) = (&boxes[0..4], &boxes[12..16]);
+    for other in [&boxes[4..8], &boxes[8..12]] {
+        assert_eq!(
+            frame, other,
+            "the frame and the pointer's canvas differ: {boxes:?}"
+        );
+    }
+    assert!(frame[2] < 600.0, "the frame was not scaled down: {boxes:?}");
+    assert!(
+        (frame[2] / frame[3] - 1.5).abs() < 0.01,
+        "the frame's aspect changed: {boxes:?}"
+    );
+    assert!(
+        frame[0] >= room[0]
+            && frame[1] >= room[1]
+            && frame[0] + frame[2] <= room[2] + 0.01
+            && frame[1] + frame[3] <= room[3] + 0.01,
+        "the frame overflows the room it has: {boxes:?}"
+    );
+    // The pointer over the frame's pixel (300, 380), near its bottom, reads that pixel.
+    let k = frame[2] / 600.0;
+    let (x, y) = (frame[0] + 300.25 * k, frame[1] + 380.25 * k);
+    browser.mouse("mouseMoved", x, y).unwrap();
+    wait_for(
+        &mut browser,
+        "document.getElementById('coords').textContent.startsWith('canvas [300, 380]')",
+    );
+    drop(browser);
+    assert!(repl.finish().success());
+}

@@ -66,6 +66,7 @@
       frame.width = overlay.width = width;
       frame.height = overlay.height = height;
       frameData = new ImageData(width, height);
+      fitStage();
     }
     if (w > 0 && hh > 0) {
       const data = frameData.data;
@@ -144,6 +145,21 @@
     const r = overlay.getBoundingClientRect();
     return [((e.clientX - r.left) * overlay.width) / r.width, ((e.clientY - r.top) * overlay.height) / r.height];
   }
+  // The stage (the frame, the pointer's canvas and the marks over it) is sized in whole CSS
+  // pixels to fit the space the header, timeline and footer leave, keeping the canvas's
+  // aspect and never enlarging it: sized by CSS limits alone, the frame could overflow that
+  // space and be clipped while the pointer's canvas was squeezed into it, so pointer
+  // positions were off vertically.
+  const stage = $("stage"), room = document.querySelector("main");
+  function fitStage() {
+    const [aw, ah] = [room.clientWidth - 20, room.clientHeight - 10];
+    const s = Math.max(Math.min(1, aw / frame.width, ah / frame.height), 0);
+    const [w, h] = [Math.floor(frame.width * s), Math.floor(frame.height * s)];
+    if (stage.style.width !== `${w}px`) stage.style.width = `${w}px`;
+    if (stage.style.height !== `${h}px`) stage.style.height = `${h}px`;
+    drawOverlay();
+  }
+  new ResizeObserver(fitStage).observe(room);
   const screenScale = () => overlay.width / overlay.getBoundingClientRect().width;
   const patchNamed = (name) => scene && scene.patches.find((p) => p.name === name);
   const r2 = (v) => Math.round(v * 100) / 100;
