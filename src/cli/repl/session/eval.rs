@@ -40,7 +40,9 @@ impl Session {
         self.functions = self.functions.merge(&ast.clone_functions_only());
         self.imports.extend(import_statements(text));
         self.refresh_words();
-        if !value.is_unit() {
+        // A page's edit is shown as its `(view)` line; the patch or handle the call gives
+        // back would be a second line of noise under every gesture.
+        if !value.is_unit() && !self.from_view {
             let shown = self.display(value);
             self.say(if self.interactive {
                 format!("=> {shown}")
