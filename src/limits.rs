@@ -134,9 +134,21 @@ pub fn check_frame_count(frames: u64) -> Result<(), LimitError> {
 /// The width and height in an image file's header (format guessed from its content),
 /// without decoding its pixels.
 pub fn image_dimensions(path: &Path) -> Result<(u32, u32), ImageOpenError> {
-    crate::util::check_input_file(path)?;
-    let reader = image::ImageReader::open(path)?.with_guessed_format()?;
-    Ok(reader.into_dimensions()?)
+    Ok(image_reader(path)?.into_dimensions()?)
+}
+
+/// A reader of the image file `path` (a regular file: see
+/// [`open_input_file`](crate::util::open_input_file)), its format guessed from its content,
+/// else from its extension.
+fn image_reader(
+    path: &Path,
+) -> Result<image::ImageReader<std::io::BufReader<std::fs::File>>, ImageOpenError> {
+    let file = crate::util::open_input_file(path)?;
+    let mut reader = image::ImageReader::new(std::io::BufReader::new(file));
+    if let Ok(format) = image::ImageFormat::from_path(path) {
+        reader.set_format(format);
+    }
+    Ok(reader.with_guessed_format()?)
 }
 
 /// Reads an image file whose header passes [`check_image_size`]; the decoder runs with
@@ -144,7 +156,7 @@ pub fn image_dimensions(path: &Path) -> Result<(u32, u32), ImageOpenError> {
 pub fn open_image(path: &Path) -> Result<image::DynamicImage, ImageOpenError> {
     let (width, height) = image_dimensions(path)?;
     check_image_size(u64::from(width), u64::from(height))?;
-    let mut reader = image::ImageReader::open(path)?.with_guessed_format()?;
+    let mut reader = image_reader(path)?;
     let mut limits = image::Limits::default();
     limits.max_image_width = Some(MAX_IMAGE_SIDE);
     limits.max_image_height = Some(MAX_IMAGE_SIDE);

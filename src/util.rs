@@ -510,6 +510,47 @@ pub fn check_input_file(path: &Path) -> std::io::Result<()> {
     }
 }
 
+/// Reads the regular file `path`, at most `limit` bytes: `None` when it holds more, read no
+/// further than that even if it grows meanwhile. The kind of file is checked on the file
+/// opened, so a FIFO or device put in its place after [`check_input_file`] cannot make the
+/// read wait forever.
+pub fn read_input_file(path: &Path, limit: u64) -> std::io::Result<Option<Vec<u8>>> {
+    use std::io::Read as _;
+    let mut bytes = Vec::new();
+    open_input_file(path)?
+        .take(limit.saturating_add(1))
+        .read_to_end(&mut bytes)?;
+    Ok((bytes.len() as u64 <= limit).then_some(bytes))
+}
+
+/// Opens the regular file `path` for reading, refusing anything else as
+/// [`check_input_file`] does, also when it is swapped in between that check and the open.
+pub fn open_input_file(path: &Path) -> std::io::Result<std::fs::File> {
+    check_input_file(path)?;
+    open_regular(path)
+}
+
+/// Opens `path` for reading if what it opens is a regular file. On Unix the open does not
+/// wait for a FIFO's writer (it is refused once open instead).
+fn open_regular(path: &Path) -> std::io::Result<std::fs::File> {
+    #[cfg(unix)]
+    let file = {
+        use std::os::unix::fs::OpenOptionsExt as _;
+        let nonblocking = rustix::fs::OFlags::NONBLOCK.bits() as i32;
+        std::fs::OpenOptions::new()
+            .read(true)
+            .custom_flags(nonblocking)
+            .open(path)?
+    };
+    #[cfg(not(unix))]
+    let file = std::fs::File::open(path)?;
+    if !file.metadata()?.is_file() {
+        let message = "it is not a regular file (it was replaced while being opened)";
+        return Err(std::io::Error::new(std::io::ErrorKind::InvalidInput, message));
+    }
+    Ok(file)
+}
+
 /// The folder `path` is in (`.` for a bare file name).
 pub fn folder_of(path: &Path) -> &Path {
     match path.parent() {
@@ -547,7 +588,45 @@ pub fn same_file(a: &Path, b: &Path) -> bool {
 
 #[cfg(test)]
 mod tests {
-    use super::{number_text, temp_prefix};
+    use super::{number_text, open_regular, read_input_file, temp_prefix};
+
+    /// A FIFO that slipped past the check (swapped in after it) is refused once open; a
+    /// blocking open would wait for a writer that never comes.
+    #[cfg(unix)]
+    #[test]
+    fn a_fifo_opened_as_input_is_refused_at_once() {
+        let dir = tempfile::tempdir().unwrap();
+        let fifo = dir.path().join("track.csv");
+        rustix::fs::mknodat(
+            rustix::fs::CWD,
+            &fifo,
+            rustix::fs::FileType::Fifo,
+            rustix::fs::Mode::from_raw_mode(0o600),
+            0,
+        )
+        .unwrap();
+        let (done, finished) = std::sync::mpsc::channel();
+        let opener = fifo.clone();
+        std::thread::spawn(move || done.send(open_regular(&opener).map(drop)));
+        let opened = finished
+            .recv_timeout(std::time::Duration::from_secs(10))
+            .expect("opening the FIFO waited for a writer");
+        let error = opened.expect_err("a FIFO was opened as an input file");
+        assert!(error.to_string().contains("not a regular file"), "{error}");
+        assert!(read_input_file(&fifo, 10).is_err());
+    }
+
+    /// Up to the limit the bytes come back; one more and the file is refused.
+    #[test]
+    fn an_input_file_is_read_up_to_its_limit() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("in.txt");
+        std::fs::write(&path, b"0123456789").unwrap();
+        assert_eq!(read_input_file(&path, 10).unwrap().unwrap(), b"0123456789");
+        assert_eq!(read_input_file(&path, 9).unwrap(), None);
+        assert!(read_input_file(&dir.path().join("none"), 9).is_err());
+        assert!(read_input_file(dir.path(), 9).is_err());
+    }
 
     #[test]
     fn messages_show_control_characters_escaped() {

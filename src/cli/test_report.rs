@@ -299,7 +299,7 @@ pub fn refuse_replacing_other_than_junit(path: &Path) -> anyhow::Result<()> {
         return Ok(());
     }
     let mut head = Vec::new();
-    std::fs::File::open(path)
+    lapclone::util::open_input_file(path)
         .and_then(|f| f.take(256).read_to_end(&mut head))
         .with_context(|| format!("reading {}", path.display()))?;
     let text = String::from_utf8_lossy(&head);

@@ -29,7 +29,7 @@ pub(crate) struct Levels {
 pub(crate) fn decode_png_levels(path: &Path) -> Result<Option<Levels>, ImageOpenError> {
     let (width, height) = image_dimensions(path)?;
     check_image_size(u64::from(width), u64::from(height))?;
-    let mut file = BufReader::new(std::fs::File::open(path)?);
+    let mut file = BufReader::new(crate::util::open_input_file(path)?);
     let mut signature = [0; 8];
     if file.read_exact(&mut signature).is_err() || signature != SIGNATURE {
         return Ok(None);

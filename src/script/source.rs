@@ -12,19 +12,13 @@ const BOM: &[u8] = b"\xEF\xBB\xBF";
 /// [`MAX_SCENE_BYTES`](crate::limits::MAX_SCENE_BYTES), read no further than that even if it
 /// grows meanwhile.
 pub(super) fn read_source(path: &Path) -> std::io::Result<String> {
-    use std::io::Read as _;
-    crate::util::check_input_file(path)?;
     let limit = crate::limits::MAX_SCENE_BYTES;
-    let mut bytes = Vec::new();
-    std::fs::File::open(path)?
-        .take(limit + 1)
-        .read_to_end(&mut bytes)?;
-    if bytes.len() as u64 > limit {
+    let Some(mut bytes) = crate::util::read_input_file(path, limit)? else {
         return Err(std::io::Error::new(
             std::io::ErrorKind::InvalidData,
             format!("it is larger than {} MiB, the limit for scene files", limit >> 20),
         ));
-    }
+    };
     // Editors on Windows may start a UTF-8 file with a byte-order mark; it is not text.
     if bytes.starts_with(BOM) {
         bytes.drain(..BOM.len());

@@ -128,17 +128,11 @@ impl TrackFile {
             path: path.to_path_buf(),
             source,
         };
-        let meta = std::fs::metadata(path).map_err(read)?;
-        if let Some(what) = crate::util::not_a_file(path).filter(|_| !meta.is_file()) {
-            return Err(read(std::io::Error::other(format!("it {what}"))));
-        }
-        if meta.len() > MAX_FILE_BYTES {
+        let Some(bytes) = crate::util::read_input_file(path, MAX_FILE_BYTES).map_err(read)? else {
             return Err(read(std::io::Error::other(format!(
-                "{} bytes is more than the {MAX_FILE_BYTES} a track may have",
-                meta.len()
+                "it holds more than the {MAX_FILE_BYTES} bytes a track may have"
             ))));
-        }
-        let bytes = std::fs::read(path).map_err(read)?;
+        };
         let malformed = |line, message: &str| TrackError::Malformed {
             path: path.to_path_buf(),
             line,
