@@ -4,9 +4,11 @@
 //! the canvas pixels read back from the page equal `lapclone preview` of the `:save`d
 //! scene. Skips, saying why, when chromium is not installed.
 
+use std::path::Path;
 use std::time::Duration;
 
 use base64::Engine as _;
+use tempfile::TempDir;
 
 use super::view_ws::{cat_scene, handle_scene, preview_png, ViewRepl};
 
@@ -23,21 +25,11 @@ const PAGE_TIMEOUT: Duration = Duration::from_secs(60);
 
 #[test]
 fn a_drag_in_chromium_becomes_one_line_and_the_canvas_shows_the_saved_scene() {
-    let Some(program) = find_chromium() else {
-        println!("skipped: chromium is not installed (apt-get install chromium)");
-        return;
-    };
     let dir = tempfile::tempdir().unwrap();
     let scene = cat_scene(dir.path());
-    let mut repl = ViewRepl::start(dir.path(), &scene);
-    let profile = tempfile::tempdir().unwrap();
-    let mut browser = Browser::launch(&program, profile.path(), (1000, 800), &repl.url).unwrap();
-    browser
-        .wait_for(
-            "!!(window.lapcloneScene && window.lapcloneScene())",
-            PAGE_TIMEOUT,
-        )
-        .unwrap();
+    let Some((mut repl, mut browser, _profile)) = open_page(dir.path(), &scene, (1000, 800)) else {
+        return;
+    };
     // Where canvas pixel (x, y) is on the page.
     let rect = browser
         .eval(
@@ -98,6 +90,24 @@ fn a_drag_in_chromium_becomes_one_line_and_the_canvas_shows_the_saved_scene() {
     assert!(repl.finish().success());
 }
 
+/// The REPL on `scene` with its page open in chromium (a `window`-sized window) and its
+/// first scene message in; `None`, saying why, when chromium is not installed. The profile
+/// folder lives as long as the last item.
+fn open_page(dir: &Path, scene: &Path, window: (u32, u32)) -> Option<(ViewRepl, Browser, TempDir)> {
+    let Some(program) = find_chromium() else {
+        println!("skipped: chromium is not installed (apt-get install chromium)");
+        return None;
+    };
+    let repl = ViewRepl::start(dir, scene);
+    let profile = tempfile::tempdir().unwrap();
+    let mut browser = Browser::launch(&program, profile.path(), window, &repl.url).unwrap();
+    wait_for(
+        &mut browser,
+        "!!(window.lapcloneScene && window.lapcloneScene())",
+    );
+    Some((repl, browser, profile))
+}
+
 fn wait_for(browser: &mut Browser, expression: &str) {
     browser.wait_for(expression, PAGE_TIMEOUT).unwrap();
 }
@@ -139,22 +149,14 @@ const HANDLE_ON_PAGE: &str = "(() => {
 
 #[test]
 fn in_chromium_a_circle_drag_sets_the_radius_and_handle_keys_and_deletes_are_lines() {
-    let Some(program) = find_chromium() else {
-        println!("skipped: chromium is not installed (apt-get install chromium)");
-        return;
-    };
     let dir = tempfile::tempdir().unwrap();
     let scene = handle_scene(dir.path());
     let mut text = std::fs::read_to_string(&scene).unwrap();
     text.push_str("cat.pin([200, 150]);\n");
     std::fs::write(&scene, text).unwrap();
-    let repl = ViewRepl::start(dir.path(), &scene);
-    let profile = tempfile::tempdir().unwrap();
-    let mut browser = Browser::launch(&program, profile.path(), (1000, 800), &repl.url).unwrap();
-    wait_for(
-        &mut browser,
-        "!!(window.lapcloneScene && window.lapcloneScene())",
-    );
+    let Some((repl, mut browser, _profile)) = open_page(dir.path(), &scene, (1000, 800)) else {
+        return;
+    };
     // The circle's right edge, dragged 20 px further out: the radius follows.
     let h = numbers(&mut browser, HANDLE_ON_PAGE);
     let (tx, ty, edge, scale) = (h[0], h[1], h[2], h[3]);
@@ -230,20 +232,16 @@ fn in_chromium_a_circle_drag_sets_the_radius_and_handle_keys_and_deletes_are_lin
 
 #[test]
 fn in_a_small_window_the_frame_fits_and_the_pointer_reads_the_pixel_under_it() {
-    let Some(program) = find_chromium() else {
-        println!("skipped: chromium is not installed (apt-get install chromium)");
-        return;
-    };
     let dir = tempfile::tempdir().unwrap();
     let scene = cat_scene(dir.path());
-    let repl = ViewRepl::start(dir.path(), &scene);
-    let profile = tempfile::tempdir().unwrap();
     // Narrow enough that the help text wraps over several lines, leaving the frame less
     // height than its width alone would give it.
-    let mut browser = Browser::launch(&program, profile.path(), (640, 560), &repl.url).unwrap();
+    let Some((repl, mut browser, _profile)) = open_page(dir.path(), &scene, (640, 560)) else {
+        return;
+    };
     wait_for(
         &mut browser,
-        "!!window.lapcloneScene && !!window.lapcloneScene() && document.getElementById('frame').width === 600",
+        "document.getElementById('frame').width === 600",
     );
     // Frame, pointer canvas and stage: left, top, width, height; then the room it has.
     let boxes = numbers(

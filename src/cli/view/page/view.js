@@ -156,7 +156,8 @@
   function fitStage() {
     const [aw, ah] = [room.clientWidth - 20, room.clientHeight - 10];
     const s = Math.max(Math.min(1, aw / frame.width, ah / frame.height), 0);
-    const [w, h] = [Math.floor(frame.width * s), Math.floor(frame.height * s)];
+    // At least a pixel: a window with no room left would make the canvas's scale infinite.
+    const [w, h] = [frame.width * s, frame.height * s].map((v) => Math.max(1, Math.floor(v)));
     if (stage.style.width !== `${w}px`) stage.style.width = `${w}px`;
     if (stage.style.height !== `${h}px`) stage.style.height = `${h}px`;
     drawOverlay();
