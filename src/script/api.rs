@@ -499,6 +499,15 @@ impl HandleRef {
         Some((p, d.handle_index(p, self.handle)?))
     }
 
+    /// The handle as the REPL shows it: `handle 0 of patch("cat")`, its index as it is now.
+    fn describe(&mut self) -> String {
+        let d = self.draft.lock();
+        match self.indices(&d) {
+            Some((p, h)) => format!("handle {h} of patch(\"{}\")", d.patches[p].name),
+            None => "a handle removed from the scene".to_string(),
+        }
+    }
+
     /// Applies `edit` to a copy of the handle and commits it only if it succeeds.
     pub(super) fn edit(
         &self,
@@ -688,7 +697,8 @@ type HandleKey = fn(&mut HandleRef, NativeCallContext, Dynamic, Dynamic, &str) -
 impl CustomType for HandleRef {
     fn build(mut b: TypeBuilder<Self>) {
         b.with_name("Handle")
-            .with_fn("to_string", |_: &mut HandleRef| "handle".to_string())
+            .with_fn("to_string", |h: &mut HandleRef| h.describe())
+            .with_fn("to_debug", |h: &mut HandleRef| h.describe())
             .with_fn(
                 "keys",
                 |ctx: NativeCallContext, h: &mut HandleRef, l: rhai::Array| h.keys(ctx, l),

@@ -85,6 +85,29 @@ fn edits_list_and_write_the_preview() {
     assert_eq!((preview.width(), preview.height()), (64, 48));
 }
 
+/// A handle shows which handle of which patch it is, by its index now, and says so once it
+/// is removed (it showed `handle` whatever it was).
+#[test]
+fn a_handle_shows_its_patch_and_index() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = tiny_scene(dir.path());
+    let input = "let a = blob.drag([160, 70], 10);\nlet b = blob.drag([170, 80], 10);\n\
+                 b\nblob.remove_handle(0);\nb\na\n";
+    let out = repl(dir.path(), &[scene.to_str().unwrap()], input);
+    let (stdout, stderr) = (text(&out.stdout), text(&out.stderr));
+    assert!(out.status.success(), "{stdout}\n{stderr}");
+    let shown: Vec<&str> = stdout.lines().filter(|l| l.contains("handle")).collect();
+    assert_eq!(
+        shown,
+        [
+            "handle 1 of patch(\"blob\")",
+            "handle 0 of patch(\"blob\")",
+            "a handle removed from the scene"
+        ],
+        "{stdout}"
+    );
+}
+
 #[test]
 fn a_failed_line_changes_nothing_and_the_session_goes_on() {
     let dir = tempfile::tempdir().unwrap();
