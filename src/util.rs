@@ -535,12 +535,12 @@ pub fn open_input_file(path: &Path) -> std::io::Result<std::fs::File> {
 fn open_regular(path: &Path) -> std::io::Result<std::fs::File> {
     #[cfg(unix)]
     let file = {
-        use std::os::unix::fs::OpenOptionsExt as _;
-        let nonblocking = rustix::fs::OFlags::NONBLOCK.bits() as i32;
-        std::fs::OpenOptions::new()
-            .read(true)
-            .custom_flags(nonblocking)
-            .open(path)?
+        use rustix::fs::{fcntl_getfl, fcntl_setfl, Mode, OFlags};
+        let flags = OFlags::RDONLY | OFlags::NONBLOCK | OFlags::CLOEXEC;
+        let fd = rustix::fs::open(path, flags, Mode::empty())?;
+        // Reads block as on any file opened plainly (some file systems heed the flag).
+        fcntl_setfl(&fd, fcntl_getfl(&fd)? - OFlags::NONBLOCK)?;
+        std::fs::File::from(fd)
     };
     #[cfg(not(unix))]
     let file = std::fs::File::open(path)?;
