@@ -500,7 +500,7 @@ impl HandleRef {
     }
 
     /// The handle as the REPL shows it: `handle 0 of patch("cat")`, its index as it is now.
-    fn describe(&mut self) -> String {
+    fn describe(&self) -> String {
         let d = self.draft.lock();
         match self.indices(&d) {
             Some((p, h)) => format!("handle {h} of patch(\"{}\")", d.patches[p].name),
