@@ -11,6 +11,7 @@ mod types;
 mod warnings;
 
 pub use evaluate::{frame_time, FrameState, HandleState, PatchState};
+pub(crate) use to_rhai::get_patch_call;
 pub use to_rhai::rhai_string_literal;
 pub use track::{Easing, Interpolate, Key, KeyError, Track};
 pub use types::{

@@ -355,6 +355,13 @@ fn path_literal(path: &Path) -> String {
     rhai_string_literal(&path.to_string_lossy())
 }
 
+/// The Rhai expression that gives back the scene's patch `name`: `get_patch("cat")`. The
+/// REPL shows a patch as it, and a line written for the live view names a patch by it when
+/// no variable holds the patch.
+pub(crate) fn get_patch_call(name: &str) -> String {
+    format!("get_patch({})", rhai_string_literal(name))
+}
+
 /// A Rhai string literal that evaluates to exactly `text`.
 pub fn rhai_string_literal(text: &str) -> String {
     let mut out = String::with_capacity(text.len() + 2);

@@ -14,7 +14,8 @@ use super::refs::{fail, Fallible, HandleRef, PatchRef, PinRef, Placed, PLACEMENT
 use super::footage_options::{footage_keys, footage_option};
 use super::values::{self, number};
 use crate::scene::{
-    Background, Canvas, CloneMode, Easing, Handle, LaplacianKind, Patch, Pin, Polygon, Shape, Track,
+    get_patch_call, Background, Canvas, CloneMode, Easing, Handle, LaplacianKind, Patch, Pin, Polygon,
+    Shape, Track,
 };
 
 
@@ -350,6 +351,15 @@ impl PatchRef {
         edit(&mut d.patches[index]).map_err(|m| fail(ctx, m))
     }
 
+    /// The patch as the REPL shows it: the call that gives it back, `get_patch("cat")`.
+    fn describe(&self) -> String {
+        let d = self.draft.lock();
+        match d.patch_index(self.id) {
+            Some(i) => get_patch_call(&d.patches[i].name),
+            None => "a patch removed from the scene".to_string(),
+        }
+    }
+
     pub(super) fn name(&mut self) -> String {
         let d = self.draft.lock();
         d.patch_index(self.id)
@@ -499,11 +509,12 @@ impl HandleRef {
         Some((p, d.handle_index(p, self.handle)?))
     }
 
-    /// The handle as the REPL shows it: `handle 0 of patch("cat")`, its index as it is now.
+    /// The handle as the REPL shows it: `handle 0 of get_patch("cat")`, its index as it is
+    /// now.
     fn describe(&self) -> String {
         let d = self.draft.lock();
         match self.indices(&d) {
-            Some((p, h)) => format!("handle {h} of patch(\"{}\")", d.patches[p].name),
+            Some((p, h)) => format!("handle {h} of {}", get_patch_call(&d.patches[p].name)),
             None => "a handle removed from the scene".to_string(),
         }
     }
@@ -601,12 +612,8 @@ impl CustomType for PatchRef {
     fn build(mut b: TypeBuilder<Self>) {
         b.with_name("Patch")
             .with_get("name", PatchRef::name)
-            .with_fn("to_string", |p: &mut PatchRef| {
-                format!("patch(\"{}\")", p.name())
-            })
-            .with_fn("to_debug", |p: &mut PatchRef| {
-                format!("patch(\"{}\")", p.name())
-            })
+            .with_fn("to_string", |p: &mut PatchRef| p.describe())
+            .with_fn("to_debug", |p: &mut PatchRef| p.describe())
             .with_fn(
                 "key",
                 |ctx: NativeCallContext, p: &mut PatchRef, t: Dynamic, m: Map| {

@@ -37,7 +37,7 @@ fn prompt_line_completion_and_ctrl_d() {
     p.flush().unwrap();
     p.exp_string("get_patch(\"cat").unwrap();
     p.send_line("\")").unwrap();
-    p.exp_string("=> patch(\"cat\")").unwrap();
+    p.exp_string("=> get_patch(\"cat\")").unwrap();
     p.exp_string("lapclone> ").unwrap();
 
     p.send_control('d').unwrap();

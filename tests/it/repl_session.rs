@@ -100,12 +100,69 @@ fn a_handle_shows_its_patch_and_index() {
     assert_eq!(
         shown,
         [
-            "handle 1 of patch(\"blob\")",
-            "handle 0 of patch(\"blob\")",
+            "handle 1 of get_patch(\"blob\")",
+            "handle 0 of get_patch(\"blob\")",
             "a handle removed from the scene"
         ],
         "{stdout}"
     );
+}
+
+/// A patch shows as the call that gives it back (it showed `patch("blob")`, which makes a
+/// new patch, or fails without its options), and says so once it is removed.
+#[test]
+fn a_patch_shows_as_the_call_that_gives_it_back() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = tiny_scene(dir.path());
+    let input = "blob\nget_patch(\"blob\")\nremove_patch(\"blob\");\nblob\n";
+    let out = repl(dir.path(), &[scene.to_str().unwrap()], input);
+    let (stdout, stderr) = (text(&out.stdout), text(&out.stderr));
+    assert!(out.status.success(), "{stdout}\n{stderr}");
+    assert_eq!(
+        values(&stdout),
+        [
+            "get_patch(\"blob\")",
+            "get_patch(\"blob\")",
+            "a patch removed from the scene"
+        ],
+        "{stdout}"
+    );
+}
+
+/// An entry that ends in `;` is a statement and shows no value; one that ends in an
+/// expression shows it, whatever comments or strings follow it or hold a `;`.
+#[test]
+fn an_entry_ending_in_a_semicolon_shows_no_value() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = tiny_scene(dir.path());
+    let input = "\
+40 + 1;
+40 + 2
+blob.at(0.1, [40, 30]);
+40 + 3; // a note
+40 + 4 /* a block; */
+\"45;\"
+`46;`
+let s = \";\"; s
+40 + 7; /* one /* nested */ comment */
+40 + 8 // a note; with a semicolon
+[40,
+ 9];
+";
+    let out = repl(dir.path(), &[scene.to_str().unwrap()], input);
+    let (stdout, stderr) = (text(&out.stdout), text(&out.stderr));
+    assert!(out.status.success(), "{stdout}\n{stderr}");
+    assert_eq!(
+        values(&stdout),
+        ["42", "44", "45;", "46;", ";", "48"],
+        "{stdout}"
+    );
+}
+
+/// The values a piped session printed: its output less the load and preview lines.
+fn values(stdout: &str) -> Vec<&str> {
+    let noise = |l: &str| l.starts_with("loaded ") || l.starts_with("preview:");
+    stdout.lines().filter(|l| !noise(l)).collect()
 }
 
 #[test]

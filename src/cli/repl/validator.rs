@@ -3,7 +3,8 @@
 //! Rhai's own parser. Used by the interactive editor (rustyline `Validator`) and by the
 //! non-interactive reader alike, so both split input into entries the same way. The reader
 //! goes through [`EntrySplitter`], which keeps a long entry's reading linear: while a
-//! bracket is surely still open it parses again only now and then.
+//! bracket is surely still open it parses again only now and then. Also whether an entry
+//! ends in `;` ([`ends_in_semicolon`]): a statement, whose value the REPL does not show.
 
 use rhai::{Engine, LexError, ParseErrorType, Position};
 use rustyline::validate::{ValidationContext, ValidationResult, Validator};
@@ -63,6 +64,64 @@ fn at_end(text: &str, position: Position) -> bool {
     }
     let last_len = content.lines().last().map_or(0, |l| l.chars().count());
     column.is_none_or(|c| c > last_len)
+}
+
+/// Whether the last thing in `text` other than blanks and comments is a `;` outside any
+/// string: the entry ends as a statement, as in Rust or Julia, so its value is not shown.
+/// Comments are `//` to the line's end and `/* */`, which nest as in Rhai.
+pub fn ends_in_semicolon(text: &str) -> bool {
+    let mut chars = text.chars().peekable();
+    let mut last = None;
+    let mut quote = None;
+    while let Some(c) = chars.next() {
+        if let Some(q) = quote {
+            match c {
+                '\\' if q != '`' => {
+                    chars.next();
+                }
+                c if c == q => quote = None,
+                _ => {}
+            }
+            continue;
+        }
+        match (c, chars.peek()) {
+            ('/', Some('/')) => {
+                chars.by_ref().find(|&c| c == '\n');
+                continue;
+            }
+            ('/', Some('*')) => {
+                chars.next();
+                skip_block_comment(&mut chars);
+                continue;
+            }
+            ('"' | '\'' | '`', _) => quote = Some(c),
+            (c, _) if c.is_whitespace() => continue,
+            _ => {}
+        }
+        last = Some(c);
+    }
+    last == Some(';')
+}
+
+/// Skips a block comment's text after its `/*`, nested ones included.
+fn skip_block_comment(chars: &mut std::iter::Peekable<std::str::Chars>) {
+    let mut depth = 1usize;
+    while let Some(c) = chars.next() {
+        match (c, chars.peek()) {
+            ('*', Some('/')) => {
+                chars.next();
+                depth -= 1;
+                if depth == 0 {
+                    return;
+                }
+            }
+            ('/', Some('*')) => {
+                chars.next();
+                depth += 1;
+            }
+            _ => {}
+        }
+    }
 }
 
 /// Splits piped input into entries line by line, as [`InputValidator`] would. Parsing the

@@ -4,7 +4,7 @@
 //! [`Scene`] directly for the drag preview, with exactly the values the line writes.
 
 use glam::DVec2;
-use lapclone::scene::{rhai_string_literal, Easing, Handle, Patch, Scene};
+use lapclone::scene::{Easing, Handle, Patch, Scene};
 use lapclone::util::number_text;
 use serde::Deserialize;
 
@@ -403,11 +403,6 @@ fn owner(patch: &str, handle: Option<usize>) -> String {
     }
 }
 
-/// How a line names patch `name` when no variable holds it.
-pub fn get_patch_call(name: &str) -> String {
-    format!("get_patch({})", rhai_string_literal(name))
-}
-
 fn round(v: f64, per: f64) -> f64 {
     let r = (v * per).round() / per;
     if r == 0.0 {
@@ -566,10 +561,5 @@ mod tests {
         };
         assert_eq!(t(with), Some(0.75));
         assert_eq!(t(without), None);
-    }
-
-    #[test]
-    fn names_are_rhai_string_literals() {
-        assert_eq!(get_patch_call("a \"b\""), r#"get_patch("a \"b\"")"#);
     }
 }

@@ -17,7 +17,7 @@ use std::collections::VecDeque;
 use std::net::IpAddr;
 use std::sync::{Arc, Mutex};
 
-pub use edit::{get_patch_call, Edit};
+pub use edit::Edit;
 pub use hub::{Hub, SceneText};
 pub use open::open_in_browser;
 pub use scene::Playhead;

@@ -14,6 +14,7 @@ use rhai::{Dynamic, Scope, AST};
 
 use super::Session;
 use crate::cli::render::positioned;
+use crate::cli::repl::validator::ends_in_semicolon;
 
 impl Session {
     /// Runs Rhai source against the live scene; on any failure restores scene and scope.
@@ -40,9 +41,9 @@ impl Session {
         self.functions = self.functions.merge(&ast.clone_functions_only());
         self.imports.extend(import_statements(text));
         self.refresh_words();
-        // A page's edit is shown as its `(view)` line; the patch or handle the call gives
-        // back would be a second line of noise under every gesture.
-        if !value.is_unit() && !self.from_view {
+        // A page's edit is shown as its `(view)` line, a statement like any entry that ends
+        // in `;`: the patch or handle the call gives back would be a line of noise.
+        if !value.is_unit() && !ends_in_semicolon(text) {
             let shown = self.display(value);
             self.say(if self.interactive {
                 format!("=> {shown}")

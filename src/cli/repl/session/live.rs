@@ -8,13 +8,12 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use glam::DVec2;
+use lapclone::scene::get_patch_call;
 use lapclone::script::ScriptOptions;
 use rhai::Scope;
 
 use super::{Session, Step};
-use crate::cli::view::{
-    get_patch_call, locate, scene_message, Edit, Hub, LiveSession, Printer, SceneText,
-};
+use crate::cli::view::{locate, scene_message, Edit, Hub, LiveSession, Printer, SceneText};
 
 impl Session {
     /// Sends every frame and scene change to `hub`; lines printed for page edits go to
