@@ -1148,3 +1148,62 @@ fn a_close_is_answered_and_an_oversized_message_closes_the_page() {
     drop(other);
     assert!(repl.finish().success());
 }
+
+/// A page sending a message slowly still gets what the session sends meanwhile: its thread
+/// reads what has come and goes back to its queue, instead of waiting in the read for the
+/// message's rest, which held every frame for that page until the message was whole.
+#[test]
+fn a_page_sending_a_message_slowly_still_gets_the_session_s_changes_meanwhile() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = cat_scene(dir.path());
+    let mut repl = ViewRepl::start(dir.path(), &scene);
+    let mut page = repl.page();
+    // A seek padded to 4 kB in one masked frame (a zero mask leaves the payload as it is),
+    // sent a byte every millisecond: a read that waits for more is never left waiting long.
+    let mut seek = br#"{"type":"seek","t":0.25}"#.to_vec();
+    seek.resize(4000, b' ');
+    let mut bytes = vec![0x81, 0x80 | 126];
+    bytes.extend_from_slice(&(seek.len() as u16).to_be_bytes());
+    bytes.extend_from_slice(&[0; 4]);
+    bytes.extend_from_slice(&seek);
+    let stream = |page: &mut Page| match page.socket.get_mut() {
+        MaybeTlsStream::Plain(s) => s.try_clone().unwrap(),
+        _ => unreachable!("the test connects without TLS"),
+    };
+    let mut raw = stream(&mut page);
+    raw.set_nonblocking(true).unwrap();
+    // Each byte goes out at once, not held back until the last is acknowledged.
+    raw.set_nodelay(true).unwrap();
+    raw.write_all(&bytes[..10]).unwrap();
+    repl.type_line(":t 0.5");
+    let mut sent = 10;
+    loop {
+        assert!(
+            sent < bytes.len(),
+            "the page got nothing while it sent its message"
+        );
+        raw.write_all(&bytes[sent..sent + 1]).unwrap();
+        sent += 1;
+        std::thread::sleep(Duration::from_millis(1));
+        match page.socket.read() {
+            Ok(Message::Text(text)) => {
+                let value: Value = serde_json::from_str(text.as_str()).unwrap();
+                if value["type"] == "scene" && value["t"] == 0.5 {
+                    break;
+                }
+            }
+            Ok(_) => {}
+            Err(tungstenite::Error::Io(e))
+                if matches!(
+                    e.kind(),
+                    std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
+                ) => {}
+            Err(e) => panic!("{e}"),
+        }
+    }
+    // The rest of the message: the seek is applied once it is whole.
+    raw.set_nonblocking(false).unwrap();
+    raw.write_all(&bytes[sent..]).unwrap();
+    page.until(|v| v["type"] == "scene" && v["t"] == 0.25);
+    assert!(repl.finish().success());
+}

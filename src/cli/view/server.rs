@@ -20,8 +20,8 @@ use super::hub::{Hub, Outgoing, PAGE_QUEUE};
 use super::wake::{page_channel, PageQueue};
 use super::{error_message, lock};
 
-/// How long a page's socket read waits once input was seen (a message's rest may still be
-/// on its way); where the wait cannot watch the queue, how often frames are looked for.
+/// Where a page's thread cannot sleep on its socket and its queue at once (not Unix), how
+/// long a socket read waits for input, which is how often frames are looked for there.
 const POLL: Duration = Duration::from_millis(5);
 /// The longest an idle page's thread sleeps before it looks again, woken or not.
 const IDLE_WAIT: Duration = Duration::from_secs(1);
@@ -204,7 +204,7 @@ fn read_messages(
     reply: &dyn Fn(String),
 ) -> bool {
     loop {
-        match socket.read() {
+        match read_now(socket) {
             Ok(Message::Text(text)) => handle(text.as_str(), id, session, hub, reply),
             Ok(Message::Binary(_)) => reply(error_message("binary messages are not accepted")),
             Ok(Message::Close(_)) => {
@@ -226,6 +226,22 @@ fn read_messages(
             return false;
         }
     }
+}
+
+/// Reads the page's next message if it has come whole, never waiting for the rest of one
+/// (tungstenite keeps the part read for the next call), so that what is queued for the
+/// page goes out while it is still sending: the thread then sleeps on the socket and its
+/// queue together. Where it cannot ([`PageQueue::wait`] returns at once), the read waits
+/// up to [`POLL`] for input instead.
+fn read_now(socket: &mut WebSocket<TcpStream>) -> tungstenite::Result<Message> {
+    if !cfg!(unix) {
+        return socket.read();
+    }
+    // Writes keep blocking (up to their timeout): only this read must not wait.
+    socket.get_ref().set_nonblocking(true)?;
+    let read = socket.read();
+    socket.get_ref().set_nonblocking(false)?;
+    read
 }
 
 /// The close code and reason a page's fault is answered with; `None` when the page is
