@@ -14,6 +14,7 @@ use tungstenite::WebSocket;
 
 use super::admit::{PagePlace, Pending, MAX_PAGES};
 use super::edit::MAX_MESSAGE_BYTES;
+use super::page_stream::PageStream;
 
 /// Largest request head read, bytes.
 const MAX_HEAD: usize = 8 * 1024;
@@ -36,7 +37,7 @@ pub enum Accepted {
     /// A response was written (the page, or an error); the connection is done.
     Answered,
     /// A page's WebSocket, and the place it holds until dropped.
-    Socket(Box<WebSocket<TcpStream>>, PagePlace),
+    Socket(Box<WebSocket<PageStream>>, PagePlace),
 }
 
 /// A request refused: its status line and the reason shown in the body.
@@ -142,6 +143,7 @@ fn upgrade(
     let config = WebSocketConfig::default()
         .max_message_size(Some(MAX_MESSAGE_BYTES))
         .max_frame_size(Some(MAX_MESSAGE_BYTES));
+    let stream = PageStream::new(stream);
     let socket = WebSocket::from_partially_read(stream, rest, Role::Server, Some(config));
     Ok(Accepted::Socket(Box::new(socket), place))
 }

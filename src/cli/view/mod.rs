@@ -8,6 +8,7 @@ mod edit;
 mod http;
 mod hub;
 mod open;
+mod page_stream;
 mod scene;
 mod server;
 mod wake;

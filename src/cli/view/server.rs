@@ -17,6 +17,7 @@ use super::admit::{Admission, ConnectionThreads};
 use super::edit::{parse_request, Edit, Request};
 use super::http::{accept, Accepted, Routes};
 use super::hub::{Hub, Outgoing, PAGE_QUEUE};
+use super::page_stream::PageStream;
 use super::wake::{page_channel, PageQueue};
 use super::{error_message, lock};
 
@@ -152,20 +153,20 @@ fn serve(
 /// Serves one page until it closes: its messages in, frames and replies out. Its thread
 /// sleeps until the page sends something or something is queued for it.
 fn page_loop(
-    mut socket: WebSocket<TcpStream>,
+    mut socket: WebSocket<PageStream>,
     session: &Mutex<dyn LiveSession>,
     hub: &Hub,
     admission: &Admission,
 ) {
     // A page that stops reading fails the write after a while, instead of blocking its
     // connection (one of the server's few) for good.
-    let stream = socket.get_mut();
+    let stream = socket.get_ref().tcp();
     if stream.set_read_timeout(Some(POLL)).is_err()
         || stream.set_write_timeout(Some(WRITE_SLICE)).is_err()
     {
         return;
     }
-    let _ = socket.get_mut().set_nodelay(true);
+    let _ = socket.get_ref().tcp().set_nodelay(true);
     let Some((tx, queue)) = admission.with_room(|| page_channel(PAGE_QUEUE).ok()) else {
         return;
     };
@@ -184,7 +185,7 @@ fn page_loop(
             break;
         }
         hub.catch_up(id);
-        input = queue.wait(socket.get_ref(), IDLE_WAIT);
+        input = queue.wait(socket.get_ref().tcp(), IDLE_WAIT);
     }
     // A gesture never finished (the page closed mid-drag) is cancelled as Escape would be;
     // without a preview in progress the cancel changes nothing.
@@ -196,7 +197,7 @@ fn page_loop(
 /// Reads and applies the page's messages until none is waiting, sending each one's
 /// answers before the next is read; false once the page is gone.
 fn read_messages(
-    socket: &mut WebSocket<TcpStream>,
+    socket: &mut WebSocket<PageStream>,
     queue: &PageQueue<Outgoing>,
     id: u64,
     session: &Mutex<dyn LiveSession>,
@@ -233,14 +234,14 @@ fn read_messages(
 /// page goes out while it is still sending: the thread then sleeps on the socket and its
 /// queue together. Where it cannot ([`PageQueue::wait`] returns at once), the read waits
 /// up to [`POLL`] for input instead.
-fn read_now(socket: &mut WebSocket<TcpStream>) -> tungstenite::Result<Message> {
+fn read_now(socket: &mut WebSocket<PageStream>) -> tungstenite::Result<Message> {
     if !cfg!(unix) {
         return socket.read();
     }
     // Writes keep blocking (up to their timeout): only this read must not wait.
-    socket.get_ref().set_nonblocking(true)?;
+    socket.get_ref().tcp().set_nonblocking(true)?;
     let read = socket.read();
-    socket.get_ref().set_nonblocking(false)?;
+    socket.get_ref().tcp().set_nonblocking(false)?;
     read
 }
 
@@ -262,7 +263,7 @@ fn close_code(fault: &tungstenite::Error) -> Option<(CloseCode, &'static str)> {
 /// page sends next, and a frame that breaks the protocol leaves nothing after it to trust,
 /// so going on could apply part of a refused message.
 fn close_for(
-    socket: &mut WebSocket<TcpStream>,
+    socket: &mut WebSocket<PageStream>,
     queue: &PageQueue<Outgoing>,
     (code, reason): (CloseCode, &'static str),
     problem: &str,
@@ -279,24 +280,36 @@ fn close_for(
     }
     // The rest of the message may still be arriving: closing on it would reset the answer
     // away.
-    super::http::close_gently(socket.get_mut(), super::http::LINGER);
+    super::http::close_gently(socket.get_mut().tcp_mut(), super::http::LINGER);
 }
 
 /// Sends what is queued for this page; false once the page is gone, or has not taken it
 /// within [`WRITE_TIMEOUT`].
-fn flush(socket: &mut WebSocket<TcpStream>, queue: &PageQueue<Outgoing>) -> bool {
+fn flush(socket: &mut WebSocket<PageStream>, queue: &PageQueue<Outgoing>) -> bool {
     flush_within(socket, queue, WRITE_TIMEOUT)
 }
 
 /// [`flush`] with its deadline. Each write to the socket blocks at most [`WRITE_SLICE`]
-/// (its write timeout), so a page reading a little now and then is still dropped once
-/// `limit` has passed in all.
+/// (its write timeout) and none starts after the deadline, so a page reading a little now
+/// and then is still dropped once `limit` has passed in all.
 fn flush_within(
-    socket: &mut WebSocket<TcpStream>,
+    socket: &mut WebSocket<PageStream>,
     queue: &PageQueue<Outgoing>,
     limit: Duration,
 ) -> bool {
     let deadline = Instant::now() + limit;
+    socket.get_mut().set_deadline(Some(deadline));
+    let sent = send_queued(socket, queue, deadline);
+    socket.get_mut().set_deadline(None);
+    sent
+}
+
+/// Writes what is queued and flushes it; false once the page is gone or `deadline` passed.
+fn send_queued(
+    socket: &mut WebSocket<PageStream>,
+    queue: &PageQueue<Outgoing>,
+    deadline: Instant,
+) -> bool {
     let late = || Instant::now() >= deadline;
     let mut sent = false;
     while let Ok(message) = queue.try_recv() {
@@ -389,7 +402,7 @@ mod tests {
         server
             .set_write_timeout(Some(Duration::from_millis(50)))
             .unwrap();
-        let mut socket = WebSocket::from_raw_socket(server, Role::Server, None);
+        let mut socket = WebSocket::from_raw_socket(PageStream::new(server), Role::Server, None);
         let (tx, queue) = page_channel(PAGE_QUEUE).unwrap();
         let frame = tungstenite::Bytes::from(vec![7u8; 1 << 20]);
         for _ in 0..PAGE_QUEUE {
@@ -403,5 +416,44 @@ mod tests {
         // One write's timeout past the deadline at most, with room for a loaded machine.
         assert!(took < limit + Duration::from_secs(3), "took {took:?}");
         drop(client);
+    }
+
+    /// A page that reads a little now and then, so that every write moves a little, is
+    /// given up on at the deadline too: tungstenite goes on writing a buffer while each
+    /// write moves, so the deadline is kept by the stream it writes to.
+    #[test]
+    fn sending_to_a_page_that_reads_slowly_ends_at_the_deadline() {
+        use std::io::Read as _;
+        let listener = TcpListener::bind("127.0.0.1:0").unwrap();
+        let mut client = TcpStream::connect(listener.local_addr().unwrap()).unwrap();
+        let (server, _) = listener.accept().unwrap();
+        server
+            .set_write_timeout(Some(Duration::from_millis(50)))
+            .unwrap();
+        // About 3 MB/s, for at most 30 s: 64 MiB would take 20 s.
+        let reader = std::thread::spawn(move || {
+            let mut chunk = vec![0u8; 64 << 10];
+            let started = Instant::now();
+            while started.elapsed() < Duration::from_secs(30) {
+                match client.read(&mut chunk) {
+                    Ok(0) | Err(_) => break,
+                    Ok(_) => std::thread::sleep(Duration::from_millis(20)),
+                }
+            }
+        });
+        let mut socket = WebSocket::from_raw_socket(PageStream::new(server), Role::Server, None);
+        let (tx, queue) = page_channel(PAGE_QUEUE).unwrap();
+        let frame = tungstenite::Bytes::from(vec![7u8; 1 << 20]);
+        for _ in 0..PAGE_QUEUE {
+            tx.try_send(Outgoing::Binary(frame.clone())).unwrap();
+        }
+        let limit = Duration::from_millis(400);
+        let started = Instant::now();
+        assert!(!flush_within(&mut socket, &queue, limit));
+        let took = started.elapsed();
+        assert!(took >= limit, "gave up after {took:?}");
+        assert!(took < limit + Duration::from_secs(3), "took {took:?}");
+        let _ = socket.get_ref().tcp().shutdown(std::net::Shutdown::Both);
+        reader.join().unwrap();
     }
 }
