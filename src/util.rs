@@ -52,6 +52,35 @@ pub fn stderr_line(line: std::fmt::Arguments) {
     let _ = writeln!(std::io::stderr().lock(), "{}", visible_controls(&line.to_string()));
 }
 
+/// How messages name a path: `path.shown()` where `path.display()` would split a message.
+pub trait ShowPath {
+    /// The path as a message shows it: as it is, or, when it holds a newline or another
+    /// control character, as a quoted string with Rust's escapes (`"bad\nname.rhai"`), so
+    /// that the message stays on its line (`file:line:col: …` included) and the name can be
+    /// read back.
+    fn shown(&self) -> ShownPath<'_>;
+}
+
+impl ShowPath for Path {
+    fn shown(&self) -> ShownPath<'_> {
+        ShownPath(self)
+    }
+}
+
+/// A path as messages show it ([`ShowPath::shown`]).
+pub struct ShownPath<'a>(&'a Path);
+
+impl std::fmt::Display for ShownPath<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let text = self.0.to_string_lossy();
+        if text.contains(char::is_control) {
+            write!(f, "{text:?}")
+        } else {
+            f.write_str(&text)
+        }
+    }
+}
+
 /// `text` with every control character but newline and tab written as `\u{..}`.
 pub fn visible_controls(text: &str) -> std::borrow::Cow<'_, str> {
     let hidden = |c: char| c.is_control() && c != '\n' && c != '\t';

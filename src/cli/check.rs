@@ -1,6 +1,7 @@
 //! `lapclone check`: takes a scene file, parses, evaluates, validates and builds it, and
 //! prints a one-line summary (or the positioned error with a caret) and its warnings.
 
+use lapclone::util::ShowPath;
 use std::path::PathBuf;
 
 use super::scene_open::load_renderer;
@@ -19,7 +20,7 @@ pub fn run_check(args: CheckArgs) -> anyhow::Result<()> {
     let vertices: usize = renderer.vertex_counts().iter().sum();
     super::say(format_args!(
         "{}: ok — {}×{}, {} fps, {} s ({} frames), {} patches ({vertices} mesh vertices), {handles} handles, {pins} pins",
-        args.scene.display(),
+        args.scene.shown(),
         c.width,
         c.height,
         c.fps,

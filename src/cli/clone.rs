@@ -1,6 +1,7 @@
 //! `lapclone clone`: one seamless clone of a source patch into a target image, optionally
 //! deformed by drags and pins, with JSON timings and a mesh overlay on request.
 
+use lapclone::util::ShowPath;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -262,7 +263,7 @@ fn mesh_patch(
         source_size,
         options,
     )
-    .with_context(|| format!("mask {}", args.mask.display()))
+    .with_context(|| format!("mask {}", args.mask.shown()))
 }
 
 /// The cloner on the patch's mesh (the factor), and the deformation of the drags and pins.

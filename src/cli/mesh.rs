@@ -1,5 +1,6 @@
 //! `lapclone mesh`: mask → mesh, with an optional picture, JSON stats and Laplacian export.
 
+use lapclone::util::ShowPath;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -55,8 +56,8 @@ pub fn run(args: MeshArgs) -> anyhow::Result<()> {
     check_outputs(&outputs, &args.mask)?;
     let mask = BitMask::load(&args.mask, threshold as f32)?;
     let started = Instant::now();
-    let mut result = mesh::mesh_mask(&mask, &options)
-        .with_context(|| format!("mask {}", args.mask.display()))?;
+    let mut result =
+        mesh::mesh_mask(&mask, &options).with_context(|| format!("mask {}", args.mask.shown()))?;
     // The raw mask mesh (boundary on the pixel cracks unless `--boundary outside-centres`);
     // relaxation is the only finishing step that belongs to the mesh itself.
     if options.relax_sweeps > 0 {
@@ -132,7 +133,7 @@ fn check_outputs(outputs: &[PathBuf], mask: &Path) -> anyhow::Result<()> {
             .iter()
             .any(|o| lapclone::util::same_destination(o, output))
         {
-            let named = output.display();
+            let named = output.shown();
             return Err(UsageError(format!("two outputs name the same file: {named}")).into());
         }
     }
@@ -146,12 +147,12 @@ fn write_all(outputs: &[PathBuf], contents: &[Vec<u8>]) -> anyhow::Result<()> {
     for (path, bytes) in outputs.iter().zip(contents) {
         let fill = |file: &mut std::fs::File| std::io::Write::write_all(file, bytes);
         let temp = lapclone::util::write_staged(path, fill)
-            .with_context(|| format!("cannot write {}", path.display()))?;
+            .with_context(|| format!("cannot write {}", path.shown()))?;
         staged.push((temp, path));
     }
     for (temp, path) in staged {
         temp.commit()
-            .with_context(|| format!("cannot write {}", path.display()))?;
+            .with_context(|| format!("cannot write {}", path.shown()))?;
     }
     Ok(())
 }

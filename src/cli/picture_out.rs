@@ -3,6 +3,7 @@
 //! then writes a canvas or encoded PNG bytes to it. Another image extension is a usage
 //! error, so `-o x.jpg` never holds PNG bytes under a JPEG name.
 
+use lapclone::util::ShowPath;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -29,7 +30,7 @@ impl PictureOut {
             if !extension.eq_ignore_ascii_case("png") {
                 return Err(UsageError(format!(
                     "-o {}: {command} writes PNG; name the output .png (or `-` for standard output)",
-                    output.display()
+                    output.shown()
                 ))
                 .into());
             }
@@ -49,7 +50,7 @@ impl PictureOut {
         match self {
             PictureOut::File(path) => canvas
                 .save_png_threaded(path, format, threads)
-                .with_context(|| format!("writing {}", path.display())),
+                .with_context(|| format!("writing {}", path.shown())),
             PictureOut::Stdout => {
                 let mut png = Vec::new();
                 canvas.write_png(format, threads, &mut png)?;
@@ -62,7 +63,7 @@ impl PictureOut {
     pub(crate) fn write_bytes(&self, png: &[u8]) -> anyhow::Result<()> {
         match self {
             PictureOut::File(path) => lapclone::util::write_atomic(path, png)
-                .with_context(|| format!("writing {}", path.display())),
+                .with_context(|| format!("writing {}", path.shown())),
             PictureOut::Stdout => {
                 let mut out = std::io::stdout().lock();
                 out.write_all(png)

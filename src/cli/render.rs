@@ -2,6 +2,7 @@
 //! library's output stage (`lapclone::output`), with Ctrl-C, a progress bar and a summary
 //! line. The arguments are in `render_args`, the scene loading in `scene_open`.
 
+use lapclone::util::ShowPath;
 use std::time::Instant;
 
 use lapclone::output::{refuse_render_input, render_frames, OutputError, Rendered, SinkPlan};
@@ -57,7 +58,7 @@ fn summary(rendered: &Rendered, started: Instant, factorisations: usize) -> Stri
     let seconds = started.elapsed().as_secs_f64();
     format!(
         "rendered {frames} frames to {} in {seconds:.2} s ({:.1} fps; {:.2} ms/frame compute; {factorisations} factorisation{})",
-        rendered.path.display(),
+        rendered.path.shown(),
         frames as f64 / seconds,
         rendered.compute_ms / frames as f64,
         if factorisations == 1 { "" } else { "s" }

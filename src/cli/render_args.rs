@@ -2,6 +2,7 @@
 //! output, frames, format, jobs, force, PNG compression, quality), the `A..B` frame range
 //! parser the REPL and `track` share, and the output format those arguments name.
 
+use lapclone::util::ShowPath;
 use std::path::PathBuf;
 
 use lapclone::output::{OutputError, OutputKind, PngCompression, SinkSettings};
@@ -72,7 +73,7 @@ impl RenderArgs {
             Err(OutputError::UnknownExtension { extension, .. }) => {
                 return Err(UsageError(format!(
                     "-o {}: unknown output extension `.{extension}` (use .gif, .apng, .mp4, .webm, .mov, .y4m, a folder name without an extension, or --format)",
-                    self.output.display()
+                    self.output.shown()
                 ))
                 .into())
             }

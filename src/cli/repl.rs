@@ -16,6 +16,7 @@ mod session;
 mod sixel;
 mod validator;
 
+use lapclone::util::ShowPath;
 use std::io::{BufRead, IsTerminal};
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -205,9 +206,9 @@ fn script_loop(session: &Mutex<Session>, mut input: Box<dyn BufRead>) -> anyhow:
 fn open_script(path: &std::path::Path) -> anyhow::Result<std::fs::File> {
     let what = lapclone::util::not_a_file(path);
     if let Some(what) = what.filter(|w| !w.contains("FIFO")) {
-        anyhow::bail!("cannot open script {}: it {what}", path.display());
+        anyhow::bail!("cannot open script {}: it {what}", path.shown());
     }
-    std::fs::File::open(path).with_context(|| format!("cannot open script {}", path.display()))
+    std::fs::File::open(path).with_context(|| format!("cannot open script {}", path.shown()))
 }
 
 /// Longest entry a piped session reads, as long as a scene file may be.
@@ -337,7 +338,7 @@ fn default_history_path() -> Option<PathBuf> {
     if let Err(error) = std::fs::create_dir_all(&dir) {
         eprint_line!(
             "warning: no history: cannot create {}: {error}",
-            dir.display()
+            dir.shown()
         );
         return None;
     }
@@ -346,7 +347,7 @@ fn default_history_path() -> Option<PathBuf> {
 
 fn save_history(editor: &mut Editor<ReplHelper, FileHistory>, path: &std::path::Path) {
     if let Err(error) = editor.save_history(path) {
-        eprint_line!("warning: cannot write history {}: {error}", path.display());
+        eprint_line!("warning: cannot write history {}: {error}", path.shown());
     }
 }
 

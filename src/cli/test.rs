@@ -9,6 +9,7 @@
 //! load). `--accept`, `--reject` and `--review` handle pending files (`test_pending.rs`);
 //! printing and reports are in `test_report.rs`.
 
+use lapclone::util::ShowPath;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::mpsc;
@@ -49,7 +50,7 @@ pub fn run(args: TestArgs) -> anyhow::Result<()> {
         if !args.update {
             return Err(UsageError(format!(
                 "--goldens {}: no such folder (create the goldens with --update)",
-                root.display()
+                root.shown()
             ))
             .into());
         }
@@ -60,7 +61,7 @@ pub fn run(args: TestArgs) -> anyhow::Result<()> {
     }
     if let Some(junit) = &args.junit {
         lapclone::util::check_destination(junit)
-            .map_err(|e| UsageError(format!("--junit {}: {e}", junit.display())))?;
+            .map_err(|e| UsageError(format!("--junit {}: {e}", junit.shown())))?;
         test_report::refuse_replacing_other_than_junit(junit)?;
     }
     let scenes = find_scenes(&paths, &args.out_dir())?;
@@ -78,7 +79,7 @@ pub fn run(args: TestArgs) -> anyhow::Result<()> {
 }
 
 fn list(paths: &[PathBuf]) -> String {
-    let names: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
+    let names: Vec<String> = paths.iter().map(|p| p.shown().to_string()).collect();
     names.join(", ")
 }
 
@@ -144,7 +145,7 @@ fn check_scene(job: &Job, scene: &Path) -> SceneResult {
         Ok(frames) => frames,
         Err(message) => {
             result.failure = Some(SceneFailure {
-                message: format!("{}: {message}", scene.display()),
+                message: format!("{}: {message}", scene.shown()),
                 loads: false,
             });
             return result;

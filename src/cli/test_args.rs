@@ -2,6 +2,7 @@
 //! `TestArgs`, the per-frame and per-scene results, where goldens and pending frames live,
 //! the scene search and the atomic file writes.
 
+use lapclone::util::ShowPath;
 use std::path::{Path, PathBuf};
 
 use anyhow::Context as _;
@@ -156,7 +157,7 @@ impl TestArgs {
         match &self.out {
             Some(dir) if dir.exists() && !dir.is_dir() => Err(UsageError(format!(
                 "--out {}: not a folder (failure pictures and index.html go in a folder)",
-                dir.display()
+                dir.shown()
             ))),
             _ => Ok(()),
         }
@@ -212,7 +213,7 @@ pub fn check_golden_dirs(scenes: &[PathBuf], root: Option<&Path>) -> anyhow::Res
         if stem.is_empty() || stem == "." || stem == ".." {
             return Err(UsageError(format!(
                 "{}: a scene's name must make a folder name for its goldens; rename it",
-                scene.display()
+                scene.shown()
             ))
             .into());
         }
@@ -221,9 +222,9 @@ pub fn check_golden_dirs(scenes: &[PathBuf], root: Option<&Path>) -> anyhow::Res
             return Err(UsageError(format!(
                 "{} and {} would share the goldens in {}: give them separate --goldens runs \
                  or different names",
-                other.display(),
-                scene.display(),
-                dir.display()
+                other.shown(),
+                scene.shown(),
+                dir.shown()
             ))
             .into());
         }
@@ -243,15 +244,15 @@ pub fn check_out_beside_goldens(
     for folder in goldens {
         if inside.starts_with(absolute(&folder)) {
             let named = match args.out {
-                Some(_) => format!("--out {}", out.display()),
+                Some(_) => format!("--out {}", out.shown()),
                 None => format!(
                     "the report folder {} (name another with --out)",
-                    out.display()
+                    out.shown()
                 ),
             };
             return Err(UsageError(format!(
                 "{named}: it lies in the goldens folder {}; the report's pictures would mix with the goldens",
-                folder.display()
+                folder.shown()
             )));
         }
     }
@@ -366,7 +367,7 @@ pub fn find_scenes(paths: &[PathBuf], out: &Path) -> anyhow::Result<Vec<PathBuf>
         } else if path.is_file() {
             scenes.push(path.strip_prefix(".").unwrap_or(path).to_path_buf());
         } else {
-            return Err(UsageError(format!("{}: no such file or folder", path.display())).into());
+            return Err(UsageError(format!("{}: no such file or folder", path.shown())).into());
         }
     }
     scenes.sort();
@@ -376,7 +377,7 @@ pub fn find_scenes(paths: &[PathBuf], out: &Path) -> anyhow::Result<Vec<PathBuf>
 
 fn walk(dir: &Path, out: &Path, scenes: &mut Vec<PathBuf>) -> anyhow::Result<()> {
     let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)
-        .with_context(|| format!("reading {}", dir.display()))?
+        .with_context(|| format!("reading {}", dir.shown()))?
         .filter_map(|e| e.ok().map(|e| e.path()))
         .collect();
     entries.sort();
@@ -427,16 +428,16 @@ pub fn overrides(args: &TestArgs, base: Thresholds) -> Thresholds {
 pub fn write_file(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
     check_own_file(path)?;
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.shown()))?;
     }
-    lapclone::util::write_atomic(path, bytes).with_context(|| format!("writing {}", path.display()))
+    lapclone::util::write_atomic(path, bytes).with_context(|| format!("writing {}", path.shown()))
 }
 
 pub fn remove_if_present(path: &Path) -> anyhow::Result<()> {
     check_own_file(path)?;
     match std::fs::remove_file(path) {
         Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-            Err(e).with_context(|| format!("removing {}", path.display()))
+            Err(e).with_context(|| format!("removing {}", path.shown()))
         }
         _ => Ok(()),
     }
@@ -449,7 +450,7 @@ pub fn remove_if_present(path: &Path) -> anyhow::Result<()> {
 pub fn check_own_file(path: &Path) -> anyhow::Result<()> {
     let meta = match std::fs::symlink_metadata(path) {
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
-        Err(e) => return Err(e).with_context(|| format!("reading {}", path.display())),
+        Err(e) => return Err(e).with_context(|| format!("reading {}", path.shown())),
         Ok(meta) => meta,
     };
     let what = match meta.file_type() {
@@ -459,6 +460,6 @@ pub fn check_own_file(path: &Path) -> anyhow::Result<()> {
     };
     anyhow::bail!(
         "{} {what}: lapclone test reads, writes and removes only regular files there; move it away",
-        path.display()
+        path.shown()
     )
 }

@@ -3,6 +3,7 @@
 //! and `--review` (each shown with its figures and triptych — inline where the terminal can
 //! show images — and accepted, rejected or skipped as the user answers).
 
+use lapclone::util::ShowPath;
 use std::io::{BufRead, IsTerminal as _, Write as _};
 use std::path::{Path, PathBuf};
 
@@ -38,9 +39,9 @@ fn act(args: &TestArgs, paths: &[PathBuf]) -> anyhow::Result<()> {
     let mut failed = 0;
     for file in &pending {
         let done = if args.accept {
-            accept(file).map(|()| format!("accepted {}", golden_of(file).display()))
+            accept(file).map(|()| format!("accepted {}", golden_of(file).shown()))
         } else {
-            remove_if_present(file).map(|()| format!("rejected {}", file.display()))
+            remove_if_present(file).map(|()| format!("rejected {}", file.shown()))
         };
         match done {
             Ok(line) => super::print_line(line),
@@ -57,7 +58,7 @@ fn act(args: &TestArgs, paths: &[PathBuf]) -> anyhow::Result<()> {
 }
 
 fn list(paths: &[PathBuf]) -> String {
-    let names: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
+    let names: Vec<String> = paths.iter().map(|p| p.shown().to_string()).collect();
     names.join(", ")
 }
 
@@ -95,7 +96,7 @@ fn find_pending(args: &TestArgs, paths: &[PathBuf]) -> anyhow::Result<Vec<PathBu
 }
 
 fn collect_in(dir: &Path, found: &mut Vec<PathBuf>) -> anyhow::Result<()> {
-    for entry in std::fs::read_dir(dir).with_context(|| format!("reading {}", dir.display()))? {
+    for entry in std::fs::read_dir(dir).with_context(|| format!("reading {}", dir.shown()))? {
         let path = entry?.path();
         let name = path.file_name().unwrap_or_default().to_string_lossy();
         if path.is_file() && is_pending_name(&name) {
@@ -110,7 +111,7 @@ fn walk(dir: &Path, out: &Path, found: &mut Vec<PathBuf>) -> anyhow::Result<()> 
     if parent.is_some_and(|p| p == "goldens") {
         collect_in(dir, found)?;
     }
-    for entry in std::fs::read_dir(dir).with_context(|| format!("reading {}", dir.display()))? {
+    for entry in std::fs::read_dir(dir).with_context(|| format!("reading {}", dir.shown()))? {
         let path = entry?.path();
         let name = path.file_name().unwrap_or_default().to_string_lossy();
         let skipped =
@@ -134,9 +135,9 @@ fn accept(pending: &Path) -> anyhow::Result<()> {
     check_own_file(pending)?;
     check_own_file(&golden)?;
     // A golden must be a frame: a pending file that does not decode is not promoted.
-    GoldenFrame::load(pending).with_context(|| format!("not accepted: {}", pending.display()))?;
+    GoldenFrame::load(pending).with_context(|| format!("not accepted: {}", pending.shown()))?;
     std::fs::rename(pending, &golden)
-        .with_context(|| format!("renaming {} to {}", pending.display(), golden.display()))
+        .with_context(|| format!("renaming {} to {}", pending.shown(), golden.shown()))
 }
 
 /// Asks about each pending frame in turn; end of input skips the rest.
@@ -149,7 +150,7 @@ fn review(args: &TestArgs, pending: &[PathBuf]) -> anyhow::Result<()> {
             "[{}/{}] {}",
             index + 1,
             pending.len(),
-            file.display()
+            file.shown()
         ));
         if let Err(error) = show(args, file) {
             // One unreadable pending file is reported and passed over, not the end of the
@@ -163,12 +164,12 @@ fn review(args: &TestArgs, pending: &[PathBuf]) -> anyhow::Result<()> {
             "a" => {
                 accept(file)?;
                 accepted += 1;
-                super::print_line(format_args!("accepted {}", golden_of(file).display()));
+                super::print_line(format_args!("accepted {}", golden_of(file).shown()));
             }
             "r" => {
                 remove_if_present(file)?;
                 rejected += 1;
-                super::print_line(format_args!("rejected {}", file.display()));
+                super::print_line(format_args!("rejected {}", file.shown()));
             }
             "s" => skipped += 1,
             _ => {
@@ -222,7 +223,7 @@ fn show(args: &TestArgs, file: &Path) -> anyhow::Result<()> {
             }
         }
     } else {
-        super::print_line(format_args!("  new: no golden {}", golden_path.display()));
+        super::print_line(format_args!("  new: no golden {}", golden_path.shown()));
         None
     };
     let thresholds = super::test_args::overrides(args, Thresholds::default());
@@ -258,7 +259,7 @@ fn show(args: &TestArgs, file: &Path) -> anyhow::Result<()> {
     write_file(&path, &lapclone::golden::encode_rgba_png(&sheet))?;
     super::print_line(format_args!(
         "  expected | difference | actual: {}",
-        path.display()
+        path.shown()
     ));
     Ok(())
 }

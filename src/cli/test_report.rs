@@ -2,6 +2,7 @@
 //! JSON objects), the summary, the `index.html` of failing and pending frames under `--out`,
 //! the JUnit XML file, and the run's exit status (an error for exit 1 or 2).
 
+use lapclone::util::ShowPath;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -111,7 +112,7 @@ fn notes(report: Option<std::path::PathBuf>, results: &[SceneResult]) -> Vec<Str
         .count();
     let mut notes = Vec::new();
     if let Some(dir) = report {
-        notes.push(format!("report: {}", dir.join("index.html").display()));
+        notes.push(format!("report: {}", dir.join("index.html").shown()));
     }
     if pending > 0 {
         notes.push(format!(
@@ -208,17 +209,17 @@ pub fn outcome_text(frame: &FrameResult) -> String {
         Outcome::Missing { folder } => {
             let dir = frame.paths.golden.parent().unwrap_or(Path::new("."));
             if *folder {
-                format!("no golden {}", frame.paths.golden.display())
+                format!("no golden {}", frame.paths.golden.shown())
             } else {
                 format!(
                     "no golden {} (no goldens folder {}; create it with --update)",
-                    frame.paths.golden.display(),
-                    dir.display()
+                    frame.paths.golden.shown(),
+                    dir.shown()
                 )
             }
         }
         Outcome::Unreadable(message) => message.clone(),
-        Outcome::Updated => format!("wrote {}", frame.paths.golden.display()),
+        Outcome::Updated => format!("wrote {}", frame.paths.golden.shown()),
     }
 }
 
@@ -226,7 +227,7 @@ fn frame_line(scene: &Path, frame: &FrameResult) -> String {
     format!(
         "{:<7} {}  frame {}  {}",
         status_word(frame.outcome.status()),
-        scene.display(),
+        scene.shown(),
         frame.frame,
         outcome_text(frame)
     )
@@ -234,9 +235,9 @@ fn frame_line(scene: &Path, frame: &FrameResult) -> String {
 
 fn detail_line(frame: &FrameResult) -> Option<String> {
     let pictures = frame.pictures.as_ref()?;
-    let mut line = format!("        triptych {}", pictures.triptych.display());
+    let mut line = format!("        triptych {}", pictures.triptych.shown());
     if let Some(pending) = &frame.pending_written {
-        let _ = write!(line, "; pending {}", pending.display());
+        let _ = write!(line, "; pending {}", pending.shown());
     }
     Some(line)
 }
@@ -301,7 +302,7 @@ pub fn refuse_replacing_other_than_junit(path: &Path) -> anyhow::Result<()> {
     let mut head = Vec::new();
     lapclone::util::open_input_file(path)
         .and_then(|f| f.take(256).read_to_end(&mut head))
-        .with_context(|| format!("reading {}", path.display()))?;
+        .with_context(|| format!("reading {}", path.shown()))?;
     let text = String::from_utf8_lossy(&head);
     let junit = text.trim_start().starts_with("<?xml") && text.contains("<testsuites");
     if head.is_empty() || junit {
@@ -310,7 +311,7 @@ pub fn refuse_replacing_other_than_junit(path: &Path) -> anyhow::Result<()> {
     Err(UsageError(format!(
         "--junit {}: the file exists and is not a JUnit report; lapclone replaces only its own \
          reports",
-        path.display()
+        path.shown()
     ))
     .into())
 }

@@ -2,6 +2,7 @@
 //! frame and tracking settings, and writes the track CSV (atomically), warning on stderr for
 //! each run of frames where a point was lost.
 
+use lapclone::util::ShowPath;
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -56,7 +57,7 @@ pub fn run(args: TrackArgs) -> anyhow::Result<()> {
     check_arguments(&args)?;
     // `track` has no setting that holds a last frame: its messages suggest none.
     let footage = Footage::open(&args.footage, args.start, false, "")
-        .with_context(|| format!("opening {}", args.footage.display()))?;
+        .with_context(|| format!("opening {}", args.footage.shown()))?;
     let to_stdout = args.output.as_os_str() == "-";
     if !to_stdout {
         lapclone::output::refuse_footage_input(&args.output, &footage)?;
@@ -97,8 +98,8 @@ pub fn run(args: TrackArgs) -> anyhow::Result<()> {
             lapclone::track::write_csv(&mut out, &frames)?;
             out.flush()
         })
-        .with_context(|| format!("writing {}", args.output.display()))?;
-        args.output.display().to_string()
+        .with_context(|| format!("writing {}", args.output.shown()))?;
+        args.output.shown().to_string()
     };
     eprint_line!(
         "tracked {} point{} through frames {}..{} into {into}",
@@ -201,7 +202,7 @@ fn check_arguments(args: &TrackArgs) -> anyhow::Result<()> {
         return super::check_stdout_for_data();
     }
     if args.output.is_dir() {
-        return Err(UsageError(format!("-o {} is a folder", args.output.display())).into());
+        return Err(UsageError(format!("-o {} is a folder", args.output.shown())).into());
     }
     Ok(lapclone::output::check_output_folder(&args.output)?)
 }
@@ -227,14 +228,14 @@ fn available_frames(
             if let Some(what) =
                 lapclone::util::not_a_file(&missing).filter(|w| *w != "does not exist")
             {
-                anyhow::bail!("frame {} ({}) {what}", count + 1, missing.display());
+                anyhow::bail!("frame {} ({}) {what}", count + 1, missing.shown());
             }
             if let Some(last) = pattern.highest_number().filter(|n| *n > start + count) {
                 return Err(UsageError(format!(
                     "frame {} ({}) is missing, but plates up to number {last} follow: fill the \
                      gap, or give --frames 1..{count}",
                     count + 1,
-                    missing.display()
+                    missing.shown()
                 ))
                 .into());
             }

@@ -4,6 +4,7 @@
 //! compared by identity (links and hard links followed, `util::same_file`), so an output
 //! path cannot reach an input through another spelling of it.
 
+use crate::util::ShowPath;
 use std::path::{Path, PathBuf};
 
 use super::{foreign_frames, OutputError, OutputKind};
@@ -37,7 +38,7 @@ impl Input {
 
     fn describe(&self) -> String {
         match self {
-            Input::File(file) => file.display().to_string(),
+            Input::File(file) => file.shown().to_string(),
             Input::Sequence(pattern) => pattern.text().to_string(),
         }
     }
@@ -168,7 +169,7 @@ pub fn refuse_footage_input(output: &Path, footage: &Footage) -> Result<(), Outp
 /// Refuses an output that is one of `inputs` (a command's input files).
 pub fn refuse_input(output: &Path, inputs: &[&Path]) -> Result<(), OutputError> {
     match inputs.iter().find(|input| same_file(input, output)) {
-        Some(input) => Err(overwrite(output, &input.display().to_string())),
+        Some(input) => Err(overwrite(output, &input.shown().to_string())),
         None => Ok(()),
     }
 }

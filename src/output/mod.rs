@@ -46,6 +46,7 @@ pub use sink::{FrameSink, SinkPlan};
 pub use y4m::{fps_fraction, Y4mWriter};
 pub use yuv::{frame_to_yuv420, rgb_to_ycbcr, yuv420_len, yuv420_size};
 
+use crate::util::ShowPath;
 use std::path::{Path, PathBuf};
 
 impl OutputError {
@@ -73,7 +74,7 @@ impl OutputError {
 #[derive(Debug, thiserror::Error)]
 pub enum OutputError {
     /// Reading or writing `path` failed.
-    #[error("{}: {source}", path.display())]
+    #[error("{}: {source}", path.shown())]
     Io {
         /// The file.
         path: PathBuf,
@@ -91,7 +92,7 @@ pub enum OutputError {
     #[error("bad frame: {0}")]
     BadFrame(String),
     /// A frame folder that does not exist.
-    #[error("output folder {} does not exist", .0.display())]
+    #[error("output folder {} does not exist", .0.shown())]
     NotAFolder(PathBuf),
     /// An encoder thread failed.
     #[error("{0}")]
@@ -100,7 +101,7 @@ pub enum OutputError {
     #[error("{}", crate::util::FFMPEG_MISSING)]
     NoFfmpeg,
     /// ffmpeg failed; the last lines it wrote.
-    #[error("ffmpeg failed writing {}; it said:\n  {stderr}", path.display())]
+    #[error("ffmpeg failed writing {}; it said:\n  {stderr}", path.shown())]
     Ffmpeg {
         /// The video.
         path: PathBuf,
@@ -111,7 +112,7 @@ pub enum OutputError {
     #[error("cancelled")]
     Cancelled,
     /// The output's parent folder is missing (`exists` false) or not a folder.
-    #[error("{}: the output folder {} {}", output.display(), folder.display(), if *exists { "is not a folder" } else { "does not exist" })]
+    #[error("{}: the output folder {} {}", output.shown(), folder.shown(), if *exists { "is not a folder" } else { "does not exist" })]
     MissingFolder {
         /// The output path.
         output: PathBuf,
@@ -121,7 +122,7 @@ pub enum OutputError {
         exists: bool,
     },
     /// A file output names an existing folder.
-    #[error("{} is a folder; name a file for {kind:?} output", path.display())]
+    #[error("{} is a folder; name a file for {kind:?} output", path.shown())]
     IsAFolder {
         /// The output path.
         path: PathBuf,
@@ -129,10 +130,10 @@ pub enum OutputError {
         kind: OutputKind,
     },
     /// A PNG frame folder's path is a file.
-    #[error("{} exists and is not a folder; name a folder for PNG frames", .0.display())]
+    #[error("{} exists and is not a folder; name a folder for PNG frames", .0.shown())]
     NotAFrameFolder(PathBuf),
     /// A PNG frame folder holds frame files of another render (and `force` is off).
-    #[error("{} holds {count} frame files of another render (e.g. {example}); use --force to remove them, or another folder", folder.display())]
+    #[error("{} holds {count} frame files of another render (e.g. {example}); use --force to remove them, or another folder", folder.shown())]
     ForeignFrames {
         /// The folder.
         folder: PathBuf,
@@ -142,7 +143,7 @@ pub enum OutputError {
         example: String,
     },
     /// The output would replace one of the inputs.
-    #[error("{}: the output would replace an input of this command ({input}); write it elsewhere", output.display())]
+    #[error("{}: the output would replace an input of this command ({input}); write it elsewhere", output.shown())]
     ReplacesInput {
         /// The output path (or the frame file in a PNG folder).
         output: PathBuf,
@@ -150,7 +151,7 @@ pub enum OutputError {
         input: String,
     },
     /// The output path's extension names no format.
-    #[error("{}: unknown output extension `.{extension}` (use .gif, .apng, .mp4, .webm, .mov, .y4m, a folder name without an extension, or a format)", path.display())]
+    #[error("{}: unknown output extension `.{extension}` (use .gif, .apng, .mp4, .webm, .mov, .y4m, a folder name without an extension, or a format)", path.shown())]
     UnknownExtension {
         /// The output path.
         path: PathBuf,
@@ -175,7 +176,7 @@ pub enum OutputError {
     #[error("too many frames for an APNG")]
     TooManyFrames(#[source] std::num::TryFromIntError),
     /// Listing a frame folder failed.
-    #[error("reading {}", path.display())]
+    #[error("reading {}", path.shown())]
     ReadingFolder {
         /// The folder.
         path: PathBuf,
@@ -184,7 +185,7 @@ pub enum OutputError {
         source: std::io::Error,
     },
     /// The temporary folder beside the output could not be made.
-    #[error("creating a folder beside {}", beside.display())]
+    #[error("creating a folder beside {}", beside.shown())]
     CreatingFolder {
         /// The output.
         beside: PathBuf,
@@ -193,7 +194,7 @@ pub enum OutputError {
         source: std::io::Error,
     },
     /// Moving the finished frames into the destination failed.
-    #[error("moving the frames to {}", dest.display())]
+    #[error("moving the frames to {}", dest.shown())]
     Moving {
         /// The destination folder.
         dest: PathBuf,
@@ -202,7 +203,7 @@ pub enum OutputError {
         source: std::io::Error,
     },
     /// Removing another render's frame file (with `force`) failed.
-    #[error("removing {}", path.display())]
+    #[error("removing {}", path.shown())]
     Removing {
         /// The file.
         path: PathBuf,

@@ -1,5 +1,6 @@
 //! Errors of the render stage: which patch failed, and why.
 
+use crate::util::ShowPath;
 use std::path::PathBuf;
 
 use crate::clone::CloneError;
@@ -28,7 +29,7 @@ pub enum RenderError {
         source: DeformError,
     },
     /// A patch's mask cannot be read or meshed.
-    #[error("patch `{patch}`: mask {}: {source}", path.display())]
+    #[error("patch `{patch}`: mask {}: {source}", path.shown())]
     Mask {
         /// The patch's name.
         patch: String,

@@ -3,6 +3,7 @@
 //! (it is drawn from the top-left corner, black where it does not reach) and when a
 //! polygon patch reaches past its source's edge (the pixels there repeat the edge).
 
+use crate::util::ShowPath;
 use super::layer::polygons_outside;
 use super::Renderer;
 use crate::clone::PAST_EDGE_TOLERANCE;
@@ -22,7 +23,7 @@ impl Renderer {
                 if size.0 < canvas.0 || size.1 < canvas.1 {
                     out.push(format!(
                         "the background {} is {}×{} and the canvas {}×{}: it is drawn from the top-left corner, with opaque black where it does not reach",
-                        path.display(),
+                        path.shown(),
                         size.0,
                         size.1,
                         canvas.0,

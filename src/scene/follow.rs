@@ -4,6 +4,7 @@
 //! and `check` warns about frames the track does not reach.
 
 
+use crate::util::ShowPath;
 use super::types::{Follow, FollowTarget, Patch};
 
 
@@ -33,7 +34,7 @@ impl Follow {
         self.file
             .file_name()
             .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_else(|| self.file.display().to_string())
+            .unwrap_or_else(|| self.file.shown().to_string())
     }
 }
 

@@ -4,6 +4,7 @@
 //! a refusal is a runtime error at the position of the offending call. See
 //! docs/scene-language.md for the language itself.
 
+use crate::util::ShowPath;
 use std::path::{Path, PathBuf};
 
 use glam::DVec2;
@@ -54,9 +55,9 @@ fn existing_file(base_dir: &Path, text: &str, what: &str) -> Result<PathBuf, Str
         None => Ok(path),
         Some("does not exist") => Err(format!(
             "{what} file `{text}` not found (looked for {})",
-            path.display()
+            path.shown()
         )),
-        Some(problem) => Err(format!("{what} `{text}` {problem} ({})", path.display())),
+        Some(problem) => Err(format!("{what} `{text}` {problem} ({})", path.shown())),
     }
 }
 

@@ -2,6 +2,7 @@
 //! and gives a [`SceneError`] naming the file, line and column, printed as
 //! `file:line:col: message`, the source line, and a caret under the column.
 
+use crate::util::ShowPath;
 use std::fmt;
 use std::path::{Path, PathBuf};
 
@@ -207,7 +208,7 @@ fn line_and_column(position: Position) -> (Option<usize>, Option<usize>) {
 /// Where `position` is in `file`, as messages print it: `file:line:col`, `file:line` or
 /// `file`, with a word when the line or column lies past what Rhai counts.
 pub(crate) fn location(file: &Path, position: Position) -> String {
-    let file = file.display();
+    let file = file.shown();
     let past = |what| format!("{what} {POSITION_CEILING} or later");
     match (line_and_column(position), position.line(), position.position()) {
         ((Some(line), Some(col)), ..) => format!("{file}:{line}:{col}"),

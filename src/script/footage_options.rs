@@ -3,6 +3,7 @@
 //! printf-style numbered pattern (`plate_%04d.png`) or a video file — or `None` for a plain
 //! image path.
 
+use crate::util::ShowPath;
 use std::path::Path;
 
 use rhai::Map;
@@ -53,7 +54,7 @@ pub fn footage_option(
     }
     if is_video_path(&path) {
         if let Some(problem) = crate::util::not_a_file(&path).filter(|p| *p != "does not exist") {
-            return Err(format!("{key} `{text}` {problem} ({})", path.display()));
+            return Err(format!("{key} `{text}` {problem} ({})", path.shown()));
         }
     }
     Footage::open(&path, start, hold.unwrap_or(false), &hold_key)

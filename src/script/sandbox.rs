@@ -4,6 +4,7 @@
 //! data sizes, and stops when the cancel flag is raised. Rhai itself has no file or network
 //! access; the only file access is the module resolver below (read-only, `.rhai` files).
 
+use crate::util::ShowPath;
 use std::collections::HashMap;
 use std::path::{Component, Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -123,7 +124,7 @@ impl SandboxResolver {
             .iter()
             .find_map(|root| file.strip_prefix(root).ok())
             .unwrap_or(file)
-            .display()
+            .shown()
             .to_string()
     }
 
@@ -178,7 +179,7 @@ impl SandboxResolver {
             };
             if found.starts_with(root) {
                 if let Some(problem) = crate::util::not_a_file(&found) {
-                    return Err(format!("module `{name}` {problem} ({})", found.display()));
+                    return Err(format!("module `{name}` {problem} ({})", found.shown()));
                 }
                 return Ok(found);
             }
@@ -188,11 +189,11 @@ impl SandboxResolver {
             (Some(target), _) => format!(
                 "module `{name}` is a link to {}, outside the scene's folder and the project's \
                  scripts/ folder",
-                target.display()
+                target.shown()
             ),
             (None, Some(link)) => format!(
                 "module `{name}` is a symbolic link to nothing (or a loop of links): {}",
-                link.display()
+                link.shown()
             ),
             (None, None) => format!(
                 "module `{name}` not found in the scene's folder or the project's scripts/ folder"
@@ -255,7 +256,7 @@ impl SandboxResolver {
     ) -> Result<SharedModule, Box<EvalAltResult>> {
         let text = super::source::read_source(file).map_err(|e| {
             EvalAltResult::ErrorRuntime(
-                format!("cannot read module {}: {e}", file.display()).into(),
+                format!("cannot read module {}: {e}", file.shown()).into(),
                 pos,
             )
         })?;

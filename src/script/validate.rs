@@ -3,6 +3,7 @@
 //! polygons enclose area, and every frame evaluates to finite values — giving a summary or a
 //! [`SceneError`] positioned at the call that named the offending file.
 
+use crate::util::ShowPath;
 use std::path::Path;
 
 use super::engine::LoadedScene;
@@ -94,7 +95,7 @@ fn inside_pixels_of(patch: &Patch) -> Result<u64, String> {
 }
 
 fn decode(path: &Path) -> Result<image::DynamicImage, String> {
-    crate::limits::open_image(path).map_err(|e| format!("cannot decode {}: {e}", path.display()))
+    crate::limits::open_image(path).map_err(|e| format!("cannot decode {}: {e}", path.shown()))
 }
 
 fn state_is_finite(p: &crate::scene::PatchState) -> bool {

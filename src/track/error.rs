@@ -1,6 +1,7 @@
 //! Why tracking or reading a track failed: options out of range, a point outside the first
 //! frame, a frame of another size, and malformed track files (`file:line: what is wrong`).
 
+use crate::util::ShowPath;
 use std::path::PathBuf;
 
 /// Why a track cannot be made or read.
@@ -36,7 +37,7 @@ pub enum TrackError {
         expected_height: u32,
     },
     /// A track file cannot be read.
-    #[error("cannot read track {}: {source}", path.display())]
+    #[error("cannot read track {}: {source}", path.shown())]
     Read {
         /// The file.
         path: PathBuf,
@@ -44,7 +45,7 @@ pub enum TrackError {
         source: std::io::Error,
     },
     /// A track file is malformed at a line.
-    #[error("{}:{line}: {message}", path.display())]
+    #[error("{}:{line}: {message}", path.shown())]
     Malformed {
         /// The file.
         path: PathBuf,

@@ -14,6 +14,7 @@ mod pyramid;
 mod read_ahead;
 mod tracker;
 
+use crate::util::ShowPath;
 use std::path::{Path, PathBuf};
 
 use glam::DVec2;
@@ -169,7 +170,7 @@ impl TrackFile {
                 format!(
                     "point {} is not in {} (it has {count} point{})",
                     settings.point,
-                    self.path.display(),
+                    self.path.shown(),
                     if count == 1 { "" } else { "s" }
                 )
             })?;
@@ -195,7 +196,7 @@ impl TrackFile {
         if keys.is_empty() {
             return Err(format!(
                 "{} has no sure rows to follow for point {}{}",
-                self.path.display(),
+                self.path.shown(),
                 settings.point,
                 settings
                     .from_frame
@@ -213,7 +214,7 @@ fn wanted(asked: Option<bool>, present: bool, name: &str, path: &Path) -> Result
     match asked {
         Some(true) if !present => Err(format!(
             "`{name}: true`, but {} has no {name} column (a two-point track or an imported one has)",
-            path.display()
+            path.shown()
         )),
         Some(value) => Ok(value),
         None => Ok(present),

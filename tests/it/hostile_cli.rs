@@ -1606,3 +1606,28 @@ fn sizes_that_do_not_fit_are_named() {
     );
     assert!(!expect(&clone("-10,0"), 0, "").contains("warning"));
 }
+
+/// A file name holding a newline is shown quoted with its escapes, so an error stays on its
+/// line (`file:line:col: …`, which editors and CI read) instead of being split by the name.
+#[cfg(unix)]
+#[test]
+fn a_newline_in_a_file_name_keeps_each_message_on_its_line() {
+    let world = World::new();
+    world.write("bad\nname.rhai", "canvas(10, 10);\nnope(;\n");
+    let out = world.run(&["check", "bad\nname.rhai"]);
+    let stderr = expect(&out, 1, "syntax error");
+    assert_eq!(
+        stderr.lines().next(),
+        Some("lapclone: error: \"bad\\nname.rhai\":2:6: syntax error: Unexpected ';'"),
+        "{stderr}"
+    );
+    let scene = world.scene("ok.rhai", "");
+    let scene = scene.to_str().unwrap();
+    let out = world.run(&["render", scene, "-o", "no\nfolder/out.gif"]);
+    let stderr = expect(&out, 1, "does not exist");
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(stderr.contains("\"no\\nfolder\""), "{stderr}");
+    let out = world.run(&["preview", "missing\n.rhai", "-o", "p.png"]);
+    let stderr = expect(&out, 1, "missing\\n.rhai");
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+}

@@ -3,6 +3,7 @@
 //! kitty or iTerm2 image protocol or sixel, else as one line naming the file. Never prints escape
 //! sequences unless interactive.
 
+use lapclone::util::ShowPath;
 use std::io::Write as _;
 use std::path::PathBuf;
 
@@ -73,7 +74,7 @@ impl Preview {
     pub fn update(&mut self, renderer: &Renderer) -> anyhow::Result<()> {
         let png = self.encode(renderer)?;
         lapclone::util::write_atomic(&self.path, &png)
-            .with_context(|| format!("writing the preview {}", self.path.display()))?;
+            .with_context(|| format!("writing the preview {}", self.path.shown()))?;
         self.show(renderer, &png);
         Ok(())
     }
@@ -107,7 +108,7 @@ impl Preview {
         let stats = renderer.last_stats();
         let line = format!(
             "preview: {} ({}×{}, t = {} s, {:.1} ms{})",
-            self.path.display(),
+            self.path.shown(),
             canvas.width,
             canvas.height,
             stats.time,
@@ -118,7 +119,7 @@ impl Preview {
             Inline::None if self.interactive => crate::cli::print_line(&line),
             Inline::None => {
                 if !self.announced {
-                    crate::cli::print_line(format_args!("preview: {}", self.path.display()));
+                    crate::cli::print_line(format_args!("preview: {}", self.path.shown()));
                 }
             }
             protocol => {

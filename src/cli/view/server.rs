@@ -4,7 +4,7 @@
 //! (the session's lock orders pages and typed lines); replies and frames go back through
 //! the [`Hub`]. Threads only: one accepting, one per connection.
 
-use std::net::{IpAddr, Ipv4Addr, SocketAddr, TcpListener, TcpStream};
+use std::net::{IpAddr, Ipv4Addr, SocketAddr, TcpListener};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
@@ -389,7 +389,7 @@ fn handle(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::net::TcpListener;
+    use std::net::{TcpListener, TcpStream};
     use tungstenite::protocol::Role;
 
     /// A page that stops reading is given up on once the whole deadline has passed, not

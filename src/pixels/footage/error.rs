@@ -1,6 +1,7 @@
 //! Why footage cannot be opened or read: [`FootageError`], naming the pattern, file, frame
 //! or video and the setting that would help.
 
+use crate::util::ShowPath;
 use std::path::PathBuf;
 
 use crate::pixels::PixelError;
@@ -18,7 +19,7 @@ pub enum FootageError {
     #[error("pattern `{0}`: the number must be in the file name, not a folder")]
     NumberInFolder(String),
     /// No file in the folder matches the pattern (no start number can be found).
-    #[error("pattern `{pattern}` matches no files in {}", folder.display())]
+    #[error("pattern `{pattern}` matches no files in {}", folder.shown())]
     NoFiles {
         /// The pattern as given.
         pattern: String,
@@ -26,11 +27,11 @@ pub enum FootageError {
         folder: PathBuf,
     },
     /// The path (or a frame's file) is a folder.
-    #[error("{} is a folder, not an image or video", .0.display())]
+    #[error("{} is a folder, not an image or video", .0.shown())]
     IsFolder(PathBuf),
     /// A plate or video path holds something other than a regular file (a FIFO, a device,
     /// a dangling link; a plate that is a folder).
-    #[error("{} {kind}", file.display())]
+    #[error("{} {kind}", file.shown())]
     NotAFile {
         /// The path.
         file: PathBuf,
@@ -38,10 +39,10 @@ pub enum FootageError {
         kind: &'static str,
     },
     /// The video file does not exist.
-    #[error("{} not found", .0.display())]
+    #[error("{} not found", .0.shown())]
     NotFound(PathBuf),
     /// A frame's file is missing and the footage does not hold its last frame.
-    #[error("frame {frame} needs {}, which does not exist{}", file.display(), hold_hint(hold_key, *held))]
+    #[error("frame {frame} needs {}, which does not exist{}", file.shown(), hold_hint(hold_key, *held))]
     MissingFrame {
         /// The frame, counted from 1.
         frame: u64,
@@ -53,7 +54,7 @@ pub enum FootageError {
         held: bool,
     },
     /// A frame's size differs from the first frame's.
-    #[error("{}: frame {frame} is {width}×{height}, but the footage is {expected_width}×{expected_height}", file.display())]
+    #[error("{}: frame {frame} is {width}×{height}, but the footage is {expected_width}×{expected_height}", file.shown())]
     SizeChanged {
         /// The frame's file.
         file: PathBuf,
@@ -72,7 +73,7 @@ pub enum FootageError {
     #[error("{}", crate::util::FFMPEG_MISSING_FOR_FOOTAGE)]
     NoFfmpeg,
     /// ffmpeg or ffprobe cannot read the video.
-    #[error("cannot read video {}: {message}", path.display())]
+    #[error("cannot read video {}: {message}", path.shown())]
     Video {
         /// The video file.
         path: PathBuf,
@@ -80,7 +81,7 @@ pub enum FootageError {
         message: String,
     },
     /// The video ends before the scene does and the footage does not hold its last frame.
-    #[error("video {}: has {available} frames at the scene's fps, frame {frame} is needed{}", path.display(), hold_hint(hold_key, false))]
+    #[error("video {}: has {available} frames at the scene's fps, frame {frame} is needed{}", path.shown(), hold_hint(hold_key, false))]
     VideoTooShort {
         /// The video file.
         path: PathBuf,

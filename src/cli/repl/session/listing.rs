@@ -1,6 +1,7 @@
 //! What the session shows about its scene: the `:list` text (canvas, patches with their
 //! keys, handles and pins, layer order, variables), the `:keys NAME` table and `:stats`.
 
+use lapclone::util::ShowPath;
 use std::path::Path;
 
 use lapclone::scene::{Background, Canvas as SceneCanvas, Patch, Scene, Shape};
@@ -166,7 +167,7 @@ fn layer_order(draft: &Draft, t: f64) -> String {
 
 fn short(path: &Path) -> String {
     path.file_name().map_or_else(
-        || path.display().to_string(),
+        || path.shown().to_string(),
         |n| n.to_string_lossy().into_owned(),
     )
 }

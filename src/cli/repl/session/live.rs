@@ -4,6 +4,7 @@
 //! session's own entry path, so it is printed, undoable and saved like a typed one; a
 //! previewed edit only renders (no history), and cancel renders the committed scene again.
 
+use lapclone::util::ShowPath;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -173,7 +174,7 @@ impl Session {
             self.say(format!(
                 "{} changed on disk; not reloaded: the session has unsaved edits (:save it, or \
                  :reload to drop them)",
-                file.display()
+                file.shown()
             ));
         } else if let Err(error) = self.load(&file) {
             self.say(crate::cli::describe(&error));
@@ -292,7 +293,7 @@ impl LiveSession for Session {
             .file
             .clone()
             .ok_or("no scene file loaded: use :save FILE in the terminal")?;
-        self.say_from_view(format!("(view) :save {}", file.display()));
+        self.say_from_view(format!("(view) :save {}", file.shown()));
         self.as_page(|s| s.save(&file))
     }
 }

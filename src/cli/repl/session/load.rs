@@ -1,6 +1,7 @@
 //! `:load` and `:reload`: takes a scene file and gives the session its scene, engine,
 //! scope, functions and imports, replacing the live scene (the undo history is cleared).
 
+use lapclone::util::ShowPath;
 use std::path::Path;
 
 use anyhow::Context as _;
@@ -15,7 +16,7 @@ impl Session {
     pub fn load(&mut self, path: &Path) -> anyhow::Result<()> {
         let file = path
             .canonicalize()
-            .with_context(|| format!("cannot open scene {}", path.display()))?;
+            .with_context(|| format!("cannot open scene {}", path.shown()))?;
         let text = read_scene_text(&file).map_err(|e| anyhow::anyhow!("{e}"))?;
         let options = ScriptOptions {
             cancel: self.cancel.clone(),
@@ -49,7 +50,7 @@ impl Session {
         self.undo.clear();
         self.file = Some(file.clone());
         self.refresh_words();
-        self.say(format!("loaded {}", file.display()));
+        self.say(format!("loaded {}", file.shown()));
         self.warn();
         self.show_frame()
     }

@@ -2,6 +2,7 @@
 //! live scene's frames through the library's output stage, with a fresh renderer, so the
 //! files are byte-identical to `lapclone render` of the `:save`d scene.
 
+use lapclone::util::ShowPath;
 use std::path::Path;
 use std::time::Instant;
 
@@ -55,7 +56,7 @@ impl Session {
         crate::cli::print_line(format_args!(
             "rendered {} frames to {} in {:.2} s",
             rendered.frames,
-            rendered.path.display(),
+            rendered.path.shown(),
             started.elapsed().as_secs_f64()
         ));
         Ok(())

@@ -1,6 +1,7 @@
 //! `:save`: takes a path and writes the live scene there (see `repl/save.rs` for the two
 //! forms the text takes).
 
+use lapclone::util::ShowPath;
 use std::path::Path;
 
 use anyhow::Context as _;
@@ -16,17 +17,17 @@ impl Session {
         self.refuse_input(path, true)?;
         let (text, form) = saved_text(&scene, self.base_text.as_deref(), &self.edits, path);
         lapclone::util::write_atomic(path, text.as_bytes())
-            .with_context(|| format!("writing {}", path.display()))?;
+            .with_context(|| format!("writing {}", path.shown()))?;
         if path.canonicalize().ok() == self.file {
             self.saved_revision = self.revision;
             self.file_text = Some(text);
         }
         match form {
-            SaveForm::Script => self.say(format!("saved {}", path.display())),
+            SaveForm::Script => self.say(format!("saved {}", path.shown())),
             SaveForm::Keys => self.say(format!(
                 "saved {} (every key written out: the session's text does not rebuild this \
                  scene from that folder)",
-                path.display()
+                path.shown()
             )),
         }
         Ok(())
