@@ -159,6 +159,12 @@ fn start_view(
             server.addr
         );
     }
+    if args.bind.is_some_and(|ip| ip.is_unspecified()) {
+        eprint_line!(
+            "note: on every address, the URL names this machine's loopback one; from another \
+             machine, put one of this machine's addresses in its place"
+        );
+    }
     super::print_line(format_args!("view: {}", server.url));
     if args.open {
         crate::cli::view::open_in_browser(&server.url);

@@ -1207,3 +1207,50 @@ fn a_page_sending_a_message_slowly_still_gets_the_session_s_changes_meanwhile() 
     page.until(|v| v["type"] == "scene" && v["t"] == 0.25);
     assert!(repl.finish().success());
 }
+
+/// The resident memory of process `pid`, in bytes.
+#[cfg(target_os = "linux")]
+fn resident_bytes(pid: u32) -> u64 {
+    let status = std::fs::read_to_string(format!("/proc/{pid}/status")).unwrap();
+    let kib = status
+        .lines()
+        .find_map(|l| l.strip_prefix("VmRSS:"))
+        .and_then(|v| v.trim().trim_end_matches("kB").trim().parse::<u64>().ok());
+    kib.unwrap() * 1024
+}
+
+/// A page that sends pings and never reads gets its pongs sent under the page's deadline,
+/// one at a time: it is disconnected when it has not taken them in time, holding no more
+/// than a pong, instead of the server keeping every pong it owes (48 MiB of pings grew it
+/// by about as much).
+#[cfg(target_os = "linux")]
+#[test]
+fn a_page_sending_pings_and_never_reading_holds_no_memory_for_its_pongs() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = cat_scene(dir.path());
+    let mut repl = ViewRepl::start(dir.path(), &scene);
+    let mut page = repl.page();
+    let before = resident_bytes(repl.pid());
+    let mut raw = match page.socket.get_mut() {
+        MaybeTlsStream::Plain(s) => s.try_clone().unwrap(),
+        _ => unreachable!("the test connects without TLS"),
+    };
+    raw.set_write_timeout(Some(WAIT)).unwrap();
+    // Masked pings of 125 bytes (a zero mask leaves the payload as it is), 1 MiB a write.
+    let mut ping = vec![0x89, 0x80 | 125, 0, 0, 0, 0];
+    ping.resize(131, b'x');
+    let burst: Vec<u8> = ping.iter().copied().cycle().take(131 * 8000).collect();
+    let mut sent = 0usize;
+    while sent < 48 << 20 && raw.write_all(&burst).is_ok() {
+        sent += burst.len();
+    }
+    let grown = resident_bytes(repl.pid()).saturating_sub(before);
+    assert!(
+        grown < 16 << 20,
+        "{grown} bytes more after {sent} bytes of pings"
+    );
+    drop(page);
+    repl.type_line("40 + 2");
+    repl.wait_line(|l| l == "42");
+    assert!(repl.finish().success());
+}

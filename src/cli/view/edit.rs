@@ -137,8 +137,13 @@ pub fn parse_request(text: &str) -> Result<Request, String> {
     if text.len() > MAX_MESSAGE_BYTES {
         return Err(format!("message over {MAX_MESSAGE_BYTES} bytes"));
     }
-    let request: Request =
+    let mut request: Request =
         serde_json::from_str(text).map_err(|e| format!("malformed message: {e}"))?;
+    // A time of -0 is 0: the lines it reaches read `0`, not `-0`.
+    match &mut request {
+        Request::Seek { t } | Request::Edit { t: Some(t), .. } => *t += 0.0,
+        _ => {}
+    }
     match &request {
         Request::Seek { t } => time(*t)?,
         Request::Locate { x, y } => {
@@ -498,6 +503,19 @@ mod tests {
         for (json, line) in cases {
             assert_eq!(edit(json).line(1.25, "cat", "h2"), line, "{json}");
         }
+    }
+
+    /// A time of -0 is taken as 0, so no line or scene message reads `-0`.
+    #[test]
+    fn a_time_of_minus_zero_is_zero() {
+        let seek = parse_request(r#"{"type":"seek","t":-0.0}"#).unwrap();
+        assert!(matches!(seek, Request::Seek { t } if t.to_bits() == 0), "{seek:?}");
+        let edit = r#"{"type":"edit","rev":1,"commit":true,"t":-0.0,"edit":{"op":"scale","patch":"cat","value":2}}"#;
+        let edit = parse_request(edit).unwrap();
+        assert!(
+            matches!(edit, Request::Edit { t: Some(t), .. } if t.to_bits() == 0),
+            "{edit:?}"
+        );
     }
 
     #[test]

@@ -30,6 +30,20 @@ pub struct Routes {
     pub token: String,
     pub page: String,
     pub hosts: Vec<String>,
+    /// Listening on every address (`--bind 0.0.0.0` or `::`), this port: any IP address
+    /// with it names the server too. An address, unlike a name, cannot be rebound.
+    pub any_address_port: Option<u16>,
+}
+
+impl Routes {
+    /// Whether `host` (a `Host` header, or an `Origin` less its `http://`) names this server.
+    fn names_this_server(&self, host: &str) -> bool {
+        self.hosts.iter().any(|h| h.eq_ignore_ascii_case(host))
+            || self.any_address_port.is_some_and(|port| {
+                host.parse::<std::net::SocketAddr>()
+                    .is_ok_and(|addr| addr.port() == port)
+            })
+    }
 }
 
 /// What a connection became.
@@ -195,17 +209,28 @@ fn read_head(stream: &mut TcpStream) -> Result<(Head, Vec<u8>), Refusal> {
             return Err(Refusal("400 Bad Request", "connection closed".into()));
         }
         buffer.extend_from_slice(&chunk[..n]);
-        if let Some(end) = buffer.windows(4).position(|w| w == b"\r\n\r\n") {
-            if end + 4 > MAX_HEAD {
+        if let Some(end) = head_end(&buffer) {
+            if end > MAX_HEAD {
                 return Err(too_large());
             }
-            let head = parse_head(&buffer[..end + 4])?;
-            return Ok((head, buffer[end + 4..].to_vec()));
+            let head = parse_head(&buffer[..end])?;
+            return Ok((head, buffer[end..].to_vec()));
         }
         if buffer.len() > MAX_HEAD {
             return Err(too_large());
         }
     }
+}
+
+/// Where the head in `buffer` ends: after its first empty line, which ends in CRLF or, as
+/// HTTP lets a server accept, in a bare LF.
+fn head_end(buffer: &[u8]) -> Option<usize> {
+    let lf = buffer.iter().enumerate().filter(|&(_, &b)| b == b'\n');
+    lf.map(|(i, _)| i).find_map(|i| match buffer.get(i + 1..) {
+        Some([b'\n', ..]) => Some(i + 2),
+        Some([b'\r', b'\n', ..]) => Some(i + 3),
+        _ => None,
+    })
 }
 
 fn too_large() -> Refusal {
@@ -253,8 +278,15 @@ fn route(head: &Head, routes: &Routes) -> Result<Route, Refusal> {
     if head.method != "GET" {
         return Err(Refusal("405 Method Not Allowed", "only GET".into()));
     }
+    let hosts = head
+        .headers
+        .iter()
+        .filter(|(n, _)| n.eq_ignore_ascii_case("Host"));
+    if hosts.count() > 1 {
+        return Err(Refusal("400 Bad Request", "more than one Host".into()));
+    }
     let host = head.header("Host").unwrap_or("");
-    if !routes.hosts.iter().any(|h| h.eq_ignore_ascii_case(host)) {
+    if !routes.names_this_server(host) {
         return Err(Refusal(
             "403 Forbidden",
             format!("unexpected Host {host:?}"),
@@ -275,11 +307,10 @@ fn route(head: &Head, routes: &Routes) -> Result<Route, Refusal> {
         return Ok(Route::Page);
     }
     let origin = head.header("Origin").unwrap_or("");
-    if !routes
-        .hosts
-        .iter()
-        .any(|h| origin.eq_ignore_ascii_case(&format!("http://{h}")))
-    {
+    let scheme = origin
+        .get(..7)
+        .filter(|s| s.eq_ignore_ascii_case("http://"));
+    if scheme.is_none() || !routes.names_this_server(&origin[7..]) {
         return Err(Refusal(
             "403 Forbidden",
             format!("foreign Origin {origin:?}"),
@@ -336,6 +367,7 @@ mod tests {
             token: "abc123".into(),
             page: String::new(),
             hosts: vec!["127.0.0.1:8000".into(), "localhost:8000".into()],
+            any_address_port: None,
         }
     }
 
@@ -375,5 +407,56 @@ mod tests {
         assert!(route(&head(&foreign), &r).unwrap_err().1.contains("Origin"));
         let no_origin = ok.replace("Origin: http://localhost:8000\n", "");
         assert!(route(&head(&no_origin), &r).is_err());
+    }
+
+    /// One `Host` only: with two, which one a proxy or cache read is anyone's guess.
+    #[test]
+    fn a_second_host_is_refused() {
+        let two = "GET /?token=abc123 HTTP/1.1\nHost: 127.0.0.1:8000\nHost: evil.example\n\n";
+        let refusal = route(&head(two), &routes()).unwrap_err();
+        assert_eq!(refusal.0, "400 Bad Request");
+    }
+
+    /// Listening on every address, any IP address with the port names the server (so
+    /// another machine can open the page), but never a name, which could be rebound.
+    #[test]
+    fn on_every_address_any_ip_with_the_port_is_this_server() {
+        let r = Routes {
+            any_address_port: Some(8000),
+            ..routes()
+        };
+        let page = |host: &str| format!("GET /?token=abc123 HTTP/1.1\nHost: {host}\n\n");
+        for host in ["192.0.2.7:8000", "[2001:db8::1]:8000", "127.0.0.1:8000"] {
+            assert_eq!(
+                route(&head(&page(host)), &r).unwrap(),
+                Route::Page,
+                "{host}"
+            );
+            assert!(route(&head(&page(host)), &routes()).is_err() || host.starts_with("127"));
+        }
+        for host in [
+            "192.0.2.7:8001",
+            "192.0.2.7",
+            "evil.example:8000",
+            "1.2.3.4.nip.io:8000",
+        ] {
+            assert!(route(&head(&page(host)), &r).is_err(), "{host}");
+        }
+        let socket = |origin: &str| {
+            format!("GET /ws?token=abc123 HTTP/1.1\nHost: 192.0.2.7:8000\nOrigin: {origin}\n{WS}\n")
+        };
+        assert!(route(&head(&socket("http://192.0.2.7:8000")), &r).is_ok());
+        assert!(route(&head(&socket("http://evil.example:8000")), &r).is_err());
+        assert!(route(&head(&socket("https://192.0.2.7:8000")), &r).is_err());
+    }
+
+    /// A head may end in bare LFs: it is read at once, not waited on until the timeout.
+    #[test]
+    fn a_head_ends_at_its_first_empty_line_in_crlf_or_lf() {
+        assert_eq!(head_end(b"GET / HTTP/1.1\r\nHost: a\r\n\r\nrest"), Some(27));
+        assert_eq!(head_end(b"GET / HTTP/1.1\nHost: a\n\nrest"), Some(24));
+        assert_eq!(head_end(b"GET / HTTP/1.1\nHost: a\n\r\nrest"), Some(25));
+        assert_eq!(head_end(b"GET / HTTP/1.1\r\nHost: a\r\n"), None);
+        assert_eq!(head_end(b""), None);
     }
 }

@@ -86,7 +86,11 @@ pub fn start(
         format!("localhost:{}", addr.port()),
         format!("[::1]:{}", addr.port()),
     ];
+    // On every address the URL names the loopback one, which works here; another machine
+    // puts one of this machine's addresses in its place.
     let shown = match ip {
+        IpAddr::V6(v6) if v6.is_unspecified() => format!("[::1]:{}", addr.port()),
+        IpAddr::V4(v4) if v4.is_unspecified() => format!("127.0.0.1:{}", addr.port()),
         IpAddr::V6(v6) => format!("[{v6}]:{}", addr.port()),
         IpAddr::V4(v4) => format!("{v4}:{}", addr.port()),
     };
@@ -100,6 +104,7 @@ pub fn start(
         token: token.clone(),
         page,
         hosts,
+        any_address_port: ip.is_unspecified().then_some(addr.port()),
     });
     let url = format!("http://{shown}/?token={token}");
     std::thread::Builder::new()
@@ -304,14 +309,14 @@ fn flush_within(
     sent
 }
 
-/// Writes what is queued and flushes it; false once the page is gone or `deadline` passed.
+/// Writes what is queued and flushes everything buffered; false once the page is gone or
+/// `deadline` passed.
 fn send_queued(
     socket: &mut WebSocket<PageStream>,
     queue: &PageQueue<Outgoing>,
     deadline: Instant,
 ) -> bool {
     let late = || Instant::now() >= deadline;
-    let mut sent = false;
     while let Ok(message) = queue.try_recv() {
         let message = match message {
             Outgoing::Binary(bytes) => Message::Binary(bytes),
@@ -323,11 +328,9 @@ fn send_queued(
             Err(tungstenite::Error::Io(e)) if blocked(&e) && !late() => {}
             Err(_) => return false,
         }
-        sent = true;
     }
-    if !sent {
-        return true;
-    }
+    // Flushed even with nothing queued: the replies tungstenite owes (a pong for each ping
+    // read) wait in its buffer, which a page that never reads would grow without bound.
     loop {
         match socket.flush() {
             Ok(()) => return true,
