@@ -9,7 +9,7 @@ use rhai::{Dynamic, Engine, Scope, AST};
 
 use super::draft::{Draft, Origin, Origins, SharedDraft};
 use super::error::{ErrorKind, SceneError};
-use super::memory::MemoryBudget;
+use super::budget::Budget;
 use super::sandbox::{sandboxed_engine, Limits, ModuleFiles, SandboxResolver};
 use super::{api, golden};
 use crate::scene::Scene;
@@ -60,7 +60,7 @@ pub struct SceneEngine {
     engine: Engine,
     draft: SharedDraft,
     modules: ModuleFiles,
-    budget: MemoryBudget,
+    budget: Budget,
 }
 
 /// A parsed scene with the source positions of its objects.
@@ -115,7 +115,8 @@ impl SceneEngine {
     pub fn new(options: &ScriptOptions) -> Self {
         let resolver = SandboxResolver::new(&options.scene_dir, options.scripts_dir.as_deref());
         let modules = resolver.module_files();
-        let budget = MemoryBudget::new(options.limits.max_memory);
+        let seconds = std::time::Duration::from_secs(options.limits.max_seconds);
+        let budget = Budget::new(options.limits.max_memory, seconds);
         let mut engine = sandboxed_engine(
             resolver,
             &options.limits,

@@ -11,7 +11,7 @@ mod engine;
 mod error;
 mod golden;
 mod follow_api;
-mod memory;
+mod budget;
 mod footage_options;
 mod sandbox;
 mod source;
@@ -25,7 +25,7 @@ pub use engine::{
     ScriptOptions,
 };
 pub use error::{ErrorKind, SceneError};
-pub use memory::set_allocation_probe;
+pub use budget::set_allocation_probe;
 pub use sandbox::{Limits, ModuleFiles, SandboxResolver};
 pub use api::{OTHER_OPTION_KEYS, PATCH_OPTIONS};
 pub use validate::{validate_scene, CheckSummary};

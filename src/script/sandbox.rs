@@ -13,7 +13,7 @@ use std::sync::{Arc, Mutex};
 use rhai::module_resolvers::ModuleResolver;
 use rhai::{Dynamic, Engine, EvalAltResult, Module, Position, Scope, Shared};
 
-use super::memory::MemoryBudget;
+use super::budget::Budget;
 use crate::util::lock;
 
 type SharedModule = Shared<Module>;
@@ -35,6 +35,9 @@ pub struct Limits {
     /// Bytes an evaluation may allocate in all (its strings, arrays and maps together),
     /// when the program measures allocations (`set_allocation_probe`).
     pub max_memory: usize,
+    /// Seconds an evaluation may run: a bound on what the operation limit does not count
+    /// (the size check after each change to a value, which walks all of it).
+    pub max_seconds: u64,
 }
 
 impl Default for Limits {
@@ -55,6 +58,7 @@ impl Default for Limits {
             max_map_size: 1_000_000,
             max_modules: 64,
             max_memory: 256 << 20,
+            max_seconds: 60,
         }
     }
 }
@@ -64,7 +68,7 @@ pub fn sandboxed_engine(
     resolver: SandboxResolver,
     limits: &Limits,
     cancel: Arc<AtomicBool>,
-    budget: MemoryBudget,
+    budget: Budget,
 ) -> Engine {
     let mut engine = Engine::new();
     engine
@@ -77,11 +81,23 @@ pub fn sandboxed_engine(
         .set_max_modules(limits.max_modules)
         .set_module_resolver(resolver)
         .disable_symbol("eval");
-    engine.on_progress(move |_| {
+    // A scene gives the same frames on every run, in bounded time: no clock, no waiting.
+    // Functions registered here are found before the standard package's.
+    let refuse = |name: &str| -> Result<(), Box<rhai::EvalAltResult>> {
+        Err(format!("`{name}` is not available in scenes: a scene gives the same frames on every run").into())
+    };
+    engine
+        .register_fn("sleep", move |_: rhai::FLOAT| refuse("sleep"))
+        .register_fn("sleep", move |_: rhai::INT| refuse("sleep"))
+        .register_fn("timestamp", move || refuse("timestamp"));
+    engine.on_progress(move |operations| {
         if cancel.load(Ordering::Relaxed) {
             Some(Dynamic::from(CANCELLED))
         } else {
-            budget.exceeded().map(Dynamic::from)
+            budget
+                .exceeded()
+                .or_else(|| budget.late(operations))
+                .map(Dynamic::from)
         }
     });
     // Script output goes to stderr so stdout stays machine-readable.

@@ -325,6 +325,34 @@ fn runaway_loop_ends_with_an_error() {
     assert_eq!(e.kind, ErrorKind::Limit, "{e}");
 }
 
+/// A scene cannot wait or read a clock: the same scene gives the same frames on every
+/// run, in bounded time (`sleep(1e9)` hung even a render told to stop).
+#[test]
+fn sleep_and_timestamp_are_refused() {
+    for call in ["sleep(1e9)", "sleep(5)", "timestamp()"] {
+        let e = parse_err(&format!("canvas(8, 8);\nlet x = {call};"));
+        assert_eq!((e.line(), e.column()), (Some(2), Some(9)), "{e}");
+        assert!(e.message.contains("not available in scenes"), "{e}");
+    }
+}
+
+/// Growing a list by `push` costs Rhai a walk over it at each push, which the operation
+/// limit does not count: the time limit stops it with a hint.
+#[test]
+fn an_evaluation_past_its_time_limit_is_stopped() {
+    let options = ScriptOptions {
+        limits: Limits {
+            max_seconds: 1,
+            ..Limits::default()
+        },
+        ..options()
+    };
+    let text = "canvas(8, 8);\nlet a = [];\nfor i in 0..1000000 { a.push([1.0, 2.0]); }";
+    let e = parse_scene(text, &scene_file(), &options).unwrap_err();
+    assert_eq!(e.kind, ErrorKind::Limit, "{e}");
+    assert!(e.message.contains("ran for over 1 s"), "{e}");
+}
+
 #[test]
 fn deep_recursion_ends_with_an_error() {
     let e = parse_err("fn down(n) { down(n + 1) }\ndown(0);");

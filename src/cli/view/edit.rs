@@ -509,7 +509,10 @@ mod tests {
     #[test]
     fn a_time_of_minus_zero_is_zero() {
         let seek = parse_request(r#"{"type":"seek","t":-0.0}"#).unwrap();
-        assert!(matches!(seek, Request::Seek { t } if t.to_bits() == 0), "{seek:?}");
+        assert!(
+            matches!(seek, Request::Seek { t } if t.to_bits() == 0),
+            "{seek:?}"
+        );
         let edit = r#"{"type":"edit","rev":1,"commit":true,"t":-0.0,"edit":{"op":"scale","patch":"cat","value":2}}"#;
         let edit = parse_request(edit).unwrap();
         assert!(
