@@ -53,7 +53,7 @@ pub fn run(args: MeshArgs) -> anyhow::Result<()> {
         .into());
     }
     let outputs = output_files(&args);
-    check_outputs(&outputs, &args.mask)?;
+    check_outputs(&outputs, &args.mask, args.laplacian_out.as_deref())?;
     let mask = BitMask::load(&args.mask, threshold as f32)?;
     let started = Instant::now();
     let mut result =
@@ -124,10 +124,27 @@ fn output_files(args: &MeshArgs) -> Vec<PathBuf> {
     files
 }
 
-/// Refuses an output that is the mask, and two outputs naming one file (usage errors,
-/// before anything is meshed).
-fn check_outputs(outputs: &[PathBuf], mask: &Path) -> anyhow::Result<()> {
+/// Refuses an output that is the mask, two outputs naming one file, `-` (mesh writes
+/// files, not standard output), and a `--laplacian-out` that is not a regular file where one
+/// exists (its `.boundary` list would be a new file beside a device or FIFO) — usage
+/// errors, before anything is meshed.
+fn check_outputs(outputs: &[PathBuf], mask: &Path, laplacian: Option<&Path>) -> anyhow::Result<()> {
+    if let Some(path) = laplacian.filter(|p| p.exists()) {
+        if let Some(kind) = lapclone::util::not_a_file(path) {
+            let named = path.shown();
+            return Err(UsageError(format!(
+                "--laplacian-out {named} {kind}: it names two files, {named} and {named}.boundary"
+            ))
+            .into());
+        }
+    }
     for (index, output) in outputs.iter().enumerate() {
+        if output.as_os_str() == "-" {
+            return Err(UsageError(
+                "mesh writes files: `-` (standard output) is not one of its outputs".into(),
+            )
+            .into());
+        }
         lapclone::output::refuse_input(output, &[mask])?;
         if outputs[..index]
             .iter()

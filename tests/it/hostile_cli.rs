@@ -1631,3 +1631,29 @@ fn a_newline_in_a_file_name_keeps_each_message_on_its_line() {
     let stderr = expect(&out, 1, "missing\\n.rhai");
     assert_eq!(stderr.lines().count(), 1, "{stderr}");
 }
+
+/// `mesh` writes files only: `-` is refused rather than written as a file named `-`, and a
+/// `--laplacian-out` that is a device or a folder is refused rather than given a new
+/// `.boundary` file beside it (`/dev/null.boundary`).
+#[cfg(unix)]
+#[test]
+fn mesh_outputs_are_files_never_dash_or_a_device() {
+    let world = World::new();
+    let before = world.names();
+    for args in [
+        &["-o", "-"][..],
+        &["--laplacian-out", "-"],
+        &["--laplacian-out", "/dev/null"],
+        &["--laplacian-out", "."],
+    ] {
+        let mut all = vec!["mesh", "mask.png"];
+        all.extend_from_slice(args);
+        let out = world.run(&all);
+        expect(&out, 2, if args[1] == "-" { "`-`" } else { ".boundary" });
+    }
+    assert_eq!(world.names(), before);
+    assert!(!Path::new("/dev/null.boundary").exists());
+    let out = world.run(&["mesh", "mask.png", "--laplacian-out", "l.mtx", "-o", "/dev/null"]);
+    expect(&out, 0, "");
+    assert!(world.path("l.mtx").is_file() && world.path("l.mtx.boundary").is_file());
+}
