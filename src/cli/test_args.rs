@@ -103,7 +103,7 @@ pub fn frame_list(text: &str) -> Result<FrameList, String> {
         let part = part.trim();
         if part.contains("..") {
             let range = super::render::frame_range(part)?;
-            frames.extend(range.first..=range.last.min(range.first + 100_000));
+            frames.extend(range.first..=range.last.min(range.first.saturating_add(100_000)));
         } else {
             match part.parse::<u64>() {
                 Ok(n) if n >= 1 => frames.push(n),
@@ -462,4 +462,20 @@ pub fn check_own_file(path: &Path) -> anyhow::Result<()> {
         "{} {what}: lapclone test reads, writes and removes only regular files there; move it away",
         path.shown()
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A range at the top of the numbers is kept, not wrapped into an empty list that
+    /// checked nothing and passed.
+    #[test]
+    fn frame_lists_keep_every_range_they_are_given() {
+        assert_eq!(frame_list("3..4,1,3").unwrap(), FrameList(vec![1, 3, 4]));
+        let top = u64::MAX - 5;
+        let list = frame_list(&format!("{top}..{}", u64::MAX)).unwrap();
+        assert_eq!(list.0, (top..=u64::MAX).collect::<Vec<_>>());
+        assert!(frame_list("0").is_err());
+    }
 }
