@@ -195,6 +195,10 @@ fn codec_args(kind: VideoKind, crf: Option<u32>, keeps_alpha: bool) -> Vec<Strin
     args.extend(BT709_TAGS.map(String::from));
     if kind != VideoKind::Webm {
         args.extend(["-movflags".into(), "+faststart".into()]);
+    } else {
+        // The Matroska muxer writes a random segment UID otherwise: the same scene would
+        // give other bytes on every run.
+        args.extend(["-fflags".into(), "+bitexact".into()]);
     }
     args.extend(["-f".into(), kind.muxer().into()]);
     args
