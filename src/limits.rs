@@ -16,6 +16,10 @@ use std::path::Path;
 pub const MAX_IMAGE_SIDE: u32 = 16_384;
 /// Largest number of pixels (width × height) of any image read or canvas rendered.
 pub const MAX_IMAGE_PIXELS: u64 = 64 * 1024 * 1024;
+/// Most pixels the distinct still source images of one scene may hold in all: eight of the
+/// largest (2 GiB as 8-bit texels). Patches sharing a file share its pixels and count it
+/// once; 200 distinct 4096² sources would have held 13 GB.
+pub const MAX_SCENE_SOURCE_PIXELS: u64 = 8 * MAX_IMAGE_PIXELS;
 /// Default mesh vertex budget (`MeshOptions::max_vertices`): refinement stops there, and a
 /// mask whose boundary alone needs more vertices is refused.
 pub const MAX_MESH_VERTICES: usize = 2_000_000;
@@ -94,6 +98,11 @@ pub enum LimitError {
     ImageTooLarge { width: u64, height: u64 },
     #[error("{frames} frames exceed the limit of {MAX_FRAMES} frames per scene")]
     TooManyFrames { frames: u64 },
+    #[error(
+        "the scene's source images hold {pixels} pixels in all, over the limit of \
+         {MAX_SCENE_SOURCE_PIXELS} (patches sharing a file count it once)"
+    )]
+    SceneSourcesTooLarge { pixels: u64 },
 }
 
 /// Why [`open_image`] failed.
@@ -113,6 +122,16 @@ pub fn check_image_size(width: u64, height: u64) -> Result<(), LimitError> {
     let side = u64::from(MAX_IMAGE_SIDE);
     if width > side || height > side || width.saturating_mul(height) > MAX_IMAGE_PIXELS {
         return Err(LimitError::ImageTooLarge { width, height });
+    }
+    Ok(())
+}
+
+/// Adds a `width`×`height` source image to a scene's `total` source pixels, refusing a total
+/// past [`MAX_SCENE_SOURCE_PIXELS`]. Called once per distinct source file.
+pub fn add_scene_source(total: &mut u64, width: u32, height: u32) -> Result<(), LimitError> {
+    *total = total.saturating_add(u64::from(width) * u64::from(height));
+    if *total > MAX_SCENE_SOURCE_PIXELS {
+        return Err(LimitError::SceneSourcesTooLarge { pixels: *total });
     }
     Ok(())
 }
@@ -163,4 +182,21 @@ pub fn open_image(path: &Path) -> Result<image::DynamicImage, ImageOpenError> {
     limits.max_alloc = Some(MAX_DECODER_ALLOC);
     reader.limits(limits);
     Ok(reader.decode()?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_scene_s_source_pixels_are_bounded_in_all() {
+        let mut total = 0;
+        for _ in 0..8 {
+            add_scene_source(&mut total, 8192, 8192).unwrap();
+        }
+        assert_eq!(total, MAX_SCENE_SOURCE_PIXELS);
+        assert!(add_scene_source(&mut total, 1, 1).is_err());
+        let mut huge = u64::MAX - 1;
+        assert!(add_scene_source(&mut huge, u32::MAX, u32::MAX).is_err());
+    }
 }

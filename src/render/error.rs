@@ -48,6 +48,16 @@ pub enum RenderError {
         /// The source's width and height.
         size: (u32, u32),
     },
+    /// The scene's still sources hold more pixels in all than a scene may; `patch` is the
+    /// first whose source goes past the limit.
+    #[error("patch `{patch}`: {source}")]
+    Sources {
+        /// The patch's name.
+        patch: String,
+        /// The limit passed.
+        #[source]
+        source: crate::limits::LimitError,
+    },
     /// Reading an image or drawing the background failed.
     #[error(transparent)]
     Pixels(#[from] PixelError),
@@ -72,7 +82,8 @@ impl RenderError {
             RenderError::Clone { patch, .. }
             | RenderError::Deform { patch, .. }
             | RenderError::Mask { patch, .. }
-            | RenderError::OutsideSource { patch, .. } => Some(patch),
+            | RenderError::OutsideSource { patch, .. }
+            | RenderError::Sources { patch, .. } => Some(patch),
             RenderError::Footage { patch, .. } => patch.as_deref(),
             RenderError::Pixels(_) | RenderError::Scene(_) => None,
         }

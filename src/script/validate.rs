@@ -28,9 +28,11 @@ pub fn validate_scene(loaded: &LoadedScene) -> Result<CheckSummary, SceneError> 
         decode(path).map_err(|m| loaded.error_at(loaded.origins.canvas.as_ref(), m))?;
     }
     let mut inside_pixels = Vec::with_capacity(scene.patches.len());
+    // Each source file is decoded once, however many patches share it.
+    let mut sizes = (std::collections::HashMap::new(), 0);
     for (i, patch) in scene.patches.iter().enumerate() {
         let origin = loaded.origins.patches.get(i);
-        let inside = inside_pixels_of(patch)
+        let inside = inside_pixels_of(patch, &mut sizes)
             .map_err(|m| loaded.error_at(origin, format!("patch `{}`: {m}", patch.name)))?;
         inside_pixels.push(inside);
     }
@@ -59,16 +61,26 @@ pub fn validate_scene(loaded: &LoadedScene) -> Result<CheckSummary, SceneError> 
     })
 }
 
+/// Each still source file's size, and the pixels of them all.
+type SourceSizes = (std::collections::HashMap<std::path::PathBuf, (u32, u32)>, u64);
+
 /// The patch's inside pixels (polygons: their rounded area); an empty patch, or a mask whose
 /// size is not its source's, is refused.
-fn inside_pixels_of(patch: &Patch) -> Result<u64, String> {
+fn inside_pixels_of(patch: &Patch, sizes: &mut SourceSizes) -> Result<u64, String> {
     // Footage was sized when the scene named it; a video is not an image file.
     let source = match &patch.footage {
         Some(f) => (f.width, f.height),
-        None => {
-            let image = decode(&patch.source)?;
-            (image.width(), image.height())
-        }
+        None => match sizes.0.get(&patch.source) {
+            Some(&size) => size,
+            None => {
+                let image = decode(&patch.source)?;
+                let size = (image.width(), image.height());
+                crate::limits::add_scene_source(&mut sizes.1, size.0, size.1)
+                    .map_err(|e| e.to_string())?;
+                sizes.0.insert(patch.source.clone(), size);
+                size
+            }
+        },
     };
     let inside = match &patch.shape {
         Shape::Mask(path) => {

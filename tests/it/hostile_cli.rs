@@ -1653,7 +1653,14 @@ fn mesh_outputs_are_files_never_dash_or_a_device() {
     }
     assert_eq!(world.names(), before);
     assert!(!Path::new("/dev/null.boundary").exists());
-    let out = world.run(&["mesh", "mask.png", "--laplacian-out", "l.mtx", "-o", "/dev/null"]);
+    let out = world.run(&[
+        "mesh",
+        "mask.png",
+        "--laplacian-out",
+        "l.mtx",
+        "-o",
+        "/dev/null",
+    ]);
     expect(&out, 0, "");
     assert!(world.path("l.mtx").is_file() && world.path("l.mtx.boundary").is_file());
 }

@@ -1,7 +1,7 @@
 //! Scene language: parsing, evaluation against closed-form easings, number acceptance,
 //! positioned errors, the sandbox and importing scripts/motion.rhai.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
 
 use glam::DVec2;
@@ -494,4 +494,64 @@ fn failed_call_leaves_the_patch_unchanged() {
         )
         .unwrap_err();
     assert_eq!(engine.draft(), before);
+}
+
+/// A scene's distinct still sources may hold only so many pixels in all, checked from their
+/// headers before any is decoded; patches sharing one file count it once.
+#[test]
+fn a_scene_s_sources_are_bounded_in_all_and_a_shared_one_counts_once() {
+    use lapclone::render::Renderer;
+    let dir = tempfile::tempdir().unwrap();
+    // The head of a 4096×4096 RGB PNG and no pixels: enough to be sized, not decoded.
+    let header = |path: &Path| {
+        let mut ihdr = b"IHDR".to_vec();
+        ihdr.extend_from_slice(&4096u32.to_be_bytes());
+        ihdr.extend_from_slice(&4096u32.to_be_bytes());
+        ihdr.extend_from_slice(&[8, 2, 0, 0, 0]);
+        let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+        png.extend_from_slice(&13u32.to_be_bytes());
+        png.extend_from_slice(&ihdr);
+        png.extend_from_slice(&crc32(&ihdr).to_be_bytes());
+        // An empty IDAT: the decoder reads up to the first one for the image's size.
+        png.extend_from_slice(&0u32.to_be_bytes());
+        png.extend_from_slice(b"IDAT");
+        png.extend_from_slice(&crc32(b"IDAT").to_be_bytes());
+        std::fs::write(path, png).unwrap();
+    };
+    for i in 0..33 {
+        header(&dir.path().join(format!("s{i}.png")));
+    }
+    let scene = |sources: &str| {
+        format!(
+            "canvas(64, 48);\nfor i in 0..33 {{ patch(\"p\" + i, #{{ source: {sources}, \
+             polygons: [[[10, 10], [30, 10], [30, 30]]] }}); }}\n"
+        )
+    };
+    let file = dir.path().join("scene.rhai");
+    let options = ScriptOptions::for_scene_file(&file);
+    let load = |text: &str| parse_scene(text, &file, &options).unwrap().scene;
+    let error = Renderer::new(load(&scene("\"s\" + i + \".png\"")))
+        .err()
+        .unwrap();
+    assert_eq!(error.patch_name(), Some("p32"), "{error}");
+    assert!(error.to_string().contains("source images hold"), "{error}");
+    // One file for all 33: within the limit, so the decode is what fails (a header only).
+    let error = Renderer::new(load(&scene("\"s0.png\""))).err().unwrap();
+    assert!(!error.to_string().contains("source images hold"), "{error}");
+}
+
+/// The CRC-32 a PNG chunk ends with.
+fn crc32(bytes: &[u8]) -> u32 {
+    let mut crc = !0u32;
+    for &b in bytes {
+        crc ^= u32::from(b);
+        for _ in 0..8 {
+            crc = if crc & 1 == 1 {
+                (crc >> 1) ^ 0xEDB8_8320
+            } else {
+                crc >> 1
+            };
+        }
+    }
+    !crc
 }

@@ -11,6 +11,7 @@ use crate::render::RenderError;
 use crate::scene::{Background, Patch, Scene};
 
 pub(super) fn build_layers(scene: &Scene) -> Result<Vec<Layer>, RenderError> {
+    check_source_pixels(scene)?;
     let mut sources: HashMap<PathBuf, FloatImage> = HashMap::new();
     let mut layers = Vec::with_capacity(scene.patches.len());
     for patch in &scene.patches {
@@ -18,6 +19,28 @@ pub(super) fn build_layers(scene: &Scene) -> Result<Vec<Layer>, RenderError> {
         layers.push(Layer::new(patch, source, scene.canvas.fps)?);
     }
     Ok(layers)
+}
+
+/// Refuses, from their headers and before any is decoded, still sources that hold more
+/// pixels in all than a scene may (a scene built in code meets the rule `check` applies).
+fn check_source_pixels(scene: &Scene) -> Result<(), RenderError> {
+    let mut seen = std::collections::HashSet::new();
+    let mut total = 0;
+    for patch in scene.patches.iter().filter(|p| p.footage.is_none()) {
+        if !seen.insert(&patch.source) {
+            continue;
+        }
+        // A header that cannot be read is reported by the decode that follows.
+        let Ok((width, height)) = crate::limits::image_dimensions(&patch.source) else {
+            continue;
+        };
+        let named = |source| RenderError::Sources {
+            patch: patch.name.clone(),
+            source,
+        };
+        crate::limits::add_scene_source(&mut total, width, height).map_err(named)?;
+    }
+    Ok(())
 }
 
 /// The patch's source image, loaded once per path (an animated source's first frame, read
