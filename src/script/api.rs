@@ -232,10 +232,7 @@ fn new_patch(
 }
 
 fn parse_patch(base_dir: &Path, name: &Dynamic, options: &Map) -> Result<Patch, String> {
-    let name = values::string(name, "patch name")?;
-    if name.is_empty() {
-        return Err("patch name must not be empty".into());
-    }
+    let name = values::patch_name(name)?;
     values::check_keys(options, &PATCH_OPTIONS, "patch")?;
     let source = options
         .get("source")

@@ -232,10 +232,7 @@ impl PatchRef {
         let this = self.clone();
         edit_draft(&self.draft, &ctx, |d| {
             let p = index_of(d, &this)?;
-            let name = values::string(&name, "patch name")?;
-            if name.is_empty() {
-                return Err("patch name must not be empty".into());
-            }
+            let name = values::patch_name(&name)?;
             if let Some(other) = d.patches.iter().position(|q| q.name == name) {
                 if other != p {
                     let names: Vec<&str> = d.patches.iter().map(|q| q.name.as_str()).collect();

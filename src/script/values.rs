@@ -113,6 +113,27 @@ pub fn string(value: &Dynamic, what: &str) -> Result<String, String> {
         .ok_or_else(|| format!("{what} must be a string, got {}", type_name(value)))
 }
 
+/// A patch's name: a string, not empty, and without control or bidirectional formatting
+/// characters, which messages quote as they are (`patch \`cat\`: …`): a newline would split
+/// a message and a right-to-left override would show its text reversed.
+pub fn patch_name(value: &Dynamic) -> Result<String, String> {
+    let name = string(value, "patch name")?;
+    if name.is_empty() {
+        return Err("patch name must not be empty".into());
+    }
+    let hidden = |c: char| {
+        c.is_control()
+            || matches!(c, '\u{200e}' | '\u{200f}' | '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}')
+    };
+    if let Some(c) = name.chars().find(|&c| hidden(c)) {
+        return Err(format!(
+            "patch name {name:?} holds {}, a control or bidirectional formatting character",
+            c.escape_unicode()
+        ));
+    }
+    Ok(name)
+}
+
 pub fn array(value: &Dynamic, what: &str) -> Result<Array, String> {
     value
         .read_lock::<Array>()

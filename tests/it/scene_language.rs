@@ -555,3 +555,26 @@ fn crc32(bytes: &[u8]) -> u32 {
     }
     !crc
 }
+
+/// A patch name holding a control or bidirectional formatting character is refused, at the
+/// call and on a rename: messages quote names as they are, and a newline split them.
+#[test]
+fn patch_names_hold_no_control_or_bidi_characters() {
+    for name in ["x\\nfake: ok", "a\\u202eb", "tab\\there", "\\u2066"] {
+        let text = format!(
+            "canvas(8, 8);\nlet p = patch(\"{name}\", #{{ source: \"assets/chelsea.png\", \
+             polygons: [[[1, 1], [5, 1], [1, 5]]] }});"
+        );
+        let e = parse_err(&text);
+        assert!(e.message.contains("bidirectional"), "{name}: {e}");
+        let text = format!(
+            "canvas(8, 8);\nlet p = patch(\"ok\", #{{ source: \"assets/chelsea.png\", \
+             polygons: [[[1, 1], [5, 1], [1, 5]]] }});\np.rename(\"{name}\");"
+        );
+        let e = parse_err(&text);
+        assert!(e.message.contains("bidirectional"), "{name}: {e}");
+        assert_eq!(e.line(), Some(3), "{e}");
+    }
+    parse("canvas(8, 8);\npatch(\"日本 ☕ é\", #{ source: \"assets/chelsea.png\", polygons: [[[1, 1], [5, 1], [1, 5]]] });")
+        .unwrap();
+}
