@@ -176,12 +176,53 @@ pub fn open_image(path: &Path) -> Result<image::DynamicImage, ImageOpenError> {
     let (width, height) = image_dimensions(path)?;
     check_image_size(u64::from(width), u64::from(height))?;
     let mut reader = image_reader(path)?;
+    // The JPEG decoder fills what a cut-short file lacks with grey and says nothing.
+    if reader.format() == Some(image::ImageFormat::Jpeg) && !jpeg_is_whole(path)? {
+        let format = image::error::ImageFormatHint::Exact(image::ImageFormat::Jpeg);
+        let cut = "the file is cut short: its data ends before the end-of-image marker";
+        return Err(image::ImageError::Decoding(image::error::DecodingError::new(format, cut)).into());
+    }
     let mut limits = image::Limits::default();
     limits.max_image_width = Some(MAX_IMAGE_SIDE);
     limits.max_image_height = Some(MAX_IMAGE_SIDE);
     limits.max_alloc = Some(MAX_DECODER_ALLOC);
     reader.limits(limits);
     Ok(reader.decode()?)
+}
+
+/// Whether the JPEG file `path` holds an end-of-image marker (`FF D9`) after its start of
+/// scan. The segments before the scan are skipped by their lengths (an EXIF thumbnail is a
+/// JPEG of its own, markers and all); inside the scan data every `FF` byte is stuffed or
+/// starts a marker, so the first `FF D9` there ends the image, and data after it (a motion
+/// photo's video) is allowed. A file this walk does not understand is left to the decoder.
+fn jpeg_is_whole(path: &Path) -> std::io::Result<bool> {
+    use std::io::Read as _;
+    let mut bytes = Vec::new();
+    crate::util::open_input_file(path)?.read_to_end(&mut bytes)?;
+    let b = &bytes[..];
+    if !b.starts_with(&[0xFF, 0xD8]) {
+        return Ok(true);
+    }
+    let mut at = 2;
+    loop {
+        match b.get(at..at + 2) {
+            None => return Ok(false),
+            Some(&[0xFF, 0xFF]) => at += 1,
+            Some(&[0xFF, 0xD9]) => return Ok(true),
+            Some(&[0xFF, 0x01 | 0xD0..=0xD8]) => at += 2,
+            Some(&[0xFF, marker]) => {
+                let Some(&[high, low]) = b.get(at + 2..at + 4) else {
+                    return Ok(false);
+                };
+                at += 2 + usize::from(u16::from_be_bytes([high, low]));
+                if marker == 0xDA {
+                    let scan = b.get(at..).unwrap_or_default();
+                    return Ok(scan.windows(2).any(|w| w == [0xFF, 0xD9]));
+                }
+            }
+            Some(_) => return Ok(true),
+        }
+    }
 }
 
 #[cfg(test)]
@@ -198,5 +239,32 @@ mod tests {
         assert!(add_scene_source(&mut total, 1, 1).is_err());
         let mut huge = u64::MAX - 1;
         assert!(add_scene_source(&mut huge, u32::MAX, u32::MAX).is_err());
+    }
+
+    #[test]
+    fn a_jpeg_cut_short_is_refused_and_a_whole_one_read() {
+        let dir = tempfile::tempdir().unwrap();
+        let whole = dir.path().join("whole.jpg");
+        let image = image::RgbImage::from_fn(64, 48, |x, y| image::Rgb([x as u8 * 3, y as u8 * 5, 90]));
+        image.save(&whole).unwrap();
+        assert!(open_image(&whole).is_ok());
+        let bytes = std::fs::read(&whole).unwrap();
+        // Something after the image (a motion photo's video) is allowed.
+        let trailed = dir.path().join("trailed.jpg");
+        std::fs::write(&trailed, [&bytes[..], b"ftypmp42 and more"].concat()).unwrap();
+        assert!(open_image(&trailed).is_ok());
+        let cut = dir.path().join("cut.jpg");
+        std::fs::write(&cut, &bytes[..bytes.len() * 2 / 3]).unwrap();
+        let error = open_image(&cut).unwrap_err().to_string();
+        assert!(error.contains("cut short"), "{error}");
+        // A thumbnail in an APP1 segment, whole with markers of its own, does not hide the cut.
+        let thumb = [0xFF, 0xD8, 0xFF, 0xDA, 0x00, 0x02, 0x11, 0xFF, 0xD9];
+        let mut app1 = vec![0xFF, 0xE1, 0x00, (thumb.len() + 2) as u8];
+        app1.extend_from_slice(&thumb);
+        let cut_with_thumb = dir.path().join("thumb.jpg");
+        let body = &bytes[2..bytes.len() * 2 / 3];
+        std::fs::write(&cut_with_thumb, [&bytes[..2], &app1[..], body].concat()).unwrap();
+        let error = open_image(&cut_with_thumb).unwrap_err().to_string();
+        assert!(error.contains("cut short"), "{error}");
     }
 }
