@@ -395,16 +395,21 @@ mod tests {
     use std::net::{TcpListener, TcpStream};
     use tungstenite::protocol::Role;
 
-    /// A page that stops reading is given up on once the whole deadline has passed, not
-    /// after a timeout per write (each of which may move a little and start again).
-    #[test]
-    fn sending_to_a_page_that_stops_reading_ends_at_the_deadline() {
+    /// A connected pair: the page's end, and the server's, whose writes time out after 50 ms.
+    fn connection() -> (TcpStream, TcpStream) {
         let listener = TcpListener::bind("127.0.0.1:0").unwrap();
         let client = TcpStream::connect(listener.local_addr().unwrap()).unwrap();
         let (server, _) = listener.accept().unwrap();
         server
             .set_write_timeout(Some(Duration::from_millis(50)))
             .unwrap();
+        (client, server)
+    }
+
+    /// Queues 64 MiB for the page on `server` and checks that sending it gives up once a
+    /// 400 ms deadline has passed, one write's timeout past it at most (with room for a
+    /// loaded machine); gives the socket.
+    fn send_until_the_deadline(server: TcpStream) -> WebSocket<PageStream> {
         let mut socket = WebSocket::from_raw_socket(PageStream::new(server), Role::Server, None);
         let (tx, queue) = page_channel(PAGE_QUEUE).unwrap();
         let frame = tungstenite::Bytes::from(vec![7u8; 1 << 20]);
@@ -416,8 +421,16 @@ mod tests {
         assert!(!flush_within(&mut socket, &queue, limit));
         let took = started.elapsed();
         assert!(took >= limit, "gave up after {took:?}");
-        // One write's timeout past the deadline at most, with room for a loaded machine.
         assert!(took < limit + Duration::from_secs(3), "took {took:?}");
+        socket
+    }
+
+    /// A page that stops reading is given up on once the whole deadline has passed, not
+    /// after a timeout per write (each of which may move a little and start again).
+    #[test]
+    fn sending_to_a_page_that_stops_reading_ends_at_the_deadline() {
+        let (client, server) = connection();
+        send_until_the_deadline(server);
         drop(client);
     }
 
@@ -427,12 +440,7 @@ mod tests {
     #[test]
     fn sending_to_a_page_that_reads_slowly_ends_at_the_deadline() {
         use std::io::Read as _;
-        let listener = TcpListener::bind("127.0.0.1:0").unwrap();
-        let mut client = TcpStream::connect(listener.local_addr().unwrap()).unwrap();
-        let (server, _) = listener.accept().unwrap();
-        server
-            .set_write_timeout(Some(Duration::from_millis(50)))
-            .unwrap();
+        let (mut client, server) = connection();
         // About 3 MB/s, for at most 30 s: 64 MiB would take 20 s.
         let reader = std::thread::spawn(move || {
             let mut chunk = vec![0u8; 64 << 10];
@@ -444,18 +452,7 @@ mod tests {
                 }
             }
         });
-        let mut socket = WebSocket::from_raw_socket(PageStream::new(server), Role::Server, None);
-        let (tx, queue) = page_channel(PAGE_QUEUE).unwrap();
-        let frame = tungstenite::Bytes::from(vec![7u8; 1 << 20]);
-        for _ in 0..PAGE_QUEUE {
-            tx.try_send(Outgoing::Binary(frame.clone())).unwrap();
-        }
-        let limit = Duration::from_millis(400);
-        let started = Instant::now();
-        assert!(!flush_within(&mut socket, &queue, limit));
-        let took = started.elapsed();
-        assert!(took >= limit, "gave up after {took:?}");
-        assert!(took < limit + Duration::from_secs(3), "took {took:?}");
+        let socket = send_until_the_deadline(server);
         let _ = socket.get_ref().tcp().shutdown(std::net::Shutdown::Both);
         reader.join().unwrap();
     }
