@@ -111,7 +111,7 @@ impl Preview {
             self.path.shown(),
             canvas.width,
             canvas.height,
-            stats.time,
+            lapclone::util::number_text(stats.time),
             stats.total_ms,
             if self.overlay { ", mesh" } else { "" }
         );

@@ -28,7 +28,7 @@ impl Session {
         let mut out = format!(
             "t = {} s: {:.2} ms total (deform {:.2}, solve {:.2}, raster {:.2}); \
              switches: {} deform, {} clone; boundary hidden {}, outside {}, glued {}\n",
-            s.time,
+            lapclone::util::number_text(s.time),
             s.total_ms,
             s.deform_ms,
             s.solve_ms,
@@ -160,7 +160,8 @@ fn layer_order(draft: &Draft, t: f64) -> String {
         })
         .collect();
     format!(
-        "layers at t = {t} s, back to front: {}\n",
+        "layers at t = {} s, back to front: {}\n",
+        lapclone::util::number_text(t),
         layers.join(", ")
     )
 }
