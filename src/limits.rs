@@ -67,6 +67,19 @@ pub const MAX_POSITION: f64 = 1e9;
 /// past any canvas, while its placed vertices stay finite (1e308 overflowed to ∞).
 pub const MAX_SCALE: f64 = 1e6;
 
+/// Largest |value| of a rotation (degrees) or a depth a scene keys: far past any use, and
+/// far from overflow, so an eased key between two of them stays finite (keys of 1e308 and
+/// −1e308 interpolated to ∞).
+pub const MAX_ROTATION_OR_DEPTH: f64 = 1e9;
+
+/// Why `v` cannot be a rotation or a depth ([`MAX_ROTATION_OR_DEPTH`]), if it cannot.
+pub fn rotation_or_depth_error(v: f64) -> Option<String> {
+    (v.abs() > MAX_ROTATION_OR_DEPTH).then(|| {
+        let v = crate::util::number_text(v);
+        format!("{v} is past ±{MAX_ROTATION_OR_DEPTH:e}")
+    })
+}
+
 /// Why `v` cannot be a coordinate of a position ([`MAX_POSITION`]), if it cannot.
 pub fn position_error(v: f64) -> Option<String> {
     (v.abs() > MAX_POSITION)

@@ -435,7 +435,7 @@ impl PatchRef {
                 radius: values::positive(&radius, "drag radius")?,
                 depth: options
                     .get("depth")
-                    .map(|v| number(v, "depth"))
+                    .map(|v| values::rotation_or_depth(v, "depth"))
                     .transpose()?,
                 pivot: options
                     .get("pivot")
@@ -600,7 +600,7 @@ impl HandleRef {
         self.edit_in_place(&ctx, |h| {
             let t = values::time(&t)?;
             let easing = values::easing(easing)?;
-            let r = number(&degrees, "handle rotation")?;
+            let r = values::rotation_or_depth(&degrees, "handle rotation")?;
             h.rotation.push(t, r, easing).map_err(|e| e.to_string())
         })
     }

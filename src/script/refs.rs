@@ -81,8 +81,8 @@ impl Placed {
         let result = match self {
             Placed::At => p.position.push(t, values::position(value, "`at`")?, easing),
             Placed::Scale => p.scale.push(t, values::scale(value, "`scale`")?, easing),
-            Placed::Rotate => p.rotation.push(t, number(value, "`rotate`")?, easing),
-            Placed::Depth => p.depth.push(t, number(value, "`depth`")?, easing),
+            Placed::Rotate => p.rotation.push(t, values::rotation_or_depth(value, "`rotate`")?, easing),
+            Placed::Depth => p.depth.push(t, values::rotation_or_depth(value, "`depth`")?, easing),
             Placed::Opacity => p.opacity.push(t, values::unit(value, "`opacity`")?, easing),
         };
         result.map_err(|e| e.to_string())

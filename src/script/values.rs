@@ -106,6 +106,16 @@ pub fn scale(value: &Dynamic, what: &str) -> Result<f64, String> {
     }
 }
 
+/// A rotation (degrees) or a depth: finite, within
+/// [`crate::limits::MAX_ROTATION_OR_DEPTH`].
+pub fn rotation_or_depth(value: &Dynamic, what: &str) -> Result<f64, String> {
+    let v = number(value, what)?;
+    match crate::limits::rotation_or_depth_error(v) {
+        Some(error) => Err(format!("{what}: {error}")),
+        None => Ok(v),
+    }
+}
+
 pub fn string(value: &Dynamic, what: &str) -> Result<String, String> {
     value
         .read_lock::<rhai::ImmutableString>()

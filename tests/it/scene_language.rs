@@ -578,3 +578,21 @@ fn patch_names_hold_no_control_or_bidi_characters() {
     parse("canvas(8, 8);\npatch(\"日本 ☕ é\", #{ source: \"assets/chelsea.png\", polygons: [[[1, 1], [5, 1], [1, 5]]] });")
         .unwrap();
 }
+
+/// Rotations and depths are bounded as positions are: two keys of ±1e308 each finite eased
+/// to ∞ between them, reported at the patch's call as "non-finite values at frame 1".
+#[test]
+fn rotations_and_depths_are_bounded_at_the_call() {
+    for (call, what) in [
+        ("p.depth(0, 1e308);", "`depth`"),
+        ("p.rotate(0.5, -1e10);", "`rotate`"),
+        ("p.key(0, #{ rotate: 1e308 });", "`rotate`"),
+        ("p.drag([5, 5], 3, #{ depth: 1e300 });", "depth"),
+        ("p.drag([5, 5], 3).rotate(0, 1e300);", "handle rotation"),
+    ] {
+        let e = parse_err(&format!("{HEAD}{call}"));
+        assert!(e.message.contains(what) && e.message.contains("past"), "{call}: {e}");
+        assert_eq!(e.line(), Some(HEAD.lines().count() + 1), "{call}: {e}");
+    }
+    parse(&format!("{HEAD}p.depth(0, 1e9).rotate(1, -1e9);")).unwrap();
+}
