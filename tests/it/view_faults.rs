@@ -228,9 +228,11 @@ fn a_flood_of_refused_pages_keeps_the_threads_bounded() {
     std::thread::sleep(Duration::from_millis(300));
     watching.store(false, std::sync::atomic::Ordering::Relaxed);
     let most = watcher.join().unwrap();
-    // 32 waiting connections and 8 finishing, over the threads the 32 pages already run.
+    // 32 waiting connections and 8 finishing, over the threads the 32 pages already run,
+    // and a few more: a thread whose join has returned is still counted for a moment while
+    // the kernel finishes its exit (CI once saw one). Unbounded, the flood would make 400.
     assert!(
-        most <= before + 40,
+        most <= before + 44,
         "{most} threads at most, {before} with the 32 pages"
     );
     drop((held, pages));
