@@ -591,7 +591,10 @@ fn rotations_and_depths_are_bounded_at_the_call() {
         ("p.drag([5, 5], 3).rotate(0, 1e300);", "handle rotation"),
     ] {
         let e = parse_err(&format!("{HEAD}{call}"));
-        assert!(e.message.contains(what) && e.message.contains("past"), "{call}: {e}");
+        assert!(
+            e.message.contains(what) && e.message.contains("past"),
+            "{call}: {e}"
+        );
         assert_eq!(e.line(), Some(HEAD.lines().count() + 1), "{call}: {e}");
     }
     parse(&format!("{HEAD}p.depth(0, 1e9).rotate(1, -1e9);")).unwrap();
