@@ -5,7 +5,7 @@
 use rhai::{Dynamic, EvalAltResult, NativeCallContext};
 
 use super::draft::SharedDraft;
-use super::values::{self, number};
+use super::values;
 use crate::scene::{Easing, Patch};
 
 pub(super) type Fallible<T> = Result<T, Box<EvalAltResult>>;
