@@ -68,10 +68,15 @@ fn frames(options: &Map, frame_count: Option<u64>) -> Result<Option<Vec<u64>>, S
     let mut numbers = Vec::with_capacity(list.len());
     for item in &list {
         let n = values::number(item, "frame number")?;
+        let shown = crate::util::number_text(n);
         if n.fract() != 0.0 || n < 1.0 {
             return Err(format!(
-                "frame numbers count from 1 (as in `lapclone render`), got {n}"
+                "frame numbers count from 1 (as in `lapclone render`), got {shown}"
             ));
+        }
+        let most = crate::limits::MAX_FRAMES;
+        if n > most as f64 {
+            return Err(format!("frame {shown} is past the most frames a scene has ({most})"));
         }
         let n = n as u64;
         if let Some(count) = frame_count.filter(|&c| n > c) {
@@ -133,6 +138,8 @@ mod tests {
         let head = "canvas(8, 8, #{ fps: 4, duration: 1 });\n";
         for (call, message) in [
             ("golden(#{ frames: [0] });", "count from 1"),
+            ("golden(#{ frames: [1e300] });", "frame 1e300 is past the most frames"),
+            ("golden(#{ frames: [-1e300] });", "got -1e300"),
             (
                 "golden(#{ frames: [5] });",
                 "frame 5 is past the end: the scene has 4 frames",
