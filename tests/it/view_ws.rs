@@ -261,6 +261,14 @@ impl Page {
         self.rects.push([x, y, w, h]);
     }
 
+    /// The page's connection itself, for bytes sent as no WebSocket client would send them.
+    fn raw_stream(&self) -> TcpStream {
+        match self.socket.get_ref() {
+            MaybeTlsStream::Plain(s) => s.try_clone().unwrap(),
+            _ => unreachable!("the tests connect without TLS"),
+        }
+    }
+
     fn rev(&self) -> u64 {
         self.scene["rev"].as_u64().unwrap()
     }
@@ -1166,11 +1174,7 @@ fn a_page_sending_a_message_slowly_still_gets_the_session_s_changes_meanwhile() 
     bytes.extend_from_slice(&(seek.len() as u16).to_be_bytes());
     bytes.extend_from_slice(&[0; 4]);
     bytes.extend_from_slice(&seek);
-    let stream = |page: &mut Page| match page.socket.get_mut() {
-        MaybeTlsStream::Plain(s) => s.try_clone().unwrap(),
-        _ => unreachable!("the test connects without TLS"),
-    };
-    let mut raw = stream(&mut page);
+    let mut raw = page.raw_stream();
     raw.set_nonblocking(true).unwrap();
     // Each byte goes out at once, not held back until the last is acknowledged.
     raw.set_nodelay(true).unwrap();
@@ -1229,12 +1233,9 @@ fn a_page_sending_pings_and_never_reading_holds_no_memory_for_its_pongs() {
     let dir = tempfile::tempdir().unwrap();
     let scene = cat_scene(dir.path());
     let mut repl = ViewRepl::start(dir.path(), &scene);
-    let mut page = repl.page();
+    let page = repl.page();
     let before = resident_bytes(repl.pid());
-    let mut raw = match page.socket.get_mut() {
-        MaybeTlsStream::Plain(s) => s.try_clone().unwrap(),
-        _ => unreachable!("the test connects without TLS"),
-    };
+    let mut raw = page.raw_stream();
     raw.set_write_timeout(Some(WAIT)).unwrap();
     // Masked pings of 125 bytes (a zero mask leaves the payload as it is), 1 MiB a write.
     let mut ping = vec![0x89, 0x80 | 125, 0, 0, 0, 0];
