@@ -142,9 +142,9 @@ impl PatchCloner {
         })
     }
 
-    /// Shades each draw on `threads` threads (the caller's and scoped ones; 1 by default; at
-    /// most [`MAX_RASTER_THREADS`](crate::MAX_RASTER_THREADS) started per draw): for a one-shot clone of a large patch. The pixels are the
-    /// same for any count.
+    /// Shades each draw on `threads` threads (the caller's and the raster's worker pool's; 1
+    /// by default; at most [`MAX_RASTER_THREADS`](crate::MAX_RASTER_THREADS) per draw): for a
+    /// one-shot clone of a large patch. The pixels are the same for any count.
     pub fn set_raster_threads(&mut self, threads: usize) {
         self.raster_options.threads = threads.max(1);
     }

@@ -1,9 +1,8 @@
 //! Row bands for shading on several threads: takes the canvas rows of a rectangle and gives
 //! bands of [`ROWS_PER_BAND`] rows that the threads take in turn until none is left, each
 //! with its own slice of the canvas. Rows shade independently, so the pixels are the same for
-//! any split. Bands are taken rather than halves handed out because a helper thread starts
-//! 50–60 µs late (its spawn) and may share its core with other work: the caller does not
-//! wait for a fixed half that started late.
+//! any split. Bands are taken rather than halves handed out because a worker may start late
+//! or share its core with other work: the others do not wait for a fixed half it holds.
 
 use std::sync::Mutex;
 
@@ -50,17 +49,4 @@ impl<'a, T> Bands<'a, T> {
         }
         sum
     }
-}
-
-/// `mine` plus what each of `helpers` gave.
-pub(crate) fn join_sum(
-    mine: (usize, usize),
-    helpers: Vec<std::thread::ScopedJoinHandle<'_, (usize, usize)>>,
-) -> (usize, usize) {
-    helpers.into_iter().fold(mine, |(h, w), handle| {
-        // invariant: shading does not panic on validated input; a panic is a bug to
-        // surface, not to hide.
-        let (h2, w2) = handle.join().expect("a shading thread");
-        (h + h2, w + w2)
-    })
 }

@@ -4,15 +4,16 @@
 //! depth test, then shading row by row; on one thread, or with `RasterOptions::threads` on
 //! several (the same pixels).
 
-use std::sync::{mpsc, Mutex};
+use std::sync::{Mutex, OnceLock};
 
-use super::bands::{join_sum, Bands};
+use super::bands::Bands;
 use super::coverage::Silhouette;
 use super::feather::apply_feather;
 use super::prepare::{prepare, prepare_setups, prepare_silhouette};
 use super::setup::{TriangleSetup, MAX_COORDINATE};
 use super::shade::{shade_and_composite, CoverageTexel, ShadeInput};
 use super::triangles::{bands, rasterise_triangles, Band, TriangleBins, NO_TRIANGLE};
+use super::workers;
 use super::{Patch, PixelRect, RasterError, RasterScratch};
 use crate::pixels::{Canvas, CanvasPixels, Texel};
 
@@ -23,9 +24,10 @@ pub struct RasterOptions {
     pub feather: f32,
     /// Anti-alias the silhouette (tiny-skia coverage); off: pixel-centre coverage only.
     pub anti_alias: bool,
-    /// Threads that shade (row ranges, the caller's thread and scoped ones); the pixels are
-    /// the same for any count. 1 by default: a scene render's other cores encode frames.
-    /// At most [`MAX_RASTER_THREADS`], and one per 64 rows of the patch, are started.
+    /// Threads that draw (the caller's, and the raster's worker pool, one thread per core,
+    /// started on the first draw that asks for more than one); the pixels are the same for
+    /// any count. 1 by default: a scene render's other cores encode frames. At most
+    /// [`MAX_RASTER_THREADS`], and one per 64 rows of the patch, share a draw.
     pub threads: usize,
 }
 
@@ -98,17 +100,11 @@ pub fn draw_patch(
     })
 }
 
-/// Patches with fewer triangles draw their ids on the caller's thread alone, with one spawn
-/// per draw: a second spawn and join costs about 50 µs, a tenth of the README cat's whole
-/// re-clone (1,068 triangles). The folding horse (4,600 triangles, a 1.3 ms ownership pass)
-/// gains about half a millisecond a frame from sharing the pass.
-const SHARED_IDS_TRIANGLES: usize = 2048;
-
 /// Fewer rows than this per thread are shaded on the caller's thread alone.
 const MIN_ROWS_PER_THREAD: usize = 64;
 
-/// The most threads one draw shades on, whatever a caller asks for: a bound on what a
-/// caller's number can start, well above the cores shading can use.
+/// The most threads one draw shades on, whatever a caller asks for, and the most the worker
+/// pool starts: well above the cores shading can use.
 pub const MAX_RASTER_THREADS: usize = 64;
 
 /// One draw's rectangles and canvas width.
@@ -140,29 +136,28 @@ impl Frame<'_> {
         use_depth
     }
 
-    /// The anti-aliased, unfeathered draw on several threads, in two parts. First a helper
-    /// fills the silhouette while the caller sets up the triangles and bins them by row
-    /// band, then both draw the bands' ids in turn (the three depend only on the patch); then
-    /// every thread shades [`Bands`]. The helper's start-up overlaps the caller's work
-    /// instead of delaying the rest. A patch with fewer than [`SHARED_IDS_TRIANGLES`]
-    /// triangles draws its ids on the caller alone, with one spawn instead of two.
+    /// The anti-aliased, unfeathered draw on the raster's workers, in two parts. First the
+    /// caller sets up the triangles and bins them by row band while a free worker fills the
+    /// silhouette, and both draw the bands' ids (the three depend only on the patch); then
+    /// the workers shade [`Bands`]. A part no worker took in time runs on the caller's
+    /// thread (see [`workers`](super::workers)), so nothing waits for a busy core.
     fn draw_overlapped<T: Texel + Send>(
         &self,
         scratch: &mut RasterScratch,
         canvas: &mut [[T; 4]],
     ) -> (usize, usize) {
-        if self.patch.triangles.len() < SHARED_IDS_TRIANGLES {
-            return self.draw_overlapped_ids_on_caller(scratch, canvas);
-        }
-        self.prepare_shared(scratch);
-        let drawn = (&scratch.setups[..], &scratch.ids[..], &scratch.silhouette);
-        self.in_parts(self.target, canvas, |part, canvas| {
-            self.shade_strips(drawn, part, canvas)
+        workers::on_pool(|| {
+            self.prepare_shared(scratch);
+            let drawn = (&scratch.setups[..], &scratch.ids[..], &scratch.silhouette);
+            self.in_parts(self.target, canvas, |part, canvas| {
+                self.shade_strips(drawn, part, canvas)
+            })
         })
     }
 
-    /// The first part of [`draw_overlapped`](Self::draw_overlapped): the helper fills the
-    /// silhouette, the caller sets up and bins the triangles, then both draw id bands.
+    /// The first part of [`draw_overlapped`](Self::draw_overlapped): the caller sets up and
+    /// bins the triangles and draws id bands; the silhouette's part fills it, then draws id
+    /// bands too if the bins are ready by then.
     fn prepare_shared(&self, scratch: &mut RasterScratch) {
         let use_depth = self.sized((&mut scratch.ids, &mut scratch.depths));
         let RasterScratch {
@@ -176,78 +171,22 @@ impl Frame<'_> {
             ..
         } = scratch;
         let (patch, work) = (self.patch, self.work);
-        let id_bands = Mutex::new(bands(work, ids, depths, use_depth));
-        let (to_helper, from_caller) = mpsc::channel::<(&[TriangleSetup], &TriangleBins)>();
-        std::thread::scope(|scope| {
-            let id_bands = &id_bands;
-            let helper = scope.spawn(move || {
+        let id_bands = &Mutex::new(bands(work, ids, depths, use_depth));
+        let binned: &OnceLock<(&[TriangleSetup], &TriangleBins)> = &OnceLock::new();
+        workers::both(
+            move || {
+                prepare_setups(patch, snapped, setups);
+                bins.fill(setups, work);
+                let (setups, bins) = binned.get_or_init(|| (setups, bins));
+                draw_bands(setups, bins, id_bands);
+            },
+            move || {
                 prepare_silhouette(patch, work, folds, silhouette);
-                // Nothing comes only when the caller panicked, which its scope reports.
-                if let Ok((setups, bins)) = from_caller.recv() {
+                if let Some((setups, bins)) = binned.get() {
                     draw_bands(setups, bins, id_bands);
                 }
-            });
-            prepare_setups(patch, snapped, setups);
-            bins.fill(setups, work);
-            let _ = to_helper.send((setups, bins));
-            draw_bands(setups, bins, id_bands);
-            helper
-                .join()
-                .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
-        });
-    }
-
-    /// [`draw_overlapped`](Self::draw_overlapped) of a patch with few triangles, with one
-    /// spawn per draw: a helper fills the silhouette while the caller sets up the triangles
-    /// and rasterises their ids (the two depend only on the patch), then every thread shades
-    /// [`Bands`].
-    fn draw_overlapped_ids_on_caller<T: Texel + Send>(
-        &self,
-        scratch: &mut RasterScratch,
-        canvas: &mut [[T; 4]],
-    ) -> (usize, usize) {
-        let RasterScratch {
-            setups,
-            snapped,
-            ids,
-            depths,
-            silhouette,
-            folds,
-            bins,
-            ..
-        } = scratch;
-        let (patch, work, rows) = (self.patch, self.work, self.target);
-        let canvas = &mut canvas[rows.y0.max(0) as usize * self.width..];
-        let bands = &Bands::new(rows, self.width, canvas);
-        let (to_helper, from_caller) = mpsc::channel::<(&[TriangleSetup], &[u32])>();
-        let (to_caller, from_helper) = mpsc::channel::<&Silhouette>();
-        std::thread::scope(|scope| {
-            let first = scope.spawn(move || {
-                prepare_silhouette(patch, work, folds, silhouette);
-                let silhouette: &Silhouette = silhouette;
-                let _ = to_caller.send(silhouette);
-                // Nothing comes only when the caller panicked, which its scope reports.
-                let Ok((setups, ids)) = from_caller.recv() else {
-                    return (0, 0);
-                };
-                bands.shade(|part, canvas| self.shade_strips((setups, ids, silhouette), part, canvas))
-            });
-            prepare_setups(patch, snapped, setups);
-            self.rasterise(setups, (ids, depths), bins);
-            let (setups, ids): (&[TriangleSetup], &[u32]) = (setups, ids);
-            let _ = to_helper.send((setups, ids));
-            // Nothing comes only when the helper panicked, which its join reports.
-            let Ok(silhouette) = from_helper.recv() else {
-                return join_sum((0, 0), vec![first]);
-            };
-            let drawn = (setups, ids, silhouette);
-            let shade = move |part, canvas: &mut [[T; 4]]| self.shade_strips(drawn, part, canvas);
-            let mut spawned = vec![first];
-            for _ in 1..self.helpers(rows) {
-                spawned.push(scope.spawn(move || bands.shade(shade)));
-            }
-            join_sum(bands.shade(shade), spawned)
-        })
+            },
+        );
     }
 
     /// Shades the target rectangle with the coverage the options ask for; gives (centre
@@ -364,9 +303,9 @@ impl Frame<'_> {
         })
     }
 
-    /// Runs `shade` over `rows` of the canvas on the caller's thread and up to `threads −
-    /// 1` scoped ones, which take [`Bands`] in turn; `shade` gets a band and the canvas from
-    /// its first row on, and gives (centre hits, pixels written), summed here.
+    /// Runs `shade` over `rows` of the canvas as up to `threads` copies on the raster's
+    /// workers, which take [`Bands`] in turn; `shade` gets a band and the canvas from its
+    /// first row on, and gives (centre hits, pixels written), summed here.
     fn in_parts<T: Texel + Send>(
         &self,
         rows: PixelRect,
@@ -379,15 +318,10 @@ impl Frame<'_> {
             return shade(rows, canvas_rows);
         }
         let bands = Bands::new(rows, self.width, canvas_rows);
-        let (bands, shade) = (&bands, &shade);
-        std::thread::scope(|scope| {
-            let spawned = (0..helpers).map(|_| scope.spawn(move || bands.shade(shade)));
-            let spawned: Vec<_> = spawned.collect();
-            join_sum(bands.shade(shade), spawned)
-        })
+        workers::on_pool(|| workers::copies(helpers + 1, &|| bands.shade(&shade)))
     }
 
-    /// Scoped threads besides the caller's to shade `rows` on.
+    /// Threads besides the caller's to shade `rows` on.
     fn helpers(&self, rows: PixelRect) -> usize {
         let threads = self.threads.min(MAX_RASTER_THREADS);
         threads.min(rows.height() / MIN_ROWS_PER_THREAD).max(1) - 1

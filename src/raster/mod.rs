@@ -20,8 +20,9 @@
 //! the patch's own front layer (the clone stage switches their constraints off) and which
 //! lie over a lower layer of it (the clone stage glues them).
 //!
-//! A draw is one sequential pass on the calling thread (callers draw different patches or
-//! frames in parallel if they wish); every pixel depends only on the draw's inputs.
+//! A draw runs on the calling thread, or with `RasterOptions::threads` shares its parts with
+//! the raster's worker pool (`workers.rs`); every pixel depends only on the draw's inputs,
+//! never on the thread count.
 //!
 //! Once-per-mesh vs per-frame: nothing is cached across frames except the buffers in
 //! [`RasterScratch`] and [`CoverageGrid`]; a frame re-does the per-triangle setup (cheap) and
@@ -44,6 +45,7 @@ mod scratch;
 mod setup;
 mod shade;
 mod triangles;
+mod workers;
 
 pub use crate::pixels::PixelRect;
 pub use covered::{

@@ -128,8 +128,9 @@ impl Renderer {
         })
     }
 
-    /// Shades each patch on `threads` threads (the caller's and scoped ones; 1 by default,
-    /// at least 1; at most [`MAX_RASTER_THREADS`](crate::MAX_RASTER_THREADS) started per draw): the pixels are the same for any count. One thread suits a scene render,
+    /// Shades each patch on `threads` threads (the caller's and the raster's worker pool's;
+    /// 1 by default, at least 1; at most [`MAX_RASTER_THREADS`](crate::MAX_RASTER_THREADS)
+    /// per draw): the pixels are the same for any count. One thread suits a scene render,
     /// whose other cores encode frames; an interactive session that waits on each frame
     /// gives it every core.
     pub fn set_raster_threads(&mut self, threads: usize) {
