@@ -29,11 +29,7 @@ pub fn run_preview(args: PreviewArgs) -> anyhow::Result<()> {
     let out = PictureOut::check("preview", &args.output, &[])?;
     let (loaded, imports, mut renderer) = load_renderer(&args.scene)?;
     lapclone::output::refuse_scene_input(&args.output, &loaded, &imports)?;
-    check_inside(
-        &args,
-        renderer.scene().canvas.duration,
-        renderer.frame_count(),
-    )?;
+    check_inside(&args, &renderer.scene().canvas)?;
     let format = renderer.output_format();
     let canvas = match (args.t, args.frame) {
         (Some(t), _) => renderer.render_time(t),
@@ -46,13 +42,17 @@ pub fn run_preview(args: PreviewArgs) -> anyhow::Result<()> {
 
 /// A time past the scene's end or a frame past its last is a usage error, as `render
 /// --frames` past the end is: the picture would be of no frame the scene renders.
-fn check_inside(args: &PreviewArgs, duration: f64, frames: u64) -> Result<(), UsageError> {
+fn check_inside(
+    args: &PreviewArgs,
+    canvas: &lapclone::animation::SceneCanvas,
+) -> Result<(), UsageError> {
     let number = lapclone::util::number_text;
+    let frames = canvas.frame_count();
     match (args.t, args.frame) {
-        (Some(t), _) if t > duration => Err(UsageError(format!(
+        (Some(t), _) if canvas.is_past_end(t) => Err(UsageError(format!(
             "--t {}: the scene lasts {} s",
             number(t),
-            number(duration)
+            number(canvas.duration)
         ))),
         (_, Some(frame)) if frame > frames => Err(UsageError(format!(
             "--frame {frame}: the scene has {frames} frames"

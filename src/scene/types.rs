@@ -227,6 +227,12 @@ pub enum ModelError {
 }
 
 impl Canvas {
+    /// Whether time `t` (seconds) lies after the scene's end: `preview --t`, the REPL's `:t`
+    /// and the live view's playhead refuse such a time, whose picture no render makes.
+    pub fn is_past_end(&self, t: f64) -> bool {
+        t > self.duration
+    }
+
     /// Number of frames: every i with i / fps < duration.
     pub fn frame_count(&self) -> u64 {
         // The small slack keeps e.g. duration 3, fps 24 at exactly 72 frames despite rounding.

@@ -313,7 +313,7 @@ fn script_file_mode_and_bad_commands() {
     let scene = tiny_scene(dir.path());
     std::fs::write(
         dir.path().join("edit.txt"),
-        ":frame 2\n:stats\n:frame 9\n:bogus\n",
+        ":frame 2\n:stats\n:frame 9\n:bogus\n:t 0.75\n:t 0.5\n",
     )
     .unwrap();
     let out = repl(
@@ -329,5 +329,10 @@ fn script_file_mode_and_bad_commands() {
         "{stderr}"
     );
     assert!(stderr.contains("unknown command `:bogus`"), "{stderr}");
-    assert!(stderr.contains("2 failed entries"), "{stderr}");
+    // A playhead past the end is refused as `preview --t` refuses it; the end is inside.
+    assert!(
+        stderr.contains("t = 0.75 s is past the scene's end: it lasts 0.5 s"),
+        "{stderr}"
+    );
+    assert!(stderr.contains("3 failed entries"), "{stderr}");
 }

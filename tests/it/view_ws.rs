@@ -368,6 +368,43 @@ fn escape_leaves_no_trace_and_stale_edits_are_refused() {
     assert!(repl.finish().success());
 }
 
+/// A page's playhead past the scene's end is refused, as `preview --t` and `:t` refuse it:
+/// a seek there, and an edit keyed there, get an error and change nothing.
+#[test]
+fn a_page_seeking_or_keying_past_the_scene_s_end_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = cat_scene(dir.path());
+    let repl = ViewRepl::start(dir.path(), &scene);
+    let mut page = repl.page();
+    let (before, rev) = (page.frame.clone(), page.rev());
+    let t = page.scene["t"].as_f64().unwrap();
+    page.send(&json!({"type": "seek", "t": 2.5}));
+    let error = page.until(|v| v["type"] == "error");
+    let message = error["message"].as_str().unwrap();
+    assert!(
+        message.contains("t = 2.5 s is past the scene's end: it lasts 2 s"),
+        "{error}"
+    );
+    let edit = json!({"op": "at", "patch": "cat", "value": [300, 150]});
+    page.send(&json!({"type": "edit", "rev": rev, "commit": true, "t": 3, "edit": edit}));
+    let error = page.until(|v| v["type"] == "error");
+    assert!(
+        error["message"]
+            .as_str()
+            .unwrap()
+            .contains("past the scene's end"),
+        "{error}"
+    );
+    // The end itself is inside.
+    page.send(&json!({"type": "seek", "t": 2}));
+    page.until(|v| v["type"] == "scene" && v["t"].as_f64() == Some(2.0));
+    page.send(&json!({"type": "seek", "t": t}));
+    page.until(|v| v["type"] == "scene" && v["t"].as_f64() == Some(t));
+    assert!(page.frame == before);
+    assert_eq!(page.rev(), rev);
+    assert!(repl.finish().success());
+}
+
 /// A preview lasts only until the session runs an entry: one that shows nothing (a plain
 /// `let`) or a commit that changes nothing still puts the committed scene back on every page.
 #[test]

@@ -198,6 +198,7 @@ impl Session {
             }
             Command::Save(path) => self.save(&path)?,
             Command::Time(t) => {
+                self.check_time(t).map_err(anyhow::Error::msg)?;
                 self.time = t;
                 self.show_frame()?;
             }
@@ -230,6 +231,23 @@ impl Session {
             Command::Quit => {}
         }
         Ok(())
+    }
+
+    /// Refuses a playhead past the scene's end (the rule `preview --t` follows); any time
+    /// is taken before there is a scene.
+    fn check_time(&self, t: f64) -> Result<(), String> {
+        let Some(canvas) = self.renderer.as_ref().map(|r| &r.scene().canvas) else {
+            return Ok(());
+        };
+        if !canvas.is_past_end(t) {
+            return Ok(());
+        }
+        let number = lapclone::util::number_text;
+        Err(format!(
+            "t = {} s is past the scene's end: it lasts {} s",
+            number(t),
+            number(canvas.duration)
+        ))
     }
 
     fn renderer(&self) -> anyhow::Result<&Renderer> {

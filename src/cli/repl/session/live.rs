@@ -207,6 +207,7 @@ impl LiveSession for Session {
 
     /// Moves the playhead (no history).
     fn view_seek(&mut self, t: f64) -> Result<(), String> {
+        self.check_time(t)?;
         self.time = t;
         self.as_page(|s| s.show_frame())
     }
@@ -235,6 +236,7 @@ impl LiveSession for Session {
         t: Option<f64>,
     ) -> Result<(), String> {
         let t = t.unwrap_or(self.time);
+        self.check_time(t)?;
         if rev != self.revision {
             self.publish();
             return Err(format!(
