@@ -122,7 +122,17 @@ fn set_canvas(
     let options = renamed(ctx, draft, options)?;
     let mut d = draft.lock();
     let canvas = parse_canvas(&d.base_dir, size, &options).map_err(|m| fail(ctx, m))?;
-    d.origins.canvas = Some(origin(ctx, &d.base_dir));
+    let at = origin(ctx, &d.base_dir);
+    // A scene has one canvas: a second call (an imported module's, or one left in by
+    // mistake) replaces the first, which a reader of the first call would not expect.
+    if let Some(first) = d.origins.canvas.replace(at.clone()) {
+        let location = super::error::location;
+        d.origins.warnings.push(format!(
+            "{}: `canvas` again: this canvas replaces the one of {} (a scene has one)",
+            location(&at.file, at.position),
+            location(&first.file, first.position)
+        ));
+    }
     d.canvas = Some(canvas);
     Ok(())
 }

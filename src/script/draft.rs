@@ -22,7 +22,8 @@ pub struct Origin {
 pub struct Origins {
     pub canvas: Option<Origin>,
     pub patches: Vec<Origin>,
-    /// `file:line:col: …` for each old spelling the script used.
+    /// `file:line:col: …` for each old spelling the script used, and each `canvas` call
+    /// that replaced an earlier one.
     pub warnings: Vec<String>,
     /// Track files the script read (`follow`, `track_keys`): inputs of every render, also
     /// when a later call replaced the keys one of them gave.

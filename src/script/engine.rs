@@ -102,8 +102,8 @@ impl LoadedScene {
         SceneError::with_text(ErrorKind::Validation, file, position, message, text)
     }
 
-    /// What `lapclone check` warns about: old spellings the file used (positioned), then
-    /// [`Scene::warnings`].
+    /// What `lapclone check` warns about: old spellings the file used and `canvas` calls that
+    /// replaced an earlier one (positioned), then [`Scene::warnings`].
     pub fn warnings(&self) -> Vec<String> {
         let mut all = self.origins.warnings.clone();
         all.extend(self.scene.warnings());

@@ -336,3 +336,26 @@ fn script_file_mode_and_bad_commands() {
     );
     assert!(stderr.contains("3 failed entries"), "{stderr}");
 }
+
+/// The session warns as `lapclone check` does, once each: a second `canvas` call and an old
+/// option name are named at their entries, as a key past the end already was.
+#[test]
+fn the_session_warns_about_a_second_canvas_and_an_old_name_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = tiny_scene(dir.path());
+    let input = format!(
+        "canvas(64, 48, #{{ fps: 6, duration: 1 }});\nlet n = 1;\n\
+         let q = patch(\"q\", #{{ source: \"{}\", polygons: [[[10, 10], [60, 12], [30, 50]]], boundary_data: \"vertex\" }});\n",
+        asset("chelsea.png")
+    );
+    let out = repl(dir.path(), &[scene.to_str().unwrap()], &input);
+    let stderr = text(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    let canvas = format!(
+        "warning: <entry 1>:1:1: `canvas` again: this canvas replaces the one of {}:1:1 (a scene has one)",
+        scene.display()
+    );
+    assert_eq!(stderr.matches(&canvas).count(), 1, "{stderr}");
+    let renamed = "warning: <entry 3>:1:9: `boundary_data` is now `boundary_sampling` (the old name still works)";
+    assert_eq!(stderr.matches(renamed).count(), 1, "{stderr}");
+}

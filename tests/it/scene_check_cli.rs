@@ -126,6 +126,23 @@ fn preview_time_and_frame_are_exclusive() {
     assert_eq!(out.status.code(), Some(2));
 }
 
+/// A scene has one canvas: a second `canvas` call (a module's, or one left in) replaces the
+/// first, and `check` says where both are; the later one is the scene's.
+#[test]
+fn check_warns_about_a_second_canvas_at_both_calls() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = "canvas(320, 240);\nlet n = 1;\n  canvas(100, 80, #{ fps: 12 });\n";
+    let (code, stdout, stderr) = check(dir.path(), text);
+    assert_eq!(code, 0, "{stderr}");
+    let scene = dir.path().join("scene.rhai");
+    let expected = format!(
+        "warning: {0}:3:3: `canvas` again: this canvas replaces the one of {0}:1:1 (a scene has one)",
+        scene.display()
+    );
+    assert!(stderr.contains(&expected), "{stderr}");
+    assert!(stdout.contains("100×80, 12 fps"), "{stdout}");
+}
+
 #[test]
 fn check_warns_about_an_old_option_name_at_its_call() {
     let dir = tempfile::tempdir().unwrap();

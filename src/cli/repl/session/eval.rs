@@ -148,12 +148,14 @@ impl Session {
         self.preview.update(renderer)
     }
 
-    /// Prints the scene's new warnings (keys no frame shows) to stderr.
+    /// Prints the scene's new warnings (old spellings, a replaced canvas, keys no frame
+    /// shows) to stderr, as `lapclone check` lists them.
     pub(super) fn warn(&mut self) {
-        let Ok((scene, _)) = self.engine.scene(Path::new("<repl>")) else {
+        let Ok((scene, origins)) = self.engine.scene(Path::new("<repl>")) else {
             return;
         };
-        let warnings = scene.warnings();
+        let mut warnings = origins.warnings;
+        warnings.extend(scene.warnings());
         for warning in warnings.iter().filter(|w| !self.warned.contains(w)) {
             self.say_warning(format!("warning: {warning}"));
         }
