@@ -339,11 +339,14 @@ fn a_drag_updates_the_frame_as_preview_renders_the_saved_scene_and_undo_restores
     assert!(repl.finish().success());
 }
 
+/// Escape leaves no trace; an edit against a revision the scene never had is refused as
+/// such, and one against a past revision as stale, with the scene sent again to redo it
+/// against; neither changes anything.
 #[test]
 fn escape_leaves_no_trace_and_stale_edits_are_refused() {
     let dir = tempfile::tempdir().unwrap();
     let scene = cat_scene(dir.path());
-    let repl = ViewRepl::start(dir.path(), &scene);
+    let mut repl = ViewRepl::start(dir.path(), &scene);
     let mut page = repl.page();
     let before = page.frame.clone();
     let rev = page.rev();
@@ -354,17 +357,33 @@ fn escape_leaves_no_trace_and_stale_edits_are_refused() {
     page.send(&json!({"type": "cancel"}));
     page.until_scene();
     assert!(page.frame == before, "cancel did not restore the frame");
-    let stale = json!({"type": "edit", "rev": rev + 7, "commit": true, "edit": {"op": "at", "patch": "cat", "value": [x + 5.0, y]}});
-    page.send(&stale);
+    let moved = json!({"op": "at", "patch": "cat", "value": [x + 5.0, y]});
+    page.send(&json!({"type": "edit", "rev": rev + 7, "commit": true, "edit": moved}));
     let error = page.until(|v| v["type"] == "error");
+    let expected = format!(
+        "edit against revision {}: the scene is at revision {rev}",
+        rev + 7
+    );
     assert!(
-        error["message"].as_str().unwrap().contains("stale"),
+        error["message"].as_str().unwrap().contains(&expected),
         "{error}"
     );
     page.send(&json!({"type": "mesh", "on": false}));
     page.until_scene();
     assert_eq!(page.rev(), rev);
     assert!(page.frame == before);
+    // A typed entry moves the scene on; the page's edit against the revision before is stale.
+    repl.type_line("cat.scale(0, 0.43);");
+    let now = page.until(|v| v["type"] == "scene" && v["rev"].as_u64() != Some(rev))["rev"].clone();
+    page.send(&json!({"type": "edit", "rev": rev, "commit": true, "edit": moved}));
+    let error = page.until(|v| v["type"] == "error");
+    let expected = format!("stale edit: the scene changed since (revision {rev}, now {now})");
+    assert!(
+        error["message"].as_str().unwrap().contains(&expected),
+        "{error}"
+    );
+    // The scene sent again came before the error, and the cat is where it was.
+    assert_eq!((page.rev(), page.cat_at()), (now.as_u64().unwrap(), [x, y]));
     assert!(repl.finish().success());
 }
 

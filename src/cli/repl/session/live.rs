@@ -196,6 +196,25 @@ impl Session {
             .find(|n| !taken(n))
             .unwrap_or_else(|| "h".into())
     }
+
+    /// Refuses a page's `what` made against revision `rev` unless it is the session's: a
+    /// past one is stale (the page is sent the scene again, to redo it against), a future
+    /// one never existed.
+    fn check_revision(&mut self, rev: u64, what: &str) -> Result<(), String> {
+        let now = self.revision;
+        if rev > now {
+            return Err(format!(
+                "{what} against revision {rev}: the scene is at revision {now}"
+            ));
+        }
+        if rev < now {
+            self.publish();
+            return Err(format!(
+                "stale {what}: the scene changed since (revision {rev}, now {now}); try again"
+            ));
+        }
+        Ok(())
+    }
 }
 
 impl LiveSession for Session {
@@ -237,13 +256,7 @@ impl LiveSession for Session {
     ) -> Result<(), String> {
         let t = t.unwrap_or(self.time);
         self.check_time(t)?;
-        if rev != self.revision {
-            self.publish();
-            return Err(format!(
-                "stale edit: the scene changed since (revision {rev}, now {}); try again",
-                self.revision
-            ));
-        }
+        self.check_revision(rev, "edit")?;
         if self
             .engine
             .draft()
@@ -288,9 +301,7 @@ impl LiveSession for Session {
 
     /// Ctrl+S in a page (confirmed there): `:save` to the loaded file.
     fn view_save(&mut self, rev: u64) -> Result<(), String> {
-        if rev != self.revision {
-            return Err("stale save: the scene changed since; try again".into());
-        }
+        self.check_revision(rev, "save")?;
         let file = self
             .file
             .clone()
