@@ -166,7 +166,12 @@ pub fn check_frame_count(frames: u64) -> Result<(), LimitError> {
 /// The width and height in an image file's header (format guessed from its content),
 /// without decoding its pixels.
 pub fn image_dimensions(path: &Path) -> Result<(u32, u32), ImageOpenError> {
-    Ok(image_reader(path)?.into_dimensions()?)
+    let mut reader = image_reader(path)?;
+    // Only the header is read here; its size is judged by `check_image_size`, whose message
+    // names the limit. The decoder's default allocation limit would refuse a huge header
+    // first, as "Memory limit exceeded".
+    reader.no_limits();
+    Ok(reader.into_dimensions()?)
 }
 
 /// A reader of the image file `path` (a regular file: see

@@ -88,6 +88,7 @@ impl Fixture {
         std::fs::create_dir(self.path("in/folder.png")).unwrap();
         write_zero_grey_png(&self.path("in/huge.png"), 20_000, 20_000);
         write_zero_grey_png(&self.path("in/wide.png"), 20_000, 3);
+        write_png_header_only(&self.path("in/header.png"), i32::MAX as u32, 1);
     }
 
     /// Every file and folder under the root with its size (folders: 0).
@@ -291,6 +292,12 @@ fn images_over_the_size_limit_are_refused_before_decoding() {
         clone_case(&[("--source", "in/huge.png")], 1, limit),
         clone_case(&[("--target", "in/huge.png")], 1, limit),
         clone_case(&[("--target", "in/wide.png")], 1, limit),
+        // A header past what the decoder would allocate is refused by the same rule.
+        clone_case(
+            &[("--target", "in/header.png")],
+            1,
+            "2147483647×1 image exceeds the size limit",
+        ),
     ];
     let background = fixture.scene(
         "huge_background",
@@ -1019,6 +1026,28 @@ fn write_zero_grey_png(path: &Path, width: u32, height: u32) {
         std::io::Write::write_all(&mut writer, &row).unwrap();
     }
     writer.finish().unwrap();
+}
+
+/// A PNG of `width`×`height` 8-bit RGB pixels whose data stops after the header (one empty
+/// row's worth of compressed bytes): for headers too large to write in full.
+fn write_png_header_only(path: &Path, width: u32, height: u32) {
+    let chunk = |kind: &[u8; 4], data: &[u8]| {
+        let mut out = (data.len() as u32).to_be_bytes().to_vec();
+        out.extend_from_slice(kind);
+        out.extend_from_slice(data);
+        let crc = crc32fast::hash(&[&kind[..], data].concat());
+        out.extend_from_slice(&crc.to_be_bytes());
+        out
+    };
+    let mut header = [width.to_be_bytes(), height.to_be_bytes()].concat();
+    header.extend_from_slice(&[8, 2, 0, 0, 0]);
+    // zlib of one empty filter byte.
+    let data = [0x78, 0x9c, 0x63, 0x00, 0x00, 0x00, 0x01, 0x00, 0x01];
+    let mut png = vec![0x89, b'P', b'N', b'G', 0x0d, 0x0a, 0x1a, 0x0a];
+    png.extend(chunk(b"IHDR", &header));
+    png.extend(chunk(b"IDAT", &data));
+    png.extend(chunk(b"IEND", &[]));
+    std::fs::write(path, png).unwrap();
 }
 
 /// Finite but extreme numbers: each either works (exit 0, a whole PNG of the target's size)
