@@ -189,17 +189,31 @@ fn image_reader(
 }
 
 /// Reads an image file whose header passes [`check_image_size`]; the decoder runs with
-/// matching allocation limits, so a header that lies cannot make it allocate more.
+/// matching allocation limits, so a header that lies cannot make it allocate more. A JPEG
+/// is read once: its bytes are checked to be whole, then decoded.
 pub fn open_image(path: &Path) -> Result<image::DynamicImage, ImageOpenError> {
     let (width, height) = image_dimensions(path)?;
     check_image_size(u64::from(width), u64::from(height))?;
-    let mut reader = image_reader(path)?;
+    let reader = image_reader(path)?;
+    if reader.format() != Some(image::ImageFormat::Jpeg) {
+        return decode_within_limits(reader);
+    }
+    let mut bytes = Vec::new();
+    std::io::Read::read_to_end(&mut reader.into_inner(), &mut bytes)?;
     // The JPEG decoder fills what a cut-short file lacks with grey and says nothing.
-    if reader.format() == Some(image::ImageFormat::Jpeg) && !jpeg_is_whole(path)? {
+    if !jpeg_is_whole(&bytes) {
         let format = image::error::ImageFormatHint::Exact(image::ImageFormat::Jpeg);
         let cut = "the file is cut short: its data ends before the end-of-image marker";
         return Err(image::ImageError::Decoding(image::error::DecodingError::new(format, cut)).into());
     }
+    let cursor = std::io::Cursor::new(bytes);
+    decode_within_limits(image::ImageReader::with_format(cursor, image::ImageFormat::Jpeg))
+}
+
+/// Decodes with the size and allocation limits of [`open_image`].
+fn decode_within_limits<R: std::io::BufRead + std::io::Seek>(
+    mut reader: image::ImageReader<R>,
+) -> Result<image::DynamicImage, ImageOpenError> {
     let mut limits = image::Limits::default();
     limits.max_image_width = Some(MAX_IMAGE_SIDE);
     limits.max_image_height = Some(MAX_IMAGE_SIDE);
@@ -208,37 +222,33 @@ pub fn open_image(path: &Path) -> Result<image::DynamicImage, ImageOpenError> {
     Ok(reader.decode()?)
 }
 
-/// Whether the JPEG file `path` holds an end-of-image marker (`FF D9`) after its start of
+/// Whether the JPEG file's bytes hold an end-of-image marker (`FF D9`) after its start of
 /// scan. The segments before the scan are skipped by their lengths (an EXIF thumbnail is a
 /// JPEG of its own, markers and all); inside the scan data every `FF` byte is stuffed or
 /// starts a marker, so the first `FF D9` there ends the image, and data after it (a motion
 /// photo's video) is allowed. A file this walk does not understand is left to the decoder.
-fn jpeg_is_whole(path: &Path) -> std::io::Result<bool> {
-    use std::io::Read as _;
-    let mut bytes = Vec::new();
-    crate::util::open_input_file(path)?.read_to_end(&mut bytes)?;
-    let b = &bytes[..];
+fn jpeg_is_whole(b: &[u8]) -> bool {
     if !b.starts_with(&[0xFF, 0xD8]) {
-        return Ok(true);
+        return true;
     }
     let mut at = 2;
     loop {
         match b.get(at..at + 2) {
-            None => return Ok(false),
+            None => return false,
             Some(&[0xFF, 0xFF]) => at += 1,
-            Some(&[0xFF, 0xD9]) => return Ok(true),
+            Some(&[0xFF, 0xD9]) => return true,
             Some(&[0xFF, 0x01 | 0xD0..=0xD8]) => at += 2,
             Some(&[0xFF, marker]) => {
                 let Some(&[high, low]) = b.get(at + 2..at + 4) else {
-                    return Ok(false);
+                    return false;
                 };
                 at += 2 + usize::from(u16::from_be_bytes([high, low]));
                 if marker == 0xDA {
                     let scan = b.get(at..).unwrap_or_default();
-                    return Ok(scan.windows(2).any(|w| w == [0xFF, 0xD9]));
+                    return scan.windows(2).any(|w| w == [0xFF, 0xD9]);
                 }
             }
-            Some(_) => return Ok(true),
+            Some(_) => return true,
         }
     }
 }
@@ -265,7 +275,9 @@ mod tests {
         let whole = dir.path().join("whole.jpg");
         let image = image::RgbImage::from_fn(64, 48, |x, y| image::Rgb([x as u8 * 3, y as u8 * 5, 90]));
         image.save(&whole).unwrap();
-        assert!(open_image(&whole).is_ok());
+        // Read once and decoded from memory, the pixels the decoder gives from the file.
+        let read = open_image(&whole).unwrap();
+        assert!(read == image::open(&whole).unwrap());
         let bytes = std::fs::read(&whole).unwrap();
         // Something after the image (a motion photo's video) is allowed.
         let trailed = dir.path().join("trailed.jpg");
