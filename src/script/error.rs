@@ -127,11 +127,17 @@ impl SceneError {
         // Where the scene file called into what failed: named when the failure is in a
         // module, whose line alone does not say which of the scene's calls gave the bad value.
         let mut scene_call = None;
+        // The innermost call with a position: where a positionless error (Rhai's own
+        // `range` with step 0) is reported.
+        let mut last_call = None;
         loop {
             match *error {
                 EvalAltResult::ErrorInFunctionCall(_, source, inner, call) => {
                     if current_file == file && !call.is_none() {
                         scene_call = Some(call);
+                    }
+                    if !call.is_none() {
+                        last_call = Some((current_file.clone(), call));
                     }
                     if !source.is_empty() {
                         current_file = PathBuf::from(source);
@@ -148,7 +154,10 @@ impl SceneError {
             }
         }
         let mut error = error;
-        let position = error.take_position();
+        let mut position = error.take_position();
+        if let Some((call_file, call)) = last_call.filter(|_| position.is_none()) {
+            (current_file, position) = (call_file, call);
+        }
         let (kind, mut message) = classify(&error);
         if let Some(call) = scene_call.filter(|_| current_file != file) {
             message = format!("{message} (called at {})", location(file, call));

@@ -126,6 +126,20 @@ fn preview_time_and_frame_are_exclusive() {
     assert_eq!(out.status.code(), Some(2));
 }
 
+/// An error Rhai raises without a position (`range` with a step of 0) is reported at the
+/// call that raised it, as every other error is.
+#[test]
+fn a_range_with_step_zero_is_reported_at_its_call() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = "canvas(32, 24);\nlet n = 0;\nfor i in range(0, 10, 0) { n += i; }\n";
+    let (code, _, stderr) = check(dir.path(), text);
+    assert_eq!(code, 1, "{stderr}");
+    let scene = dir.path().join("scene.rhai");
+    let expected = format!("{}:3:10: step value cannot be zero", scene.display());
+    assert!(stderr.contains(&expected), "{stderr}");
+    assert!(stderr.contains("for i in range(0, 10, 0)"), "{stderr}");
+}
+
 /// A scene has one canvas: a second `canvas` call (a module's, or one left in) replaces the
 /// first, and `check` says where both are; the later one is the scene's.
 #[test]
