@@ -164,15 +164,15 @@ fn a_page_lines_output_goes_above_a_prompt_in_use() {
             }
         }
     };
-    // A key past the scene's end: the line and a warning are both printed (not the value
-    // the call gives back).
-    let edit = serde_json::json!({"type": "edit", "rev": rev, "commit": true, "t": 5,
-        "edit": {"op": "at", "patch": "cat", "value": [300, 160]}});
+    // A key moved past the scene's end: the line and a warning are both printed (not the
+    // value the call gives back).
+    let edit = serde_json::json!({"type": "edit", "rev": rev, "commit": true,
+        "edit": {"op": "move_key", "patch": "cat", "track": "at", "from": 2, "to": 5}});
     let text = edit.to_string();
     socket
         .send(tungstenite::Message::Text(text.into()))
         .unwrap();
-    p.exp_string("(view) cat.at(5, [300, 160]);").unwrap();
+    p.exp_string("(view) cat.move_key(2, 5, \"at\");").unwrap();
     p.exp_string("warning: ").unwrap();
     // The prompt comes back, with the half-typed entry, after everything the line printed.
     p.exp_string("lapclone> cat.na").unwrap();
