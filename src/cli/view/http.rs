@@ -166,6 +166,9 @@ fn upgrade(
 #[derive(Debug, Default)]
 pub struct Head {
     pub method: String,
+    /// The authority of an absolute-form target (`GET http://host:port/ws?…`), which must
+    /// name this server as `Host` must.
+    pub authority: Option<String>,
     pub path: String,
     pub query: String,
     pub headers: Vec<(String, String)>,
@@ -250,9 +253,27 @@ fn parse_head(bytes: &[u8]) -> Result<Head, Refusal> {
         _ => return Err(bad("malformed request")),
     }
     let target = request.path.unwrap_or("");
-    let (path, query) = target.split_once('?').unwrap_or((target, ""));
+    // An origin server takes the absolute form too (RFC 9112, 3.2.2).
+    let absolute = target
+        .get(..7)
+        .filter(|s| s.eq_ignore_ascii_case("http://"));
+    let (authority, target) = match absolute {
+        Some(_) => {
+            let rest = &target[7..];
+            let end = rest.find(['/', '?']).unwrap_or(rest.len());
+            let path = match &rest[end..] {
+                tail if tail.starts_with('?') => format!("/{tail}"),
+                "" => "/".to_string(),
+                tail => tail.to_string(),
+            };
+            (Some(rest[..end].to_string()), path)
+        }
+        None => (None, target.to_string()),
+    };
+    let (path, query) = target.split_once('?').unwrap_or((&target, ""));
     Ok(Head {
         method: request.method.unwrap_or("").to_string(),
+        authority,
         path: path.to_string(),
         query: query.to_string(),
         headers: request
@@ -286,11 +307,13 @@ fn route(head: &Head, routes: &Routes) -> Result<Route, Refusal> {
         return Err(Refusal("400 Bad Request", "more than one Host".into()));
     }
     let host = head.header("Host").unwrap_or("");
-    if !routes.names_this_server(host) {
-        return Err(Refusal(
-            "403 Forbidden",
-            format!("unexpected Host {host:?}"),
-        ));
+    for named in std::iter::once(host).chain(head.authority.as_deref()) {
+        if !routes.names_this_server(named) {
+            return Err(Refusal(
+                "403 Forbidden",
+                format!("unexpected Host {named:?}"),
+            ));
+        }
     }
     if !matches!(head.path.as_str(), "/" | "/ws") {
         return Err(Refusal("404 Not Found", "no such page".into()));
@@ -316,16 +339,35 @@ fn route(head: &Head, routes: &Routes) -> Result<Route, Refusal> {
             format!("foreign Origin {origin:?}"),
         ));
     }
-    let upgrade = head
-        .header("Upgrade")
-        .is_some_and(|v| v.eq_ignore_ascii_case("websocket"));
+    // `Upgrade` may list several protocols (`h2c, websocket`).
+    let upgrade = head.header("Upgrade").is_some_and(|v| {
+        v.split(',')
+            .any(|p| p.trim().eq_ignore_ascii_case("websocket"))
+    });
     let key = head.header("Sec-WebSocket-Key").unwrap_or("");
-    if !upgrade || key.is_empty() || head.header("Sec-WebSocket-Version") != Some("13") {
+    if !upgrade || head.header("Sec-WebSocket-Version") != Some("13") {
         return Err(Refusal("400 Bad Request", "not a WebSocket request".into()));
+    }
+    if !is_websocket_key(key) {
+        return Err(Refusal(
+            "400 Bad Request",
+            "Sec-WebSocket-Key is not 16 bytes in base64".into(),
+        ));
     }
     Ok(Route::Socket {
         key: key.to_string(),
     })
+}
+
+/// Whether `key` is 16 bytes in base64 (RFC 6455, 4.2.1): 22 base64 digits, the last
+/// holding 2 bits (so one of `AQgw`), then `==`.
+fn is_websocket_key(key: &str) -> bool {
+    let digit = |b: &u8| b.is_ascii_alphanumeric() || *b == b'+' || *b == b'/';
+    let bytes = key.as_bytes();
+    bytes.len() == 24
+        && bytes.ends_with(b"==")
+        && bytes[..22].iter().all(digit)
+        && b"AQgw".contains(&bytes[21])
 }
 
 /// Compares tokens in time independent of where they first differ.
@@ -448,6 +490,53 @@ mod tests {
         assert!(route(&head(&socket("http://192.0.2.7:8000")), &r).is_ok());
         assert!(route(&head(&socket("http://evil.example:8000")), &r).is_err());
         assert!(route(&head(&socket("https://192.0.2.7:8000")), &r).is_err());
+    }
+
+    /// An absolute-form target is taken as its path, when its authority names this server
+    /// as `Host` must; `Upgrade` may list several protocols; the key must be 16 bytes.
+    #[test]
+    fn absolute_targets_upgrade_lists_and_keys() {
+        let r = routes();
+        let page = |target: &str| format!("GET {target} HTTP/1.1\nHost: 127.0.0.1:8000\n\n");
+        for target in [
+            "http://127.0.0.1:8000/?token=abc123",
+            "HTTP://localhost:8000?token=abc123",
+        ] {
+            assert_eq!(
+                route(&head(&page(target)), &r).unwrap(),
+                Route::Page,
+                "{target}"
+            );
+        }
+        for target in [
+            "http://evil.example:8000/?token=abc123",
+            "http://127.0.0.1:8000/?token=abc124",
+            "http://127.0.0.1:8000/etc?token=abc123",
+        ] {
+            assert!(route(&head(&page(target)), &r).is_err(), "{target}");
+        }
+        let socket = |upgrade: &str, key: &str| {
+            format!(
+                "GET /ws?token=abc123 HTTP/1.1\nHost: 127.0.0.1:8000\nOrigin: http://127.0.0.1:8000\n\
+                 Upgrade: {upgrade}\nConnection: Upgrade\nSec-WebSocket-Key: {key}\n\
+                 Sec-WebSocket-Version: 13\n\n"
+            )
+        };
+        let key = "dGhlIHNhbXBsZSBub25jZQ==";
+        for upgrade in ["websocket", "h2c, websocket", "WebSocket ,foo"] {
+            assert!(route(&head(&socket(upgrade, key)), &r).is_ok(), "{upgrade}");
+        }
+        assert!(route(&head(&socket("h2c", key)), &r).is_err());
+        for bad in [
+            "",
+            "abc",
+            "dGhlIHNhbXBsZSBub25jZR==",
+            "dGhlIHNhbXBsZSBub25jZQ=",
+            "dGhlIHNhbXBsZSBub25j*Q==",
+        ] {
+            let refusal = route(&head(&socket("websocket", bad)), &r).unwrap_err();
+            assert_eq!(refusal.0, "400 Bad Request", "{bad}");
+        }
     }
 
     /// A head may end in bare LFs: it is read at once, not waited on until the timeout.
