@@ -13,7 +13,7 @@ use super::prepare::{prepare, prepare_setups, prepare_silhouette};
 use super::setup::{TriangleSetup, MAX_COORDINATE};
 use super::shade::{shade_and_composite, CoverageTexel, ShadeInput};
 use super::triangles::{bands, rasterise_triangles, Band, TriangleBins, NO_TRIANGLE};
-use super::workers;
+use super::workers::{self, MAX_RASTER_THREADS};
 use super::{Patch, PixelRect, RasterError, RasterScratch};
 use crate::pixels::{Canvas, CanvasPixels, Texel};
 
@@ -102,10 +102,6 @@ pub fn draw_patch(
 
 /// Fewer rows than this per thread are shaded on the caller's thread alone.
 const MIN_ROWS_PER_THREAD: usize = 64;
-
-/// The most threads one draw shades on, whatever a caller asks for, and the most the worker
-/// pool starts: well above the cores shading can use.
-pub const MAX_RASTER_THREADS: usize = 64;
 
 /// One draw's rectangles and canvas width.
 struct Frame<'a> {

@@ -52,7 +52,8 @@ pub use covered::{
     boundary_layers, covered_boundary_vertices, weights_if_strictly_inside, Beneath, CoverageGrid,
 };
 pub use point_grid::PointGrid;
-pub use draw::{draw_patch, RasterOptions, RasterStats, MAX_RASTER_THREADS};
+pub use draw::{draw_patch, RasterOptions, RasterStats};
+pub use workers::MAX_RASTER_THREADS;
 pub use error::RasterError;
 pub use patch::Patch;
 pub use scratch::RasterScratch;

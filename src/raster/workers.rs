@@ -13,7 +13,9 @@ use std::sync::OnceLock;
 
 use rayon_core::{ThreadPool, ThreadPoolBuilder};
 
-use super::draw::MAX_RASTER_THREADS;
+/// The most threads one draw shades on, whatever a caller asks for, and the most the worker
+/// pool starts: well above the cores shading can use.
+pub const MAX_RASTER_THREADS: usize = 64;
 
 /// The pool, started on first use; `None` when its threads could not be started, or in a
 /// process forked after they were (it has none of them: Python's `multiprocessing` forks).
