@@ -254,19 +254,11 @@ fn parse_head(bytes: &[u8]) -> Result<Head, Refusal> {
     }
     let target = request.path.unwrap_or("");
     // An origin server takes the absolute form too (RFC 9112, 3.2.2).
-    let absolute = target
-        .get(..7)
-        .filter(|s| s.eq_ignore_ascii_case("http://"));
-    let (authority, target) = match absolute {
-        Some(_) => {
-            let rest = &target[7..];
-            let end = rest.find(['/', '?']).unwrap_or(rest.len());
-            let path = match &rest[end..] {
-                tail if tail.starts_with('?') => format!("/{tail}"),
-                "" => "/".to_string(),
-                tail => tail.to_string(),
-            };
-            (Some(rest[..end].to_string()), path)
+    let (authority, target) = match after_http_scheme(target) {
+        Some(rest) => {
+            let (authority, tail) = rest.split_at(rest.find(['/', '?']).unwrap_or(rest.len()));
+            let slash = if tail.starts_with('/') { "" } else { "/" };
+            (Some(authority.to_string()), format!("{slash}{tail}"))
         }
         None => (None, target.to_string()),
     };
@@ -330,10 +322,7 @@ fn route(head: &Head, routes: &Routes) -> Result<Route, Refusal> {
         return Ok(Route::Page);
     }
     let origin = head.header("Origin").unwrap_or("");
-    let scheme = origin
-        .get(..7)
-        .filter(|s| s.eq_ignore_ascii_case("http://"));
-    if scheme.is_none() || !routes.names_this_server(&origin[7..]) {
+    if !after_http_scheme(origin).is_some_and(|host| routes.names_this_server(host)) {
         return Err(Refusal(
             "403 Forbidden",
             format!("foreign Origin {origin:?}"),
@@ -357,6 +346,13 @@ fn route(head: &Head, routes: &Routes) -> Result<Route, Refusal> {
     Ok(Route::Socket {
         key: key.to_string(),
     })
+}
+
+/// What follows `http://` (in any case) at the start of `text`: the host of an `Origin`, or
+/// an absolute-form target's authority and path.
+fn after_http_scheme(text: &str) -> Option<&str> {
+    let scheme = text.get(..7)?;
+    scheme.eq_ignore_ascii_case("http://").then(|| &text[7..])
 }
 
 /// Whether `key` is 16 bytes in base64 (RFC 6455, 4.2.1): 22 base64 digits, the last
