@@ -29,10 +29,11 @@ pub fn watch(
                     .collect(),
                 false => Vec::new(),
             };
+            // Stamped before the reload reads the files: a write while it runs is either read
+            // by it or seen by the next poll, never taken for the state just loaded.
             last = now;
             if !changed.is_empty() {
                 reload(&changed);
-                last = stamp(&files);
             }
         });
     if let Err(error) = spawned {
@@ -54,4 +55,43 @@ fn stamp(files: &impl Fn() -> Vec<PathBuf>) -> Stamp {
 /// Whether two stamps list the same files (a `:load` of another file is no change on disk).
 fn same_files(a: &Stamp, b: &Stamp) -> bool {
     a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.0 == y.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::mpsc;
+
+    use super::*;
+
+    /// A file written again while its reload runs (an editor saving twice, a build step)
+    /// is reloaded once more: the second write is not lost.
+    #[test]
+    fn a_write_during_a_reload_is_reloaded_too() {
+        let dir = tempfile::tempdir().unwrap();
+        let file = dir.path().join("scene.rhai");
+        std::fs::write(&file, "one").unwrap();
+        let (tx, calls) = mpsc::channel();
+        let (watched, written) = (file.clone(), file.clone());
+        watch(
+            move || vec![watched.clone()],
+            move |changed| {
+                let text = std::fs::read_to_string(&written).unwrap();
+                if text == "two" {
+                    std::fs::write(&written, "three!").unwrap();
+                }
+                let _ = tx.send((changed.to_vec(), text));
+            },
+        );
+        std::thread::sleep(POLL / 2);
+        std::fs::write(&file, "two").unwrap();
+        let wait = Duration::from_secs(10);
+        let first = calls
+            .recv_timeout(wait)
+            .expect("the first write is reloaded");
+        assert_eq!(first, (vec![file.clone()], "two".to_string()));
+        let second = calls
+            .recv_timeout(wait)
+            .expect("the write during the reload is reloaded");
+        assert_eq!(second, (vec![file], "three!".to_string()));
+    }
 }
