@@ -4,7 +4,7 @@
 use lapclone::util::ShowPath;
 use std::path::PathBuf;
 
-use super::scene_open::load_renderer;
+use super::scene_open::{load_renderer, print_warnings};
 
 #[derive(clap::Args, Debug)]
 pub struct CheckArgs {
@@ -28,8 +28,6 @@ pub fn run_check(args: CheckArgs) -> anyhow::Result<()> {
         c.frame_count(),
         loaded.scene.patches.len(),
     ))?;
-    for warning in loaded.warnings().into_iter().chain(renderer.warnings()) {
-        eprint_line!("warning: {warning}");
-    }
+    print_warnings(&loaded, &renderer);
     Ok(())
 }

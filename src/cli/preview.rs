@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 
 use super::picture_out::PictureOut;
-use super::scene_open::{default_jobs, load_renderer, positioned};
+use super::scene_open::{default_jobs, load_renderer, positioned, print_warnings};
 use crate::cli::UsageError;
 
 #[derive(clap::Args, Debug)]
@@ -30,6 +30,7 @@ pub fn run_preview(args: PreviewArgs) -> anyhow::Result<()> {
     let (loaded, imports, mut renderer) = load_renderer(&args.scene)?;
     lapclone::output::refuse_scene_input(&args.output, &loaded, &imports)?;
     check_inside(&args, &renderer.scene().canvas)?;
+    print_warnings(&loaded, &renderer);
     let format = renderer.output_format();
     let canvas = match (args.t, args.frame) {
         (Some(t), _) => renderer.render_time(t),

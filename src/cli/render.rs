@@ -10,7 +10,7 @@ use lapclone::script::LoadedScene;
 
 pub use super::render_args::{frame_range, OutputFormat, RenderArgs};
 pub(crate) use super::scene_open::{default_jobs, positioned, progress_bar};
-use super::scene_open::{load_renderer, TerminalProgress};
+use super::scene_open::{load_renderer, print_warnings, TerminalProgress};
 pub use lapclone::FrameRange;
 
 pub fn run_render(args: RenderArgs) -> anyhow::Result<()> {
@@ -24,9 +24,7 @@ pub fn run_render(args: RenderArgs) -> anyhow::Result<()> {
     // Before the scene: a video's ffmpeg starts up while the scene loads.
     let plan = SinkPlan::new(kind, &args.output, args.sink_settings())?;
     let (loaded, imports, mut renderer) = load_renderer(&args.scene)?;
-    for warning in renderer.warnings() {
-        eprint_line!("warning: {warning}");
-    }
+    print_warnings(&loaded, &renderer);
     refuse_render_input(kind, &args.output, &loaded, &imports)?;
     let range = args.range(renderer.frame_count())?;
     let started = Instant::now();

@@ -1,6 +1,6 @@
 //! Scene files opened for the commands that render them (`render`, `preview`, `check`,
 //! `test`): takes a path and gives the loaded scene, its imported modules and a built
-//! renderer, every error positioned at the scene call it is about; also the shared
+//! renderer, every error positioned at the scene call it is about, and their warnings; also the shared
 //! pieces of a render's terminal side (cancel on Ctrl-C, the progress bar, default jobs).
 
 use std::io::IsTerminal;
@@ -17,6 +17,15 @@ pub(crate) fn load_renderer(scene: &Path) -> anyhow::Result<(LoadedScene, Vec<Pa
     let (loaded, imports) = load_scene_and_imports(scene).map_err(|e| anyhow::anyhow!("{e}"))?;
     let renderer = lapclone::build_renderer(&loaded).map_err(|e| anyhow::anyhow!("{e}"))?;
     Ok((loaded, imports, renderer))
+}
+
+/// Prints what the scene warns about (old option names, a second `canvas`, keys past the
+/// end), then what its renderer does, one `warning:` line each: what `check`, `render` and
+/// `preview` say about a scene, so a user who only renders hears it too.
+pub(crate) fn print_warnings(loaded: &LoadedScene, renderer: &Renderer) {
+    for warning in loaded.warnings().into_iter().chain(renderer.warnings()) {
+        eprint_line!("warning: {warning}");
+    }
 }
 
 pub(crate) fn positioned(loaded: &LoadedScene, error: RenderError) -> anyhow::Error {

@@ -138,6 +138,7 @@ fn check_scene(job: &Job, scene: &Path) -> SceneResult {
             return result;
         }
     };
+    super::scene_open::print_warnings(&loaded, &renderer);
     let settings = loaded.scene.golden.clone().unwrap_or_default();
     result.thresholds = overrides(job.args, settings.apply(Thresholds::default()));
     let total = renderer.frame_count();

@@ -8,11 +8,18 @@ use crate::files;
 use files::asset;
 
 fn check(dir: &Path, text: &str) -> (i32, String, String) {
+    run(dir, text, &["check"], &[])
+}
+
+/// Runs `lapclone COMMAND scene.rhai ARGS…` on `text` written to `dir/scene.rhai`.
+fn run(dir: &Path, text: &str, command: &[&str], args: &[&str]) -> (i32, String, String) {
     let scene = dir.join("scene.rhai");
     std::fs::write(&scene, text).unwrap();
     let out = Command::new(env!("CARGO_BIN_EXE_lapclone"))
-        .arg("check")
+        .current_dir(dir)
+        .args(command)
         .arg(&scene)
+        .args(args)
         .output()
         .unwrap();
     (
@@ -172,4 +179,39 @@ fn check_warns_about_an_old_option_name_at_its_call() {
         scene.display()
     );
     assert!(stderr.contains(&expected), "{stderr}");
+}
+
+/// What `check` warns about, `render` and `preview` warn about too, each once: a user who
+/// only renders still learns of an old name or a key past the scene's end.
+#[test]
+fn render_and_preview_warn_as_check_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = format!(
+        "canvas(64, 48, #{{ fps: 2, duration: 1 }});\nlet p = patch(\"p\", #{{ source: \"{}\", polygons: [[[4, 4], [40, 6], [10, 40]]], boundary_data: \"vertex\" }});\np.at(3, [20, 20]);\n",
+        asset("astronaut.png")
+    );
+    let scene = dir.path().join("scene.rhai");
+    let old_name = format!(
+        "warning: {}:2:9: `boundary_data` is now `boundary_sampling` (the old name still works)",
+        scene.display()
+    );
+    let runs: [(&[&str], &[&str]); 3] = [
+        (&["check"], &[]),
+        (&["render"], &["-o", "frames"]),
+        (&["preview"], &["--frame", "1", "-o", "one.png"]),
+    ];
+    for (command, args) in runs {
+        let (code, _, stderr) = run(dir.path(), &text, command, args);
+        assert_eq!(code, 0, "{command:?}: {stderr}");
+        assert_eq!(
+            stderr.matches(&old_name).count(),
+            1,
+            "{command:?}: {stderr}"
+        );
+        let late = stderr
+            .lines()
+            .filter(|l| l.contains("after the scene's end"))
+            .count();
+        assert_eq!(late, 1, "{command:?}: {stderr}");
+    }
 }

@@ -525,3 +525,25 @@ fn pending_frames_are_the_same_bytes_on_one_thread_or_several() {
     }
     assert_eq!(runs[0], runs[1]);
 }
+
+/// A golden-frame run in CI says what `check` would: a key past the scene's end is named on
+/// standard error, once, and the frames still pass.
+#[test]
+fn a_scene_s_warnings_are_printed_once_and_the_run_passes() {
+    let fixture = Fixture::new(10);
+    fixture.write_scene(10, "p.at(5, [12, 8]);\n");
+    let update = fixture.run(&["--update"]);
+    assert_eq!(code(&update), 0, "{}", stderr(&update));
+    let check = fixture.run(&[]);
+    assert_eq!(code(&check), 0, "{}", stderr(&check));
+    let warnings = stderr(&check);
+    let late: Vec<&str> = warnings
+        .lines()
+        .filter(|l| l.starts_with("warning:"))
+        .collect();
+    assert_eq!(late.len(), 1, "{warnings}");
+    assert!(
+        late[0].contains("\"at\" key(s) at t = 5 after the scene's end"),
+        "{warnings}"
+    );
+}
