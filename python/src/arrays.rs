@@ -199,8 +199,8 @@ pub fn read_picture(object: &Bound<'_, PyAny>, what: &str, bgr: bool) -> PyResul
 }
 
 /// Reads a mask: as [`read_picture`], bool arrays too (`True` = 255).
-pub fn read_mask(object: &Bound<'_, PyAny>, what: &str) -> PyResult<Picture> {
-    read_with(object, what, true, true)
+pub fn read_mask(object: &Bound<'_, PyAny>, what: &str, bgr: bool) -> PyResult<Picture> {
+    read_with(object, what, bgr, true)
 }
 
 fn read_with(
@@ -214,8 +214,14 @@ fn read_with(
     let (w, h) = (layout.width as u32, layout.height as u32);
     let untyped = untyped(object, what)?;
     let image = if untyped.dtype().is_equiv_to(&numpy::dtype::<bool>(py)) {
-        let bits: Vec<bool> = samples(object, &layout, false)?;
-        let bytes = bits.iter().map(|&b| if b { 255 } else { 0 }).collect();
+        // Read as the bytes they are: numpy takes any nonzero byte as True (a 0/255 mask
+        // viewed as bool), which a Rust `bool` may not hold.
+        let bytes = object.call_method1("view", ("uint8",))?;
+        let bytes: Vec<u8> = samples(&bytes, &layout, false)?;
+        let bytes = bytes
+            .iter()
+            .map(|&b| if b != 0 { 255 } else { 0 })
+            .collect();
         eight_bit(w, h, layout.channel_count(), bytes)
     } else if layout.dtype == Dtype::U8 {
         eight_bit(w, h, layout.channel_count(), samples(object, &layout, bgr)?)

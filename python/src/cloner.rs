@@ -196,7 +196,7 @@ fn build(
 ) -> PyResult<Cloner> {
     let mesh_options = mesh_options(density)?;
     let source = arrays::read_picture(source, "source", bgr)?;
-    let mask = arrays::read_mask(mask, "mask")?;
+    let mask = arrays::read_mask(mask, "mask", bgr)?;
     let source_layout = source.layout;
     let patch = Patch::new(py, source, mask, &mesh_options, options, threads)?;
     Ok(Cloner {
@@ -365,17 +365,19 @@ pub fn seamless_clone<'py>(
     cloner.patch.clone_onto(dst, &layout, true, &pose, None)
 }
 
-/// The patch mesh of `mask` (inside where its luma, or alpha, is at least half scale), as
-/// `Cloner` meshes it: `(vertices, triangles)`.
+/// The patch mesh of `mask` (inside where its luma, or alpha, is at least half scale; a
+/// colour mask's channels in BGR order with `bgr=True`), as `Cloner` meshes it:
+/// `(vertices, triangles)`.
 #[pyfunction]
-#[pyo3(signature = (mask, *, density=InRange(3.0)))]
+#[pyo3(signature = (mask, *, density=InRange(3.0), bgr=false))]
 pub fn mesh<'py>(
     py: Python<'py>,
     mask: &Bound<'py, PyAny>,
     density: InRange<f64>,
+    bgr: bool,
 ) -> PyResult<arrays::MeshArrays<'py>> {
     let options = mesh_options(density.0)?;
-    let mask = arrays::read_mask(mask, "mask")?;
+    let mask = arrays::read_mask(mask, "mask", bgr)?;
     let size = (mask.image.width(), mask.image.height());
     let patch = py.allow_threads(|| {
         let bits = BitMask::from_image(&mask.image, MASK_THRESHOLD);

@@ -4,6 +4,7 @@
 //! placed patch's bounding box and a margin), so a frame costs its patch, not its size; the
 //! mesh, factor and solve run with the GIL released.
 
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Mutex, MutexGuard};
 
 use lapclone::glam::DVec2;
@@ -11,6 +12,7 @@ use lapclone::{
     mesh_from_mask, BitMask, Canvas, CloneOptions, DeformRig, Deformed, Handle, MeshOptions,
     PatchCloner, PatchMesh, Pin, Placement,
 };
+use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
 
 use crate::arrays::{self, Layout, Picture, Rect};
@@ -43,6 +45,8 @@ pub struct PatchState {
 /// the lock is only ever waited for with the GIL released.
 pub struct Patch {
     state: Mutex<PatchState>,
+    /// The thread holding `state` ([`thread_number`]; 0: none).
+    holder: AtomicU64,
     /// The patch mesh's bounding box of inside mask pixels and its default drag radius.
     pub bbox_min: DVec2,
     pub bbox_max: DVec2,
@@ -89,6 +93,7 @@ impl Patch {
         let vertex_count = state.cloner.mesh().vertex_count();
         Ok(Patch {
             state: Mutex::new(state),
+            holder: AtomicU64::new(0),
             bbox_min,
             bbox_max,
             drag_radius,
@@ -112,7 +117,7 @@ impl Patch {
         let out: Option<Py<PyAny>> = out.map(|out| out.clone().unbind());
         let result = py.allow_threads(|| {
             // Waited for without the GIL, so a thread holding the lock can always take it.
-            let mut state = lock(&self.state);
+            let mut state = self.lock()?;
             let rect = state.prepare(pose, layout)?;
             // Each time the GIL is taken back the arrays are checked again: other threads ran
             // meanwhile. No code but numpy's runs while the lock is held, so a clone called
@@ -146,12 +151,64 @@ impl Patch {
     }
 }
 
-/// The state behind `mutex`, also after a panic on another thread (every clone starts by
-/// resetting what it uses, so a half-done one leaves nothing wrong behind).
-fn lock(mutex: &Mutex<PatchState>) -> MutexGuard<'_, PatchState> {
-    mutex
-        .lock()
-        .unwrap_or_else(|poisoned| poisoned.into_inner())
+impl Patch {
+    /// The state, also after a panic on another thread (every clone starts by resetting
+    /// what it uses, so a half-done one leaves nothing wrong behind). A clone called on the
+    /// thread already holding it is refused: Python code can run inside a clone (garbage
+    /// collection calling a finaliser while numpy allocates the result), and waiting there
+    /// would wait for itself.
+    fn lock(&self) -> PyResult<StateGuard<'_>> {
+        let me = thread_number();
+        if self.holder.load(Ordering::Relaxed) == me {
+            return Err(PyRuntimeError::new_err(
+                "this Cloner is already cloning on this thread: a clone was called from inside \
+                 another (a finaliser run by garbage collection?); give that code its own Cloner",
+            ));
+        }
+        let state = self
+            .state
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner());
+        self.holder.store(me, Ordering::Relaxed);
+        Ok(StateGuard {
+            state,
+            holder: &self.holder,
+        })
+    }
+}
+
+/// The locked state; clears the holder when dropped.
+struct StateGuard<'a> {
+    state: MutexGuard<'a, PatchState>,
+    holder: &'a AtomicU64,
+}
+
+impl Drop for StateGuard<'_> {
+    fn drop(&mut self) {
+        self.holder.store(0, Ordering::Relaxed);
+    }
+}
+
+impl std::ops::Deref for StateGuard<'_> {
+    type Target = PatchState;
+    fn deref(&self) -> &PatchState {
+        &self.state
+    }
+}
+
+impl std::ops::DerefMut for StateGuard<'_> {
+    fn deref_mut(&mut self) -> &mut PatchState {
+        &mut self.state
+    }
+}
+
+/// This thread's number, from 1: the same for the thread's life, never another's.
+fn thread_number() -> u64 {
+    static NEXT: AtomicU64 = AtomicU64::new(1);
+    thread_local! {
+        static NUMBER: u64 = NEXT.fetch_add(1, Ordering::Relaxed);
+    }
+    NUMBER.with(|n| *n)
 }
 
 impl PatchState {
