@@ -103,8 +103,8 @@ pub use render::{DrawnRegion, FrameStats, RenderError, Renderer, SceneUpdate};
 /// The scene language's engine: [`SceneError::position`] is its [`rhai::Position`].
 pub use rhai;
 pub use script::{
-    load_scene, load_scene_and_imports, set_allocation_probe, ErrorKind as SceneErrorKind,
-    LoadedScene, SceneError,
+    load_scene, load_scene_and_imports, load_scene_cancellable, set_allocation_probe,
+    ErrorKind as SceneErrorKind, LoadedScene, SceneError,
 };
 pub use simd::{levels_to_rgb8, rgb8_to_levels};
 pub use solve::{FactorMethod, LaplacianKind, PenaltyOptions, SolveError, SwitchStats};

@@ -5,7 +5,8 @@ Images are numpy arrays: H×W (grey) or H×W×C with C = 1 (grey), 3 (RGB) or 4 
 flag says BGR(A), as OpenCV reads images; ``seamless_clone`` always takes and gives BGR, as
 ``cv2.seamlessClone`` does. Results have the target's shape, dtype and channel order. A
 mask is inside where its luma (or, with an alpha channel, its alpha) is at least half scale;
-``bool`` masks are accepted. Bad input raises ``ValueError`` (``TypeError`` for something
+``bool`` masks are accepted (any nonzero byte is ``True``, as numpy reads it); a colour
+mask's channels are in the call's order too. Bad input raises ``ValueError`` (``TypeError`` for something
 that is not an array), never crashes the interpreter.
 """
 
@@ -95,7 +96,8 @@ class Cloner:
         - ``mode``: ``"normal"`` or ``"monochrome"`` (the source turned grey first).
         - ``feather``: soften the patch's outer edge over this many pixels.
         - ``boundary_data``: ``"hat-average"`` or ``"vertex"``.
-        - ``bgr``: the source, every target and every result are BGR(A), as OpenCV's.
+        - ``bgr``: the source, the mask, every target and every result are BGR(A), as
+          OpenCV's.
         - ``threads``: threads each clone shades on (default: every core); the pixels are
           the same for any count.
         """
@@ -169,7 +171,11 @@ class Scene:
     def __iter__(self) -> Iterator[Image]:
         """Every frame in order (Ctrl-C stops between frames, in ``list(scene)`` too)."""
     def render(
-        self, path: Union[str, PathLike[str]], format: Optional[str] = None
+        self,
+        path: Union[str, PathLike[str]],
+        format: Optional[str] = None,
+        *,
+        force: bool = False,
     ) -> str:
         """Renders every frame to ``path`` as ``lapclone render -o path [--format format]``
         does, byte for byte, and returns the path written. The GIL is released while it
@@ -182,9 +188,14 @@ class Scene:
         ``.png``: a folder of frames).
 
         The output appears whole or not at all (a temporary file or folder beside it,
-        renamed at the end). A PNG folder holding frame files of another render is refused.
-        Ctrl-C stops the render after the frame in progress and raises
-        ``KeyboardInterrupt``; nothing is written.
+        renamed at the end). A PNG folder holding frame files of another render is refused
+        (``FileExistsError``) unless ``force=True`` (``--force``), which removes them.
+        ``path`` ``"-"`` writes Y4M to standard output: ``sys.stdout`` must be file
+        descriptor 1 (it is flushed first). Ctrl-C stops the render after the frame in
+        progress and raises ``KeyboardInterrupt``; nothing is written. A signal that ends
+        the process (SIGTERM's default) leaves the hidden temporary output beside ``path``:
+        install a handler that raises (``signal.signal(signal.SIGTERM, …)``) to have it
+        removed as Ctrl-C's is.
 
         Raises ``ValueError`` for an unknown format or extension and for an output that is
         one of the scene's inputs (the scene, its imports, images, plates, videos);
@@ -194,8 +205,9 @@ class Scene:
         """
 
 def mesh(
-    mask: Mask, *, density: float = 3.0
+    mask: Mask, *, density: float = 3.0, bgr: bool = False
 ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.uint32]]:
     """The patch mesh ``Cloner`` makes of ``mask``: ``(vertices, triangles)``, an N×2
     float64 array of positions in mask pixels (x right, y down; pixel (i, j) covers
-    [i, i+1] × [j, j+1]) and an M×3 uint32 array of counter-clockwise vertex indices."""
+    [i, i+1] × [j, j+1]) and an M×3 uint32 array of counter-clockwise vertex indices.
+    A colour mask is read in RGB order, BGR with ``bgr=True`` (its luma decides)."""

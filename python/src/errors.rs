@@ -8,8 +8,8 @@
 
 use lapclone::{CloneError, MeshError, OutputError};
 use pyo3::exceptions::{
-    PyFileNotFoundError, PyIndexError, PyIsADirectoryError, PyNotADirectoryError, PyOSError,
-    PyOverflowError, PyValueError,
+    PyFileExistsError, PyFileNotFoundError, PyIndexError, PyIsADirectoryError,
+    PyNotADirectoryError, PyOSError, PyOverflowError, PyValueError,
 };
 use pyo3::prelude::*;
 
@@ -118,6 +118,16 @@ pub fn scene_error(py: Python<'_>, error: &lapclone::SceneError) -> PyResult<PyE
 pub fn output_error(py: Python<'_>, error: OutputError) -> PyErr {
     let message = with_causes(&error);
     match error {
+        // The library's message names the command line's `--force`.
+        OutputError::ForeignFrames {
+            folder,
+            count,
+            example,
+        } => PyFileExistsError::new_err(format!(
+            "{} holds {count} frame files of another render (e.g. {example}); pass \
+             force=True to remove them, or render into another folder",
+            folder.display()
+        )),
         OutputError::Scene(scene) => scene_error(py, &scene).unwrap_or_else(|e| e),
         OutputError::UnknownFormat(_)
         | OutputError::UnknownExtension { .. }

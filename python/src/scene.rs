@@ -7,7 +7,7 @@
 //! progress, its output removed, and stops iterating between frames.
 
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::mpsc::{self, RecvTimeoutError};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
@@ -64,11 +64,16 @@ impl Scene {
         if let Some(kind) = lapclone::not_a_file(&path) {
             return Err(PyValueError::new_err(format!("{} {kind}", path.display())));
         }
-        let opened = py.allow_threads(|| {
-            let (loaded, imports) = lapclone::load_scene_and_imports(&path)?;
+        // A scene file can run for a long while (up to its time limit): Ctrl-C stops it.
+        let cancel = Arc::new(AtomicBool::new(false));
+        let (opened, interrupt) = until_signal(py, &cancel, || {
+            let (loaded, imports) = lapclone::load_scene_cancellable(&path, cancel.clone())?;
             let renderer = lapclone::build_renderer(&loaded)?;
             Ok::<_, lapclone::SceneError>((loaded, imports, renderer))
-        });
+        })?;
+        if let Some(interrupt) = interrupt {
+            return Err(interrupt);
+        }
         let (loaded, imports, renderer) = match opened {
             Ok(opened) => opened,
             Err(error) => return Err(scene_error(py, &error)?),
@@ -149,21 +154,31 @@ impl Scene {
     /// folder). The GIL is released while it renders. Ctrl-C stops it after the frame in
     /// progress: KeyboardInterrupt is raised and nothing is written (one that comes once the
     /// output is finished carries a note naming it).
-    #[pyo3(signature = (path, format=None))]
-    fn render(&self, py: Python<'_>, path: PathBuf, format: Option<&str>) -> PyResult<String> {
+    #[pyo3(signature = (path, format=None, *, force=false))]
+    fn render(
+        &self,
+        py: Python<'_>,
+        path: PathBuf,
+        format: Option<&str>,
+        force: bool,
+    ) -> PyResult<String> {
         if path.as_os_str().is_empty() {
             return Err(PyValueError::new_err("the output path is empty"));
+        }
+        if path.as_os_str() == "-" {
+            python_stdout_is_fd_1(py)?;
         }
         let format = format
             .map(OutputKind::from_name)
             .transpose()
             .map_err(|e| output_error(py, e))?;
         let cancel = Arc::new(AtomicBool::new(false));
-        let options = RenderOptions {
+        let mut options = RenderOptions {
             format,
             cancel: Some(cancel.clone()),
             ..RenderOptions::default()
         };
+        options.settings.force = force;
         let (rendered, interrupt) = until_signal(py, &cancel, || {
             let mut renderer = self.renderer()?;
             Ok::<_, PyErr>(lapclone::render_scene(
@@ -199,7 +214,7 @@ impl Scene {
     fn __iter__(slf: Py<Self>) -> SceneFrames {
         SceneFrames {
             scene: slf,
-            next: 0,
+            next: AtomicU64::new(0),
         }
     }
 
@@ -215,11 +230,12 @@ impl Scene {
     }
 }
 
-/// The frames of a scene, in order.
-#[pyclass(module = "lapclone")]
+/// The frames of a scene, in order. Threads sharing one iterator each get the next frame
+/// not yet given out, as a queue would.
+#[pyclass(module = "lapclone", frozen)]
 pub struct SceneFrames {
     scene: Py<Scene>,
-    next: u64,
+    next: AtomicU64,
 }
 
 impl Scene {
@@ -240,17 +256,45 @@ impl SceneFrames {
         slf
     }
 
-    fn __next__<'py>(&mut self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+    fn __next__<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
         let scene = self.scene.get();
         // `list(scene)` runs no Python between frames, so nothing else would look for Ctrl-C.
         py.check_signals()?;
-        if self.next >= scene.frames {
-            return Ok(None);
+        // Taken before the frame is drawn (the GIL is released meanwhile); a frame that
+        // fails is not given again, as a failed `next` of a generator is not.
+        let taken = self
+            .next
+            .fetch_update(Ordering::Relaxed, Ordering::Relaxed, |n| {
+                (n < scene.frames).then_some(n + 1)
+            });
+        match taken {
+            Ok(index) => scene.frame(py, FrameIndex(index as i64)).map(Some),
+            Err(_) => Ok(None),
         }
-        let frame = scene.frame(py, FrameIndex(self.next as i64))?;
-        self.next += 1;
-        Ok(Some(frame))
     }
+}
+
+/// `render("-")` writes to file descriptor 1: refused unless Python's `sys.stdout` is that
+/// descriptor (with it closed at start, `sys.stdout` is None and the next file opened takes
+/// descriptor 1; a notebook's `sys.stdout` is no descriptor at all), else flushed first, so
+/// what Python printed comes before the frames.
+fn python_stdout_is_fd_1(py: Python<'_>) -> PyResult<()> {
+    let stdout = py.import("sys")?.getattr("stdout")?;
+    let descriptor = match stdout.is_none() {
+        true => None,
+        false => stdout
+            .call_method0("fileno")
+            .and_then(|fd| fd.extract::<i64>())
+            .ok(),
+    };
+    if descriptor != Some(1) {
+        return Err(PyValueError::new_err(
+            "render(\"-\"): Python's standard output (sys.stdout) is not file descriptor 1 \
+             (it is closed, or replaced): the frames would go elsewhere; render to a file",
+        ));
+    }
+    stdout.call_method0("flush")?;
+    Ok(())
 }
 
 /// How often a render's caller looks for a signal while the render runs.

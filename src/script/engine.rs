@@ -213,8 +213,20 @@ pub fn load_scene(path: &Path) -> Result<LoadedScene, SceneError> {
 /// [`load_scene`], also giving the module files the scene imported (directly or through
 /// other modules): with the scene and its images, what a render reads.
 pub fn load_scene_and_imports(path: &Path) -> Result<(LoadedScene, Vec<PathBuf>), SceneError> {
+    load_scene_cancellable(path, Arc::default())
+}
+
+/// [`load_scene_and_imports`], stopped as soon as another thread (or a signal handler)
+/// raises `cancel`, as Ctrl-C stops `lapclone render`: the error is then
+/// [`ErrorKind::Cancelled`].
+pub fn load_scene_cancellable(
+    path: &Path,
+    cancel: Arc<AtomicBool>,
+) -> Result<(LoadedScene, Vec<PathBuf>), SceneError> {
     let text = read_scene_text(path)?;
-    run_scene(&text, path, &ScriptOptions::for_scene_file(path))
+    let mut options = ScriptOptions::for_scene_file(path);
+    options.cancel = cancel;
+    run_scene(&text, path, &options)
 }
 
 /// The text of the scene file at `path`, which must be a regular file (a FIFO or a device

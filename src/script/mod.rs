@@ -21,7 +21,7 @@ mod values;
 pub use refs::{HandleRef, PatchRef, PinRef};
 pub use draft::{Draft, Ids, Origin, Origins};
 pub use engine::{
-    find_scripts_dir, load_scene, load_scene_and_imports, parse_scene, read_scene_text, LoadedScene, SceneEngine,
+    find_scripts_dir, load_scene, load_scene_and_imports, load_scene_cancellable, parse_scene, read_scene_text, LoadedScene, SceneEngine,
     ScriptOptions,
 };
 pub use error::{ErrorKind, SceneError};
