@@ -291,14 +291,7 @@ fn route(head: &Head, routes: &Routes) -> Result<Route, Refusal> {
     if head.method != "GET" {
         return Err(Refusal("405 Method Not Allowed", "only GET".into()));
     }
-    let hosts = head
-        .headers
-        .iter()
-        .filter(|(n, _)| n.eq_ignore_ascii_case("Host"));
-    if hosts.count() > 1 {
-        return Err(Refusal("400 Bad Request", "more than one Host".into()));
-    }
-    let host = head.header("Host").unwrap_or("");
+    let host = single_header(head, "Host")?;
     for named in std::iter::once(host).chain(head.authority.as_deref()) {
         if !routes.names_this_server(named) {
             return Err(Refusal(
@@ -321,8 +314,12 @@ fn route(head: &Head, routes: &Routes) -> Result<Route, Refusal> {
     if head.path == "/" {
         return Ok(Route::Page);
     }
-    let origin = head.header("Origin").unwrap_or("");
-    if !after_http_scheme(origin).is_some_and(|host| routes.names_this_server(host)) {
+    // The page's own origin is the address it was loaded from, which is this request's
+    // `Host`: on a wildcard bind another machine's address names the server too, but a
+    // page from there is not this one.
+    let origin = single_header(head, "Origin")?;
+    let same = |from: &str| from.eq_ignore_ascii_case(host) && routes.names_this_server(from);
+    if !after_http_scheme(origin).is_some_and(same) {
         return Err(Refusal(
             "403 Forbidden",
             format!("foreign Origin {origin:?}"),
@@ -346,6 +343,20 @@ fn route(head: &Head, routes: &Routes) -> Result<Route, Refusal> {
     Ok(Route::Socket {
         key: key.to_string(),
     })
+}
+
+/// The value of header `name`, empty when absent; refused when given twice (which of two
+/// would be checked, and which a proxy would pass on, is anyone's guess).
+fn single_header<'a>(head: &'a Head, name: &str) -> Result<&'a str, Refusal> {
+    let mut values = head
+        .headers
+        .iter()
+        .filter(|(n, _)| n.eq_ignore_ascii_case(name));
+    let first = values.next().map_or("", |(_, v)| v.as_str());
+    match values.next() {
+        Some(_) => Err(Refusal("400 Bad Request", format!("more than one {name}"))),
+        None => Ok(first),
+    }
 }
 
 /// What follows `http://` (in any case) at the start of `text`: the host of an `Origin`, or
@@ -486,6 +497,22 @@ mod tests {
         assert!(route(&head(&socket("http://192.0.2.7:8000")), &r).is_ok());
         assert!(route(&head(&socket("http://evil.example:8000")), &r).is_err());
         assert!(route(&head(&socket("https://192.0.2.7:8000")), &r).is_err());
+        // Another address with the port names the server, but a page from there is not
+        // the one this request's Host says it was loaded from.
+        for foreign in [
+            "http://203.0.113.5:8000",
+            "http://[2001:db8::1]:8000",
+            "http://0.0.0.0:8000",
+        ] {
+            let refused = route(&head(&socket(foreign)), &r).map(|_| ());
+            assert!(
+                refused.is_err_and(|e| e.1.contains("foreign Origin")),
+                "{foreign}"
+            );
+        }
+        let two = socket("http://192.0.2.7:8000")
+            .replace("Origin:", "Origin: http://evil.example\nOrigin:");
+        assert!(route(&head(&two), &r).is_err_and(|e| e.1.contains("more than one Origin")));
     }
 
     /// An absolute-form target is taken as its path, when its authority names this server
