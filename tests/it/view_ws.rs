@@ -414,6 +414,15 @@ fn a_page_seeking_or_keying_past_the_scene_s_end_is_refused() {
             .contains("past the scene's end"),
         "{error}"
     );
+    // Nor can a key be moved there (the cat's `at` has a key at 0).
+    let edit = json!({"op": "move_key", "patch": "cat", "track": "at", "from": 0, "to": 999999.5});
+    page.send(&json!({"type": "edit", "rev": rev, "commit": true, "edit": edit}));
+    let error = page.until(|v| v["type"] == "error");
+    let message = error["message"].as_str().unwrap();
+    assert!(
+        message.contains("t = 999999.5 s is past the scene's end"),
+        "{error}"
+    );
     // The end itself is inside.
     page.send(&json!({"type": "seek", "t": 2}));
     page.until(|v| v["type"] == "scene" && v["t"].as_f64() == Some(2.0));
@@ -421,6 +430,32 @@ fn a_page_seeking_or_keying_past_the_scene_s_end_is_refused() {
     page.until(|v| v["type"] == "scene" && v["t"].as_f64() == Some(t));
     assert!(page.frame == before);
     assert_eq!(page.rev(), rev);
+    assert!(repl.finish().success());
+}
+
+/// A page's save is acknowledged as its other entries are: the `:save` line in every page.
+#[test]
+fn a_page_save_is_shown_as_its_line_in_every_page() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = cat_scene(dir.path());
+    let repl = ViewRepl::start(dir.path(), &scene);
+    let (mut page, mut other) = (repl.page(), repl.page());
+    let rev = page.rev();
+    let edit = json!({"op": "at", "patch": "cat", "value": [300, 150]});
+    page.send(&json!({"type": "edit", "rev": rev, "commit": true, "edit": edit}));
+    page.until(|v| v["type"] == "scene" && v["rev"].as_u64() > Some(rev));
+    page.send(&json!({"type": "save", "rev": page.rev()}));
+    for p in [&mut page, &mut other] {
+        let line = p.until(|v| {
+            v["type"] == "line" && v["text"].as_str().is_some_and(|t| t.starts_with(":save "))
+        });
+        assert!(
+            line["text"].as_str().unwrap().ends_with("cat.rhai"),
+            "{line}"
+        );
+    }
+    let saved = std::fs::read_to_string(&scene).unwrap();
+    assert!(saved.contains("cat.at(0, [300, 150]);"), "{saved}");
     assert!(repl.finish().success());
 }
 

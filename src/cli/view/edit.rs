@@ -263,6 +263,14 @@ impl Edit {
         }
     }
 
+    /// The time this edit puts a key at besides the playhead: where `move_key` moves one.
+    pub fn keys_elsewhere(&self) -> Option<f64> {
+        match self {
+            Edit::MoveKey { to, .. } => Some(*to),
+            _ => None,
+        }
+    }
+
     /// The handle and pin indices this edit names, with what each indexes.
     fn indices(&self) -> Vec<(usize, &'static str)> {
         match self {

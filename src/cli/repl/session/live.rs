@@ -84,9 +84,7 @@ impl Session {
                 if let Some(printer) = &self.printer {
                     printer.remember(line);
                 }
-                if let Some(hub) = &self.view {
-                    hub.broadcast(serde_json::json!({ "type": "line", "text": line }).to_string());
-                }
+                self.tell_pages(line);
                 Ok(())
             }
             Ok(Step::Failed) => Err(format!("{line} failed")),
@@ -95,6 +93,13 @@ impl Session {
                 self.say_from_view(message.clone());
                 Err(message)
             }
+        }
+    }
+
+    /// Shows a page's line, done, in every page's log.
+    fn tell_pages(&self, line: &str) {
+        if let Some(hub) = &self.view {
+            hub.broadcast(serde_json::json!({ "type": "line", "text": line }).to_string());
         }
     }
 
@@ -255,7 +260,9 @@ impl LiveSession for Session {
         t: Option<f64>,
     ) -> Result<(), String> {
         let t = t.unwrap_or(self.time);
-        self.check_time(t)?;
+        for keyed in std::iter::once(t).chain(edit.keys_elsewhere()) {
+            self.check_time(keyed)?;
+        }
         self.check_revision(rev, "edit")?;
         if self
             .engine
@@ -306,7 +313,10 @@ impl LiveSession for Session {
             .file
             .clone()
             .ok_or("no scene file loaded: use :save FILE in the terminal")?;
-        self.say_from_view(format!("(view) :save {}", file.shown()));
-        self.as_page(|s| s.save(&file))
+        let line = format!(":save {}", file.shown());
+        self.say_from_view(format!("(view) {line}"));
+        self.as_page(|s| s.save(&file))?;
+        self.tell_pages(&line);
+        Ok(())
     }
 }
