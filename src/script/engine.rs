@@ -167,10 +167,12 @@ impl SceneEngine {
         text: &str,
         file: &Path,
     ) -> Result<Dynamic, SceneError> {
-        self.budget.start();
-        self.engine
-            .eval_ast_with_scope::<Dynamic>(scope, ast)
-            .map_err(|e| SceneError::from_eval(e, file, text, &|name| self.modules.file_of(name)))
+        super::on_scene_stack(|| {
+            self.budget.start();
+            self.engine
+                .eval_ast_with_scope::<Dynamic>(scope, ast)
+                .map_err(|e| SceneError::from_eval(e, file, text, &|name| self.modules.file_of(name)))
+        })
     }
 
     /// A copy of the scene under construction.
@@ -251,6 +253,8 @@ fn run_scene(
     file: &Path,
     options: &ScriptOptions,
 ) -> Result<(LoadedScene, Vec<PathBuf>), SceneError> {
+    // The scope (and every value the scene built) is dropped on the scene's stack too.
+    super::on_scene_stack(|| {
     let engine = SceneEngine::new(options);
     let _ = engine.run(&mut Scope::new(), text, file)?;
     let (scene, origins) = engine.scene(file)?;
@@ -261,4 +265,5 @@ fn run_scene(
         text: text.to_string(),
     };
     Ok((loaded, engine.module_files().files()))
+    })
 }

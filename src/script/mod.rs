@@ -15,6 +15,7 @@ mod budget;
 mod footage_options;
 mod sandbox;
 mod source;
+mod stack;
 mod validate;
 mod values;
 
@@ -26,6 +27,7 @@ pub use engine::{
 };
 pub use error::{ErrorKind, SceneError};
 pub use budget::set_allocation_probe;
+pub use stack::{on_scene_stack, SCENE_STACK};
 pub use sandbox::{Limits, ModuleFiles, SandboxResolver};
 pub use api::{OTHER_OPTION_KEYS, PATCH_OPTIONS};
 pub use validate::{validate_scene, CheckSummary};

@@ -1664,3 +1664,25 @@ fn mesh_outputs_are_files_never_dash_or_a_device() {
     expect(&out, 0, "");
     assert!(world.path("l.mtx").is_file() && world.path("l.mtx.boundary").is_file());
 }
+
+/// A value nested thousands deep (a loop of `m = [m]`) printed, compared, interpolated and
+/// echoed: the scene's code runs on a stack that holds it, in every command, where the
+/// main thread's 8 MB (and a `test` job's 2 MB) overflowed and aborted the process.
+#[test]
+fn values_nested_thousands_deep_do_not_overflow_the_stack() {
+    let world = World::new();
+    let deep = "let m = []; for i in 0..6000 { m = [m]; }\n";
+    let uses = "print(m == m); let s = `${m}`; debug(s.len());\n";
+    world.scene("deep.rhai", &format!("{deep}{uses}"));
+    let check = world.run(&["check", "deep.rhai"]);
+    expect(&check, 0, "[line 5, position");
+    let render = world.run(&["render", "deep.rhai", "-o", "frames"]);
+    expect(&render, 0, "");
+    std::fs::create_dir(world.path("goldens")).unwrap();
+    let test = world.run(&["test", "deep.rhai", "--update"]);
+    expect(&test, 0, "");
+    let input = format!("canvas(10, 10);\n{deep}m == m\nm\n:quit\n");
+    let (code, all) = world.session(input.as_bytes());
+    assert_eq!(code, Some(0), "{}", &all[all.len().saturating_sub(400)..]);
+    assert!(all.contains("true") && all.contains("[[[[[[") && !all.contains("overflowed"));
+}

@@ -146,8 +146,14 @@ impl Session {
         }
     }
 
-    /// Runs one entry and gives its error instead of printing it.
+    /// Runs one entry and gives its error instead of printing it, on the scene's stack:
+    /// the entry, and the snapshots, values shown and history it clones or drops, may hold
+    /// values nested deeper than a thread's usual stack can walk.
     fn run_entry(&mut self, text: &str) -> anyhow::Result<Step> {
+        lapclone::script::on_scene_stack(|| self.run_entry_here(text))
+    }
+
+    fn run_entry_here(&mut self, text: &str) -> anyhow::Result<Step> {
         let dropped = std::mem::take(&mut self.previewing);
         if dropped {
             // A page gesture left its preview in the renderer: the entry starts from the

@@ -166,6 +166,11 @@ impl Session {
 
     /// A watched file changed: reloads unless the session has edits not saved to it.
     pub fn watch_reload(&mut self, changed: &[PathBuf]) {
+        // The old scope is dropped here: on the scene's stack, as an entry's would be.
+        lapclone::script::on_scene_stack(|| self.watch_reload_here(changed));
+    }
+
+    fn watch_reload_here(&mut self, changed: &[PathBuf]) {
         let Some(file) = self.file.clone() else {
             return;
         };
