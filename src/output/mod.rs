@@ -193,6 +193,15 @@ pub enum OutputError {
         #[source]
         source: std::io::Error,
     },
+    /// An entry of a PNG frame folder, named as a frame this render writes or one it would
+    /// remove, is no regular file: it is never written over or removed.
+    #[error("{} {kind}: only a regular frame file is written over or removed; move it away", path.shown())]
+    NotAFrameFile {
+        /// The entry.
+        path: PathBuf,
+        /// What it is ("is a folder, not a file", "is a symbolic link", …).
+        kind: &'static str,
+    },
     /// Moving the finished frames into the destination failed.
     #[error("moving the frames to {}", dest.shown())]
     Moving {

@@ -101,7 +101,7 @@ fn existing_frames(
     settings: SinkSettings,
 ) -> Result<Vec<PathBuf>, OutputError> {
     let digits = frame_digits(frame_count);
-    let ours: std::collections::HashSet<String> = (range.first..=range.last)
+    let ours: std::collections::BTreeSet<String> = (range.first..=range.last)
         .map(|n| frame_file_name(n, digits))
         .collect();
     let foreign =
@@ -111,6 +111,14 @@ fn existing_frames(
                 source,
             }
         })?;
+    // A folder, FIFO or link with a frame's name would be replaced by a rename, or fail it
+    // half-way through the moves: refused before anything is rendered.
+    let named = ours.iter().map(|name| output.join(name));
+    for path in named.chain(foreign.iter().cloned()) {
+        if let Some(kind) = not_a_plain_file(&path) {
+            return Err(OutputError::NotAFrameFile { path, kind });
+        }
+    }
     if let Some(first) = foreign.first() {
         if !settings.force {
             return Err(OutputError::ForeignFrames {
@@ -121,4 +129,14 @@ fn existing_frames(
         }
     }
     Ok(foreign)
+}
+
+/// What `path` is when it exists and is no regular file (a link counts as a link, whatever
+/// it points to); `None` for a regular file or nothing there.
+fn not_a_plain_file(path: &Path) -> Option<&'static str> {
+    let meta = path.symlink_metadata().ok()?;
+    if meta.file_type().is_symlink() {
+        return Some("is a symbolic link");
+    }
+    crate::util::not_a_file(path)
 }

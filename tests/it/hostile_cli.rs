@@ -1686,3 +1686,36 @@ fn values_nested_thousands_deep_do_not_overflow_the_stack() {
     assert_eq!(code, Some(0), "{}", &all[all.len().saturating_sub(400)..]);
     assert!(all.contains("true") && all.contains("[[[[[[") && !all.contains("overflowed"));
 }
+
+/// An entry of a frame folder named like a frame but no regular file (a folder, a FIFO, a
+/// link) is refused before anything is rendered: the folder is left as it was, where a
+/// folder failed the moves half-way (some new frames in) and a FIFO or a link was replaced.
+#[cfg(unix)]
+#[test]
+fn a_frame_folder_entry_that_is_no_regular_file_is_refused_and_kept() {
+    let world = World::new();
+    world.scene("s.rhai", "");
+    world.write("notes.txt", "mine");
+    std::fs::create_dir_all(world.path("out/frame_0003.png")).unwrap();
+    let render = world.run(&["render", "s.rhai", "-o", "out"]);
+    expect(&render, 1, "frame_0003.png is a folder, not a file");
+    assert_eq!(sorted_names(&world.path("out")), ["frame_0003.png"]);
+    std::fs::create_dir(world.path("out2")).unwrap();
+    make_fifo(&world.path("out2/frame_0002.png"));
+    std::os::unix::fs::symlink("../notes.txt", world.path("out2/frame_0001.png")).unwrap();
+    let render = world.run(&["render", "s.rhai", "-o", "out2"]);
+    expect(&render, 1, "is a symbolic link");
+    // Another render's frame that is a link is not removed by --force either.
+    std::fs::remove_file(world.path("out2/frame_0002.png")).unwrap();
+    std::fs::remove_file(world.path("out2/frame_0001.png")).unwrap();
+    std::os::unix::fs::symlink("../notes.txt", world.path("out2/frame_0009.png")).unwrap();
+    let render = world.run(&["render", "s.rhai", "-o", "out2", "--force"]);
+    expect(&render, 1, "frame_0009.png is a symbolic link");
+    assert_eq!(sorted_names(&world.path("out2")), ["frame_0009.png"]);
+    assert!(world
+        .path("out2/frame_0009.png")
+        .symlink_metadata()
+        .unwrap()
+        .file_type()
+        .is_symlink());
+}
