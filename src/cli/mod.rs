@@ -76,6 +76,18 @@ pub fn stdout_is_open() -> bool {
     }
 }
 
+/// `-` given for a file a command writes but never streams (`--junit`, the REPL's
+/// `--preview`, `:save`): refused, where it made a file named `-` that looked like
+/// standard output. `./-` still names such a file.
+pub fn refuse_stdout_dash(what: &str, path: &std::path::Path) -> Result<(), UsageError> {
+    match path.as_os_str() == "-" {
+        true => Err(UsageError(format!(
+            "{what} -: `-` means standard output, which {what} does not write; name a file (./- for one named -)"
+        ))),
+        false => Ok(()),
+    }
+}
+
 /// For data written to standard output (`-o -`): an error when it is closed
 /// ([`stdout_is_open`]), since the data would be lost without one.
 pub fn check_stdout_for_data() -> anyhow::Result<()> {

@@ -61,6 +61,11 @@ pub struct EntriesFailed(pub usize);
 pub fn run(args: ReplArgs) -> anyhow::Result<()> {
     let interactive = args.script.is_none() && std::io::stdin().is_terminal();
     // The default preview's folder is this process's own: removed when the session ends.
+    for (flag, path) in [("--preview", &args.preview), ("--history", &args.history)] {
+        if let Some(path) = path {
+            super::refuse_stdout_dash(flag, path)?;
+        }
+    }
     let (preview_path, preview_folder) = match &args.preview {
         Some(path) => (path.clone(), None),
         None => default_preview_path().map(|(path, folder)| (path, Some(folder)))?,

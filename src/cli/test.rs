@@ -56,6 +56,9 @@ pub fn run(args: TestArgs) -> anyhow::Result<()> {
         }
     }
     // lapclone never creates a missing parent of a path it is given.
+    if let Some(junit) = &args.junit {
+        super::refuse_stdout_dash("--junit", junit)?;
+    }
     for path in args.junit.iter().chain(&args.out).chain(&args.goldens) {
         lapclone::output::check_output_folder(path)?;
     }

@@ -1719,3 +1719,20 @@ fn a_frame_folder_entry_that_is_no_regular_file_is_refused_and_kept() {
         .file_type()
         .is_symlink());
 }
+
+/// `-` for a file a command writes but never streams is a usage error naming `./-`, where
+/// it made a file named `-` (which looked like standard output).
+#[test]
+fn a_dash_for_a_file_that_is_never_streamed_is_a_usage_error() {
+    let world = World::new();
+    world.scene("s.rhai", "");
+    std::fs::create_dir(world.path("goldens")).unwrap();
+    let test = world.run(&["test", "s.rhai", "--junit", "-"]);
+    expect(&test, 2, "--junit -: `-` means standard output");
+    let repl = world.run(&["repl", "--preview", "-"]);
+    expect(&repl, 2, "--preview -: `-` means standard output");
+    let (code, all) = world.session(b"canvas(8, 8);\n:save -\n:gif -\n");
+    assert_eq!(code, Some(1), "{all}");
+    assert_eq!(all.matches("`-` means standard output").count(), 2, "{all}");
+    assert!(!world.path("-").exists());
+}

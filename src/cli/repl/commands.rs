@@ -110,10 +110,34 @@ pub fn parse_command(line: &str) -> Result<Command, String> {
             Err(usage())
         }
     };
-    let path = || match unquote(rest) {
-        "" if rest.is_empty() => Err(usage()),
-        "" => Err(format!("{}: the FILE is empty", usage())),
-        file => Ok(PathBuf::from(file)),
+    // A FILE in quotes is one word, as `:render -o` takes it (an unclosed or trailing
+    // quote is refused); unquoted, the rest of the line, spaces and all.
+    let path = || {
+        let file = match rest.starts_with(['"', '\'']) {
+            true => match words(rest)
+                .map_err(|e| format!("{}: {e}", usage()))?
+                .as_slice()
+            {
+                [one] => one.clone(),
+                _ => {
+                    return Err(format!(
+                        "{}: one FILE (in quotes if it has spaces)",
+                        usage()
+                    ))
+                }
+            },
+            false => rest.to_string(),
+        };
+        match file.as_str() {
+            "" if rest.is_empty() => Err(usage()),
+            "" => Err(format!("{}: the FILE is empty", usage())),
+            "-" => Err(format!(
+                "{}: `-` means standard output, which :{} does not use; name a file (./- for one named -)",
+                usage(),
+                info.name
+            )),
+            _ => Ok(PathBuf::from(file)),
+        }
     };
     match name {
         "help" => no_args(Command::Help),
@@ -258,6 +282,27 @@ mod tests {
         assert!(parse_command(":save")
             .unwrap_err()
             .contains("usage: :save FILE"));
+        // Quotes make one word, as `:render -o` reads them; `-` is no file.
+        for bad in [
+            ":save \"c d.rhai\" e",
+            ":save \"",
+            ":gif \"x.gif",
+            ":save -",
+            ":gif -",
+        ] {
+            assert!(
+                parse_command(bad).unwrap_err().contains("usage: :"),
+                "{bad}"
+            );
+        }
+        assert_eq!(
+            parse_command(":save my scene.rhai"),
+            Ok(Command::Save(PathBuf::from("my scene.rhai")))
+        );
+        assert_eq!(
+            parse_command(":save ./-"),
+            Ok(Command::Save(PathBuf::from("./-")))
+        );
         assert!(parse_command(":list extra").is_err());
         assert!(parse_command(":render 3..1").is_err());
         assert!(parse_command(":render -o").is_err());
