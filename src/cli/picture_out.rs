@@ -12,6 +12,17 @@ use lapclone::pixels::{Canvas, PixelFormat};
 
 use super::UsageError;
 
+/// A PNG's path may have no extension or `.png`: another image extension is refused
+/// (`what` says whose path it is), so no file holds PNG bytes under a JPEG name.
+pub(crate) fn png_name_only(what: &str, path: &Path) -> Result<(), UsageError> {
+    match path.extension() {
+        Some(extension) if !extension.eq_ignore_ascii_case("png") => Err(UsageError(format!(
+            "{what} writes PNG; name the output .png"
+        ))),
+        _ => Ok(()),
+    }
+}
+
 /// A checked `-o` of a one-picture command.
 pub(crate) enum PictureOut {
     File(PathBuf),
@@ -26,15 +37,8 @@ impl PictureOut {
             super::check_stdout_for_data()?;
             return Ok(PictureOut::Stdout);
         }
-        if let Some(extension) = output.extension() {
-            if !extension.eq_ignore_ascii_case("png") {
-                return Err(UsageError(format!(
-                    "-o {}: {command} writes PNG; name the output .png (or `-` for standard output)",
-                    output.shown()
-                ))
-                .into());
-            }
-        }
+        png_name_only(&format!("-o {}: {command}", output.shown()), output)
+            .map_err(|e| UsageError(format!("{} (or `-` for standard output)", e.0)))?;
         lapclone::output::check_output_folder(output)?;
         lapclone::output::refuse_input(output, inputs)?;
         Ok(PictureOut::File(output.to_path_buf()))

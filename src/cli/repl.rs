@@ -66,6 +66,10 @@ pub fn run(args: ReplArgs) -> anyhow::Result<()> {
             super::refuse_stdout_dash(flag, path)?;
         }
     }
+    if let Some(path) = &args.preview {
+        let what = format!("--preview {}: the REPL", path.shown());
+        super::picture_out::png_name_only(&what, path)?;
+    }
     let (preview_path, preview_folder) = match &args.preview {
         Some(path) => (path.clone(), None),
         None => default_preview_path().map(|(path, folder)| (path, Some(folder)))?,

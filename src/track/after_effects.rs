@@ -146,7 +146,12 @@ fn key_line(keys: &mut Keys, section: Section, number: usize, cells: &[&str]) ->
             }
             keys.position.push((frame, DVec2::new(values[1], values[2]), number))
         }
-        Section::Rotation => keys.rotation.push((frame, values[1])),
+        Section::Rotation => {
+            if let Some(error) = crate::limits::rotation_or_depth_error(values[1]) {
+                return Err((number, format!("rotation {error}")));
+            }
+            keys.rotation.push((frame, values[1]))
+        }
         _ => {
             let y = values.get(2).copied().unwrap_or(values[1]);
             let factor = (values[1] + y) / 200.0;
@@ -240,6 +245,8 @@ mod tests {
     fn a_far_position_or_a_huge_scale_names_its_line() {
         let far = SAMPLE.replace("\t101.5\t", "\t1e308\t");
         assert_eq!(parse(&far).unwrap_err(), (12, "position 1e308 is past ±1e9 px".into()));
+        let turned = SAMPLE.replace("\t1\t2\t\n", "\t1\t-1.7e308\t\n");
+        assert!(parse(&turned).unwrap_err().1.contains("rotation -1.7e308 is past ±1e9"));
         let huge = SAMPLE.replace("\t0\t100\t100\t100\t", "\t0\t1e308\t1e308\t100\t");
         let (line, message) = parse(&huge).unwrap_err();
         assert_eq!(line, 21);

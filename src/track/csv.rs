@@ -181,7 +181,10 @@ fn parse_row(line: usize, text: &str, columns: &[Column]) -> Result<(usize, Trac
                 None => row.at.y = value,
             },
             Column::Confidence => row.confidence = Some(value),
-            Column::Rotate => row.rotate = Some(value),
+            Column::Rotate => match crate::limits::rotation_or_depth_error(value) {
+                Some(error) => return Err((line, format!("column `rotate`: {error}"))),
+                None => row.rotate = Some(value),
+            },
             Column::Scale => match crate::limits::scale_error(value) {
                 Some(error) => return Err((line, format!("column `scale`: {error}"))),
                 None => row.scale = Some(value),
@@ -282,5 +285,9 @@ mod tests {
         assert_eq!(huge, (2, "column `scale`: 1e308 must be > 0 and at most 1e6".into()));
         assert!(err("frame,x,y,scale\n1,2,3,0\n").1.contains("0 must be > 0"));
         assert!(parse("frame,x,y,scale\n1,1e9,-1e9,1e6\n").is_ok(), "the bounds themselves");
+        // A rotation is bounded as a keyed one is: ±1e308 eased to ±inf.
+        let turned = err("t,x,y,rotate\n0,40,30,1.7e308\n");
+        assert_eq!(turned, (2, "column `rotate`: 1.7e308 is past ±1e9".into()));
+        assert!(parse("frame,x,y,rotate\n1,1,1,-1e9\n").is_ok());
     }
 }

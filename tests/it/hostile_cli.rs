@@ -1731,6 +1731,13 @@ fn a_dash_for_a_file_that_is_never_streamed_is_a_usage_error() {
     expect(&test, 2, "--junit -: `-` means standard output");
     let repl = world.run(&["repl", "--preview", "-"]);
     expect(&repl, 2, "--preview -: `-` means standard output");
+    // Nor PNG bytes under another image's name, as `preview -o x.jpg` refuses.
+    let repl = world.run(&["repl", "--preview", "pv.jpg"]);
+    expect(
+        &repl,
+        2,
+        "--preview pv.jpg: the REPL writes PNG; name the output .png",
+    );
     let (code, all) = world.session(b"canvas(8, 8);\n:save -\n:gif -\n");
     assert_eq!(code, Some(1), "{all}");
     assert_eq!(all.matches("`-` means standard output").count(), 2, "{all}");

@@ -123,7 +123,11 @@
       showCoords();
       if (nextLocate) { const p = nextLocate; nextLocate = null; locate(p); }
     } else if (m.type === "error") {
-      notice(m.message, "error");
+      // A line's error comes as the terminal shows it, its source line and caret below:
+      // the notice takes its first line, the log (monospace, lines kept) all of it.
+      const lines = m.message.split("\n");
+      notice(lines[0], "error");
+      if (lines.length > 1) log(m.message);
       inFlight = false;
       sentAt = 0;
     } else if (m.type === "line") {
