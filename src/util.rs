@@ -81,9 +81,17 @@ impl std::fmt::Display for ShownPath<'_> {
     }
 }
 
-/// `text` with every control character but newline and tab written as `\u{..}`.
+/// Whether a message shows `c` escaped: a control character but newline and tab, or one
+/// that changes the direction of the text after it (which would reorder the rest of the
+/// line on a terminal).
+pub fn is_hidden_char(c: char) -> bool {
+    let bidi = matches!(c, '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}' | '\u{200e}' | '\u{200f}' | '\u{061c}');
+    (c.is_control() && c != '\n' && c != '\t') || bidi
+}
+
+/// `text` with every [`is_hidden_char`] written as `\u{..}`.
 pub fn visible_controls(text: &str) -> std::borrow::Cow<'_, str> {
-    let hidden = |c: char| c.is_control() && c != '\n' && c != '\t';
+    let hidden = is_hidden_char;
     if !text.contains(hidden) {
         return text.into();
     }

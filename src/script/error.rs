@@ -235,7 +235,7 @@ impl fmt::Display for SceneError {
         let column_lost = self.column().is_none() && self.position.position().is_some();
         if let Some(source) = self.source_line.as_ref().filter(|_| !column_lost) {
             let (shown, col) = excerpt(source, self.column());
-            write!(f, "\n{shown}")?;
+            write!(f, "\n{}", crate::util::visible_controls(&shown))?;
             if let Some(col) = col {
                 write!(f, "\n{}^", caret_indent(&shown, col))?;
             }
@@ -267,14 +267,23 @@ fn excerpt(source: &str, col: Option<usize>) -> (String, Option<usize>) {
     (shown, col)
 }
 
-/// Whitespace that lines a caret up under column `col` (1-based), keeping tabs as tabs.
+/// Whitespace that lines a caret up under column `col` (1-based) of `source` as shown:
+/// tabs kept as tabs, each other character as wide as the terminal shows it (a hidden one
+/// as its `\u{..}` escape, a CJK character or an emoji two columns).
 fn caret_indent(source: &str, col: usize) -> String {
-    source
-        .chars()
-        .chain(std::iter::repeat(' '))
-        .take(col.saturating_sub(1))
-        .map(|c| if c == '\t' { '\t' } else { ' ' })
-        .collect()
+    use unicode_width::UnicodeWidthStr as _;
+    let mut indent = String::new();
+    for c in source.chars().chain(std::iter::repeat(' ')).take(col.saturating_sub(1)) {
+        match c {
+            '\t' => indent.push('\t'),
+            c => {
+                let mut one = [0u8; 4];
+                let width = crate::util::visible_controls(c.encode_utf8(&mut one)).width();
+                indent.extend(std::iter::repeat_n(' ', width));
+            }
+        }
+    }
+    indent
 }
 
 #[cfg(test)]
@@ -291,6 +300,27 @@ mod tests {
         );
         e.load_source_line(Some("first\n\tab(cd);\n"));
         assert_eq!(e.to_string(), "s.rhai:2:5: bad\n\tab(cd);\n\t   ^");
+    }
+
+    /// Before the column, a control character is shown as its escape, a character that
+    /// turns the text's direction too, and a wide one takes two columns: the caret still
+    /// sits under the column as the terminal shows the line.
+    #[test]
+    fn caret_counts_escapes_and_wide_characters() {
+        let at = |line: &str, col: u16| {
+            let mut e = SceneError::new(ErrorKind::Runtime, Path::new("s.rhai"), Position::new(1, col), "bad");
+            e.load_source_line(Some(line));
+            let text = e.to_string();
+            let lines: Vec<&str> = text.lines().collect();
+            (lines[1].to_string(), lines[2].len() - 1)
+        };
+        let (shown, caret) = at("let s = \"\u{1b}[2J\"; 1/0;", 18);
+        assert_eq!(shown, "let s = \"\\u{1b}[2J\"; 1/0;");
+        assert_eq!(&shown[caret..caret + 1], "/");
+        let (shown, caret) = at("\"猫猫\"; 1/0;", 8);
+        assert_eq!(caret, 9, "{shown}");
+        let (shown, _) = at("\"\u{202e}abc\"; 1/0;", 10);
+        assert_eq!(shown, "\"\\u{202e}abc\"; 1/0;");
     }
 
     /// Rhai stops counting lines and columns at 65,535: a position there is said to be at or
