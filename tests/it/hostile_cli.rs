@@ -1004,16 +1004,25 @@ fn the_repl_refuses_to_render_over_its_own_inputs() {
     assert_eq!(std::fs::read(&scene).unwrap(), scene_before);
     assert_eq!(std::fs::read(world.path("lib.rhai")).unwrap(), lib_before);
     assert!(world.path("out.gif").is_file(), "{all}");
-    // A preview file that is the scene or something it reads ends the session at once.
-    for preview in ["victim.rhai", "src.png", "lib.rhai"] {
+    // A preview file that is the scene or something it reads ends the session at once: a
+    // PNG by the input rule, another name already by the rule that a preview is a PNG.
+    for (preview, code, message) in [
+        (
+            "victim.rhai",
+            2,
+            "--preview victim.rhai: the REPL writes PNG",
+        ),
+        ("src.png", 1, "would replace an input"),
+        ("lib.rhai", 2, "--preview lib.rhai: the REPL writes PNG"),
+    ] {
         let output = Command::new(env!("CARGO_BIN_EXE_lapclone"))
             .args(["repl", "victim.rhai", "--preview", preview])
             .current_dir(world.root.path())
             .stdin(Stdio::null())
             .output()
             .unwrap();
-        expect(&output, 1, "--preview");
-        expect(&output, 1, "would replace an input");
+        expect(&output, code, "--preview");
+        expect(&output, code, message);
     }
     assert_eq!(std::fs::read(&scene).unwrap(), scene_before);
     assert_eq!(std::fs::read(world.path("src.png")).unwrap(), src_before);
@@ -1038,8 +1047,26 @@ fn the_repl_never_writes_over_its_own_script() {
             .unwrap()
     };
     let output = repl(&["--preview", "session.txt"]);
-    expect(&output, 1, "--preview");
+    expect(&output, 2, "--preview session.txt: the REPL writes PNG");
+    // A script with a PNG's name is still an input the preview may not replace.
+    world.write("session.png", text);
+    let output = Command::new(env!("CARGO_BIN_EXE_lapclone"))
+        .args([
+            "repl",
+            "--script",
+            "session.png",
+            "--preview",
+            "session.png",
+        ])
+        .current_dir(world.root.path())
+        .stdin(Stdio::null())
+        .output()
+        .unwrap();
     expect(&output, 1, "would replace an input");
+    assert_eq!(
+        std::fs::read_to_string(world.path("session.png")).unwrap(),
+        text
+    );
     let output = repl(&[]);
     expect(&output, 1, "2 failed entries");
     let all = String::from_utf8_lossy(&output.stderr);
