@@ -47,6 +47,14 @@ pub fn run(args: TestArgs) -> anyhow::Result<()> {
         return super::test_pending::run(&args, &paths);
     }
     if let Some(root) = args.goldens.as_deref().filter(|r| !r.is_dir()) {
+        // A file (or a FIFO, a device) in its place is no missing folder.
+        if root.exists() {
+            let message = format!(
+                "--goldens {}: it is not a folder; name a folder",
+                root.shown()
+            );
+            return Err(UsageError(message).into());
+        }
         if !args.update {
             return Err(UsageError(format!(
                 "--goldens {}: no such folder (create the goldens with --update)",

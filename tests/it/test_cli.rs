@@ -362,6 +362,16 @@ fn bad_inputs_give_clear_messages_and_exit_codes() {
         "{}",
         stderr(&named)
     );
+    // A file where the goldens folder should be is no missing folder, --update or not.
+    for update in [&[][..], &["--update"]] {
+        let file = fixture.run(&[&["--goldens", "tiny.rhai"][..], update].concat());
+        assert_eq!(code(&file), 2, "{}", stderr(&file));
+        assert!(
+            stderr(&file).contains("--goldens tiny.rhai: it is not a folder"),
+            "{}",
+            stderr(&file)
+        );
+    }
 
     assert_eq!(code(&fixture.run(&["--update"])), 0);
     // An --out that is a file (here the scene) is a usage error before anything runs.

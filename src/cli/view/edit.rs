@@ -198,7 +198,10 @@ fn index(i: usize, what: &str) -> Result<(), String> {
 fn check_edit(edit: &Edit) -> Result<(), String> {
     let patch = edit.patch();
     if patch.is_empty() || patch.len() > MAX_NAME {
-        return Err("patch name empty or too long".into());
+        return Err(format!(
+            "a patch name must have 1 to {MAX_NAME} bytes, not {}",
+            patch.len()
+        ));
     }
     edit.indices()
         .into_iter()
@@ -450,6 +453,19 @@ mod tests {
             Ok(Request::Edit { edit, .. }) => edit,
             other => panic!("{other:?}"),
         }
+    }
+
+    #[test]
+    fn a_patch_name_past_the_limit_says_the_limit() {
+        let name = "p".repeat(300);
+        let text = format!(
+            r#"{{"type":"edit","rev":1,"commit":true,"edit":{{"op":"at","patch":"{name}","value":[1,2]}}}}"#
+        );
+        let error = parse_request(&text).unwrap_err();
+        assert!(
+            error.contains("a patch name must have 1 to 256 bytes, not 300"),
+            "{error}"
+        );
     }
 
     #[test]

@@ -243,13 +243,22 @@ fn too_large() -> Refusal {
     )
 }
 
+/// Header fields a request may have: a browser sends about a dozen.
+const MAX_HEADERS: usize = 32;
+
 /// Parses a complete request head.
 fn parse_head(bytes: &[u8]) -> Result<Head, Refusal> {
     let bad = |m: &str| Refusal("400 Bad Request", m.to_string());
-    let mut headers = [httparse::EMPTY_HEADER; 32];
+    let mut headers = [httparse::EMPTY_HEADER; MAX_HEADERS];
     let mut request = httparse::Request::new(&mut headers);
     match request.parse(bytes) {
         Ok(httparse::Status::Complete(_)) => {}
+        Err(httparse::Error::TooManyHeaders) => {
+            return Err(Refusal(
+                "431 Request Header Fields Too Large",
+                format!("more than {MAX_HEADERS} header fields"),
+            ))
+        }
         _ => return Err(bad("malformed request")),
     }
     let target = request.path.unwrap_or("");
@@ -422,6 +431,19 @@ mod tests {
 
     fn head(text: &str) -> Head {
         parse_head(text.replace('\n', "\r\n").as_bytes()).unwrap()
+    }
+
+    #[test]
+    fn more_header_fields_than_the_limit_are_refused_as_too_large() {
+        let many: String = (0..33).map(|i| format!("X-{i}: {i}\r\n")).collect();
+        let text = format!("GET / HTTP/1.1\r\nHost: 127.0.0.1:8000\r\n{many}\r\n");
+        let refused = parse_head(text.as_bytes()).map(|_| ()).unwrap_err();
+        assert_eq!(refused.0, "431 Request Header Fields Too Large");
+        assert!(
+            refused.1.contains("more than 32 header fields"),
+            "{}",
+            refused.1
+        );
     }
 
     const WS: &str = "Upgrade: websocket\nConnection: Upgrade\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\nSec-WebSocket-Version: 13\n";
