@@ -746,3 +746,39 @@ fn a_short_video_is_an_animated_source() {
         assert!(dir.path().join("out.gif").is_file(), "{video}");
     }
 }
+
+/// A video shorter than one frame at the scene's rate (1 s at 0.4 fps) still has frame 1,
+/// its picture at t = 0: ffmpeg's rate filter gave none, so the scene was "too short" and
+/// `background_hold` then failed with "ffmpeg decoded no frames".
+#[test]
+fn a_video_shorter_than_one_scene_frame_gives_its_first_frame() {
+    if !has_ffmpeg() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    run_ffmpeg(
+        dir.path(),
+        "-f lavfi -i testsrc=size=64x48:rate=10:duration=1 -pix_fmt yuv420p vid.mp4",
+    );
+    // Its first frame, converted as lapclone has ffmpeg convert the frames it reads.
+    run_ffmpeg(
+        dir.path(),
+        "-i vid.mp4 -frames:v 1 -f rawvideo -pix_fmt rgba first.rgba",
+    );
+    let first = std::fs::read(dir.path().join("first.rgba")).unwrap();
+    for hold in ["", ", background_hold: true"] {
+        let canvas =
+            format!("canvas(#{{ fps: 0.4, duration: 2.5, background: \"vid.mp4\"{hold} }});");
+        let scene = dir.path().join("short.rhai");
+        std::fs::write(&scene, &canvas).unwrap();
+        let out = dir.path().join(format!("out{}", hold.len()));
+        let o = render(&scene, &out, &[]);
+        assert!(o.status.success(), "{canvas}: {}", stderr(&o));
+        assert_eq!(sorted_names(&out), ["frame_0001.png"]);
+        let frame = rgba(&out.join("frame_0001.png")).into_raw();
+        assert!(
+            frame == first,
+            "{canvas}: frame 1 is not the video's first frame"
+        );
+    }
+}

@@ -177,8 +177,9 @@ impl Footage {
                     return Ok(());
                 };
                 // Frames whose time i / fps is before the end; half a frame of slack for
-                // containers that round their duration.
-                let available = (seconds * fps + 0.5).floor() as u64;
+                // containers that round their duration. Frame 1 (t = 0) is in any video
+                // with a duration, however short against the frame rate.
+                let available = ((seconds * fps + 0.5).floor() as u64).max(u64::from(seconds > 0.0));
                 if !self.hold && available < frames {
                     return Err(FootageError::VideoTooShort {
                         path: path.clone(),

@@ -12,6 +12,11 @@ use crate::process::Child;
 /// An ffmpeg process decoding one video to raw RGBA frames at a fixed rate.
 pub(super) struct VideoStream {
     path: PathBuf,
+    size: (u32, u32),
+    fps: f64,
+    /// Decoding only the video's first frame, without the rate filter: for a video shorter
+    /// than one frame at the scene's rate, of which the filter gives none.
+    first_only: bool,
     child: Child,
     stdout: ChildStdout,
     frame_bytes: usize,
@@ -24,10 +29,25 @@ pub(super) struct VideoStream {
 
 impl VideoStream {
     pub(super) fn start(path: &Path, width: u32, height: u32, fps: f64) -> Result<Self, FootageError> {
+        Self::start_with(path, (width, height), fps, false)
+    }
+
+    fn start_with(
+        path: &Path,
+        (width, height): (u32, u32),
+        fps: f64,
+        first_only: bool,
+    ) -> Result<Self, FootageError> {
+        let rate = format!("fps={fps}");
+        let frames: [&str; 2] = match first_only {
+            true => ["-frames:v", "1"],
+            false => ["-vf", &rate],
+        };
         let mut child = spawn("ffmpeg", path, |c| {
             c.args(["-v", "error", "-nostdin", "-i"])
                 .arg(path)
-                .args(["-map", "0:v:0", "-vf", &format!("fps={fps}")])
+                .args(["-map", "0:v:0"])
+                .args(frames)
                 .args(["-f", "rawvideo", "-pix_fmt", "rgba", "-"])
                 .stdin(Stdio::null())
                 .stdout(Stdio::piped())
@@ -36,6 +56,9 @@ impl VideoStream {
         let stdout = child.take_stdout().expect("piped stdout");
         Ok(VideoStream {
             path: path.to_path_buf(),
+            size: (width, height),
+            fps,
+            first_only,
             child,
             stdout,
             frame_bytes: width as usize * height as usize * 4,
@@ -68,7 +91,16 @@ impl VideoStream {
             .child
             .wait(None)
             .map_err(|e| video_error(&self.path, e.to_string()))?;
-        if !status.is_some_and(|s| s.success()) || self.next == 0 {
+        let succeeded = status.is_some_and(|s| s.success());
+        if succeeded && self.next == 0 && !self.first_only {
+            // A video shorter than one frame at the scene's rate (1 s at 0.4 fps): the rate
+            // filter gives no frame, though frame 1, the picture at t = 0, is in the video.
+            // Only then is its first frame decoded on its own; every other video keeps the
+            // frames the filter gives.
+            *self = Self::start_with(&self.path, self.size, self.fps, true)?;
+            return self.read_next();
+        }
+        if !succeeded || self.next == 0 {
             return Err(failure(&self.path, &mut self.child, "ffmpeg decoded no frames"));
         }
         Ok(false)
